@@ -1,0 +1,65 @@
+"""Project error types and the argument checks every public entry point shares.
+
+Every check raises before anything is computed or changed, and its message names the
+parameter and the rule it broke, so a caller can fix the call without reading our code.
+"""
+
+from __future__ import annotations
+
+import math
+
+#: Largest magnitude a PCL6045 28-bit signed counter holds (-2**27 .. 2**27 - 1).
+COUNTER28_MAX = 2**27 - 1
+
+
+class MotionError(ValueError):
+    """Invalid argument or infeasible request. Derives from ValueError."""
+
+
+class InfeasibleError(MotionError):
+    """A well-formed request that the motion cannot satisfy (e.g. too little distance left)."""
+
+
+def check_finite(name: str, value: float) -> float:
+    """Return `value` as float; refuse NaN, infinities and non-numbers."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise MotionError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise MotionError(f"{name} must be finite, got {value!r}")
+    return x
+
+
+def check_positive(name: str, value: float) -> float:
+    """Finite and strictly greater than zero."""
+    x = check_finite(name, value)
+    if x <= 0.0:
+        raise MotionError(f"{name} must be > 0, got {value!r}")
+    return x
+
+
+def check_nonnegative(name: str, value: float) -> float:
+    """Finite and not below zero."""
+    x = check_finite(name, value)
+    if x < 0.0:
+        raise MotionError(f"{name} must be >= 0, got {value!r}")
+    return x
+
+
+def check_range(name: str, value: float, lo: float, hi: float) -> float:
+    """Finite and within [lo, hi]."""
+    x = check_finite(name, value)
+    if not lo <= x <= hi:
+        raise MotionError(f"{name} must be in [{lo:g}, {hi:g}], got {value!r}")
+    return x
+
+
+def check_distance(name: str, value: float, limit: float = COUNTER28_MAX) -> float:
+    """A finite distance (pulses) whose magnitude a 28-bit position counter can hold."""
+    x = check_finite(name, value)
+    if abs(x) > limit:
+        raise MotionError(
+            f"{name} must satisfy |{name}| <= {limit} (28-bit counter), got {value!r}"
+        )
+    return x

@@ -1,0 +1,86 @@
+"""The hardware boundary: the one narrow interface the control layer talks to.
+
+The control layer never knows whether the hardware is simulated. Each cycle it:
+
+1. hands every axis the commanded motion for the coming cycle as one cubic piece
+   (`AxisCommand`): a pulse generator emits pulses exactly where that polynomial crosses
+   each integer count, so the command is exact between cycles, not only at cycle ends;
+2. calls `advance(t)`, which moves the hardware to time t and returns every input edge that
+   happened since the last call, each with its exact time (`InputEdge`);
+3. reads counters and input levels (`read_axis`), and writes outputs.
+
+Signal levels crossing this boundary are *electrical* (True = contact closed / line
+active-high as wired). Logic (normally open / closed, active high / low) is applied by the
+control layer from the machine configuration, as a real controller's registers do.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+#: Names of the per-axis motion input signals (HSL-4XMO chapter 3).
+AXIS_INPUTS = ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy")
+#: Names of the per-axis motion output signals.
+AXIS_OUTPUTS = ("svon", "erc")
+
+
+@dataclass(frozen=True, slots=True)
+class AxisCommand:
+    """Commanded pulse position over [t0, t0 + dt]: p0 + v0*s + a0*s**2/2 + j*s**3/6.
+
+    Positions are in command pulses (float); the pulse output is the integer part crossed.
+    """
+
+    t0: float
+    dt: float
+    p0: float
+    v0: float = 0.0
+    a0: float = 0.0
+    j: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class InputEdge:
+    """An input changed level at an exact time. `axis` is None for board-level inputs
+    (emergency stop `emg`, general inputs `di<n>`)."""
+
+    time: float
+    axis: int | None
+    signal: str
+    level: bool
+
+
+@dataclass(frozen=True, slots=True)
+class AxisReadback:
+    """What the hardware reports for one axis at the current time."""
+
+    pulses_out: int          # pulses emitted so far (signed, not wrapped)
+    encoder: int             # encoder counts as decoded by the input mode (signed, not wrapped)
+    inputs: dict[str, bool]  # electrical levels of AXIS_INPUTS
+
+
+@runtime_checkable
+class Hardware(Protocol):
+    """What a back end (the simulator, or a real board driver) provides."""
+
+    @property
+    def n_axes(self) -> int: ...
+
+    @property
+    def time(self) -> float: ...
+
+    def command(self, axis: int, cmd: AxisCommand) -> None:
+        """Set the commanded motion of `axis` for the coming cycle."""
+
+    def advance(self, t: float) -> list[InputEdge]:
+        """Move the hardware to time t (>= current time); return the edges, time-ordered."""
+
+    def read_axis(self, axis: int) -> AxisReadback:
+        """Counters and input levels of `axis` at the current time."""
+
+    def write_output(self, axis: int | None, signal: str, level: bool) -> None:
+        """Drive an output: per-axis `svon`/`erc`, or board-level `do<n>` (axis None)."""
+
+    def read_input(self, signal: str) -> bool:
+        """Board-level input level: `emg` or `di<n>`."""
