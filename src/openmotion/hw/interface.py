@@ -49,6 +49,7 @@ class InputEdge:
     axis: int | None
     signal: str
     level: bool
+    encoders: tuple[int, ...] = ()  # every axis's encoder count at `time` (for latches)
 
 
 @dataclass(frozen=True, slots=True)
