@@ -65,6 +65,8 @@ class Profile:
     start: State
     end: State
     labels: tuple[str, ...] = field(default=())
+    #: Exact segment durations (differences of t0 lose precision late in long profiles).
+    dt: Array | None = None
 
     # ------------------------------------------------------------------ queries
     @property
@@ -133,6 +135,8 @@ class Profile:
         )
 
     def segment_duration(self, k: int) -> float:
+        if self.dt is not None:
+            return float(self.dt[k])
         nxt = float(self.t0[k + 1]) if k + 1 < self.n_segments else self.duration
         return nxt - float(self.t0[k])
 
@@ -165,6 +169,12 @@ class Profile:
         t = min(max(t, 0.0), self.duration)
         keep = self.t0 < t
         shift = t
+        n_keep = int(keep.sum())
+        head_dt = np.array([self.segment_duration(k) for k in range(n_keep)])
+        if n_keep:
+            head_dt[-1] = t - float(self.t0[n_keep - 1])
+        tail_dt = (tail.dt if tail.dt is not None
+                   else np.array([tail.segment_duration(k) for k in range(tail.n_segments)]))
         return Profile(
             t0=np.concatenate([self.t0[keep], tail.t0 + shift]),
             p0=np.concatenate([self.p0[keep], tail.p0]),
@@ -176,6 +186,7 @@ class Profile:
             end=tail.end,
             labels=tuple(lb for lb, k in zip(self.labels, keep, strict=False) if k)
             + tail.labels,
+            dt=np.concatenate([head_dt, tail_dt]),
         )
 
     def shifted(self, dp: float) -> Profile:
@@ -184,7 +195,7 @@ class Profile:
             self.t0, self.p0 + dp, self.v0, self.a0, self.j, self.duration,
             State(self.start.p + dp, self.start.v, self.start.a),
             State(self.end.p + dp, self.end.v, self.end.a),
-            self.labels,
+            self.labels, self.dt,
         )
 
 
@@ -205,6 +216,7 @@ class ProfileBuilder:
         self._start = State(float(p), vb, 0.0)
         self._t = 0.0
         self._rows: list[tuple[float, float, float, float, float]] = []
+        self._dts: list[float] = []
         self._labels: list[str] = []
 
     @property
@@ -239,6 +251,7 @@ class ProfileBuilder:
         j = float(jerk) * self._dir
         p, v, a, dt = self._p, self._v, self._a, float(duration)
         self._rows.append((self._t, p, v, a, j))
+        self._dts.append(dt)
         self._labels.append(label or f"segment {len(self._labels)}")
         self._p = p + dt * (v + dt * (a / 2.0 + dt * j / 6.0))
         self._v = v + dt * (a + dt * j / 2.0)
@@ -256,6 +269,7 @@ class ProfileBuilder:
             t0=rows[:, 0].copy(), p0=rows[:, 1].copy(), v0=rows[:, 2].copy(),
             a0=rows[:, 3].copy(), j=rows[:, 4].copy(), duration=self._t,
             start=self._start, end=end, labels=tuple(self._labels),
+            dt=np.array(self._dts, dtype=np.float64),
         )
 
 
