@@ -3,11 +3,25 @@ simulated plant behind each axis. Built in code or loaded from / saved to TOML.
 
 Units: mechanism-related lengths are in the axis's user unit; speeds in user units per
 second; the simulator section is in command pulses unless a name says otherwise.
+
+Every dataclass validates itself on construction (also through `dataclasses.replace`), so a
+MachineConfig that exists is valid. Errors are MotionError naming the path of the bad field,
+e.g. "axes.x.lead must be > 0, got -2".
+
+Sources: mechanism parameters follow MCCL SYS_MACH_PARAM (dwPPR, dfPitch, dfGearRatio,
+wPosToEncoderDir, wRPM, wPulseMode, wPulseWidth, over-travel sensor NO/NC); pulse output
+modes HSL-4XMO 4.6 "Pulse Command Output"; encoder modes and move ratio HSL-4XMO 4.9 /
+4.6 (HSL_M_set_pls_iptmode, HSL_M_set_move_ratio); signal logic HSL-4XMO 4.7 / 4.8.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from typing import Any
+
+from openmotion.errors import MotionError, check_distance
+from openmotion.units import MAX_PULSE_RATE, pulses_per_unit
 
 USER_UNITS = ("pulse", "mm", "inch", "degree")
 PULSE_MODES = (
@@ -22,6 +36,64 @@ ENCODER_MODES = ("ab_x1", "ab_x2", "ab_x4", "cw_ccw", "pulse_dir")
 SIGNAL_LOGIC = ("no", "nc")  # normally open / normally closed contacts
 LOGIC_SIGNALS = ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy", "emg")
 DRIVE_TYPES = ("ideal_stepper", "stepper", "servo")
+SWITCHES = ("pel", "mel", "org", "sd")
+
+#: Counts per encoder line for each input mode (CW/CCW and pulse/dir count every pulse).
+ENCODER_MULTIPLIER = {"ab_x1": 1, "ab_x2": 2, "ab_x4": 4, "cw_ccw": 1, "pulse_dir": 1}
+#: MCCL interpolation period range, 1..1000 ms (MCCL manual, MCC_InitSystem).
+CYCLE_RANGE_S = (0.001, 1.0)
+MAX_PULSE_WIDTH_US = 1000.0
+MAX_GENERAL_IO = 4096
+
+
+# -- field checks: each names the field path and the rule ------------------------------
+def _real(path: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise MotionError(f"{path} must be a real number, got {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise MotionError(f"{path} must be finite, got {value!r}")
+    return x
+
+
+def _positive(path: str, value: Any) -> float:
+    x = _real(path, value)
+    if x <= 0.0:
+        raise MotionError(f"{path} must be > 0, got {value!r}")
+    return x
+
+
+def _nonneg(path: str, value: Any) -> float:
+    x = _real(path, value)
+    if x < 0.0:
+        raise MotionError(f"{path} must be >= 0, got {value!r}")
+    return x
+
+
+def _int(path: str, value: Any, lo: int, hi: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise MotionError(f"{path} must be an integer, got {value!r}")
+    if value < lo or (hi is not None and value > hi):
+        rule = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
+        raise MotionError(f"{path} must be {rule}, got {value!r}")
+    return value
+
+
+def _bool(path: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise MotionError(f"{path} must be true or false, got {value!r}")
+    return value
+
+
+def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
+    if value not in choices:
+        raise MotionError(f"{path} must be one of {', '.join(choices)}; got {value!r}")
+    return value
+
+
+def _set(obj: object, name: str, value: Any) -> None:
+    """Store a normalised value on a frozen dataclass during __post_init__."""
+    object.__setattr__(obj, name, value)
 
 
 @dataclass(frozen=True)
@@ -31,11 +103,25 @@ class SwitchConfig:
     It is active while the carriage is within [position, position + width) (width < 0
     spans downwards); `hysteresis` (pulses) is the extra travel needed to release it.
     End limits normally use a large width so they stay active beyond the switch.
+    In a TOML file all three are written in the axis's user units instead.
     """
 
     position: float
     width: float = 100.0
     hysteresis: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.validate("switch")
+
+    def validate(self, path: str) -> None:
+        """Check the fields; `path` prefixes error messages (e.g. "axes.x.pel")."""
+        _set(self, "position", check_distance(f"{path}.position", _real(f"{path}.position",
+                                                                          self.position)))
+        w = _real(f"{path}.width", self.width)
+        if w == 0.0:
+            raise MotionError(f"{path}.width must be non-zero, got {self.width!r}")
+        _set(self, "width", w)
+        _set(self, "hysteresis", _nonneg(f"{path}.hysteresis", self.hysteresis))
 
 
 @dataclass(frozen=True)
@@ -56,6 +142,28 @@ class DriveConfig:
     inp_band: float = 5.0
     backlash: float = 0.0          # mechanical backlash (command pulses), feedback side
     pitch_error: tuple[float, ...] = ()  # lead-screw error table (pulses), see docs
+
+    def __post_init__(self) -> None:
+        self.validate("drive")
+
+    def validate(self, path: str) -> None:
+        """Check the fields; `path` prefixes error messages (e.g. "axes.x.drive")."""
+        _choice(f"{path}.type", self.type, DRIVE_TYPES)
+        if self.type == "stepper":
+            _set(self, "pullout_speed", _positive(f"{path}.pullout_speed", self.pullout_speed))
+            _set(self, "pullout_accel", _positive(f"{path}.pullout_accel", self.pullout_accel))
+        else:
+            _set(self, "pullout_speed", _nonneg(f"{path}.pullout_speed", self.pullout_speed))
+            _set(self, "pullout_accel", _nonneg(f"{path}.pullout_accel", self.pullout_accel))
+        _set(self, "bandwidth_hz", _positive(f"{path}.bandwidth_hz", self.bandwidth_hz))
+        _set(self, "damping", _positive(f"{path}.damping", self.damping))
+        _set(self, "inp_band", _nonneg(f"{path}.inp_band", self.inp_band))
+        _set(self, "backlash", _nonneg(f"{path}.backlash", self.backlash))
+        if isinstance(self.pitch_error, (str, bytes)) or not hasattr(self.pitch_error, "__iter__"):
+            raise MotionError(f"{path}.pitch_error must be a list of numbers, "
+                              f"got {self.pitch_error!r}")
+        _set(self, "pitch_error", tuple(
+            _real(f"{path}.pitch_error[{i}]", e) for i, e in enumerate(self.pitch_error)))
 
 
 @dataclass(frozen=True)
@@ -85,6 +193,83 @@ class AxisConfig:
     org: SwitchConfig | None = None
     sd: SwitchConfig | None = None
 
+    def __post_init__(self) -> None:
+        self.validate()
+
+    def validate(self) -> None:
+        """Check every field; messages name "axes.<name>.<field>"."""
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise MotionError(f"axes name must be an identifier (letters, digits, _), "
+                              f"got {self.name!r}")
+        p = f"axes.{self.name}"
+        _int(f"{p}.pulses_per_rev", self.pulses_per_rev, 1)
+        _set(self, "lead", _positive(f"{p}.lead", self.lead))
+        _set(self, "gear_ratio", _positive(f"{p}.gear_ratio", self.gear_ratio))
+        _choice(f"{p}.unit", self.unit, USER_UNITS)
+        _set(self, "max_speed", _positive(f"{p}.max_speed", self.max_speed))
+        max_pps = self.max_speed * self.pulses_per_unit
+        if max_pps > MAX_PULSE_RATE:
+            raise MotionError(
+                f"{p}.max_speed must be <= {MAX_PULSE_RATE / self.pulses_per_unit:g} "
+                f"{self.unit}/s (pulse output limit {MAX_PULSE_RATE:g} pps), "
+                f"got {self.max_speed!r}")
+        _choice(f"{p}.pulse_mode", self.pulse_mode, PULSE_MODES)
+        w = _positive(f"{p}.pulse_width_us", self.pulse_width_us)
+        if w > MAX_PULSE_WIDTH_US:
+            raise MotionError(f"{p}.pulse_width_us must be <= {MAX_PULSE_WIDTH_US:g}, "
+                              f"got {self.pulse_width_us!r}")
+        _set(self, "pulse_width_us", w)
+        _choice(f"{p}.encoder_mode", self.encoder_mode, ENCODER_MODES)
+        _int(f"{p}.encoder_lines_per_rev", self.encoder_lines_per_rev, 1)
+        for flag in ("reverse", "invert_a", "invert_b", "invert_z", "swap_ab"):
+            _bool(f"{p}.{flag}", getattr(self, flag))
+        _set(self, "move_ratio", _positive(f"{p}.move_ratio", self.move_ratio))
+        if not isinstance(self.logic, dict):
+            raise MotionError(f"{p}.logic must be a table of signal = \"no\" | \"nc\", "
+                              f"got {self.logic!r}")
+        for sig, val in self.logic.items():
+            if sig not in LOGIC_SIGNALS:
+                raise MotionError(f"{p}.logic.{sig}: unknown signal; "
+                                  f"valid signals: {', '.join(LOGIC_SIGNALS)}")
+            _choice(f"{p}.logic.{sig}", val, SIGNAL_LOGIC)
+        _set(self, "logic", dict(self.logic))  # own copy: the caller's dict stays theirs
+        if not isinstance(self.drive, DriveConfig):
+            raise MotionError(f"{p}.drive must be a DriveConfig, got {self.drive!r}")
+        self.drive.validate(f"{p}.drive")
+        for sw in SWITCHES:
+            s = getattr(self, sw)
+            if s is not None:
+                if not isinstance(s, SwitchConfig):
+                    raise MotionError(f"{p}.{sw} must be a SwitchConfig or None, got {s!r}")
+                s.validate(f"{p}.{sw}")
+        if self.pel is not None and self.mel is not None and \
+                not self.pel.position > self.mel.position:
+            raise MotionError(
+                f"{p}.pel.position must be > {p}.mel.position in command pulses "
+                f"(PEL is the limit in the positive pulse direction), got "
+                f"pel {self.pel.position!r} <= mel {self.mel.position!r}")
+
+    # -- derived figures ---------------------------------------------------------------
+    @property
+    def pulses_per_unit(self) -> float:
+        """Command pulses per user unit (see openmotion.units)."""
+        return pulses_per_unit(self.pulses_per_rev, self.gear_ratio, self.lead, self.unit)
+
+    @property
+    def max_speed_pps(self) -> float:
+        """Maximum safe speed in command pulses per second."""
+        return self.max_speed * self.pulses_per_unit
+
+    @property
+    def encoder_counts_per_rev(self) -> int:
+        """Feedback counts per motor revolution (lines x the input-mode multiplier)."""
+        return self.encoder_lines_per_rev * ENCODER_MULTIPLIER[self.encoder_mode]
+
+    def signal_logic(self, signal: str) -> str:
+        """"no" or "nc" for a signal; signals not listed in `logic` are normally open."""
+        _choice("signal", signal, LOGIC_SIGNALS)
+        return self.logic.get(signal, "no")
+
 
 @dataclass(frozen=True)
 class MachineConfig:
@@ -95,3 +280,106 @@ class MachineConfig:
     digital_inputs: int = 16
     digital_outputs: int = 16
     cycle_s: float = 0.001
+
+    def __post_init__(self) -> None:
+        self.validate()
+
+    def validate(self) -> None:
+        """Check every field and every axis; axis names must be unique."""
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise MotionError(f"name must be a non-empty string, got {self.name!r}")
+        if isinstance(self.axes, (str, bytes, dict)) or not hasattr(self.axes, "__iter__"):
+            raise MotionError(f"axes must be a sequence of AxisConfig, got {self.axes!r}")
+        axes = tuple(self.axes)
+        seen: set[str] = set()
+        for i, ax in enumerate(axes):
+            if not isinstance(ax, AxisConfig):
+                raise MotionError(f"axes[{i}] must be an AxisConfig, got {ax!r}")
+            ax.validate()
+            if ax.name in seen:
+                raise MotionError(f"axes.{ax.name}: axis names must be unique, "
+                                  f"{ax.name!r} appears twice")
+            seen.add(ax.name)
+        _set(self, "axes", axes)
+        _int("digital_inputs", self.digital_inputs, 0, MAX_GENERAL_IO)
+        _int("digital_outputs", self.digital_outputs, 0, MAX_GENERAL_IO)
+        c = _real("cycle_s", self.cycle_s)
+        lo, hi = CYCLE_RANGE_S
+        if not lo <= c <= hi:
+            raise MotionError(f"cycle_s must be in [{lo:g}, {hi:g}] (MCCL 1..1000 ms), "
+                              f"got {self.cycle_s!r}")
+        _set(self, "cycle_s", c)
+
+    @property
+    def axis_names(self) -> tuple[str, ...]:
+        return tuple(a.name for a in self.axes)
+
+    def axis(self, key: str | int) -> AxisConfig:
+        """An axis by name or by controller index; MotionError if there is none."""
+        if isinstance(key, bool):
+            raise MotionError(f"axis must be a name or an index, got {key!r}")
+        if isinstance(key, int):
+            if not 0 <= key < len(self.axes):
+                raise MotionError(f"axis index must be in [0, {len(self.axes) - 1}], "
+                                  f"got {key!r}")
+            return self.axes[key]
+        for a in self.axes:
+            if a.name == key:
+                return a
+        raise MotionError(f"axis {key!r} is not on machine {self.name!r}; "
+                          f"axes: {', '.join(self.axis_names) or '(none)'}")
+
+    def index(self, name: str) -> int:
+        """Controller index of the axis called `name`."""
+        return self.axes.index(self.axis(name))
+
+    def with_axis(self, axis: AxisConfig) -> MachineConfig:
+        """A copy with `axis` replacing the axis of the same name, or appended if new."""
+        if not isinstance(axis, AxisConfig):
+            raise MotionError(f"axis must be an AxisConfig, got {axis!r}")
+        names = self.axis_names
+        if axis.name in names:
+            axes = tuple(axis if a.name == axis.name else a for a in self.axes)
+        else:
+            axes = self.axes + (axis,)
+        return MachineConfig(self.name, axes, self.digital_inputs, self.digital_outputs,
+                             self.cycle_s)
+
+
+# -- the default machine -------------------------------------------------------------------
+def _linear(name: str, lead: float, gear: float, max_speed: float, travel: float) -> AxisConfig:
+    """A ball-screw axis, 10000 pulses/rev, with MEL below 0, ORG at 0..3 and PEL past
+    `travel` (all given here in mm and converted to command pulses)."""
+    ppu = 10000 * gear / lead
+    return AxisConfig(
+        name=name, pulses_per_rev=10000, lead=lead, gear_ratio=gear, unit="mm",
+        max_speed=max_speed, logic={"pel": "nc", "mel": "nc", "org": "no"},
+        mel=SwitchConfig(position=-5.0 * ppu, width=-50.0 * ppu, hysteresis=0.05 * ppu),
+        org=SwitchConfig(position=0.0, width=3.0 * ppu, hysteresis=0.05 * ppu),
+        pel=SwitchConfig(position=(travel + 5.0) * ppu, width=50.0 * ppu,
+                         hysteresis=0.05 * ppu),
+    )
+
+
+def default_machine() -> MachineConfig:
+    """The 4-axis XYZU table, identical to examples/xyzu.toml.
+
+    x: 10 mm lead, 1000 pulses/mm, 300 mm travel; y: 5 mm lead, 2000 pulses/mm, 200 mm;
+    z: 5 mm lead on a 2:1 belt, 4000 pulses/mm, 100 mm; u: rotary, 7200 pulses/rev on a 5:1
+    reducer, 100 pulses/degree, ORG at 0..2 degrees, no end limits. Ideal stepper drives.
+    """
+    u = AxisConfig(
+        name="u", pulses_per_rev=7200, lead=360.0, gear_ratio=5.0, unit="degree",
+        max_speed=720.0, encoder_lines_per_rev=1800, logic={"org": "no"},
+        org=SwitchConfig(position=0.0, width=200.0, hysteresis=5.0),
+    )
+    return MachineConfig(
+        name="xyzu",
+        axes=(
+            _linear("x", lead=10.0, gear=1.0, max_speed=500.0, travel=300.0),
+            _linear("y", lead=5.0, gear=1.0, max_speed=250.0, travel=200.0),
+            _linear("z", lead=5.0, gear=2.0, max_speed=100.0, travel=100.0),
+            u,
+        ),
+        digital_inputs=16, digital_outputs=16, cycle_s=0.001,
+    )
