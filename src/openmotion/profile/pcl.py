@@ -1,0 +1,269 @@
+"""PCL6045 (HSL-4XMO) point-to-point moves: T-curve and S-curve with StrVel, Tacc/Tdec, VS.
+
+Semantics (HSL-4XMO manual §4.6 "Trapezoidal Motion", "S-curve Profile Motion", fig. 4-10):
+
+* The pulse rate jumps from 0 to StrVel at the start, ramps to MaxVel in Tacc, cruises,
+  ramps back to StrVel in Tdec and jumps to 0 at the end (a stepper starting and stopping
+  inside its start-stop rate).
+* T-curve: accel = (MaxVel - StrVel)/Tacc, decel = (MaxVel - StrVel)/Tdec (constant).
+* S-curve: each ramp = constant-jerk region covering VS of velocity, a linear
+  (constant-acceleration) region, and a constant-jerk region covering VS. VS = 0 means no
+  linear region (pure S), the same as VS = (MaxVel - StrVel)/2. Valid VS: [0, dv/2].
+  (seed-facts 1.2: the manual's "from (MaxVel - StrVel) to MaxVel" must read
+  "from (MaxVel - VS) to MaxVel".)
+* Automatic velocity decrease: when the distance is too short to reach MaxVel, MaxVel (and
+  with it Tacc, Tdec, VSacc, VSdec) is lowered while StrVel, acceleration and jerk stay.
+
+`MoveSpec` carries the parameters; `MoveSpec.plan` returns a `MovePlan` with the profile and
+the effective (possibly lowered) parameters. `trapezoid` and `scurve` are the plain entry
+points that return only the profile.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from ..errors import (
+    MotionError,
+    check_distance,
+    check_finite,
+    check_nonnegative,
+    check_positive,
+)
+from .ramps import ramp_jerk
+from .segments import Profile, ProfileBuilder, empty_profile
+
+# S-curve ramp algebra (one ramp covering dv = MaxVel - StrVel in time Tacc):
+#   jerk region: a goes 0 -> A in tj = A/J and covers VS = J*tj**2/2 = A**2/(2J) of velocity,
+#   so tj = 2*VS/A; linear region covers dv - 2*VS at A, lasting (dv - 2*VS)/A.
+#   Tacc = 2*tj + (dv - 2*VS)/A = (dv + 2*VS)/A   =>   A = (dv + 2*VS)/Tacc,
+#   J = A/tj = A**2/(2*VS).  VS = 0 (pure S) is VS = dv/2:  A = 2*dv/Tacc, J = 4*dv/Tacc**2.
+# A ramp of x = V - StrVel under (A, J) with x < A**2/J = 2*VS has no linear region:
+#   peak accel sqrt(J*x), duration 2*sqrt(x/J).  Otherwise duration x/A + A/J.
+# Every ramp's acceleration is symmetric about its midpoint, so its mean velocity is
+# (StrVel + V)/2 and its distance (StrVel + V)/2 * duration (T-curve included).
+
+
+@dataclass(frozen=True)
+class Rates:
+    """Acceleration/deceleration (pulses/s^2) and jerks (pulses/s^3; inf for a T-curve)."""
+
+    accel: float
+    decel: float
+    jerk_acc: float
+    jerk_dec: float
+
+
+@dataclass(frozen=True)
+class MoveSpec:
+    """PCL6045 move parameters: shape 'T' or 'S', StrVel, MaxVel (pps), Tacc, Tdec (s),
+    VSacc, VSdec (pps, S-curve only; 0 = pure S). Validated on construction."""
+
+    shape: str
+    str_vel: float
+    max_vel: float
+    tacc: float
+    tdec: float
+    vs_acc: float = 0.0
+    vs_dec: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.shape not in ("T", "S"):
+            raise MotionError(f"shape must be 'T' or 'S', got {self.shape!r}")
+        sv = check_nonnegative("str_vel", self.str_vel)
+        mv = check_positive("max_vel", self.max_vel)
+        if mv < sv:
+            raise MotionError(f"max_vel must be >= str_vel ({sv!r}), got {self.max_vel!r}")
+        ta = check_positive("tacc", self.tacc)
+        td = check_positive("tdec", self.tdec)
+        half = (mv - sv) / 2.0
+        vals = {"str_vel": sv, "max_vel": mv, "tacc": ta, "tdec": td}
+        for name in ("vs_acc", "vs_dec"):
+            vs = check_nonnegative(name, getattr(self, name))
+            if vs > half:
+                raise MotionError(
+                    f"{name} must be in [0, (max_vel - str_vel)/2 = {half:g}], "
+                    f"got {getattr(self, name)!r}"
+                )
+            vals[name] = vs
+        for name, x in vals.items():
+            object.__setattr__(self, name, x)
+
+    @property
+    def rates(self) -> Rates:
+        """Acceleration, deceleration and jerks implied by the parameters."""
+        dv = self.max_vel - self.str_vel
+        if self.shape == "T":
+            return Rates(dv / self.tacc, dv / self.tdec, math.inf, math.inf)
+        a, ja = _s_rates(dv, self.tacc, self.vs_acc)
+        d, jd = _s_rates(dv, self.tdec, self.vs_dec)
+        return Rates(a, d, ja, jd)
+
+    def plan(self, distance: float, start: float = 0.0) -> MovePlan:
+        """Plan a relative move of `distance` pulses from position `start` (at rest)."""
+        dist = check_distance("distance", distance)
+        p0 = check_finite("start", start)
+        return _plan(self, dist, p0)
+
+
+@dataclass(frozen=True)
+class MovePlan:
+    """A planned move: the profile and the parameters the hardware would really run.
+
+    `effective` is the spec after the automatic velocity decrease (equal to `spec` when
+    MaxVel is reached); `rates` are unchanged by the decrease; `t_decel` is when the final
+    deceleration begins (the HSL p_change cut-off); `reduced` tells whether MaxVel was lowered.
+    """
+
+    profile: Profile
+    spec: MoveSpec
+    effective: MoveSpec
+    rates: Rates
+    t_decel: float
+    reduced: bool
+
+
+def _s_rates(dv: float, t: float, vs: float) -> tuple[float, float]:
+    """(A, J) of one S ramp covering dv in time t with jerk regions of vs (0 = pure S)."""
+    if dv <= 0.0:
+        return 0.0, math.inf
+    vs = dv / 2.0 if vs == 0.0 else vs
+    a = (dv + 2.0 * vs) / t
+    return a, a * a / (2.0 * vs)
+
+
+def ramp_time(x: float, accel: float, jerk: float) -> float:
+    """Duration of a ramp covering x >= 0 of velocity from a = 0 to a = 0 (PCL shape)."""
+    if x <= 0.0:
+        return 0.0
+    if math.isinf(jerk):
+        return x / accel
+    if x >= accel * accel / jerk:
+        return x / accel + accel / jerk
+    return 2.0 * math.sqrt(x / jerk)
+
+
+def _ramp_time_dx(x: float, accel: float, jerk: float) -> float:
+    """d ramp_time / dx (for Newton)."""
+    if math.isinf(jerk) or x >= accel * accel / jerk:
+        return 1.0 / accel
+    return 1.0 / math.sqrt(max(x, 1e-300) * jerk)
+
+
+def ramp_distance(v_low: float, v_high: float, accel: float, jerk: float) -> float:
+    """Distance of a PCL ramp between v_low and v_high (either direction)."""
+    return (v_low + v_high) / 2.0 * ramp_time(abs(v_high - v_low), accel, jerk)
+
+
+def _peak_excess(dist: float, s: float, dv: float, r: Rates) -> float:
+    """x = V - StrVel such that ramp up + ramp down covers `dist` exactly (0 < x < dv).
+
+    T-curve: (V**2 - s**2)/2 * (1/a + 1/d) = dist, closed form.  S-curve: the distance
+    D(x) = (2s + x)/2 * (Ta(x) + Td(x)) is continuous and strictly increasing, so a Newton
+    iteration kept inside a shrinking bracket [lo, hi] converges to double precision.
+    """
+    if r.jerk_acc == math.inf:
+        k = 1.0 / r.accel + 1.0 / r.decel
+        v = math.sqrt(s * s + 2.0 * dist / k)
+        return min(max(v - s, 0.0), dv)
+
+    def f(x: float) -> tuple[float, float]:
+        tt = ramp_time(x, r.accel, r.jerk_acc) + ramp_time(x, r.decel, r.jerk_dec)
+        dt = _ramp_time_dx(x, r.accel, r.jerk_acc) + _ramp_time_dx(x, r.decel, r.jerk_dec)
+        return (2.0 * s + x) / 2.0 * tt - dist, tt / 2.0 + (2.0 * s + x) / 2.0 * dt
+
+    lo, hi = 0.0, dv
+    x = dv
+    for _ in range(200):
+        fx, dfx = f(x)
+        if fx == 0.0:
+            return x
+        if fx > 0.0:
+            hi = x
+        else:
+            lo = x
+        nx = x - fx / dfx if dfx > 0.0 else 0.5 * (lo + hi)
+        if not lo < nx < hi:
+            nx = 0.5 * (lo + hi)
+        if nx == x or hi - lo <= 4.0 * math.ulp(hi):
+            return nx
+        x = nx
+    return 0.5 * (lo + hi)
+
+
+def append_ramp(b: ProfileBuilder, v1: float, accel: float, jerk: float,
+                label: str) -> ProfileBuilder:
+    """Append a PCL ramp from b's velocity (acceleration 0) to v1 (move frame)."""
+    if math.isinf(jerk):
+        v0 = b.state.v
+        if v1 != v0:
+            b.segment(abs(v1 - v0) / accel, 0.0, accel=math.copysign(accel, v1 - v0),
+                      label=label)
+        b.set_acceleration(0.0)
+        return b
+    return ramp_jerk(b, v1, accel, jerk, label=label)
+
+
+def _plan(spec: MoveSpec, dist: float, p0: float) -> MovePlan:
+    if dist == 0.0:
+        return MovePlan(empty_profile(p0), spec, spec, spec.rates, 0.0, False)
+    r = spec.rates
+    s, dv, d = spec.str_vel, spec.max_vel - spec.str_vel, abs(dist)
+    full = ramp_distance(s, spec.max_vel, r.accel, r.jerk_acc) + ramp_distance(
+        s, spec.max_vel, r.decel, r.jerk_dec
+    )
+    b = ProfileBuilder(p0, s, direction=1.0 if dist > 0 else -1.0, v_before=0.0)
+    if dv == 0.0 or full <= d:
+        x, t_cruise, eff, reduced = dv, (d - full) / spec.max_vel, spec, False
+    else:
+        eff = _reduced_spec(spec, r, s + _peak_excess(d, s, dv, r))
+        x, reduced = eff.max_vel - s, True
+        # the root leaves a rounding-level residual; a (near-zero) cruise absorbs it
+        used = ramp_distance(s, s + x, r.accel, r.jerk_acc) + ramp_distance(
+            s, s + x, r.decel, r.jerk_dec)
+        t_cruise = max(0.0, d - used) / (s + x) if s + x > 0.0 else 0.0
+    v = s + x
+    append_ramp(b, v, r.accel, r.jerk_acc, "accel")
+    b.segment(t_cruise, 0.0, accel=0.0, label="cruise")
+    t_decel = b.time
+    append_ramp(b, s, r.decel, r.jerk_dec, "decel")
+    prof = b.build(end_p=p0 + dist, end_v=0.0)
+    return MovePlan(prof, spec, eff, r, t_decel, reduced)
+
+
+def _reduced_spec(spec: MoveSpec, r: Rates, v: float) -> MoveSpec:
+    """Spec with MaxVel lowered to v and Tacc, Tdec, VS lowered to keep accel and jerk."""
+    s = spec.str_vel
+    x = v - s
+    if x <= 0.0:  # only by rounding, when StrVel dwarfs the distance
+        return replace(spec, max_vel=s, vs_acc=0.0, vs_dec=0.0)
+    tacc = ramp_time(x, r.accel, r.jerk_acc)
+    tdec = ramp_time(x, r.decel, r.jerk_dec)
+    if spec.shape == "T":
+        return replace(spec, max_vel=v, tacc=tacc, tdec=tdec)
+    vs_a = r.accel * r.accel / (2.0 * r.jerk_acc)
+    vs_d = r.decel * r.decel / (2.0 * r.jerk_dec)
+    half = x / 2.0
+    return replace(
+        spec, max_vel=v, tacc=tacc, tdec=tdec,
+        vs_acc=spec.vs_acc if vs_a <= half else half,
+        vs_dec=spec.vs_dec if vs_d <= half else half,
+    )
+
+
+def _spec(shape: str, str_vel: float, max_vel: float, tacc: float, tdec: float,
+          vs_acc: float = 0.0, vs_dec: float = 0.0) -> MoveSpec:
+    return MoveSpec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec)
+
+
+def trapezoid(distance: float, str_vel: float, max_vel: float, tacc: float, tdec: float,
+              *, start: float = 0.0) -> Profile:
+    """PCL6045 T-curve move of `distance` pulses (HSL_M_start_tr_move)."""
+    return _spec("T", str_vel, max_vel, tacc, tdec).plan(distance, start).profile
+
+
+def scurve(distance: float, str_vel: float, max_vel: float, tacc: float, tdec: float,
+           vs_acc: float, vs_dec: float, *, start: float = 0.0) -> Profile:
+    """PCL6045 S-curve move of `distance` pulses (HSL_M_start_sr_move)."""
+    return _spec("S", str_vel, max_vel, tacc, tdec, vs_acc, vs_dec).plan(distance, start).profile
