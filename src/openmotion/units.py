@@ -46,7 +46,7 @@ def _finite(name: str, x: ArrayLike) -> ArrayLike:
         if not np.issubdtype(x.dtype, np.number) or not np.all(np.isfinite(x)):
             raise MotionError(f"{name} must contain only finite numbers")
         return x.astype(float, copy=False)
-    if isinstance(x, bool):
+    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
         raise MotionError(f"{name} must be a real number, got {x!r}")
     return check_finite(name, x)
 
