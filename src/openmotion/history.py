@@ -1,0 +1,424 @@
+"""Motion history: per-axis constant-jerk records in absolute time (a trapq, anchors.md b2).
+
+Every profile the controller executes is appended here, so later code can ask "where was
+the axis at time t?" (latches, homing, plots) and "when did it pass position x?" (compare,
+PSO, limits). As in Klipper's trapq, any time maps to exactly one record:
+
+- record i covers [ts[i], ts[i+1]); the last record is open-ended. Its polynomial is
+  p(dt) = p0 + v0*dt + a0*dt**2/2 + j*dt**3/6 with dt = t - ts[i].
+- a profile appended at t_abs becomes one record per segment plus a *tail* record at
+  t_abs + duration holding `profile.end` (exact target position, constant end velocity),
+  so gaps between moves are standstill (or constant velocity after a velocity ramp).
+- times before the oldest retained record read that record's start position at rest.
+
+Memory is bounded (architecture.md "Memory is bounded"): records that ended more than
+`window_s` before the newest append are dropped, and each axis stores its records in numpy
+arrays that are compacted or grown in chunks, so appending is amortised O(1) and a 10-hour
+job runs in flat memory.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from numbers import Integral
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import MotionError, check_finite, check_positive
+from .profile.segments import Profile, Samples, State
+
+Array = NDArray[np.float64]
+
+_MIN_CAPACITY = 32
+_EPS = np.finfo(np.float64).eps
+
+
+class _Track:
+    """One axis's records as five parallel arrays; live rows are [lo, hi)."""
+
+    __slots__ = ("ts", "p0", "v0", "a0", "j", "lo", "hi")
+
+    def __init__(self, t_start: float, p: float, capacity: int = _MIN_CAPACITY) -> None:
+        self.ts = np.empty(capacity)
+        self.p0 = np.empty(capacity)
+        self.v0 = np.empty(capacity)
+        self.a0 = np.empty(capacity)
+        self.j = np.empty(capacity)
+        self.lo = 0
+        self.hi = 0
+        self.push(t_start, p, 0.0, 0.0, 0.0)
+
+    @property
+    def capacity(self) -> int:
+        return int(self.ts.size)
+
+    def cols(self) -> tuple[Array, Array, Array, Array, Array]:
+        lo, hi = self.lo, self.hi
+        return self.ts[lo:hi], self.p0[lo:hi], self.v0[lo:hi], self.a0[lo:hi], self.j[lo:hi]
+
+    def reserve(self, n: int) -> None:
+        """Make room for n more rows at hi (compact in place, or grow by doubling)."""
+        cap = self.capacity
+        if self.hi + n <= cap:
+            return
+        live = self.hi - self.lo
+        need = live + n
+        # Compacting only when at most half the buffer is live keeps at least cap/2 free rows
+        # afterwards, so every row moved is paid for by a later append: amortised O(1).
+        new_cap = cap if 2 * need <= cap else max(2 * need, _MIN_CAPACITY)
+        for name in ("ts", "p0", "v0", "a0", "j"):
+            old = getattr(self, name)
+            new = old if new_cap == cap else np.empty(new_cap)
+            new[:live] = old[self.lo:self.hi]
+            setattr(self, name, new)
+        self.lo, self.hi = 0, live
+
+    def push(self, t: float, p: float, v: float, a: float, j: float) -> None:
+        self.reserve(1)
+        i = self.hi
+        self.ts[i], self.p0[i], self.v0[i], self.a0[i], self.j[i] = t, p, v, a, j
+        self.hi = i + 1
+
+    def index_at(self, t: float) -> int:
+        """Absolute row index of the record covering t (lo - 1 when t is before them all)."""
+        return self.lo + int(np.searchsorted(self.ts[self.lo:self.hi], t, side="right")) - 1
+
+    def state_at(self, t: float) -> State:
+        k = self.index_at(t)
+        if k < self.lo:
+            return State(float(self.p0[self.lo]), 0.0, 0.0)
+        dt = t - float(self.ts[k])
+        p0, v0, a0, j = float(self.p0[k]), float(self.v0[k]), float(self.a0[k]), float(self.j[k])
+        return State(
+            p0 + dt * (v0 + dt * (a0 / 2.0 + dt * j / 6.0)),
+            v0 + dt * (a0 + dt * j / 2.0),
+            a0 + dt * j,
+        )
+
+
+def _check_times(name: str, times: ArrayLike) -> Array:
+    try:
+        ts = np.asarray(times, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise MotionError(f"{name} must be real numbers, got {times!r}") from None
+    if not np.all(np.isfinite(ts)):
+        raise MotionError(f"{name} must all be finite")
+    return ts
+
+
+class MotionHistory:
+    """Time-indexed per-axis segment store (Klipper trapq model), bounded by a time window.
+
+    `positions` are the axes' positions before any motion (default 0); the initial standstill
+    record starts at `t_start`.
+    """
+
+    def __init__(self, n_axes: int, window_s: float = 60.0, *,
+                 positions: Sequence[float] | None = None, t_start: float = 0.0) -> None:
+        if not isinstance(n_axes, Integral) or isinstance(n_axes, bool) or n_axes < 1:
+            raise MotionError(f"n_axes must be an integer >= 1, got {n_axes!r}")
+        self.window_s = check_positive("window_s", window_s)
+        t_start = check_finite("t_start", t_start)
+        if positions is None:
+            pos = [0.0] * int(n_axes)
+        else:
+            if len(positions) != n_axes:
+                raise MotionError(
+                    f"positions must have n_axes={n_axes} entries, got {len(positions)}"
+                )
+            pos = [check_finite(f"positions[{i}]", p) for i, p in enumerate(positions)]
+        self.n_axes = int(n_axes)
+        self._tracks = [_Track(t_start, p) for p in pos]
+
+    # ------------------------------------------------------------------ checks
+    def _axis(self, axis: int) -> _Track:
+        if not isinstance(axis, Integral) or isinstance(axis, bool):
+            raise MotionError(f"axis must be an integer, got {axis!r}")
+        if not 0 <= axis < self.n_axes:
+            raise MotionError(f"axis must be in [0, {self.n_axes - 1}], got {axis!r}")
+        return self._tracks[int(axis)]
+
+    # ------------------------------------------------------------------ writing
+    def append(self, axis: int, t_abs: float, profile: Profile) -> None:
+        """Add `profile` starting at absolute time `t_abs` (its time 0).
+
+        Records at or after `t_abs` are cut first, so a re-planned profile splices onto the
+        running motion. Records older than `t_abs - window_s` are then forgotten.
+        """
+        tr = self._axis(axis)
+        t_abs = check_finite("t_abs", t_abs)
+        if not isinstance(profile, Profile):
+            raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
+        n = profile.n_segments
+        first = float(profile.t0[0]) if n else profile.duration
+        self._cut(tr, t_abs)
+        tr.reserve(n + 2)
+        if first > 0.0:
+            # Profile semantics before its first segment: the start state at constant speed.
+            tr.push(t_abs, profile.start.p, profile.start.v, 0.0, 0.0)
+        if n:
+            sl = slice(tr.hi, tr.hi + n)
+            tr.ts[sl] = t_abs + profile.t0
+            tr.p0[sl] = profile.p0
+            tr.v0[sl] = profile.v0
+            tr.a0[sl] = profile.a0
+            tr.j[sl] = profile.j
+            tr.hi += n
+        end = profile.end
+        tr.push(t_abs + profile.duration, end.p, end.v, 0.0, 0.0)
+        self._forget(tr, t_abs - self.window_s)
+
+    def truncate(self, axis: int, t_abs: float) -> State:
+        """Cut everything after `t_abs`; the axis holds its position there at rest.
+
+        Returns the state the axis had at `t_abs` (before the cut), e.g. for an immediate
+        stop's report.
+        """
+        tr = self._axis(axis)
+        t_abs = check_finite("t_abs", t_abs)
+        st = tr.state_at(t_abs)
+        self._cut(tr, t_abs)
+        tr.push(t_abs, st.p, 0.0, 0.0, 0.0)
+        return st
+
+    @staticmethod
+    def _cut(tr: _Track, t_abs: float) -> None:
+        """Drop records starting at or after t_abs (the one covering t_abs now ends there)."""
+        k = tr.lo + int(np.searchsorted(tr.ts[tr.lo:tr.hi], t_abs, side="left"))
+        tr.hi = k
+
+    def forget_before(self, t: float, axis: int | None = None) -> None:
+        """Drop records that ended at or before `t` (all axes unless `axis` is given).
+
+        The record covering `t` is kept, so every time from `t` on still reads exactly.
+        """
+        t = check_finite("t", t)
+        tracks = self._tracks if axis is None else [self._axis(axis)]
+        for tr in tracks:
+            self._forget(tr, t)
+
+    def expire(self, now: float) -> None:
+        """Forget what is older than the window: `forget_before(now - window_s)`."""
+        self.forget_before(check_finite("now", now) - self.window_s)
+
+    @staticmethod
+    def _forget(tr: _Track, t: float) -> None:
+        k = tr.index_at(t)
+        if k > tr.lo:
+            tr.lo = k
+
+    # ------------------------------------------------------------------ reading
+    def state_at(self, axis: int, t: float) -> State:
+        """(p, v, a) of `axis` at absolute time `t`."""
+        tr = self._axis(axis)
+        return tr.state_at(check_finite("t", t))
+
+    def sample(self, axis: int, times: ArrayLike) -> Samples:
+        """Position, velocity, acceleration, jerk at absolute `times` (vectorized)."""
+        tr = self._axis(axis)
+        t = _check_times("times", times)
+        shape = t.shape
+        t = t.reshape(-1)
+        ts, p0, v0, a0, j0 = tr.cols()
+        k = np.searchsorted(ts, t, side="right") - 1
+        before = k < 0
+        np.maximum(k, 0, out=k)
+        dt = t - ts[k]
+        dt[before] = 0.0
+        vk, ak, jk = v0[k], a0[k], j0[k]
+        vk[before] = 0.0
+        ak[before] = 0.0
+        jk[before] = 0.0
+        p = p0[k] + dt * (vk + dt * (ak / 2.0 + dt * jk / 6.0))
+        v = vk + dt * (ak + dt * jk / 2.0)
+        a = ak + dt * jk
+        return Samples(p.reshape(shape), v.reshape(shape), a.reshape(shape), jk.reshape(shape))
+
+    def position_at(self, axis: int, times: ArrayLike) -> Array | float:
+        """Position at `times`: a float for a scalar time, else an array shaped like times."""
+        p = self.sample(axis, times).p
+        return float(p) if p.ndim == 0 else p
+
+    def end_time(self, axis: int) -> float:
+        """Start of the last (open-ended) record: after it the axis holds its end state."""
+        tr = self._axis(axis)
+        return float(tr.ts[tr.hi - 1])
+
+    def end_state(self, axis: int) -> State:
+        """The state of the last record at its start (exact target position of the last move)."""
+        tr = self._axis(axis)
+        i = tr.hi - 1
+        return State(float(tr.p0[i]), float(tr.v0[i]), float(tr.a0[i]))
+
+    def start_time(self, axis: int) -> float:
+        """Start of the oldest retained record; earlier times read its start position."""
+        tr = self._axis(axis)
+        return float(tr.ts[tr.lo])
+
+    def n_records(self, axis: int) -> int:
+        return self._axis(axis).hi - self._axis(axis).lo
+
+    def capacity(self, axis: int) -> int:
+        """Rows allocated for `axis` (for memory checks)."""
+        return self._axis(axis).capacity
+
+    def records(self, axis: int) -> dict[str, Array]:
+        """Copies of the retained records: ts, p0, v0, a0, j (each record to the next ts)."""
+        ts, p0, v0, a0, j = self._axis(axis).cols()
+        return {"ts": ts.copy(), "p0": p0.copy(), "v0": v0.copy(), "a0": a0.copy(),
+                "j": j.copy()}
+
+    # ------------------------------------------------------------------ events
+    def crossings(self, axis: int, level: float, t0: float, t1: float,
+                  direction: int = 0) -> Array:
+        """Exact times in [t0, t1] where the position reaches `level`.
+
+        direction=+1: position < level just before and >= level at the time (upward);
+        -1: > level just before and <= level at the time; 0: both. A tangent touch counts as
+        reaching the level from the side it came from; a dwell at the level counts once, on
+        arrival. Times are found by solving each record's cubic on its monotone pieces.
+        """
+        times, dirs = self.crossing_events(axis, level, t0, t1)
+        if direction not in (-1, 0, 1):
+            raise MotionError(f"direction must be -1, 0 or +1, got {direction!r}")
+        return times if direction == 0 else times[dirs == direction]
+
+    def crossing_events(self, axis: int, level: float, t0: float,
+                        t1: float) -> tuple[Array, NDArray[np.int8]]:
+        """Like `crossings` with direction 0, plus each event's direction (+1/-1)."""
+        tr = self._axis(axis)
+        level = check_finite("level", level)
+        t0 = check_finite("t0", t0)
+        t1 = check_finite("t1", t1)
+        if t1 < t0:
+            raise MotionError(f"t1 must be >= t0, got t0={t0!r}, t1={t1!r}")
+        return _find_crossings(*tr.cols(), level, t0, t1)
+
+
+# ---------------------------------------------------------------------------- crossings
+# Method: split every record in the query range at its critical points (roots of the
+# velocity quadratic) and at t0, so each piece is monotone. Then, with f = p - level:
+# - at each piece start tau an event fires when f was < 0 just before tau and f(tau) >= 0
+#   (upward), or > 0 and <= 0 (downward): this catches arrivals, tangent touches and
+#   position jumps between records;
+# - inside a piece with f(u) and f(w) of strictly opposite sign there is exactly one root,
+#   found by bisection to adjacent floats (the root is the first float where the sign
+#   has changed).
+# The sign "just before" a piece start is the sign at the end of the previous piece, or the
+# sign of its start value when it ends exactly on the level (monotone in between).
+# Values within a few ulps of the level are snapped onto it, so a tangent touch computed
+# with rounding error reads as one touch, not as two crossings or none.
+
+
+def _poly(c: Array, v: Array, a: Array, j: Array, dt: Array) -> Array:
+    return c + dt * (v + dt * (a / 2.0 + dt * j / 6.0))
+
+
+def _snapped(f: Array, level: float, p0: Array, v: Array, a: Array, j: Array,
+             dt: Array) -> Array:
+    scale = abs(level) + np.abs(p0) + np.abs(dt * v) + np.abs(dt * dt * a / 2.0) \
+        + np.abs(dt * dt * dt * j / 6.0)
+    return np.where(np.abs(f) <= 8.0 * _EPS * scale, 0.0, f)
+
+
+def _critical_points(v: Array, a: Array, j: Array) -> tuple[Array, Array]:
+    """Roots of the velocity v + a*dt + j*dt**2/2 (NaN where there is none)."""
+    half_j = 0.5 * j
+    c1 = np.full(v.size, np.nan)
+    c2 = np.full(v.size, np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lin = (half_j == 0.0) & (a != 0.0)
+        c1[lin] = -v[lin] / a[lin]
+        disc = a * a - 4.0 * half_j * v
+        quad = (half_j != 0.0) & (disc >= 0.0)
+        q = -0.5 * (a + np.copysign(np.sqrt(np.where(quad, disc, 0.0)), a))
+        qn = quad & (q != 0.0)
+        c1[qn] = q[qn] / half_j[qn]
+        c2[qn] = v[qn] / q[qn]
+        c1[quad & (q == 0.0)] = 0.0  # v == a == 0: double root at dt = 0
+    return c1, c2
+
+
+def _find_crossings(ts: Array, p0: Array, v0: Array, a0: Array, j0: Array, level: float,
+                    t0: float, t1: float) -> tuple[Array, NDArray[np.int8]]:
+    empty = (np.empty(0), np.empty(0, dtype=np.int8))
+    if t1 <= ts[0]:
+        return empty  # constant (the oldest record's start) before its start
+    # Scan from the last record starting before t0, to know the sign just before t0.
+    ks = max(int(np.searchsorted(ts, t0, side="left")) - 1, 0)
+    ke = int(np.searchsorted(ts, t1, side="right")) - 1
+    kc = int(np.searchsorted(ts, t0, side="right")) - 1  # record holding t0 (-1: before all)
+    T = ts[ks:ke + 1]
+    m = T.size
+    L = np.empty(m)
+    L[:-1] = np.diff(T)
+    L[-1] = t1 - T[-1]
+    P, V, A, J = p0[ks:ke + 1], v0[ks:ke + 1], a0[ks:ke + 1], j0[ks:ke + 1]
+    C = P - level
+    x0 = np.full(m, np.nan)
+    r0 = kc - ks
+    x0v = t0 - ts[kc] if kc >= 0 else 0.0
+    if kc >= ks:
+        x0[r0] = x0v
+    c1, c2 = _critical_points(V, A, J)
+    B = np.column_stack([np.zeros(m), c1, c2, x0, L])
+    inner = (B > 0.0) & (L[:, None] > B)
+    inner[:, 0] = True
+    inner[:, -1] = True
+    B = np.where(inner, B, np.nan)
+    B.sort(axis=1)
+    U, W = B[:, :-1], B[:, 1:]
+    ok = W > U  # NaN compares False
+    rec = np.broadcast_to(np.arange(m)[:, None], U.shape)[ok]
+    u, w = U[ok], W[ok]
+    n = u.size
+    if n == 0:
+        return empty
+    c, v, a, j, pr = C[rec], V[rec], A[rec], J[rec], P[rec]
+    fu = _snapped(_poly(c, v, a, j, u), level, pr, v, a, j, u)
+    fw = _snapped(_poly(c, v, a, j, w), level, pr, v, a, j, w)
+    su, sw = np.sign(fu), np.sign(fw)
+    s_end = np.where(sw != 0.0, sw, su)  # sign just before each piece's end
+    s_left = np.empty(n)
+    s_left[0] = su[0]
+    s_left[1:] = s_end[:-1]
+    in_range = (rec > r0) | ((rec == r0) & (u >= x0v))  # all pieces when t0 < ts[0]
+    tau = T[rec] + u
+    tau[(rec == r0) & (u == x0v)] = t0
+
+    times = np.zeros((n, 2))
+    dirs = np.zeros((n, 2), dtype=np.int8)
+    up = in_range & (s_left < 0) & (fu >= 0.0)
+    down = in_range & (s_left > 0) & (fu <= 0.0)
+    times[:, 0] = tau
+    dirs[up, 0] = 1
+    dirs[down, 0] = -1
+
+    sel = np.flatnonzero(in_range & (su * sw < 0.0))
+    if sel.size:
+        lo, hi = u[sel].copy(), w[sel].copy()
+        s = su[sel]
+        cs, vs, as_, js = c[sel], v[sel], a[sel], j[sel]
+        for _ in range(1100):  # enough to reach adjacent floats from any bracket
+            mid = 0.5 * (lo + hi)
+            active = (mid > lo) & (mid < hi)
+            if not active.any():
+                break
+            same = np.sign(_poly(cs, vs, as_, js, mid)) == s
+            lo = np.where(active & same, mid, lo)
+            hi = np.where(active & ~same, mid, hi)
+        times[sel, 1] = T[rec[sel]] + hi
+        dirs[sel, 1] = np.where(s < 0, 1, -1)
+
+    dt1 = L[-1:]
+    f1 = _snapped(_poly(C[-1:], V[-1:], A[-1:], J[-1:], dt1), level, P[-1:], V[-1:], A[-1:],
+                  J[-1:], dt1)[0]
+    d1 = 1 if (s_end[-1] < 0 and f1 >= 0.0) else -1 if (s_end[-1] > 0 and f1 <= 0.0) else 0
+    flat_t, flat_d = times.reshape(-1), dirs.reshape(-1)
+    keep = flat_d != 0
+    out_t, out_d = flat_t[keep], flat_d[keep]
+    if d1:
+        out_t = np.append(out_t, t1)
+        out_d = np.append(out_d, np.int8(d1))
+    return out_t, out_d
