@@ -1,0 +1,256 @@
+"""Time-optimal jerk-limited (seven-phase) rest-to-rest moves, single axis and time-synced.
+
+A rest-to-rest move under |v| <= V, acceleration <= A (accelerating), <= D (decelerating)
+and |jerk| <= J is, at its fastest, an acceleration ramp 0 -> Vp, a cruise at Vp and a
+deceleration ramp Vp -> 0, each ramp the three-phase "S" (jerk +J, 0, -J). The only
+unknown is the peak velocity Vp; the phase times follow from it in closed form.
+
+Derivation (one ramp 0 -> V with limit X, zero acceleration at both ends):
+    V >= X**2/J (X reached):  T = V/X + X/J,   d = V*T/2 = V**2/(2X) + V*X/(2J)
+    V <  X**2/J (triangle):   T = 2*sqrt(V/J), d = V*T/2 = V**1.5/sqrt(J)
+(d = V*T/2 because the ramp's velocity is point-symmetric about its midpoint.)
+With f(V) = d_acc(V) + d_dec(V) (continuous, increasing), Vp = v_max if f(v_max) <= L,
+otherwise the root of f(V) = L:
+    both limits reached:  k*V**2 + c*V - L = 0, k = (1/A + 1/D)/2, c = (A + D)/(2J)
+    neither reached:      2*V**1.5/sqrt(J) = L  ->  V = (L*sqrt(J)/2)**(2/3)
+    only the smaller H reached, u = sqrt(V):
+                          g(u) = u**4/(2H) + u**3/sqrt(J) + u**2*H/(2J) - L = 0
+g is convex and increasing for u > 0 (it is C1 across the regime borders, and its second
+derivative only jumps up there), so Newton started above the root falls monotonically onto
+it. Each term alone is <= L at the root and one term is >= L/3, so the root lies within
+[m/sqrt(3), m], m = smallest single-term root: ~7 Newton steps reach full precision.
+
+Time sync: with a cruise cap vc <= Vp the duration is T(vc) = T_acc(vc)/2 + T_dec(vc)/2
++ L/vc, decreasing in vc; a slower axis gets the vc with T(vc) = T_sync (bracketed Newton).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+
+from ..errors import MotionError, check_distance, check_finite, check_positive
+from .segments import Profile, ProfileBuilder
+
+NEWTON_STEPS = 10  # from within a factor sqrt(3) of the root, 7 reach full double precision
+
+PHASE_LABELS = ("jerk-in", "const-acc", "jerk-out", "cruise", "jerk-in (dec)",
+                "const-dec", "jerk-out (dec)")
+
+
+# ----------------------------------------------------------------- closed-form pieces
+def _ramp(v: float, x: float, j: float) -> tuple[float, float]:
+    """(jerk time, constant-acceleration time) of the ramp 0 -> v under limit x."""
+    if v * j >= x * x:
+        return x / j, v / x - x / j
+    return math.sqrt(v / j), 0.0
+
+
+def _ramp_distance(v: float, x: float, j: float) -> float:
+    if v * j >= x * x:
+        return v * (v / x + x / j) / 2.0
+    return v * math.sqrt(v / j)
+
+
+def _mixed_root(length: float, h: float, j: float, u_hi: float) -> float:
+    """Root u = sqrt(V) of g(u) above (only the smaller limit h is reached)."""
+    sj = math.sqrt(j)
+    u = min(u_hi, (2.0 * h * length) ** 0.25, (length * sj) ** (1.0 / 3.0),
+            math.sqrt(2.0 * j * length / h))
+    for _ in range(NEWTON_STEPS):
+        u2 = u * u
+        g = u2 * u2 / (2.0 * h) + u2 * u / sj + u2 * h / (2.0 * j) - length
+        dg = 2.0 * u2 * u / h + 3.0 * u2 / sj + u * h / j
+        if g <= 0.0 or dg <= 0.0:
+            break
+        nxt = u - g / dg
+        if not nxt < u:
+            break
+        u = nxt
+    return u
+
+
+def peak_velocity(length: float, v_max: float, a_max: float, d_max: float,
+                  j_max: float) -> float:
+    """Highest velocity of the time-optimal move of `length` > 0 (see module notes)."""
+    if _ramp_distance(v_max, a_max, j_max) + _ramp_distance(v_max, d_max, j_max) <= length:
+        return v_max
+    lo, hi = min(a_max, d_max), max(a_max, d_max)
+    v2 = hi * hi / j_max
+    if _ramp_distance(v2, hi, j_max) + _ramp_distance(v2, lo, j_max) <= length:
+        k = (1.0 / a_max + 1.0 / d_max) / 2.0
+        c = (a_max + d_max) / (2.0 * j_max)
+        return 2.0 * length / (c + math.sqrt(c * c + 4.0 * k * length))
+    if length <= 2.0 * lo**3 / (j_max * j_max):
+        return (length * math.sqrt(j_max) / 2.0) ** (2.0 / 3.0)
+    u = _mixed_root(length, lo, j_max, math.sqrt(v2))
+    return min(u * u, v_max)
+
+
+def phase_times(length: float, v_max: float, a_max: float, d_max: float,
+                j_max: float, v_cap: float | None = None) -> tuple[float, ...]:
+    """The seven phase durations of the fastest move of `length` >= 0 (cruise capped)."""
+    if length <= 0.0:
+        return (0.0,) * 7
+    vp = peak_velocity(length, v_max, a_max, d_max, j_max)
+    if v_cap is not None and v_cap < vp:
+        vp = v_cap
+    tj1, ta = _ramp(vp, a_max, j_max)
+    tj2, td = _ramp(vp, d_max, j_max)
+    rest = length - _ramp_distance(vp, a_max, j_max) - _ramp_distance(vp, d_max, j_max)
+    tv = max(0.0, rest / vp)
+    return (tj1, ta, tj1, tv, tj2, td, tj2)
+
+
+def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
+                d_max: float, j_max: float) -> float:
+    """Cruise cap vc whose capped move lasts exactly t_target (>= the optimum)."""
+
+    def dur(vc: float) -> tuple[float, float]:
+        # T(vc) and dT/dvc, from T = T_acc/2 + T_dec/2 + L/vc.
+        t, dt = length / vc, -length / (vc * vc)
+        for x in (a_max, d_max):
+            if vc * j_max >= x * x:
+                t += (vc / x + x / j_max) / 2.0
+                dt += 0.5 / x
+            else:
+                t += math.sqrt(vc / j_max)
+                dt += 0.5 / math.sqrt(vc * j_max)
+        return t, dt
+
+    hi = peak_velocity(length, v_max, a_max, d_max, j_max)
+    lo = length / t_target  # T(lo) >= t_target since T(vc) > L/vc
+    vc = hi
+    for _ in range(200):
+        t, dt = dur(vc)
+        err = t - t_target
+        if err == 0.0:
+            return vc
+        if err > 0.0:
+            lo = vc
+        else:
+            hi = vc
+        nxt = vc - err / dt if dt < 0.0 else 0.5 * (lo + hi)
+        if not lo < nxt < hi:
+            nxt = 0.5 * (lo + hi)
+        if nxt in (lo, hi) or hi - lo <= 4e-16 * hi:
+            break
+        vc = nxt
+    return vc
+
+
+# ------------------------------------------------------------------ validation
+def _limits(v_max: float, a_max: float, j_max: float,
+            d_max: float | None) -> tuple[float, float, float, float]:
+    v = check_positive("v_max", v_max)
+    a = check_positive("a_max", a_max)
+    j = check_positive("j_max", j_max)
+    d = a if d_max is None else check_positive("d_max", d_max)
+    return v, a, d, j
+
+
+def _build(start: float, distance: float, times: Sequence[float], a_max: float,
+           d_max: float, j_max: float) -> Profile:
+    b = ProfileBuilder(start, direction=1.0 if distance >= 0.0 else -1.0)
+    tj1, ta, _, tv, tj2, td, _ = times
+    a_pk = min(a_max, j_max * tj1)
+    d_pk = min(d_max, j_max * tj2)
+    b.segment(tj1, j_max, accel=0.0, label=PHASE_LABELS[0])
+    b.segment(ta, 0.0, accel=a_pk, label=PHASE_LABELS[1])
+    b.segment(tj1, -j_max, accel=a_pk, label=PHASE_LABELS[2])
+    b.segment(tv, 0.0, accel=0.0, label=PHASE_LABELS[3])
+    b.segment(tj2, -j_max, accel=0.0, label=PHASE_LABELS[4])
+    b.segment(td, 0.0, accel=-d_pk, label=PHASE_LABELS[5])
+    b.segment(tj2, j_max, accel=-d_pk, label=PHASE_LABELS[6])
+    b.set_acceleration(0.0)
+    return b.build(end_p=start + distance)
+
+
+# ------------------------------------------------------------------- public API
+def jerk_limited(distance: float, v_max: float, a_max: float, j_max: float, *,
+                 d_max: float | None = None, start: float = 0.0) -> Profile:
+    """Time-optimal rest-to-rest jerk-limited move of `distance` pulses from `start`.
+
+    `d_max` limits deceleration separately (None: same as `a_max`). Negative distances move
+    backwards; zero gives an empty profile. The profile ends exactly on start + distance.
+    """
+    dist = check_distance("distance", distance)
+    st = check_finite("start", start)
+    v, a, d, j = _limits(v_max, a_max, j_max, d_max)
+    times = phase_times(abs(dist), v, a, d, j)
+    return _build(st, dist, times, a, d, j)
+
+
+def jerk_limited_duration(distance: float, v_max: float, a_max: float, j_max: float, *,
+                          d_max: float | None = None) -> float:
+    """Duration of `jerk_limited` without building the profile."""
+    dist = check_distance("distance", distance)
+    v, a, d, j = _limits(v_max, a_max, j_max, d_max)
+    return math.fsum(phase_times(abs(dist), v, a, d, j))
+
+
+def _per_axis(name: str, value: float | Sequence[float] | None, n: int) -> list:
+    if value is None or isinstance(value, (int, float)):
+        return [value] * n
+    try:
+        vals = list(value)
+    except TypeError:
+        raise MotionError(f"{name} must be a number or a sequence of {n} numbers") from None
+    if len(vals) != n:
+        raise MotionError(f"{name} must have one value per axis ({n}), got {len(vals)}")
+    return vals
+
+
+def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float],
+                      a_max: float | Sequence[float], j_max: float | Sequence[float], *,
+                      d_max: float | Sequence[float] | None = None,
+                      starts: Sequence[float] | None = None) -> list[Profile]:
+    """Jerk-limited moves of several axes that start together and all last T.
+
+    T is the longest per-axis optimum; every other axis cruises slower so that its profile
+    lasts exactly T (within its own limits). A zero-distance axis dwells for T.
+    Limits are scalars or one value per axis.
+    """
+    try:
+        dists = list(distances)
+    except TypeError:
+        raise MotionError("distances must be a sequence of numbers") from None
+    n = len(dists)
+    if n == 0:
+        raise MotionError("distances must hold at least one axis")
+    dists = [check_distance(f"distances[{i}]", x) for i, x in enumerate(dists)]
+    st = [0.0] * n if starts is None else [
+        check_finite(f"starts[{i}]", x) for i, x in enumerate(_per_axis("starts", starts, n))
+    ]
+    vs, as_, js, ds = (_per_axis(nm, val, n) for nm, val in
+                       (("v_max", v_max), ("a_max", a_max), ("j_max", j_max),
+                        ("d_max", d_max)))
+    lims = []
+    for i in range(n):
+        try:
+            lims.append(_limits(vs[i], as_[i], js[i], ds[i]))
+        except MotionError as e:
+            raise MotionError(f"axis {i}: {e}") from None
+    times = [phase_times(abs(x), *lim) for x, lim in zip(dists, lims, strict=True)]
+    durs = [math.fsum(t) for t in times]
+    t_sync = max(durs)
+    out = []
+    for i in range(n):
+        v, a, d, j = lims[i]
+        if t_sync <= 0.0:
+            out.append(_build(st[i], 0.0, times[i], a, d, j))
+            continue
+        if dists[i] == 0.0:
+            b = ProfileBuilder(st[i])
+            b.segment(t_sync, 0.0, label="dwell")
+            out.append(b.build(end_p=st[i]))
+            continue
+        tm = times[i]
+        if durs[i] < t_sync:
+            cap = _synced_cap(abs(dists[i]), t_sync, v, a, d, j)
+            tm = phase_times(abs(dists[i]), v, a, d, j, v_cap=cap)
+        prof = _build(st[i], dists[i], tm, a, d, j)
+        # Float sums of phase times differ from T in the last ulp; pin every axis to T.
+        out.append(replace(prof, duration=t_sync))
+    return out
