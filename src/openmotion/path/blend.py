@@ -1,0 +1,147 @@
+"""Corners: arc blends within a path tolerance, junction speed limits, arc speed limits.
+
+Blend (LinuxCNC G64 P, anchors b6). Two lines meet at the corner P with unit directions
+u1 (in) and u2 (out). With the half-angle theta of the corner's interior angle 2*theta:
+
+    cos(theta) = |u1 - u2| / 2,  sin(theta) = |u1 + u2| / 2     (no acos, exact near 0/90 deg)
+
+a circle tangent to both lines at distance d from P has radius R = d*tan(theta), centre
+P + n*d/cos(theta) (n: unit bisector (u2 - u1)/|u2 - u1|), and its midpoint lies
+    dev = d/cos(theta) - R = d*(1 - sin(theta))/cos(theta)
+from P: that is the largest distance between the blend and the programmed corner. dev <= T
+gives d_tol = T*cos(theta)/(1 - sin(theta)) = T*(1 + sin(theta))/cos(theta); d is also at most
+BLEND_DIST_FRACTION of each line, so two blends never overlap on a line.
+
+Junction speed (grbl/Klipper, anchors b1), with Klipper's half-angle phi (cos(phi) = -u1.u2):
+    sin(phi/2) = |u1 + u2|/2,  cos(phi/2) = |u1 - u2|/2
+    R_jd = sin(phi/2)/(1 - sin(phi/2)) = sin(phi/2)*(1 + sin(phi/2))/cos(phi/2)**2
+    delta = scv**2*(sqrt(2) - 1)/accel    (scv: speed allowed through a 90 degree corner)
+    v**2 = accel*delta*R_jd,  and v**2 <= 0.5*L*accel*tan(phi/2) for each adjoining length L
+(the approximating circle touches each move no further than its middle).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import MotionError, check_nonnegative, check_positive
+from .arcs import Arc3D
+from .geometry import Line, as_point
+
+#: A blend may use at most this fraction of each line (LinuxCNC BLEND_DIST_FRACTION).
+BLEND_DIST_FRACTION = 0.5
+#: Turn angles below this (radians) are treated as straight: no blend, no corner limit.
+TANGENT_ANGLE = 1e-9
+#: Corners whose lines are within this angle (radians) of a full reversal need an exact stop.
+REVERSAL_ANGLE = 1e-9
+_SQRT2_M1 = math.sqrt(2.0) - 1.0
+
+
+@dataclass(frozen=True, eq=False)
+class Blend:
+    """A rounded corner: `first` trimmed, the tangent `arc`, `second` trimmed."""
+
+    first: Line
+    arc: Arc3D
+    second: Line
+    #: Largest distance between the arc and the programmed corner (at the arc's midpoint).
+    deviation: float
+
+    @property
+    def elements(self) -> tuple[Line, Arc3D, Line]:
+        return (self.first, self.arc, self.second)
+
+
+def _unit(name: str, value: ArrayLike, dim: int | None = None) -> np.ndarray:
+    v = as_point(name, value, dim)
+    norm = float(np.linalg.norm(v))
+    if norm == 0.0:
+        raise MotionError(f"{name} must be a non-zero direction")
+    return v / norm
+
+
+def blend_corner(first: Line, second: Line, tolerance: float, *,
+                 fraction: float = BLEND_DIST_FRACTION) -> Blend | None:
+    """Round the corner first.end == second.start with an arc at most `tolerance` from it.
+
+    Returns None when no blend is wanted: tolerance 0, a zero-length line, collinear lines
+    (nothing to round) or a reversal (the path must stop exactly at the corner).
+    """
+    if not isinstance(first, Line) or not isinstance(second, Line):
+        raise MotionError("first and second must be Line elements")
+    if first.dim != second.dim:
+        raise MotionError(f"second must have {first.dim} axes like first, got {second.dim}")
+    t = check_nonnegative("tolerance", tolerance)
+    frac = check_positive("fraction", fraction)
+    if frac > 0.5:
+        raise MotionError(f"fraction must be in (0, 0.5], got {fraction!r}")
+    gap = float(np.linalg.norm(second.start - first.end))
+    scale = max(1.0, float(np.max(np.abs(first.end))))
+    if gap > 1e-9 * scale:
+        raise MotionError(f"second.start must equal first.end, they are {gap:.6g} apart")
+    if t == 0.0 or first.length == 0.0 or second.length == 0.0:
+        return None
+    u1, u2 = first.direction, second.direction
+    cos_t = float(np.linalg.norm(u1 - u2)) / 2.0
+    sin_t = float(np.linalg.norm(u1 + u2)) / 2.0
+    turn = 2.0 * math.atan2(cos_t, sin_t)  # angle between u1 and u2
+    if turn < TANGENT_ANGLE or math.pi - turn < REVERSAL_ANGLE:
+        return None
+    corner = first.end
+    d_tol = t * (1.0 + sin_t) / cos_t
+    d = min(frac * first.length, frac * second.length, d_tol)
+    radius = d * sin_t / cos_t
+    normal = (u2 - u1) / np.linalg.norm(u2 - u1)
+    centre = corner + normal * (d / cos_t)
+    a_start = corner - u1 * d
+    a_end = corner + u2 * d
+    e1 = a_start - centre
+    e1 = e1 - (e1 @ u1) * u1
+    e1 = e1 / np.linalg.norm(e1)
+    e2 = u1 - (u1 @ e1) * e1
+    e2 = e2 / np.linalg.norm(e2)
+    arc = Arc3D.from_frame(centre, e1, e2, radius, turn, start=a_start, end=a_end)
+    dev = d * (1.0 - sin_t) / cos_t
+    return Blend(Line(first.start, a_start), arc, Line(a_end, second.end), dev)
+
+
+def corner_speed(u1: ArrayLike, u2: ArrayLike, accel: float, square_corner_velocity: float,
+                 *, lengths: tuple[float, float] | None = None) -> float:
+    """Junction-deviation speed limit for a sharp corner from direction u1 to u2.
+
+    `square_corner_velocity` is the speed allowed through a 90 degree corner (Klipper);
+    `lengths` (of the two moves) adds the "circle touches each move no further than its
+    middle" cap. Straight on: inf. Full reversal: 0 (exact stop).
+    """
+    a = _unit("u1", u1)
+    b = _unit("u2", u2, a.size)
+    acc = check_positive("accel", accel)
+    scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
+    caps = ()
+    if lengths is not None:
+        try:
+            caps = tuple(check_nonnegative("lengths", x) for x in lengths)
+        except TypeError:
+            raise MotionError(f"lengths must be two lengths, got {lengths!r}") from None
+        if len(caps) != 2:
+            raise MotionError(f"lengths must be two lengths, got {lengths!r}")
+    sin_h = float(np.linalg.norm(a + b)) / 2.0
+    cos_h = float(np.linalg.norm(a - b)) / 2.0
+    if cos_h == 0.0:
+        return math.inf
+    v2 = scv * scv * _SQRT2_M1 * sin_h * (1.0 + sin_h) / (cos_h * cos_h)
+    tan_h = sin_h / cos_h
+    for length in caps:
+        v2 = min(v2, 0.5 * length * acc * tan_h)
+    return math.sqrt(v2)
+
+
+def centripetal_speed(radius: float, normal_accel: float) -> float:
+    """Fastest speed on a curve of `radius` with at most `normal_accel` sideways: sqrt(a*R)."""
+    r = check_nonnegative("radius", radius)
+    a = check_nonnegative("normal_accel", normal_accel)
+    return math.sqrt(a * r)

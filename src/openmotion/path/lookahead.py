@@ -1,0 +1,193 @@
+"""Look-ahead: entry, cruise and exit speeds along a sequence of path elements.
+
+Pure function of the geometry and the limits (anchors b1: grbl planner_recalculate,
+Klipper LookAheadQueue.flush). Everything is in v**2, where constant acceleration a over a
+length L is linear: v1**2 = v0**2 + 2*a*L.
+
+1. Per element: the tangential acceleration `a_k` and the speed cap `vmax_k`.
+   Lines: a_k = min(accel, amax_i/|u_i|), vmax_k = min(feed, vmax_i/|u_i|).
+   Arcs: the total acceleration sqrt(a_t**2 + a_n**2) is split as in LinuxCNC (anchors b6):
+   a_t = r*A, a_n = sqrt(1 - r**2)*A with r = arc_tangential_ratio and
+   A = min(accel, amax_i/w_i), w_i >= sqrt(t_i**2 + n_i**2) along the arc, so every axis
+   acceleration |a_t*t_i + a_n*n_i| <= A*w_i <= amax_i (Cauchy-Schwarz). Centripetal cap:
+   kappa*v**2 <= a_n. Axis speeds: v*max|t_i| <= vmax_i.
+2. Junction caps: the smaller of both neighbours' vmax and, when the tangent turns, the
+   junction-deviation corner speed (blend.corner_speed) with the acceleration limited per
+   axis along u2 - u1 (grbl's limit_value_by_axis_maximum).
+3. Backward pass from the end speed, then forward pass from the start speed.
+4. Cruise: the highest speed reachable between entry and exit: v**2 = (vin**2+vout**2)/2 + a*L.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import InfeasibleError, MotionError, check_nonnegative, check_positive
+from .blend import TANGENT_ANGLE, corner_speed
+from .geometry import Array, PathElement
+
+
+@dataclass(frozen=True)
+class ElementSpeeds:
+    """Planned speeds of one element: accelerate at `accel` from `entry` up to `cruise`,
+    hold, decelerate at `accel` to `exit` (trapezoid along the path)."""
+
+    entry: float
+    cruise: float
+    exit: float
+    accel: float
+    vmax: float
+    length: float
+
+    @property
+    def duration(self) -> float:
+        """Time of the trapezoid entry -> cruise -> exit over `length`."""
+        if self.length == 0.0 or self.cruise == 0.0:
+            return 0.0
+        a, vc = self.accel, self.cruise
+        d_acc = (vc * vc - self.entry**2) / (2.0 * a)
+        d_dec = (vc * vc - self.exit**2) / (2.0 * a)
+        hold = max(0.0, self.length - d_acc - d_dec)
+        return (vc - self.entry) / a + (vc - self.exit) / a + hold / vc
+
+
+def _axis_limits(name: str, value: ArrayLike | None, dim: int) -> Array | None:
+    if value is None:
+        return None
+    try:
+        arr = np.array(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise MotionError(f"{name} must be {dim} positive numbers, got {value!r}") from None
+    if arr.size != dim or np.any(np.isnan(arr)) or np.any(arr <= 0.0):
+        raise MotionError(f"{name} must be {dim} numbers > 0 (inf = unlimited), got {value!r}")
+    return arr
+
+
+def _limit_along(limit: float, axis: Array | None, weight: Array) -> float:
+    """min(limit, axis_i / weight_i) over axes with weight_i > 0."""
+    if axis is None:
+        return limit
+    mask = weight > 0.0
+    if not np.any(mask):
+        return limit
+    return min(limit, float(np.min(axis[mask] / weight[mask])))
+
+
+def _element_limits(el: PathElement, feed: float, accel: float, vmax_ax: Array | None,
+                    amax_ax: Array | None, ratio: float) -> tuple[float, float]:
+    """(tangential accel, speed cap) of one element."""
+    vmax = _limit_along(feed, vmax_ax, el.max_abs_tangent)
+    kappa = el.max_curvature
+    if kappa == 0.0:
+        return _limit_along(accel, amax_ax, el.max_abs_tangent), vmax
+    total = _limit_along(accel, amax_ax, el.axis_accel_weight)
+    a_n = math.sqrt(1.0 - ratio * ratio) * total
+    return ratio * total, min(vmax, math.sqrt(a_n / kappa))
+
+
+def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
+                  amax_ax: Array | None) -> float:
+    u1, u2 = prev.end_tangent, nxt.start_tangent
+    diff = u2 - u1
+    chord = float(np.linalg.norm(diff))
+    if 2.0 * math.asin(min(1.0, chord / 2.0)) < TANGENT_ANGLE:
+        return math.inf
+    a_j = _limit_along(accel, amax_ax, np.abs(diff) / chord)
+    # Klipper's deviation is set by the nominal accel; a lower axis-limited accel lowers
+    # v**2 proportionally: scale scv by sqrt(a_j/accel).
+    return corner_speed(u1, u2, a_j, scv * math.sqrt(a_j / accel),
+                        lengths=(prev.length, nxt.length))
+
+
+def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
+                square_corner_velocity: float = 0.0, start_speed: float = 0.0,
+                end_speed: float = 0.0, axis_vmax: ArrayLike | None = None,
+                axis_amax: ArrayLike | None = None,
+                arc_tangential_ratio: float = 0.5) -> tuple[ElementSpeeds, ...]:
+    """Entry/cruise/exit speeds for each element (see the module docstring).
+
+    `feed` is the path speed cap, `accel` the path acceleration limit. Corners where the
+    tangent turns are crossed at most at the junction-deviation speed of
+    `square_corner_velocity` (0: exact stop). The path starts at exactly `start_speed` and
+    ends at a speed <= `end_speed`. `axis_vmax`/`axis_amax` (N values, inf = unlimited)
+    bound every axis's speed and acceleration. Zero-length elements keep the speed of the
+    junction they sit on. Raises InfeasibleError if `start_speed` is too high to obey the
+    limits ahead.
+    """
+    if isinstance(elements, (str, bytes)) or not isinstance(elements, Sequence) \
+            or len(elements) == 0:
+        raise MotionError("elements must be a non-empty sequence of path elements")
+    for k, el in enumerate(elements):
+        if not isinstance(el, PathElement):
+            raise MotionError(f"elements[{k}] must be a path element (Line, Arc, Arc3D), "
+                              f"got {type(el).__name__}")
+    dim = elements[0].dim
+    for k, el in enumerate(elements):
+        if el.dim != dim:
+            raise MotionError(f"elements[{k}] must have {dim} axes like elements[0], "
+                              f"got {el.dim}")
+    f = check_positive("feed", feed)
+    a = check_positive("accel", accel)
+    scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
+    v_start = check_nonnegative("start_speed", start_speed)
+    v_end = check_nonnegative("end_speed", end_speed)
+    vmax_ax = _axis_limits("axis_vmax", axis_vmax, dim)
+    amax_ax = _axis_limits("axis_amax", axis_amax, dim)
+    ratio = check_positive("arc_tangential_ratio", arc_tangential_ratio)
+    if ratio >= 1.0:
+        raise MotionError(f"arc_tangential_ratio must be in (0, 1), got {arc_tangential_ratio!r}")
+
+    live = [k for k, el in enumerate(elements) if el.length > 0.0]
+    n = len(live)
+    if n == 0:
+        if v_start > 0.0:
+            raise InfeasibleError(f"start_speed {v_start:g} cannot be stopped on a path of "
+                                  "length 0")
+        return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0) for _ in elements)
+    els = [elements[k] for k in live]
+    lim = [_element_limits(el, f, a, vmax_ax, amax_ax, ratio) for el in els]
+    acc = [x[0] for x in lim]
+    cap = [x[1] for x in lim]
+    length = [el.length for el in els]
+
+    # jcap2[k]: v**2 cap at the entry of live element k (k = n: the end of the path).
+    jcap2 = [0.0] * (n + 1)
+    jcap2[0] = cap[0] ** 2
+    jcap2[n] = min(v_end, cap[n - 1]) ** 2
+    for k in range(1, n):
+        vj = min(cap[k - 1], cap[k], _junction_cap(els[k - 1], els[k], a, scv, amax_ax))
+        jcap2[k] = vj * vj
+
+    back = jcap2[:]
+    for k in range(n - 1, -1, -1):
+        back[k] = min(jcap2[k], back[k + 1] + 2.0 * acc[k] * length[k])
+    if v_start * v_start > back[0] * (1.0 + 1e-12):
+        raise InfeasibleError(f"start_speed {v_start:g} exceeds the highest speed the path "
+                              f"allows at its start, {math.sqrt(back[0]):.6g}")
+    fwd = [0.0] * (n + 1)
+    fwd[0] = min(v_start * v_start, back[0])
+    for k in range(n):
+        fwd[k + 1] = min(back[k + 1], fwd[k] + 2.0 * acc[k] * length[k])
+
+    planned: list[ElementSpeeds] = []
+    for k in range(n):
+        vin, vout = math.sqrt(fwd[k]), math.sqrt(fwd[k + 1])
+        peak2 = 0.5 * (fwd[k] + fwd[k + 1]) + acc[k] * length[k]
+        cruise = max(vin, vout, min(cap[k], math.sqrt(peak2)))
+        planned.append(ElementSpeeds(vin, cruise, vout, acc[k], cap[k], length[k]))
+
+    out: list[ElementSpeeds] = []
+    nxt = 0
+    for k in range(len(elements)):
+        if nxt < n and live[nxt] == k:
+            out.append(planned[nxt])
+            nxt += 1
+        else:  # zero length: sits on the junction before live element nxt
+            v = planned[nxt].entry if nxt < n else planned[-1].exit
+            out.append(ElementSpeeds(v, v, v, a, f, 0.0))
+    return tuple(out)
