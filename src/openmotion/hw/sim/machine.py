@@ -1,0 +1,374 @@
+"""SimMachine: the simulated machine behind the `Hardware` boundary.
+
+Per axis: a pulse generator (the commanded cubic), a drive/motor plant, the transmission
+(backlash, pitch error), switches at mechanical positions, and the encoder as decoded by
+the board. `advance(t)` cuts [now, t] at scenario action times, lets every plant produce
+its monotone motor pieces, and finds every switch/index edge on them by solving for the
+exact crossing time. Each edge carries every axis's decoded encoder count at its instant.
+
+Signal levels are electrical: a switch's level is (active XOR contact is NC), where the
+contact type is AxisConfig.logic[signal] ("no" default). The SD/LTC pin is one input: with
+no separate LTC switch placed, every SD edge is also reported as an LTC edge.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from openmotion.config import DRIVE_TYPES, AxisConfig, MachineConfig
+from openmotion.errors import MotionError, check_finite, check_nonnegative
+from openmotion.hw.interface import AXIS_INPUTS, AXIS_OUTPUTS, AxisCommand, AxisReadback, InputEdge
+
+from .cubic import Cubic
+from .encoder import Decoder, EncoderWiring, default_wiring
+from .mechanics import PitchTable, Transmission
+from .pieces import JumpPiece, Piece
+from .plant import StepperPlant
+from .pulses import PulseGenerator
+from .scenario import Scenario
+from .switches import IndexSwitch, Switch
+
+if TYPE_CHECKING:
+    from .servo import ServoPlant
+
+#: Safety bound on toggles of one switch within one piece (an EZ window per revolution).
+_MAX_TOGGLES = 100_000
+SWITCH_SIGNALS = ("pel", "mel", "org", "sd", "ltc")
+
+
+class _Axis:
+    """Everything the sim keeps for one axis."""
+
+    def __init__(self, index: int, cfg: AxisConfig, wiring: EncoderWiring | None) -> None:
+        drv = cfg.drive
+        if drv.type not in DRIVE_TYPES:
+            raise MotionError(f"axes[{index}].drive.type must be one of {DRIVE_TYPES}, "
+                              f"got {drv.type!r}")
+        self.index = index
+        self.cfg = cfg
+        self.gen = PulseGenerator()
+        if drv.type == "servo":
+            from .servo import ServoPlant
+            self.plant: StepperPlant | ServoPlant = ServoPlant(drv)
+        else:
+            self.plant = StepperPlant(drv.type == "ideal_stepper", drv.pullout_speed,
+                                      drv.pullout_accel)
+        self.is_servo = drv.type == "servo"
+        check_nonnegative(f"axes[{index}].drive.backlash", drv.backlash)
+        screw = cfg.pulses_per_rev * cfg.gear_ratio
+        self.trans = Transmission(drv.backlash, PitchTable(drv.pitch_error, screw))
+        self.y = self.trans.y_of(0.0)
+        self.decoder = Decoder(wiring or default_wiring(cfg), cfg, self.y)
+        self.nc = {s: cfg.logic.get(s, "no") == "nc" for s in (*AXIS_INPUTS, "emg")}
+        self.switches: dict[str, Switch | IndexSwitch] = {}
+        for name in ("pel", "mel", "org", "sd"):
+            sc = getattr(cfg, name)
+            if sc is not None:
+                self.switches[name] = Switch(sc.position, sc.width, sc.hysteresis, self.y)
+        wiring_ = wiring or default_wiring(cfg)
+        self.z_flip = wiring_.invert_z != cfg.invert_z
+        lines = cfg.encoder_lines_per_rev
+        ez_width = cfg.pulses_per_rev / (4.0 * lines) if lines > 0 else 1.0
+        self.switches["ez"] = IndexSwitch(float(cfg.pulses_per_rev), ez_width, self.y)
+        self.outputs = {s: False for s in AXIS_OUTPUTS}
+        self.alarm = False
+        # pieces of the current run, with the state at each piece's start (for peeks)
+        self.record: list[tuple[Piece, float, tuple[int, int, int]]] = []
+        self.run_start: tuple[float, tuple[int, int, int]] = (self.trans.z, self._dec_state())
+
+    # -- levels ----------------------------------------------------------------------------
+    def active(self, sig: str) -> bool:
+        sw = self.switches.get(sig)
+        if sig == "ltc" and sw is None:
+            sw = self.switches.get("sd")
+        if sw is not None:
+            return sw.active
+        if sig == "alm":
+            return self.alarm
+        if sig == "rdy":
+            return self.plant.ready(self.outputs["svon"], self.alarm) if self.is_servo \
+                else not self.alarm
+        if sig == "inp":
+            return self.plant.in_position if self.is_servo else True
+        return False
+
+    def level(self, sig: str) -> bool:
+        shared = sig == "ltc" and "ltc" not in self.switches
+        nc = self.nc["sd" if shared else sig]
+        lv = self.active(sig) != nc
+        if sig == "ez":
+            lv = lv != self.z_flip
+        return lv
+
+    def _dec_state(self) -> tuple[int, int, int]:
+        d = self.decoder
+        return (d.q, d.last_dir, d.count)
+
+    def encoder_at(self, t: float) -> int:
+        """Decoded count at time t within the current run (t >= run start)."""
+        rec = self.record
+        k = len(rec) - 1
+        while k >= 0 and rec[k][0].t0 > t:
+            k -= 1
+        if k < 0:
+            return self.run_start[1][2] if not rec else rec[0][2][2]
+        piece, z0, st = rec[k]
+        return self._peek(piece, z0, st, piece.m_at(t))
+
+    def _peek(self, piece: Piece, z0: float, st: tuple[int, int, int], m: float) -> int:
+        d = piece.direction
+        y = self.trans.y_of(self.trans.z_after(z0, m, d))
+        dec = self.decoder
+        q1 = dec.index_after(y, st[0], d)
+        return st[2] + dec.increment(st[0], q1, st[1])
+
+
+class SimMachine:
+    """A simulated multi-axis machine implementing `openmotion.hw.interface.Hardware`.
+
+    `wiring` optionally overrides the physical encoder of some axes (axis -> EncoderWiring)
+    to model a board set up differently from how the encoder is wired.
+    """
+
+    def __init__(self, config: MachineConfig,
+                 wiring: dict[int, EncoderWiring] | None = None) -> None:
+        if not isinstance(config, MachineConfig):
+            raise MotionError(f"config must be a MachineConfig, got {type(config).__name__}")
+        wiring = dict(wiring or {})
+        for k in wiring:
+            if not isinstance(k, int) or not 0 <= k < len(config.axes):
+                raise MotionError(f"wiring keys must be axis indices 0..{len(config.axes) - 1},"
+                                  f" got {k!r}")
+        for name in ("digital_inputs", "digital_outputs"):
+            n = getattr(config, name)
+            if not isinstance(n, int) or n < 0:
+                raise MotionError(f"{name} must be an int >= 0, got {n!r}")
+        self.config = config
+        self._axes = [_Axis(i, a, wiring.get(i)) for i, a in enumerate(config.axes)]
+        self._t = 0.0
+        self._emg_active = False
+        # EMG is a board input; its contact type may be given in any axis's logic table
+        self._emg_nc = any(a.logic.get("emg") == "nc" for a in config.axes)
+        self._di = [False] * config.digital_inputs
+        self._do = [False] * config.digital_outputs
+        self._pending: list[tuple[float, int | None, str, bool, int | None]] = []
+        self.scenario = Scenario(self)
+
+    # -- Hardware protocol --------------------------------------------------------------------
+    @property
+    def n_axes(self) -> int:
+        return len(self._axes)
+
+    @property
+    def time(self) -> float:
+        return self._t
+
+    def command(self, axis: int, cmd: AxisCommand) -> None:
+        """Set the commanded cubic of `axis` over [cmd.t0, cmd.t0 + cmd.dt].
+
+        Before cmd.t0 the command holds cmd.p0, after the end it holds the end position. If
+        the command at the current time is a whole pulse or more away from the pulses
+        emitted, the difference is emitted at once (a jump; a real stepper loses it).
+        """
+        ax = self._axis(axis)
+        if not isinstance(cmd, AxisCommand):
+            raise MotionError(f"cmd must be an AxisCommand, got {type(cmd).__name__}")
+        for f in ("t0", "p0", "v0", "a0", "j"):
+            check_finite(f"cmd.{f}", getattr(cmd, f))
+        check_nonnegative("cmd.dt", cmd.dt)
+        ax.gen.set(Cubic(float(cmd.p0), float(cmd.v0), float(cmd.a0), float(cmd.j)),
+                   float(cmd.t0), float(cmd.t0) + float(cmd.dt))
+
+    def advance(self, t: float) -> list[InputEdge]:
+        """Move every plant to time t; return the input edges since the last call."""
+        t = check_finite("t", t)
+        if t < self._t:
+            raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
+        raw = self._pending
+        self._pending = []
+        ta = self._t
+        for tk, action in self.scenario.pop_due(t):
+            tk = max(tk, ta)
+            self._run(ta, tk, raw)
+            self._t = tk
+            action(raw)
+            ta = tk
+        self._run(ta, t, raw)
+        self._t = t
+        raw.sort(key=lambda e: e[0])
+        n = len(self._axes)
+        edges = []
+        for tm, axis, sig, lv, own in raw:
+            enc = tuple(own if (j == axis and own is not None) else self._axes[j].encoder_at(tm)
+                        for j in range(n))
+            edges.append(InputEdge(tm, axis, sig, lv, enc))
+        for ax in self._axes:
+            ax.record = []
+            ax.run_start = (ax.trans.z, ax._dec_state())
+        return edges
+
+    def read_axis(self, axis: int) -> AxisReadback:
+        ax = self._axis(axis)
+        return AxisReadback(ax.gen.count, ax.decoder.count,
+                            {s: ax.level(s) for s in AXIS_INPUTS})
+
+    def write_output(self, axis: int | None, signal: str, level: bool) -> None:
+        if not isinstance(level, bool):
+            raise MotionError(f"level must be a bool, got {level!r}")
+        if axis is None:
+            self._do[self._board_index(signal, "do", len(self._do))] = level
+            return
+        ax = self._axis(axis)
+        if signal not in AXIS_OUTPUTS:
+            raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, got {signal!r}")
+        if ax.outputs[signal] == level:
+            return
+        before = {s: ax.level(s) for s in ("rdy", "inp")}
+        ax.outputs[signal] = level
+        if ax.is_servo:
+            ax.plant.set_outputs(self._t, ax.gen, ax.outputs["svon"], ax.alarm,
+                                 erc=(signal == "erc" and level))
+        for s, lv in before.items():
+            if ax.level(s) != lv:
+                self._pending.append((self._t, axis, s, not lv, ax.decoder.count))
+
+    def read_input(self, signal: str) -> bool:
+        if signal == "emg":
+            return self._emg_active != self._emg_nc
+        return self._di[self._board_index(signal, "di", len(self._di))]
+
+    # -- extras for tests and tools ---------------------------------------------------------
+    def read_output(self, axis: int | None, signal: str) -> bool:
+        """Level last written to an output (`svon`/`erc` of an axis, or `do<n>`)."""
+        if axis is None:
+            return self._do[self._board_index(signal, "do", len(self._do))]
+        ax = self._axis(axis)
+        if signal not in AXIS_OUTPUTS:
+            raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, got {signal!r}")
+        return ax.outputs[signal]
+
+    def steps_lost(self, axis: int) -> int:
+        """Pulses the stepper of `axis` has lost (stalls + injected losses); 0 for a servo."""
+        p = self._axis(axis).plant
+        return p.lost if isinstance(p, StepperPlant) else 0
+
+    def motor_position(self, axis: int) -> float:
+        """Motor position (command pulses) at the current time."""
+        ax = self._axis(axis)
+        return ax.plant.motor(ax.gen)
+
+    def load_position(self, axis: int) -> float:
+        """Position seen by encoder and switches (after backlash and pitch error)."""
+        return self._axis(axis).y
+
+    def command_position(self, axis: int) -> float:
+        """Commanded (float) position at the current time."""
+        return self._axis(axis).gen.pos(self._t)
+
+    # -- internals ----------------------------------------------------------------------------
+    def _axis(self, axis: int) -> _Axis:
+        if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._axes):
+            raise MotionError(f"axis must be an int in 0..{len(self._axes) - 1}, got {axis!r}")
+        return self._axes[axis]
+
+    @staticmethod
+    def _board_index(signal: str, prefix: str, n: int) -> int:
+        if isinstance(signal, str) and signal.startswith(prefix) and signal[len(prefix):].isdigit():
+            k = int(signal[len(prefix):])
+            if k < n:
+                return k
+        raise MotionError(f"signal must be {prefix}0..{prefix}{n - 1}, got {signal!r}")
+
+    def _run(self, ta: float, tb: float, raw: list) -> None:
+        """Move every axis over [ta, tb], appending raw edges."""
+        for ax in self._axes:
+            pieces = ax.plant.pieces(ax.gen, ta, tb)
+            if pieces:
+                self._scan(ax, pieces, raw)
+            if ax.is_servo:
+                ax.plant.status_edges(ax, ta, tb, raw)
+
+    def _scan(self, ax: _Axis, pieces: list[Piece], raw: list) -> None:
+        trans = ax.trans
+        dec = ax.decoder
+        for p in pieces:
+            d = p.direction
+            z0 = trans.z
+            st = (dec.q, dec.last_dir, dec.count)
+            ax.record.append((p, z0, st))
+            if d == 0:
+                continue
+            z1 = trans.z_after(z0, p.m1, d)
+            y1 = trans.y_of(z1)
+            if y1 != ax.y:
+                for name, sw in ax.switches.items():
+                    self._scan_switch(ax, name, sw, p, z0, st, y1, raw)
+            trans.z = z1
+            ax.y = y1
+            dec.advance(y1, d)
+
+    def _scan_switch(self, ax: _Axis, name: str, sw: Switch | IndexSwitch, p: Piece,
+                     z0: float, st: tuple[int, int, int], y1: float, raw: list) -> None:
+        d = p.direction
+        y = ax.y
+        for _ in range(_MAX_TOGGLES):
+            thr = sw.next_threshold(y, d)
+            if thr is None or (y1 < thr if d > 0 else y1 >= thr):
+                return
+            t, m = p.time_at(ax.trans.motor_level(thr, d))
+            sw.active = not sw.active
+            own = ax._peek(p, z0, st, m)
+            raw.append((t, ax.index, name, ax.level(name), own))
+            if name == "sd" and "ltc" not in ax.switches:
+                raw.append((t, ax.index, "ltc", ax.level("ltc"), own))
+            y = thr
+
+    # -- scenario actions (called by Scenario at their time, inside advance) ------------------
+    def _edge(self, raw: list, ax: _Axis, sig: str, before: bool) -> None:
+        lv = ax.level(sig)
+        if lv != before:
+            raw.append((self._t, ax.index, sig, lv, ax.decoder.count))
+
+    def _place(self, axis: int, signal: str, spec: tuple[float, float, float] | None,
+               raw: list) -> None:
+        ax = self._axes[axis]
+        sigs = ("sd", "ltc") if signal in ("sd", "ltc") else (signal,)
+        before = {s: ax.level(s) for s in sigs}
+        if spec is None:
+            ax.switches.pop(signal, None)
+        else:
+            ax.switches[signal] = Switch(*spec, ax.y)
+        for s in sigs:
+            self._edge(raw, ax, s, before[s])
+
+    def _set_alarm(self, axis: int, on: bool, raw: list) -> None:
+        ax = self._axes[axis]
+        before = {s: ax.level(s) for s in ("alm", "rdy", "inp")}
+        ax.alarm = on
+        if ax.is_servo:
+            ax.plant.set_outputs(self._t, ax.gen, ax.outputs["svon"], on, erc=False)
+        else:
+            ax.plant.enabled = not on
+        for s, lv in before.items():
+            self._edge(raw, ax, s, lv)
+
+    def _set_emg(self, on: bool, raw: list) -> None:
+        before = self.read_input("emg")
+        self._emg_active = on
+        lv = self.read_input("emg")
+        if lv != before:
+            raw.append((self._t, None, "emg", lv, None))
+
+    def _set_di(self, signal: str, level: bool, raw: list) -> None:
+        k = self._board_index(signal, "di", len(self._di))
+        if self._di[k] != level:
+            self._di[k] = level
+            raw.append((self._t, None, signal, level, None))
+
+    def _step_loss(self, axis: int, pulses: int, raw: list) -> None:
+        ax = self._axes[axis]
+        plant = ax.plant
+        m0 = plant.motor(ax.gen)
+        plant.lost += pulses
+        if pulses:
+            self._scan(ax, [JumpPiece(self._t, m0, m0 - pulses)], raw)
