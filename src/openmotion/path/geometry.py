@@ -98,9 +98,9 @@ def path_positions(s: ArrayLike, length: float) -> Array:
 
 
 def snap_ends(s: Array, p: Array, length: float, start: Array, end: Array) -> Array:
-    """Replace points at s == 0 / s == length by the exact start / end."""
-    p = np.where((s <= 0.0)[..., None], start, p)
-    return np.where((s >= length)[..., None], end, p)
+    """Replace points at s == length / s == 0 by the exact end / start."""
+    p = np.where((s >= length)[..., None], end, p)
+    return np.where((s <= 0.0)[..., None], start, p)
 
 
 def scalar_or_array(values: Array) -> Any:
@@ -133,7 +133,9 @@ class Line:
         start = as_point("start", self.start)
         end = as_point("end", self.end, start.size)
         delta = end - start
-        length = float(np.linalg.norm(delta))
+        big = float(np.max(np.abs(delta)))
+        # scaled so tiny (even subnormal) displacements do not underflow to length 0
+        length = big * float(np.linalg.norm(delta / big)) if big > 0.0 else 0.0
         u = delta / length if length > 0.0 else np.zeros_like(delta)
         object.__setattr__(self, "start", start)
         object.__setattr__(self, "end", end)
