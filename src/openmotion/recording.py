@@ -1,0 +1,252 @@
+"""Per-cycle trace recording into preallocated numpy ring buffers.
+
+The controller calls `Recorder.record` once per cycle with one value per axis for each
+channel; the recorder keeps the newest `capacity` cycles (architecture.md "Memory is
+bounded"). `arrays()` returns them in time order for plots (plot.plot_trace) and tests;
+`save()` writes .npz or .csv. With `spill_path` set, every row that would be overwritten is
+first appended to a raw file, so a 10-hour recording runs in flat memory and nothing is lost
+(`load_spill` reads it back).
+
+Channels, per axis:
+  cmd_pos  command position (pulses, float64: counts are exact up to 2**53)
+  fb_pos   feedback (encoder) position
+  cmd_vel  command velocity (pulses/s)
+  state    axis state code (int32; the controller's numbering)
+  io       I/O word (int64 bit field of the axis's input/output levels)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import MotionError
+
+FLOAT_CHANNELS = ("cmd_pos", "fb_pos", "cmd_vel")
+INT_CHANNELS = ("state", "io")
+CHANNELS = FLOAT_CHANNELS + INT_CHANNELS
+_INT_DTYPES = {"state": np.int32, "io": np.int64}
+
+
+class Recorder:
+    """Ring buffer of per-cycle traces: time plus per-axis channels."""
+
+    def __init__(self, n_axes: int, capacity: int, channels: Iterable[str] = CHANNELS, *,
+                 spill_path: str | Path | None = None) -> None:
+        if not isinstance(n_axes, int) or isinstance(n_axes, bool) or n_axes < 1:
+            raise MotionError(f"n_axes must be an integer >= 1, got {n_axes!r}")
+        if not isinstance(capacity, int) or isinstance(capacity, bool) or capacity < 1:
+            raise MotionError(f"capacity must be an integer >= 1, got {capacity!r}")
+        if isinstance(channels, str):
+            raise MotionError("channels must be a sequence of channel names, not a string")
+        chans = tuple(channels)
+        for c in chans:
+            if c not in CHANNELS:
+                raise MotionError(f"channels must be among {CHANNELS}, got {c!r}")
+        if not chans or len(set(chans)) != len(chans):
+            raise MotionError(f"channels must be non-empty and without repeats, got {chans!r}")
+        self.n_axes = n_axes
+        self.capacity = capacity
+        # Keep the canonical order whatever order the caller gave.
+        self.channels = tuple(c for c in CHANNELS if c in chans)
+        self._fchans = tuple(c for c in FLOAT_CHANNELS if c in chans)
+        self._ichans = tuple(c for c in INT_CHANNELS if c in chans)
+        rows = capacity + 1  # one scratch row: a failed write never touches a live row
+        self._t = np.zeros(rows)
+        self._f = np.zeros((rows, len(self._fchans), n_axes))
+        self._i = {c: np.zeros((rows, n_axes), dtype=_INT_DTYPES[c]) for c in self._ichans}
+        self._fslot = {c: k for k, c in enumerate(self._fchans)}
+        self._head = 0   # next row to write
+        self._count = 0  # live rows (<= capacity)
+        self.total = 0   # rows ever recorded since the last clear
+        self._last_t = -math.inf
+        self._spill: Path | None = None
+        self.spilled = 0
+        if spill_path is not None:
+            self._spill = Path(spill_path)
+            self._spill.parent.mkdir(parents=True, exist_ok=True)
+            self._spill.write_bytes(b"")
+
+    # ------------------------------------------------------------------ hot path
+    def record(self, t: float, cmd_pos: ArrayLike | None = None,
+               fb_pos: ArrayLike | None = None, cmd_vel: ArrayLike | None = None,
+               state: ArrayLike | None = None, io: ArrayLike | None = None) -> None:
+        """Store one cycle. Each channel takes one value per axis; disabled ones are ignored.
+
+        `t` must be finite and not earlier than the previous record. On a bad argument a
+        MotionError is raised and the recording is unchanged.
+        """
+        try:
+            t = float(t)
+        except (TypeError, ValueError):
+            raise MotionError(f"t must be a real number, got {t!r}") from None
+        if not (math.isfinite(t) and t >= self._last_t):
+            raise MotionError(
+                f"t must be finite and >= the previous time {self._last_t!r}, got {t!r}"
+            )
+        i = self._head
+        vals = {"cmd_pos": cmd_pos, "fb_pos": fb_pos, "cmd_vel": cmd_vel, "state": state,
+                "io": io}
+        try:
+            row = self._f[i]
+            for k, c in enumerate(self._fchans):
+                row[k] = vals[c]
+            for c in self._ichans:
+                self._i[c][i] = vals[c]
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise MotionError(
+                f"each recorded channel must hold {self.n_axes} numbers (one per axis): {exc}"
+            ) from None
+        if self._fchans and not np.isfinite(row).all():
+            raise MotionError(f"recorded positions/velocities must be finite at t={t!r}")
+        self._t[i] = t
+        self._last_t = t
+        if self._count == self.capacity:
+            if self._spill is not None:
+                self._spill_oldest()
+        else:
+            self._count += 1
+        self._head = i + 1 if i + 1 <= self.capacity else 0
+        self.total += 1
+
+    # ------------------------------------------------------------------ reading
+    def __len__(self) -> int:
+        return self._count
+
+    @property
+    def dropped(self) -> int:
+        """Rows that left the window without being spilled to a file."""
+        return self.total - self._count - self.spilled
+
+    def _order(self) -> NDArray[np.intp]:
+        rows = self.capacity + 1
+        start = (self._head - self._count) % rows
+        return (start + np.arange(self._count)) % rows
+
+    def arrays(self) -> dict[str, NDArray[Any]]:
+        """Copies of the retained rows in time order: 't' (n,) and each channel (n, n_axes)."""
+        idx = self._order()
+        out: dict[str, NDArray[Any]] = {"t": self._t[idx]}
+        for c in self.channels:
+            out[c] = self._f[idx, self._fslot[c]] if c in self._fslot else self._i[c][idx]
+        return out
+
+    def clear(self) -> None:
+        """Forget every row (the spill file, if any, is restarted empty)."""
+        self._head = 0
+        self._count = 0
+        self.total = 0
+        self.spilled = 0
+        self._last_t = -math.inf
+        if self._spill is not None:
+            self._spill.write_bytes(b"")
+
+    # ------------------------------------------------------------------ files
+    def save(self, path: str | Path) -> Path:
+        """Write the retained rows to `path` (.npz, or .csv with one column per axis)."""
+        p = Path(path)
+        suffix = p.suffix.lower()
+        if suffix not in (".npz", ".csv"):
+            raise MotionError(f"path must end with .npz or .csv, got {str(path)!r}")
+        save_arrays(self.arrays(), p)
+        return p
+
+    def _row_dtype(self) -> np.dtype:
+        fields: list[tuple[str, Any, tuple[int, ...]]] = [("t", np.float64, ())]
+        fields += [(c, np.float64, (self.n_axes,)) for c in self._fchans]
+        fields += [(c, _INT_DTYPES[c], (self.n_axes,)) for c in self._ichans]
+        return np.dtype(fields)
+
+    def _spill_oldest(self) -> None:
+        """Append the oldest half of the window to the spill file and drop it from the ring.
+
+        Called when the row just written would push the oldest one out; spilling half the
+        window at once makes the file write rare (amortised O(1) per cycle).
+        """
+        assert self._spill is not None
+        k = max(1, self.capacity // 2)
+        rows = self.capacity + 1
+        idx = (self._head - self._count + rows + np.arange(k)) % rows
+        rec = np.zeros(k, dtype=self._row_dtype())
+        rec["t"] = self._t[idx]
+        for n, c in enumerate(self._fchans):
+            rec[c] = self._f[idx, n]
+        for c in self._ichans:
+            rec[c] = self._i[c][idx]
+        with self._spill.open("ab") as fh:
+            fh.write(rec.tobytes())
+        self.spilled += k
+        # The row just written (at head) becomes live; k old rows left.
+        self._count += 1 - k
+
+    def load_spill(self) -> dict[str, NDArray[Any]]:
+        """The spilled rows (oldest first), read from the spill file as arrays."""
+        if self._spill is None:
+            raise MotionError("load_spill needs a Recorder created with spill_path")
+        data = np.fromfile(self._spill, dtype=self._row_dtype())
+        return {name: np.ascontiguousarray(data[name]) for name in data.dtype.names or ()}
+
+    def all_arrays(self) -> dict[str, NDArray[Any]]:
+        """Spilled rows followed by the retained rows (everything since the last clear)."""
+        ring = self.arrays()
+        if self._spill is None:
+            return ring
+        old = self.load_spill()
+        return {k: np.concatenate([old[k], ring[k]]) for k in ring}
+
+
+# ---------------------------------------------------------------------------- file helpers
+def _csv_columns(arrays: dict[str, NDArray[Any]]) -> tuple[list[str], list[NDArray[Any]]]:
+    names, cols = ["t"], [np.asarray(arrays["t"], dtype=np.float64)]
+    for c in CHANNELS:
+        if c in arrays:
+            a = np.asarray(arrays[c])
+            for ax in range(a.shape[1]):
+                names.append(f"{c}[{ax}]")
+                cols.append(a[:, ax])
+    return names, cols
+
+
+def save_arrays(arrays: dict[str, NDArray[Any]], path: str | Path) -> Path:
+    """Write recorder arrays to .npz (exact) or .csv (floats as %.17g, ints as integers)."""
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix == ".npz":
+        np.savez_compressed(p, **arrays)
+        return p
+    if suffix != ".csv":
+        raise MotionError(f"path must end with .npz or .csv, got {str(path)!r}")
+    names, cols = _csv_columns(arrays)
+    fmts = ["%d" if np.issubdtype(c.dtype, np.integer) else "%.17g" for c in cols]
+    table = np.empty((cols[0].size, len(cols)), dtype=object)
+    for k, c in enumerate(cols):
+        table[:, k] = c
+    np.savetxt(p, table, fmt=fmts, delimiter=",", header=",".join(names), comments="")
+    return p
+
+
+def load_trace(path: str | Path) -> dict[str, NDArray[Any]]:
+    """Read a trace written by `Recorder.save` back into the `arrays()` layout."""
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix == ".npz":
+        with np.load(p) as z:
+            return {k: z[k] for k in z.files}
+    if suffix != ".csv":
+        raise MotionError(f"path must end with .npz or .csv, got {str(path)!r}")
+    with p.open() as fh:
+        header = fh.readline().strip().split(",")
+    data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+    out: dict[str, NDArray[Any]] = {"t": data[:, 0].copy()}
+    for c in CHANNELS:
+        cols = [k for k, name in enumerate(header) if name.startswith(c + "[")]
+        if cols:
+            block = data[:, cols]
+            out[c] = block.astype(_INT_DTYPES[c]) if c in _INT_DTYPES else block
+    return out
+
