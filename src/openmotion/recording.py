@@ -92,12 +92,19 @@ class Recorder:
         i = self._head
         vals = {"cmd_pos": cmd_pos, "fb_pos": fb_pos, "cmd_vel": cmd_vel, "state": state,
                 "io": io}
+        n = self.n_axes
         try:
             row = self._f[i]
             for k, c in enumerate(self._fchans):
-                row[k] = vals[c]
+                v = vals[c]
+                if len(v) != n:  # type: ignore[arg-type]
+                    raise ValueError(f"{c} has {len(v)} values")  # type: ignore[arg-type]
+                row[k] = v
             for c in self._ichans:
-                self._i[c][i] = vals[c]
+                v = vals[c]
+                if len(v) != n:  # type: ignore[arg-type]
+                    raise ValueError(f"{c} has {len(v)} values")  # type: ignore[arg-type]
+                self._i[c][i] = v
         except (TypeError, ValueError, OverflowError) as exc:
             raise MotionError(
                 f"each recorded channel must hold {self.n_axes} numbers (one per axis): {exc}"
