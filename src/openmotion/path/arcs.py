@@ -346,8 +346,8 @@ class Arc3D(_ArcQueries):
                    end: ArrayLike | None = None) -> Arc3D:
         """Arc of `radius` about `centre` from centre + R*e1, turning `sweep` towards e2.
 
-        e1, e2 must be orthonormal; exact `start`/`end` (within 1e-9 * R of the circle
-        points) may be given so that neighbouring elements join bit for bit.
+        e1, e2 must be orthonormal; exact `start`/`end` (off the circle points by rounding
+        only: 1e-9*R + 1e-12*|centre|) may be given so neighbouring elements join bit for bit.
         """
         c = as_point("centre", centre)
         u = as_point("e1", e1, c.size)
@@ -361,10 +361,11 @@ class Arc3D(_ArcQueries):
         p0 = c + r * u
         p2 = c + r * (math.cos(sw) * u + math.sin(sw) * v)
         mid = c + r * (math.cos(sw / 2) * u + math.sin(sw / 2) * v)
+        slack = 1e-9 * r + 1e-12 * max(1.0, float(np.max(np.abs(c))))
         if start is not None:
-            p0 = _near("start", start, p0, r)
+            p0 = _near("start", start, p0, slack)
         if end is not None:
-            p2 = _near("end", end, p2, r)
+            p2 = _near("end", end, p2, slack)
         obj = object.__new__(cls)
         frame = _Frame(c, u, v, r, sw, frozen(np.zeros_like(c)), frozen(p0), frozen(p2))
         for name, value in (("start", frozen(p0)), ("via", frozen(mid)), ("end", frozen(p2)),
@@ -373,10 +374,10 @@ class Arc3D(_ArcQueries):
         return obj
 
 
-def _near(name: str, value: ArrayLike, expected: Array, radius: float) -> Array:
+def _near(name: str, value: ArrayLike, expected: Array, slack: float) -> Array:
     p = np.array(as_point(name, value, expected.size))
     miss = float(np.linalg.norm(p - expected))
-    if miss > 1e-9 * radius:
+    if miss > slack:
         raise MotionError(f"arc command error: {name} is {miss:.6g} from the arc "
-                          f"(allowed 1e-9 x radius)")
+                          f"(allowed {slack:.3g}: rounding only)")
     return p

@@ -99,7 +99,9 @@ def blend_corner(first: Line, second: Line, tolerance: float, *,
     centre = corner + normal * (d / cos_t)
     a_start = corner - u1 * d
     a_end = corner + u2 * d
-    e1 = a_start - centre
+    # centre -> arc start is -(u1*d + normal*d/cos): built from unit vectors, not from
+    # differences of (possibly large) coordinates, so tiny blends keep exact tangents.
+    e1 = -(u1 * cos_t + normal)
     e1 = e1 - (e1 @ u1) * u1
     e1 = e1 / np.linalg.norm(e1)
     e2 = u1 - (u1 @ e1) * e1
