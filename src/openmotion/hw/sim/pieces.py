@@ -114,13 +114,12 @@ class StepPiece(Piece):
 
     def time_at(self, level: float) -> tuple[float, float]:
         c = self.cubic
-        if self.direction > 0:  # m >= level  <=>  count >= ceil(level + lost)
-            k = math.ceil(level + self.lost)
-            target = k - EPS_PULSE
-        else:  # m < level  <=>  count <= ceil(level + lost) - 1
-            k = math.ceil(level + self.lost) - 1
-            target = k + EPS_PULSE
-        s = cubic_time_at(c, target, self.t0 - self.tc, self.t1 - self.tc)
+        # moving up: m >= level <=> count >= ceil(level + lost); down: m < level <=>
+        # count <= ceil(level + lost) - 1
+        k = math.ceil(level + self.lost) - (0 if self.direction > 0 else 1)
+        # the exact integer; if the cubic only gets within EPS_PULSE of it, the root is not
+        # bracketed and the piece end is returned (where the count was rounded up to k)
+        s = cubic_time_at(c, float(k), self.t0 - self.tc, self.t1 - self.tc)
         return min(max(self.tc + s, self.t0), self.t1), k - self.lost
 
 
