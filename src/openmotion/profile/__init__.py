@@ -1,5 +1,19 @@
-"""Pure motion-profile math: no clocks, no state. Units: pulses, pulses/s, seconds."""
+"""Pure motion-profile math: no clocks, no state. Units: pulses, pulses/s, seconds.
 
+Entry points: `trapezoid`, `scurve` (PCL6045 semantics, `MoveSpec` for the full parameter
+set), `jerk_limited` (time-optimal), `jerk_limited_sync` (all axes arrive together),
+`jerk_limited_durations` (vectorized batch), `quantize` (integer counts).
+"""
+
+from .batch import jerk_limited_durations, jerk_limited_phases
+from .jerk import jerk_limited, jerk_limited_duration, jerk_limited_sync
+from .pcl import MovePlan, MoveSpec, scurve, trapezoid
+from .quantize import check_quantized, quantize
 from .segments import Phase, Profile, ProfileBuilder, Samples, State, empty_profile
 
-__all__ = ["Phase", "Profile", "ProfileBuilder", "Samples", "State", "empty_profile"]
+__all__ = [
+    "MovePlan", "MoveSpec", "Phase", "Profile", "ProfileBuilder", "Samples", "State",
+    "check_quantized", "empty_profile", "jerk_limited", "jerk_limited_duration",
+    "jerk_limited_durations", "jerk_limited_phases", "jerk_limited_sync", "quantize",
+    "scurve", "trapezoid",
+]
