@@ -1,0 +1,243 @@
+"""Re-planning from any state: to rest at a new target, or to a new velocity.
+
+`retarget` takes an axis that is moving (p, v, a) to rest exactly on `target`. Limits apply
+in the frame of motion m (the sign of v_stop = v + a*|a|/(2J), the velocity reached by
+bringing the acceleration to zero at once): up to a_max speeding up, up to d_max slowing
+down. In that frame, with L = m*(target - p) and d_stop the distance of the fastest stop:
+
+  L >= d_stop (target ahead of the stopping point, the common case), one of
+    F1  ramp (v, a) -> V, cruise at V, ramp V -> 0, with V in [v_stop, v_max]. The
+        distance d(V) increases with V, so V = v_max with a cruise if it fits, otherwise
+        the root of d(V) = L (bracketed secant).
+    F2  if a < 0 and even F1 at V = v_stop overshoots: brake softer. Jerk +J for t1,
+        then the fastest stop; the distance grows with t1 in [0, -a/J] (t1 = 0 is the
+        fastest stop, t1 = -a/J is F1 at V = v_stop).
+    If the stop point itself lies beyond v_max (v_stop > v_max), first brake at full jerk
+    (and d_max) until v = v_max, as ruckig does, then F1/F2 from there.
+  L < d_stop: brake to rest (overshooting), then a rest-to-rest move back.
+Any remaining corner (the target inside the braking that gets below v_max) stops and then
+moves on rest-to-rest: valid, not optimal.
+
+The fastest ramp (v0, a0) -> (v1, 0) with separate limits up/down, see `ramps.py` for the
+symmetric derivation; if a0 already exceeds the limit in the ramp's direction, the first
+phase brings it down to the limit instead (velocity gain (a0**2 - lim**2)/(2J) there).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from ..errors import COUNTER28_MAX, MotionError, check_finite, check_positive
+from .jerk import PHASE_LABELS, phase_times
+from .ramps import ramp_jerk
+from .segments import Profile, ProfileBuilder, State
+
+# (duration, jerk, acceleration pinned at the phase start or None)
+Phase = tuple[float, float, float | None]
+
+
+# ---------------------------------------------------------------- phase algebra
+def ramp_phases(v0: float, a0: float, v1: float, a_up: float, a_dn: float,
+                j: float) -> list[Phase]:
+    """Fastest (v0, a0) -> (v1, 0) with acceleration in [-a_dn, a_up] (see module notes)."""
+    v_stop = v0 + a0 * abs(a0) / (2.0 * j)
+    diff = v1 - v_stop
+    if abs(diff) <= 4e-16 * max(abs(v0), abs(v1), a0 * a0 / j):
+        return [(abs(a0) / j, -math.copysign(j, a0), None)] if a0 else []
+    s = 1.0 if diff > 0.0 else -1.0
+    lim = a_up if s > 0.0 else a_dn
+    a0n, dv = s * a0, s * (v1 - v0)
+    if a0n > lim:
+        t_c = max(0.0, (dv - a0n * a0n / (2.0 * j)) / lim)
+        return [((a0n - lim) / j, -s * j, None), (t_c, 0.0, s * lim), (lim / j, -s * j, s * lim)]
+    needed = (2.0 * lim * lim - a0n * a0n) / (2.0 * j)
+    if needed <= dv:
+        ap, t_c = lim, (dv - needed) / lim
+    else:
+        ap, t_c = math.sqrt(max(0.0, (2.0 * j * dv + a0n * a0n) / 2.0)), 0.0
+    return [(max(0.0, (ap - a0n) / j), s * j, None), (t_c, 0.0, s * ap), (ap / j, -s * j, s * ap)]
+
+
+def advance(v: float, a: float, phases: list[Phase]) -> tuple[float, float, float]:
+    """(distance, v, a) after running `phases` from (v, a); exact polynomial steps."""
+    d = 0.0
+    for dt, jk, pin in phases:
+        if pin is not None:
+            a = pin
+        if dt <= 0.0:
+            continue
+        d += dt * (v + dt * (a / 2.0 + dt * jk / 6.0))
+        v += dt * (a + dt * jk / 2.0)
+        a += dt * jk
+    return d, v, a
+
+
+def _solve(f: Callable[[float], float], lo: float, hi: float) -> float:
+    """x in [lo, hi] with f(x) = 0 for f(lo) <= 0 <= f(hi) (Illinois secant + bisection)."""
+    flo, fhi = f(lo), f(hi)
+    if flo >= 0.0:
+        return lo
+    if fhi <= 0.0:
+        return hi
+    side = 0
+    for _ in range(200):
+        x = hi - fhi * (hi - lo) / (fhi - flo)
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
+        fx = f(x)
+        if fx == 0.0:
+            return x
+        if fx < 0.0:
+            lo, flo = x, fx
+            if side == -1:
+                fhi *= 0.5
+            side = -1
+        else:
+            hi, fhi = x, fx
+            if side == 1:
+                flo *= 0.5
+            side = 1
+        if hi - lo <= 4e-16 * max(abs(lo), abs(hi)) or abs(hi - lo) < 1e-300:
+            break
+    return lo if -flo <= fhi else hi  # keeps the root side that undershoots least
+
+
+def _brake_to_vmax(v: float, a: float, v_max: float, d_max: float, j: float) -> list[Phase]:
+    """Full-jerk braking (holding -d_max) until v = v_max; needs v_stop > v_max."""
+    if a < -d_max:  # beyond the braking limit: ease back to it while braking
+        t1 = (-d_max - a) / j
+        _, v_end, _ = advance(v, a, [(t1, j, None)])
+        if v_end <= v_max:  # v + a t + j t^2/2 = v_max, first crossing
+            t = (-a - math.sqrt(max(0.0, a * a - 2.0 * j * (v - v_max)))) / j
+            return [(t, j, None)]
+        return [(t1, j, None), ((v_end - v_max) / d_max, 0.0, -d_max)]
+    t = (a + math.sqrt(a * a + 2.0 * j * (v - v_max))) / j  # v + a t - j t^2/2 = v_max
+    if a - j * t >= -d_max:
+        return [(t, -j, None)]
+    t1 = (a + d_max) / j
+    _, v1, _ = advance(v, a, [(t1, -j, None)])
+    return [(t1, -j, None), (max(0.0, (v1 - v_max) / d_max), 0.0, -d_max)]
+
+
+def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_max: float,
+               j: float) -> list[Phase] | None:
+    """Phases to rest after exactly `length` ahead (frame of motion), or None if the
+    target lies behind the stopping point (an overshoot is needed)."""
+    stop = ramp_phases(v, a, 0.0, a_max, d_max, j)
+    d_stop = advance(v, a, stop)[0]
+    if length < d_stop:
+        return None
+    pre: list[Phase] = []
+    v_stop = v + a * abs(a) / (2.0 * j)
+    if v_stop > v_max:
+        pre = _brake_to_vmax(v, a, v_max, d_max, j)
+        d_pre, v_b, a_b = advance(v, a, pre)
+        d_rest = length - d_pre
+        if d_rest < advance(v_b, a_b, ramp_phases(v_b, a_b, 0.0, a_max, d_max, j))[0]:
+            # the target lies inside the braking: stop, then move on rest-to-rest
+            return stop + _rest_to_rest(length - d_stop, v_max, a_max, d_max, j)
+        v, a, length = v_b, a_b, d_rest
+        v_stop = v + a * abs(a) / (2.0 * j)
+
+    def f1(vc: float) -> list[Phase]:
+        return ramp_phases(v, a, vc, a_max, d_max, j) + ramp_phases(vc, 0.0, 0.0, a_max,
+                                                                    d_max, j)
+
+    def d1(vc: float) -> float:
+        return advance(v, a, f1(vc))[0] - length
+
+    v_lo = min(max(v_stop, 0.0), v_max)
+    if d1(v_max) <= 0.0:
+        up = ramp_phases(v, a, v_max, a_max, d_max, j)
+        down = ramp_phases(v_max, 0.0, 0.0, a_max, d_max, j)
+        cruise = -d1(v_max) / v_max
+        return pre + up + [(cruise, 0.0, 0.0)] + down
+    if d1(v_lo) <= 0.0:
+        return pre + f1(_solve(d1, v_lo, v_max))
+    if a < 0.0:
+        def f2(t1: float) -> list[Phase]:
+            _, v1, a1 = advance(v, a, [(t1, j, None)])
+            return [(t1, j, None)] + ramp_phases(v1, a1, 0.0, a_max, d_max, j)
+
+        t1 = _solve(lambda t: advance(v, a, f2(t))[0] - length, 0.0, -a / j)
+        return pre + f2(t1)
+    # not reached for a >= 0 (then d1(v_stop) is the stopping distance); kept for safety
+    return pre + ramp_phases(v, a, 0.0, a_max, d_max, j) + _rest_to_rest(
+        length - advance(v, a, ramp_phases(v, a, 0.0, a_max, d_max, j))[0],
+        v_max, a_max, d_max, j)
+
+
+def _rest_to_rest(length: float, v_max: float, a_max: float, d_max: float,
+                  j: float) -> list[Phase]:
+    """The seven phases of the time-optimal rest-to-rest move (length may be < 0)."""
+    s = 1.0 if length >= 0.0 else -1.0
+    tj1, ta, _, tv, tj2, td, _ = phase_times(abs(length), v_max, a_max, d_max, j)
+    ap, dp = min(a_max, j * tj1), min(d_max, j * tj2)
+    return [(tj1, s * j, 0.0), (ta, 0.0, s * ap), (tj1, -s * j, s * ap), (tv, 0.0, 0.0),
+            (tj2, -s * j, 0.0), (td, 0.0, -s * dp), (tj2, s * j, -s * dp)]
+
+
+# ------------------------------------------------------------------- public API
+def _check_state(state: State) -> tuple[float, float, float]:
+    try:
+        p, v, a = (tuple(state) + (0.0, 0.0))[:3]
+    except TypeError:
+        raise MotionError("state must be a State(p, v, a)") from None
+    return (check_finite("state.p", p), check_finite("state.v", v),
+            check_finite("state.a", a))
+
+
+def retarget(state: State, target: float, v_max: float, a_max: float, j_max: float, *,
+             d_max: float | None = None) -> Profile:
+    """From any state (p, v, a) to rest exactly on `target`, within the limits.
+
+    |v| may exceed v_max (the profile brakes to v_max first); |a| must be within
+    max(a_max, d_max). Overshoots (brakes, then comes back) only when the target lies
+    behind the stopping point.
+    """
+    p, v, a = _check_state(state)
+    tgt = check_finite("target", target)
+    if abs(tgt - p) > COUNTER28_MAX:
+        raise MotionError(f"target must satisfy |target - state.p| <= {COUNTER28_MAX} "
+                          f"(28-bit counter), got {target!r}")
+    vm = check_positive("v_max", v_max)
+    am = check_positive("a_max", a_max)
+    jm = check_positive("j_max", j_max)
+    dm = am if d_max is None else check_positive("d_max", d_max)
+    if abs(a) > max(am, dm) * (1.0 + 1e-9):
+        raise MotionError(f"state.a must satisfy |state.a| <= max(a_max, d_max), got {a!r}")
+
+    v_stop = v + a * abs(a) / (2.0 * jm)
+    m = 1.0 if v_stop > 0.0 or (v_stop == 0.0 and tgt >= p) else -1.0
+    vf, af, length = m * v, m * a, m * (tgt - p)
+    labels: list[str] = []
+    phases = plan_ahead(vf, af, length, vm, am, dm, jm)
+    if phases is None:  # reverse through zero velocity, planned in the frame of approach
+        m, vf, af, length = -m, -vf, -af, -length
+        phases = plan_ahead(vf, af, length, vm, am, dm, jm)
+    if phases is None:
+        # Only with a_max > d_max: the target is behind the stopping point braking at d_max
+        # but ahead of it braking at a_max. Stop (at d_max), then move back rest-to-rest.
+        m, vf, af, length = -m, -vf, -af, -length
+        stop = ramp_phases(vf, af, 0.0, am, dm, jm)
+        phases = stop + _rest_to_rest(length - advance(vf, af, stop)[0], vm, am, dm, jm)
+        labels = ["stop"] * len(stop) + [f"back {lb}" for lb in PHASE_LABELS]
+    b = ProfileBuilder(p, vf, af, direction=m)
+    for k, (dt, jk, pin) in enumerate(phases):
+        b.segment(dt, jk, accel=pin, label=labels[k] if labels else "")
+    b.set_acceleration(0.0)
+    return b.build(end_p=tgt)
+
+
+def retarget_velocity(state: State, v_target: float, a_max: float, j_max: float) -> Profile:
+    """Fastest jerk-limited ramp from (p, v, a) to v_target; v_target is held afterwards."""
+    p, v, a = _check_state(state)
+    vt = check_finite("v_target", v_target)
+    am = check_positive("a_max", a_max)
+    jm = check_positive("j_max", j_max)
+    if abs(a) > am * (1.0 + 1e-9):
+        raise MotionError(f"state.a must satisfy |state.a| <= a_max, got {a!r}")
+    b = ProfileBuilder(p, v, a)
+    ramp_jerk(b, vt, am, jm, label="velocity")
+    return b.build(end_v=vt)
