@@ -70,6 +70,8 @@ class _Frame:
     end: Array
     length: float = field(init=False)
     lin: Array = field(init=False)
+    t_start: Array = field(init=False)
+    t_end: Array = field(init=False)
 
     def __post_init__(self) -> None:
         h = float(np.linalg.norm(self.helix))
@@ -78,6 +80,8 @@ class _Frame:
         last = self.centre + self.radius * (c * self.e1 + sn * self.e2) + self.helix
         object.__setattr__(self, "length", length)
         object.__setattr__(self, "lin", frozen(self.helix + (self.end - last)))
+        object.__setattr__(self, "t_start", frozen(self._tangent_at(np.asarray(0.0))))
+        object.__setattr__(self, "t_end", frozen(self._tangent_at(np.asarray(length))))
 
     def point(self, s: ArrayLike) -> Array:
         ss = path_positions(s, self.length)
@@ -154,11 +158,11 @@ class _ArcQueries:
 
     @property
     def start_tangent(self) -> Array:
-        return frozen(self._frame._tangent_at(np.asarray(0.0)))
+        return self._frame.t_start
 
     @property
     def end_tangent(self) -> Array:
-        return frozen(self._frame._tangent_at(np.asarray(self._frame.length)))
+        return self._frame.t_end
 
     @property
     def max_curvature(self) -> float:

@@ -28,8 +28,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import InfeasibleError, MotionError, check_nonnegative, check_positive
+from .arcs import Arc, Arc3D
 from .blend import TANGENT_ANGLE, corner_speed
-from .geometry import Array, PathElement
+from .geometry import Array, Line, PathElement
+
+#: Element types checked by a plain isinstance (the Protocol check is slow).
+_KNOWN = (Line, Arc, Arc3D)
 
 
 @dataclass(frozen=True)
@@ -123,7 +127,7 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
             or len(elements) == 0:
         raise MotionError("elements must be a non-empty sequence of path elements")
     for k, el in enumerate(elements):
-        if not isinstance(el, PathElement):
+        if not isinstance(el, _KNOWN) and not isinstance(el, PathElement):
             raise MotionError(f"elements[{k}] must be a path element (Line, Arc, Arc3D), "
                               f"got {type(el).__name__}")
     dim = elements[0].dim
