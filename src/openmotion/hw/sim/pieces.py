@@ -129,10 +129,12 @@ class SmoothPiece(Piece):
     __slots__ = ("f", "df")
 
     def __init__(self, f: Callable[[float], float], df: Callable[[float], float],
-                 t0: float, t1: float, direction: int) -> None:
+                 t0: float, t1: float, direction: int, m0: float | None = None,
+                 m1: float | None = None) -> None:
         self.f, self.df = f, df
         self.t0, self.t1 = t0, t1
-        self.m0, self.m1 = f(t0), f(t1)
+        self.m0 = f(t0) if m0 is None else m0
+        self.m1 = f(t1) if m1 is None else m1
         self.direction = direction
 
     def m_at(self, t: float) -> float:

@@ -10,11 +10,11 @@ is a cubic or a hold over each stretch, so the motion is solved exactly, not int
 
 (the series (1 + A D + B D**2)**-1 r, exact for a cubic), and e solves the homogeneous
 equation from the state at the stretch start (under-, critically or over-damped closed
-form). x' is sampled at least 8 times per stretch and per 1/w to cut it into monotone
-pieces; crossing times are then found to ~1e-13 s by safeguarded Newton on the exact x(t).
-INP (|r - x| <= inp_band and |x'| <= inp_speed) is sampled on the same grid and its edges
-bisected to 1e-12 s; a zero of x' or an INP flicker shorter than the grid step (under
-1/(8w)) may be missed.
+form). x' is sampled on a grid (2 steps per stretch, and 2 per 1/w) to cut it into
+monotone pieces; crossing times are then found to ~1e-13 s by safeguarded Newton on the
+exact x(t). INP (|r - x| <= inp_band and |x'| <= inp_band * w) is sampled on the same grid
+and its edges bisected to 1e-12 s. Accuracy limit: two zeros of x' (a reversal and back)
+or an INP flicker within one grid step (<= 0.5 ms per 1 ms cycle) are not seen.
 
 Servo off (SVON false) or alarm: the motor stays put (x' = 0) and INP is false. RDY is
 true while SVON is on and there is no alarm.
@@ -34,7 +34,10 @@ from .pulses import PulseGenerator
 #: Below this error (pulses) and speed (pulses/s) a holding servo is taken as settled.
 SETTLE_POS = 1e-9
 SETTLE_VEL = 1e-6
-_MIN_SAMPLES = 8
+#: Grid for finding zeros of x' and INP changes: at least this many steps per stretch and
+#: 2 per 1/w (a stretch of one 1 ms cycle at 30 Hz bandwidth: 2 steps of 0.5 ms).
+_MIN_SAMPLES = 2
+_SAMPLES_PER_RAD = 2.0
 
 
 class _Solution:
@@ -106,6 +109,13 @@ class _Solution:
         e, de = self._e(s)
         return self.p.pos(s) + e, self.p.vel(s) + de
 
+    def sample(self, t: float) -> tuple[float, float, float]:
+        """(x, x', r - x) at time t with one evaluation of the homogeneous part."""
+        s = t - self.tau
+        e, de = self._e(s)
+        x = self.p.pos(s) + e
+        return x, self.p.vel(s) + de, self.r.pos(s) - x
+
     def error(self, t: float) -> float:
         """Following error r - x (pulses)."""
         s = t - self.tau
@@ -130,7 +140,7 @@ class ServoPlant:
         self.bias = 0.0
         self.active = False
         self.in_position = False
-        self._segs: list[tuple[float, float, _Solution | None]] = []
+        self._segs: list[tuple[float, float, _Solution | None, list, list]] = []
 
     def motor(self, gen: PulseGenerator) -> float:
         return self.x
@@ -159,7 +169,7 @@ class ServoPlant:
         if tb <= ta:
             return []
         if not self.active:
-            self._segs.append((ta, tb, None))
+            self._segs.append((ta, tb, None, [], []))
             return []
         out: list[Piece] = []
         tc, te = gen.tc, gen.te
@@ -174,38 +184,41 @@ class ServoPlant:
                 r = Cubic(gen.pos(t0) + self.bias)
                 if abs(self.x - r.p0) < SETTLE_POS and abs(self.v) < SETTLE_VEL:
                     self.x, self.v = r.p0, 0.0  # settled: no motion, no pieces
-                    self._segs.append((t0, t1, None))
+                    self._segs.append((t0, t1, None, [], []))
                     continue
             sol = _Solution(t0, r, self.x, self.v, self.w, self.z)
-            self._segs.append((t0, t1, sol))
-            self._monotone(sol, t0, t1, out)
-            self.x, self.v = sol.state(t1)
+            grid = self._grid(t0, t1)
+            samples = [sol.sample(t) for t in grid]
+            self._segs.append((t0, t1, sol, grid, samples))
+            self._monotone(sol, grid, samples, out)
+            self.x, self.v = samples[-1][0], samples[-1][1]
         return out
 
     def _grid(self, t0: float, t1: float) -> list[float]:
-        n = max(_MIN_SAMPLES, math.ceil((t1 - t0) * self.w * 8.0))
+        n = max(_MIN_SAMPLES, math.ceil((t1 - t0) * self.w * _SAMPLES_PER_RAD))
         h = (t1 - t0) / n
         return [t0 + i * h for i in range(n)] + [t1]
 
-    def _monotone(self, sol: _Solution, t0: float, t1: float, out: list[Piece]) -> None:
-        grid = self._grid(t0, t1)
-        cuts = [t0]
-        vs = [sol.v(t) for t in grid]
+    def _monotone(self, sol: _Solution, grid: list[float], samples: list, out: list[Piece]
+                  ) -> None:
+        cuts = [grid[0]]
+        vs = [smp[1] for smp in samples]
         for i in range(len(grid) - 1):
             if (vs[i] > 0.0) != (vs[i + 1] > 0.0) and vs[i + 1] != 0.0 and vs[i] != 0.0:
                 cuts.append(_bisect(lambda t: sol.v(t) > 0.0, grid[i], grid[i + 1]))
-        cuts.append(t1)
+        cuts.append(grid[-1])
         for i in range(len(cuts) - 1):
             a, b = cuts[i], cuts[i + 1]
             if b <= a:
                 continue
-            xa, xb = sol.x(a), sol.x(b)
+            xa = samples[0][0] if i == 0 else sol.x(a)
+            xb = samples[-1][0] if i == len(cuts) - 2 else sol.x(b)
             if xb != xa:
-                out.append(SmoothPiece(sol.x, sol.v, a, b, 1 if xb > xa else -1))
+                out.append(SmoothPiece(sol.x, sol.v, a, b, 1 if xb > xa else -1, xa, xb))
 
     def status_edges(self, ax, ta: float, tb: float, raw: list) -> None:
         """Append INP edges over the run just simulated (exact to ~1e-12 s)."""
-        for t0, t1, sol in self._segs:
+        for t0, _t1, sol, grid, samples in self._segs:
             if sol is None:
                 now = self.active and self._inp(0.0, 0.0)
                 if now != self.in_position:
@@ -217,9 +230,9 @@ class ServoPlant:
                 return self._inp(sol.error(t), sol.v(t))
 
             state = self.in_position
-            grid = self._grid(t0, t1)
             for i in range(len(grid)):
-                now = inp(grid[i])
+                _, v, err = samples[i]
+                now = self._inp(err, v)
                 if now != state:
                     te = grid[i] if i == 0 else _bisect(lambda t, s=state: inp(t) == s,
                                                         grid[i - 1], grid[i])
