@@ -1,0 +1,14 @@
+"""The controller runtime: clock and cycle loop, axes (PLCopen states, HSL counters),
+single-axis motion execution. Public positions are pulses; see Axis for unit-aware calls."""
+
+from .axis import Axis
+from .clock import CycleStats
+from .controller import Controller
+from .counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
+from .motion import ActiveMotion
+from .states import AxisState, MotionDone
+
+__all__ = [
+    "COUNTER_MAX", "COUNTER_MIN", "ActiveMotion", "Axis", "AxisState", "Controller",
+    "Counters", "CycleStats", "MotionDone", "wrap28",
+]

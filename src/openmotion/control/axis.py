@@ -1,0 +1,445 @@
+"""One controlled axis: PLCopen state machine, counters, and single-axis motion commands.
+
+Positions handed to the hardware are in the *raw pulse frame* (the hardware's unwrapped
+pulses_out). The user-facing command counter is that frame plus an offset (see counters.py),
+so setting a counter never moves anything. Public arguments are in pulses, pps and seconds;
+pass `units=True` to give positions and speeds in the axis's user unit (AxisUnits).
+
+Every command validates and plans completely before it changes anything: a refused command
+(MotionError) leaves the state, counters and running motion exactly as they were.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import wraps
+from typing import TYPE_CHECKING, Any, TypeVar
+
+from ..errors import InfeasibleError, MotionError, check_finite, check_positive
+from ..hw.interface import AxisCommand
+from ..profile.pcl import MoveSpec
+from ..units import MAX_PULSE_RATE, AxisUnits
+from . import planning
+from .counters import COUNTER_MAX, COUNTER_MIN, Counters
+from .motion import ActiveMotion
+from .states import AxisState, MotionDone, transition
+
+if TYPE_CHECKING:
+    from ..config import AxisConfig
+    from .controller import Controller
+
+F = TypeVar("F", bound=Callable[..., Any])
+S = AxisState
+
+
+def _locked(fn: F) -> F:
+    """Serialise a public call with the cycle loop (real-time mode runs on a thread)."""
+
+    @wraps(fn)
+    def wrapper(self: Axis, *args: Any, **kwargs: Any) -> Any:
+        with self._ctl._lock:
+            return fn(self, *args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
+class Axis:
+    """An axis of a `Controller`. Get it with `controller.axis(name_or_index)`."""
+
+    def __init__(self, index: int, config: AxisConfig, controller: Controller) -> None:
+        self.index = index
+        self.name = config.name
+        self.config = config
+        self.units = AxisUnits.from_axis(config)
+        self.counters = Counters(config.move_ratio)
+        self._ctl = controller
+        self._state = S.DISABLED
+        self._fault: str | None = None
+        self._powered = False
+        self._servo = config.drive.type == "servo"
+        self._motion: ActiveMotion | None = None
+        self._pos = 0.0       # commanded position, raw pulse frame, at controller time
+        self._vel = 0.0
+        self._inp_enabled = False
+        self._waiting_inp = False
+        self._speed_range: float | None = None
+        self._max_speed = min(config.max_speed_pps, MAX_PULSE_RATE)
+
+    # ------------------------------------------------------------------ status
+    @property
+    def state(self) -> AxisState:
+        return self._state
+
+    @property
+    def fault(self) -> str | None:
+        """Reason of the last fault (None until one happens; kept after reset)."""
+        return self._fault
+
+    @property
+    def is_moving(self) -> bool:
+        return self._motion is not None or self._waiting_inp
+
+    @property
+    def position(self) -> float:
+        """Commanded position in the command-counter frame (float, unwrapped)."""
+        return self._pos + self.counters._cmd_off
+
+    @property
+    def velocity(self) -> float:
+        """Commanded velocity (pps, signed)."""
+        return self._vel
+
+    @property
+    def speed(self) -> float:
+        """Current speed (pps, >= 0): HSL_M_get_current_speed."""
+        return abs(self._vel)
+
+    @property
+    def motion_done(self) -> int:
+        """HSL motion_done status: 0 stopped, 10..13 moving, 14 waiting for INP."""
+        m = self._motion
+        if m is not None:
+            return m.done_code(self._ctl.time)
+        return MotionDone.WAITING_INP if self._waiting_inp else MotionDone.STOPPED
+
+    @property
+    def motion(self) -> ActiveMotion | None:
+        """The motion being executed (profile anchored at `t_start`), if any."""
+        return self._motion
+
+    @property
+    def speed_range(self) -> float | None:
+        """The fixed speed range (pps) set by `fix_speed_range`, or None."""
+        return self._speed_range
+
+    # ------------------------------------------------------------------ power and faults
+    @_locked
+    def enable(self) -> None:
+        """Power the axis (servo on through SVON for servo drives): Disabled -> Standstill.
+
+        Refused while the emergency stop is active. Enabling an axis already enabled does
+        nothing; an axis in ErrorStop needs `reset()`.
+        """
+        if self._state is S.ERROR_STOP:
+            raise MotionError(f"axis {self.name}: in ErrorStop ({self._fault}); reset() first")
+        if self._ctl.estop_active:
+            raise MotionError(f"axis {self.name}: emergency stop is active")
+        if self._state is not S.DISABLED:
+            return
+        if self._servo:
+            self._ctl.hardware.write_output(self.index, "svon", True)
+        self._powered = True
+        self._state = transition(self._state, S.STANDSTILL, self.name)
+        if self._ctl.alarm_active(self.index):
+            self.fault_stop("servo alarm")
+
+    @_locked
+    def disable(self) -> None:
+        """Power off: any motion stops immediately; SVON off. From ErrorStop the axis stays
+        in ErrorStop (PLCopen) until reset."""
+        self._kill_motion()
+        if self._servo:
+            self._ctl.hardware.write_output(self.index, "svon", False)
+        self._powered = False
+        if self._state is not S.ERROR_STOP:
+            self._state = transition(self._state, S.DISABLED, self.name)
+
+    @_locked
+    def reset(self) -> None:
+        """Leave ErrorStop (MC_Reset): to Standstill if powered, else Disabled.
+
+        Refused while the cause persists (emergency stop or servo alarm still active).
+        Does nothing in any other state.
+        """
+        if self._state is not S.ERROR_STOP:
+            return
+        if self._ctl.estop_active:
+            raise MotionError(f"axis {self.name}: emergency stop still active; release it first")
+        if self._ctl.alarm_active(self.index):
+            raise MotionError(f"axis {self.name}: servo alarm still active")
+        self._state = transition(self._state, S.STANDSTILL if self._powered else S.DISABLED,
+                                 self.name)
+
+    def fault_stop(self, reason: str) -> None:
+        """Stop immediately and go to ErrorStop with `reason` (used by edge hooks)."""
+        with self._ctl._lock:
+            self._kill_motion()
+            self._fault = reason
+            self._state = transition(self._state, S.ERROR_STOP, self.name)
+
+    # ------------------------------------------------------------------ settings
+    @_locked
+    def fix_speed_range(self, max_vel: float, *, units: bool = False) -> None:
+        """Fix the speed range: the maximum speed `change_speed` may reach (HSL 4.11)."""
+        v = self._speed_in("max_vel", max_vel, units)
+        if v <= 0.0:
+            raise MotionError(f"max_vel must be > 0, got {max_vel!r}")
+        self._speed_range = v
+
+    @_locked
+    def unfix_speed_range(self) -> None:
+        """Release the range: each move's own MaxVel is again the change_speed maximum."""
+        self._speed_range = None
+
+    @_locked
+    def set_move_ratio(self, ratio: float) -> None:
+        """Feedback counts per command pulse (HSL_M_set_move_ratio)."""
+        self.counters.set_move_ratio(ratio)
+
+    @_locked
+    def set_inp(self, enabled: bool) -> None:
+        """When enabled, a positioning move is done only once the drive's INP is active."""
+        if not isinstance(enabled, bool):
+            raise MotionError(f"enabled must be a bool, got {enabled!r}")
+        self._inp_enabled = enabled
+
+    # ------------------------------------------------------------------ argument helpers
+    def _speed_in(self, name: str, value: float, units: bool) -> float:
+        v = check_finite(name, value)
+        v = float(self.units.scale_to_pulses(v)) if units else v
+        if abs(v) > self._max_speed * (1.0 + 1e-9):
+            raise MotionError(f"{name} on axis {self.name} must be <= {self._max_speed:g} pps "
+                              f"(maximum safe speed), got {value!r}")
+        return v
+
+    def _spec(self, shape: str, str_vel: float, max_vel: float, tacc: float,
+              tdec: float | None, vs_acc: float, vs_dec: float, units: bool) -> MoveSpec:
+        sv = self._speed_in("str_vel", str_vel, units)
+        mv = self._speed_in("max_vel", max_vel, units)
+        va = self._speed_in("vs_acc", vs_acc, units)
+        vd = self._speed_in("vs_dec", vs_dec, units)
+        td = tacc if tdec is None else tdec
+        return MoveSpec(shape, sv, mv, tacc, td, va, vd)
+
+    def _check_can_start(self) -> None:
+        st = self._state
+        if st is S.ERROR_STOP:
+            raise MotionError(f"axis {self.name}: in ErrorStop ({self._fault}); reset() first")
+        if st is S.DISABLED:
+            raise MotionError(f"axis {self.name}: disabled; enable() first")
+        if st is S.STOPPING:
+            raise MotionError(f"axis {self.name}: stopping; wait for Standstill")
+        if st is S.HOMING:
+            raise MotionError(f"axis {self.name}: homing in progress")
+        if self._motion is not None or self._waiting_inp:
+            raise MotionError(
+                f"axis {self.name}: a motion is running; use change_speed / change_position "
+                "or stop it first")
+
+    def _check_running(self, what: str) -> ActiveMotion:
+        m = self._motion
+        if m is None or self._state not in (S.DISCRETE_MOTION, S.CONTINUOUS_MOTION):
+            raise MotionError(f"axis {self.name}: {what} needs a running move "
+                              f"(state {self._state.value})")
+        return m
+
+    # ------------------------------------------------------------------ motion commands
+    @_locked
+    def move_velocity(self, velocity: float, *, str_vel: float = 0.0, tacc: float = 0.1,
+                      shape: str = "T", vs_acc: float = 0.0, units: bool = False) -> None:
+        """Velocity mode (HSL tv_move / sv_move): ramp from StrVel to `velocity` (signed,
+        pps) in `tacc` and hold it until changed or stopped."""
+        v = self._speed_in("velocity", velocity, units)
+        if v == 0.0:
+            raise MotionError("velocity must be non-zero (its sign gives the direction)")
+        spec = self._spec(shape, str_vel, abs(v), tacc, None, vs_acc, vs_acc, units)
+        self._check_can_start()
+        profile = planning.velocity_move(spec, 1.0 if v > 0 else -1.0, self._pos)
+        self._start(ActiveMotion(profile, self._ctl.time, "velocity", spec),
+                    S.CONTINUOUS_MOTION)
+
+    @_locked
+    def move_relative(self, distance: float, *, max_vel: float, str_vel: float = 0.0,
+                      tacc: float = 0.1, tdec: float | None = None, shape: str = "T",
+                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False) -> None:
+        """Relative T/S move (HSL start_tr_move / start_sr_move) of `distance` pulses.
+
+        The target is the command position plus the distance rounded to a whole pulse; the
+        move ends exactly there. `tdec` defaults to `tacc`.
+        """
+        d = check_finite("distance", distance)
+        d = float(self.units.to_pulses(d)) if units else d
+        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units)
+        self._check_can_start()
+        target = round(self._pos + d)
+        self._start_discrete(spec, target, "relative", None)
+        self.counters.add_target(round(d))
+
+    @_locked
+    def move_absolute(self, position: float, *, max_vel: float, str_vel: float = 0.0,
+                      tacc: float = 0.1, tdec: float | None = None, shape: str = "T",
+                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False) -> None:
+        """Absolute T/S move (HSL start_ta_move / start_sa_move) to `position` (command
+        counter frame). As the seed describes, the distance is measured from the *feedback*
+        position converted through the move ratio: distance = position - feedback/ratio.
+        """
+        p = check_finite("position", position)
+        p = float(self.units.to_pulses(p)) if units else p
+        if not COUNTER_MIN <= p <= COUNTER_MAX:
+            raise MotionError(f"position must be in [{COUNTER_MIN}, {COUNTER_MAX}] "
+                              f"(28-bit counter), got {position!r}")
+        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units)
+        self._check_can_start()
+        d = p - self.counters.feedback_in_pulses()
+        target = round(self._pos + d)
+        self._start_discrete(spec, target, "absolute", p)
+        self.counters.add_target(p - self.counters.target)
+
+    @_locked
+    def move_jerk_limited(self, distance: float, *, v_max: float, a_max: float,
+                          j_max: float, d_max: float | None = None, absolute: bool = False,
+                          units: bool = False) -> None:
+        """Time-optimal jerk-limited move (profile.jerk), relative or, with absolute=True, to
+        a position measured like `move_absolute`. Limits in pps, pps^2, pps^3 (or user units
+        with units=True). On-the-fly changes are not offered for this kind; stops are."""
+        d = check_finite("distance", distance)
+        vm = self._speed_in("v_max", v_max, units)
+        am = check_positive("a_max", a_max)
+        jm = check_positive("j_max", j_max)
+        dm = None if d_max is None else check_positive("d_max", d_max)
+        if units:
+            d = float(self.units.to_pulses(d))
+            am, jm = float(self.units.scale_to_pulses(am)), float(self.units.scale_to_pulses(jm))
+            dm = None if dm is None else float(self.units.scale_to_pulses(dm))
+        if absolute and not COUNTER_MIN <= d <= COUNTER_MAX:
+            raise MotionError(f"distance (an absolute position) must be in [{COUNTER_MIN}, "
+                              f"{COUNTER_MAX}], got {distance!r}")
+        self._check_can_start()
+        disp = d - self.counters.feedback_in_pulses() if absolute else d
+        target = round(self._pos + disp)
+        profile = planning.jerk_move(self._pos, float(target), vm, am, jm, dm)
+        self._start(ActiveMotion(profile, self._ctl.time, "jerk", None, float(target),
+                                 limits=(vm, max(am, dm or 0.0), jm)), S.DISCRETE_MOTION)
+        self.counters.add_target(d - self.counters.target if absolute else round(d))
+
+    @_locked
+    def change_speed(self, new_vel: float, tacc: float, *, units: bool = False) -> None:
+        """Change speed on the fly (HSL v_change), for velocity and positioning moves.
+
+        The new speed may not exceed the fixed speed range (`fix_speed_range`) or, when none
+        is fixed, the move's own MaxVel. Refused (InfeasibleError, motion unchanged) when a
+        positioning move has too few pulses left to reach the speed and still stop.
+        """
+        v = abs(self._speed_in("new_vel", new_vel, units))
+        ta = check_positive("tacc", tacc)
+        m = self._check_running("change_speed")
+        if m.spec is None:
+            raise MotionError(f"axis {self.name}: change_speed applies to T/S and velocity "
+                              "moves, not jerk-limited ones")
+        limit = self._speed_range if self._speed_range is not None else m.spec.max_vel
+        if v > limit * (1.0 + 1e-12):
+            raise InfeasibleError(
+                f"new_vel must be <= the speed range {limit:g} pps "
+                f"(fix_speed_range to allow more), got {new_vel!r}")
+        t = self._ctl.time
+        profile, spec = planning.change_speed(m, t, v, ta, limit)
+        self._replace(m, profile, spec, m.target)
+
+    @_locked
+    def change_position(self, new_position: float, *, units: bool = False) -> None:
+        """Change the target of a running absolute move on the fly (HSL p_change).
+
+        Refused (InfeasibleError, motion unchanged) during the final deceleration or when
+        the new target is too close to stop at; a target already passed makes the axis stop
+        and come back ("go back").
+        """
+        p = check_finite("new_position", new_position)
+        p = float(self.units.to_pulses(p)) if units else p
+        if not COUNTER_MIN <= p <= COUNTER_MAX:
+            raise MotionError(f"new_position must be in [{COUNTER_MIN}, {COUNTER_MAX}], "
+                              f"got {new_position!r}")
+        m = self._check_running("change_position")
+        if m.kind != "absolute":
+            raise MotionError(f"axis {self.name}: change_position applies to absolute moves "
+                              "only (HSL 4.11)")
+        new_target = round(m.target + (p - m.abs_target))
+        profile = planning.change_position(m, self._ctl.time, new_target)
+        self._replace(m, profile, m.spec, float(new_target), abs_target=p)
+        self.counters.add_target(p - self.counters.target)
+
+    @_locked
+    def stop(self, tdec: float | None = None) -> None:
+        """Decelerating stop (HSL sd_stop / PLCopen MC_Stop) from any motion.
+
+        `tdec` is the deceleration time of the move's parameters (MaxVel -> StrVel); by
+        default the running move's own Tdec. Stopping an axis at rest does nothing.
+        """
+        td = None if tdec is None else check_positive("tdec", tdec)
+        m = self._motion
+        if m is None or self._state is S.STOPPING and td is None:
+            return
+        t = self._ctl.time
+        profile = planning.decel_stop(m, t, td)
+        self._replace(m, profile, m.spec, None, kind="stop")
+        self._state = transition(self._state, S.STOPPING, self.name)
+
+    @_locked
+    def stop_immediately(self) -> None:
+        """Immediate stop (HSL emg_stop): the pulse output stops at once, at any state."""
+        self._kill_motion()
+        if self._state in (S.DISCRETE_MOTION, S.CONTINUOUS_MOTION, S.STOPPING, S.HOMING):
+            self._state = transition(self._state, S.STANDSTILL, self.name)
+
+    # ------------------------------------------------------------------ internals
+    def _start_discrete(self, spec: MoveSpec, target: int, kind: str,
+                        abs_target: float | None) -> None:
+        profile = planning.position_move(spec, self._pos, float(target))
+        self._start(ActiveMotion(profile, self._ctl.time, kind, spec, float(target),
+                                 abs_target), S.DISCRETE_MOTION)
+
+    def _start(self, motion: ActiveMotion, state: AxisState) -> None:
+        self._state = transition(self._state, state, self.name)
+        self._motion = motion
+        self._ctl._motion_changed(self, motion)
+
+    def _replace(self, old: ActiveMotion, profile: Any, spec: MoveSpec | None,
+                 target: float | None, *, kind: str | None = None,
+                 abs_target: float | None = None) -> None:
+        m = ActiveMotion(profile, old.t_start, kind or old.kind, spec, target,
+                         abs_target if abs_target is not None else old.abs_target,
+                         old.limits)
+        self._motion = m
+        self._ctl._motion_changed(self, m)
+
+    def _kill_motion(self) -> None:
+        """End any motion at the current commanded position, at rest."""
+        m = self._motion
+        self._waiting_inp = False
+        if m is None:
+            return
+        self._motion = None
+        self._vel = 0.0
+        self._ctl._motion_changed(self, None)
+
+    # -- cycle hooks (called by the controller, lock held) --------------------------------
+    def _command(self, t0: float, t1: float) -> AxisCommand | None:
+        m = self._motion
+        if m is None:
+            return None  # the pulse generator holds its last end position
+        p0, v0, a0, j, p1, v1 = m.piece(t0, t1)
+        self._pos = p1
+        self._vel = v1 if t1 < m.t_end or m.kind == "velocity" else 0.0
+        return AxisCommand(t0, t1 - t0, p0, v0, a0, j)
+
+    def _cycle_end(self, t1: float, pulses_out: int, encoder: int,
+                   inputs: dict[str, bool]) -> None:
+        self.counters.update(pulses_out, encoder, t1)
+        m = self._motion
+        if m is not None and m.finished(t1):
+            self._motion = None
+            self._vel = 0.0
+            self._pos = m.profile.end.p
+            if self._inp_enabled and m.kind != "stop":
+                self._waiting_inp = True
+            else:
+                self._state = transition(self._state, S.STANDSTILL, self.name)
+        if self._waiting_inp and self._ctl.input_active(self.index, "inp", inputs):
+            self._waiting_inp = False
+            self._state = transition(self._state, S.STANDSTILL, self.name)
+
+    def snapshot(self) -> tuple:
+        """Everything a refused command must leave unchanged (used by tests)."""
+        m = self._motion
+        return (self._state, self._fault, self._pos, self._vel, self._speed_range,
+                self.counters.snapshot(), id(m),
+                None if m is None else (m.t_start, m.kind, m.target, m.profile.duration))

@@ -1,0 +1,129 @@
+"""The controller clock: one cycle function, paced either by the caller (virtual time) or
+by a thread against the wall clock (real time), with cycle-time statistics.
+
+Virtual time is the cycle count times the period (no float accumulation, so cycle n always
+ends at exactly n * period). Real time runs the same cycle function; it records, per cycle,
+how late the cycle started against its schedule (jitter) and how long it took, in a ring
+buffer of fixed size, so statistics cost flat memory however long it runs.
+"""
+
+from __future__ import annotations
+
+import threading
+import time as _time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import MotionError, check_finite
+
+PERIOD_MIN = 0.001
+PERIOD_MAX = 1.0
+_STATS_WINDOW = 65536
+
+
+def check_period(period: float) -> float:
+    """Interpolation period in seconds: 1 ms .. 1000 ms (the MCCL range)."""
+    p = check_finite("period", period)
+    if not PERIOD_MIN - 1e-15 <= p <= PERIOD_MAX:
+        raise MotionError(f"period must be in [0.001, 1] s (1..1000 ms), got {period!r}")
+    return p
+
+
+@dataclass(frozen=True)
+class CycleStats:
+    """Real-time cycle statistics over the last (up to 65536) cycles, in seconds.
+
+    jitter = start lateness against the schedule; busy = time spent inside the cycle;
+    overruns = cycles that ended after the next cycle was due (counted over the whole run).
+    """
+
+    cycles: int
+    period: float
+    mean_busy: float
+    p99_busy: float
+    max_busy: float
+    mean_jitter: float
+    p99_jitter: float
+    max_jitter: float
+    overruns: int
+
+
+class RealtimePacer:
+    """Runs `cycle()` every `period` seconds of wall clock on a daemon thread."""
+
+    def __init__(self, cycle: Callable[[], None], period: float) -> None:
+        self._cycle = cycle
+        self._period = period
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+        self._busy = np.zeros(_STATS_WINDOW)
+        self._late = np.zeros(_STATS_WINDOW)
+        self._n = 0
+        self._overruns = 0
+        self.error: BaseException | None = None
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self) -> None:
+        if self.running:
+            raise MotionError("real-time mode is already running")
+        self._stop.clear()
+        self.error = None
+        self._thread = threading.Thread(target=self._run, name="openmotion-rt", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+
+    def _run(self) -> None:
+        clock = _time.perf_counter
+        period = self._period
+        t_next = clock()
+        try:
+            while not self._stop.is_set():
+                now = clock()
+                if now < t_next:
+                    # Plain sleep, no spinning: a spin would hold the GIL against the
+                    # threads that issue commands. Linux wakes within ~0.1 ms.
+                    _time.sleep(t_next - now)
+                    now = clock()
+                start = now
+                self._cycle()
+                end = clock()
+                i = self._n % _STATS_WINDOW
+                self._late[i] = start - t_next
+                self._busy[i] = end - start
+                self._n += 1
+                t_next += period
+                if end > t_next:
+                    self._overruns += 1
+                    # Do not try to catch up a backlog in a burst: resume on the grid.
+                    missed = int((end - t_next) // period) + 1
+                    t_next += missed * period
+        except BaseException as exc:  # surfaced by stop()/stats, never silently dropped
+            self.error = exc
+
+    def stats(self) -> CycleStats:
+        n = min(self._n, _STATS_WINDOW)
+        if n == 0:
+            return CycleStats(0, self._period, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
+        busy = self._busy[:n]
+        late = self._late[:n]
+        return CycleStats(
+            cycles=self._n,
+            period=self._period,
+            mean_busy=float(busy.mean()),
+            p99_busy=float(np.percentile(busy, 99)),
+            max_busy=float(busy.max()),
+            mean_jitter=float(late.mean()),
+            p99_jitter=float(np.percentile(late, 99)),
+            max_jitter=float(late.max()),
+            overruns=self._overruns,
+        )

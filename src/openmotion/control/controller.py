@@ -1,0 +1,348 @@
+"""The Controller: owns the hardware, the axes and the clock, and runs the cycle.
+
+One cycle (period T, from t0 to t1 = t0 + T):
+
+1. every axis with motion hands the hardware the cubic piece of its profile for [t0, t1]
+   (evaluated analytically at the cycle ends, never integrated);
+2. `hardware.advance(t1)` moves the machine and returns the input edges, time-ordered;
+3. each edge goes through the edge-hook list (E-stop and servo alarm are the first two;
+   limits, latches and compare subscribe with `add_edge_hook`);
+4. every axis reads back its counters and finishes a motion that reached its end;
+5. cycle hooks run (`add_cycle_hook`), then the recorder if recording is on.
+
+Virtual time: `step()`, `advance(dt)`, `run_until(condition, timeout)` - deterministic, as
+fast as Python goes. Real time: `start_realtime()` paces the same cycle to the wall clock on
+a thread; `stop_realtime()`; `with controller.start_realtime(): ...`; `cycle_stats()`.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from ..config import MachineConfig, default_machine
+from ..errors import MotionError, check_finite, check_nonnegative
+from ..history import MotionHistory
+from ..hw.interface import Hardware, InputEdge
+from ..recording import Recorder
+from .axis import Axis
+from .clock import CycleStats, RealtimePacer, check_period
+from .motion import ActiveMotion
+from .states import AxisState
+
+#: Recorder state channel numbering (the order of AxisState).
+STATE_CODES = {st: i for i, st in enumerate(AxisState)}
+#: Recorder io channel bits, after HSL get_io_status (seed-facts 2.4); logical levels.
+IO_BITS = (("rdy", 0), ("alm", 1), ("pel", 2), ("mel", 3), ("org", 4), ("ez", 9),
+           ("ltc", 11), ("sd", 12), ("inp", 13))
+
+EdgeHook = Callable[["Controller", InputEdge], None]
+CycleHook = Callable[["Controller", float], None]
+
+
+class Controller:
+    """Multi-axis controller over a `Hardware` back end (the simulator by default).
+
+    config: the machine (default `default_machine()`); hardware: a back end implementing
+    hw.interface.Hardware (default `SimMachine(config)`); period: interpolation period in
+    seconds (default config.cycle_s, 1 ms .. 1 s); history_window_s: how much motion history
+    to keep (flat memory).
+    """
+
+    def __init__(self, config: MachineConfig | None = None, hardware: Hardware | None = None,
+                 *, period: float | None = None, history_window_s: float = 60.0) -> None:
+        if config is None:
+            config = default_machine()
+        if not isinstance(config, MachineConfig):
+            raise MotionError(f"config must be a MachineConfig, got {type(config).__name__}")
+        if not config.axes:
+            raise MotionError("config must describe at least one axis")
+        self.period = check_period(config.cycle_s if period is None else period)
+        if hardware is None:
+            from ..hw.sim import SimMachine  # the default back end; control never needs it
+
+            hardware = SimMachine(config)
+        if not isinstance(hardware, Hardware):
+            raise MotionError("hardware must implement openmotion.hw.interface.Hardware")
+        if hardware.n_axes != len(config.axes):
+            raise MotionError(f"hardware has {hardware.n_axes} axes, config has "
+                              f"{len(config.axes)}")
+        self.config = config
+        self.hardware = hardware
+        self._lock = threading.RLock()
+        self._t_origin = float(hardware.time)
+        self._n = 0
+        self._time = self._t_origin
+        self.axes: tuple[Axis, ...] = tuple(
+            Axis(i, ax, self) for i, ax in enumerate(config.axes))
+        self._by_name = {a.name: a for a in self.axes}
+        self.history = MotionHistory(len(self.axes), history_window_s, t_start=self._time)
+        self._edge_hooks: list[EdgeHook] = [_estop_hook, _alarm_hook]
+        self._cycle_hooks: list[CycleHook] = []
+        self._estop = False
+        self._inputs: list[dict[str, bool]] = [{} for _ in self.axes]
+        self._nc = [{s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy")
+                     if ax.signal_logic(s) == "nc"} for ax in config.axes]
+        self._emg_nc = any(ax.signal_logic("emg") == "nc" for ax in config.axes)
+        self.recorder: Any = None
+        self._pacer = RealtimePacer(self.step, self.period)
+        self._read_back()
+        self._estop = self._emg_level_active(hardware.read_input("emg"))
+
+    # ------------------------------------------------------------------ lookup
+    def axis(self, key: int | str) -> Axis:
+        """An axis by name or index; MotionError naming the choices otherwise."""
+        if isinstance(key, str):
+            ax = self._by_name.get(key)
+            if ax is None:
+                raise MotionError(f"axis {key!r} is unknown; axes: {', '.join(self._by_name)}")
+            return ax
+        if isinstance(key, bool) or not isinstance(key, int):
+            raise MotionError(f"axis must be a name or an index, got {key!r}")
+        if not 0 <= key < len(self.axes):
+            raise MotionError(f"axis index must be in [0, {len(self.axes) - 1}], got {key!r}")
+        return self.axes[key]
+
+    def __getitem__(self, key: int | str) -> Axis:
+        return self.axis(key)
+
+    @property
+    def time(self) -> float:
+        """Controller time (s): the end of the last cycle run."""
+        return self._time
+
+    @property
+    def cycles(self) -> int:
+        return self._n
+
+    @property
+    def estop_active(self) -> bool:
+        return self._estop
+
+    # ------------------------------------------------------------------ inputs
+    def input_active(self, axis: int, signal: str, inputs: dict[str, bool] | None = None
+                     ) -> bool:
+        """Logical level of an axis input (configured NO/NC logic applied)."""
+        level = (self._inputs[axis] if inputs is None else inputs).get(signal, False)
+        return level != (signal in self._nc[axis])
+
+    def alarm_active(self, axis: int) -> bool:
+        return self.input_active(axis, "alm")
+
+    def _emg_level_active(self, level: bool) -> bool:
+        return level != self._emg_nc
+
+    # ------------------------------------------------------------------ hooks
+    def add_edge_hook(self, hook: EdgeHook) -> None:
+        """Call `hook(controller, edge)` for every input edge, after the built-in hooks."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._edge_hooks.append(hook)
+
+    def remove_edge_hook(self, hook: EdgeHook) -> None:
+        with self._lock:
+            if hook in self._edge_hooks[2:]:
+                self._edge_hooks.remove(hook)
+
+    def add_cycle_hook(self, hook: CycleHook) -> None:
+        """Call `hook(controller, t)` at the end of every cycle (t = cycle end time)."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._cycle_hooks.append(hook)
+
+    def remove_cycle_hook(self, hook: CycleHook) -> None:
+        with self._lock:
+            if hook in self._cycle_hooks:
+                self._cycle_hooks.remove(hook)
+
+    # ------------------------------------------------------------------ convenience
+    def enable_all(self) -> None:
+        """Enable every axis (see Axis.enable)."""
+        for ax in self.axes:
+            ax.enable()
+
+    def stop_all(self, *, immediately: bool = False) -> None:
+        """Decelerating (or immediate) stop of every axis."""
+        for ax in self.axes:
+            if immediately:
+                ax.stop_immediately()
+            else:
+                ax.stop()
+
+    def emergency_stop(self, reason: str = "emergency stop") -> None:
+        """Software E-stop: every axis stops immediately and goes to ErrorStop."""
+        with self._lock:
+            for ax in self.axes:
+                ax.fault_stop(reason)
+
+    # ------------------------------------------------------------------ the cycle
+    def step(self) -> None:
+        """Run one cycle (virtual time: the caller paces it)."""
+        with self._lock:
+            t0 = self._time
+            n = self._n + 1
+            t1 = self._t_origin + n * self.period
+            hw = self.hardware
+            for ax in self.axes:
+                cmd = ax._command(t0, t1)
+                if cmd is not None:
+                    hw.command(ax.index, cmd)
+            edges = hw.advance(t1)
+            self._n = n
+            self._time = t1
+            if edges:
+                hooks = self._edge_hooks
+                for e in edges:
+                    for h in hooks:
+                        h(self, e)
+            self._read_back()
+            for h in self._cycle_hooks:
+                h(self, t1)
+            if self.recorder is not None:
+                self._record(t1)
+
+    def _read_back(self) -> None:
+        hw = self.hardware
+        t = self._time
+        for ax in self.axes:
+            rb = hw.read_axis(ax.index)
+            self._inputs[ax.index] = rb.inputs
+            ax._cycle_end(t, rb.pulses_out, rb.encoder, rb.inputs)
+
+    def advance(self, dt: float) -> None:
+        """Run the cycles covering `dt` seconds of virtual time (rounded up to whole cycles)."""
+        dt = check_nonnegative("dt", dt)
+        self._check_virtual()
+        n = math.ceil(dt / self.period - 1e-9)
+        for _ in range(n):
+            self.step()
+
+    def run_until(self, condition: Callable[[], bool], timeout: float) -> bool:
+        """Run cycles until `condition()` is true (checked before each cycle); False if
+        `timeout` seconds of virtual time pass first. Never raises on timeout."""
+        if not callable(condition):
+            raise MotionError(f"condition must be callable, got {condition!r}")
+        timeout = check_nonnegative("timeout", timeout)
+        self._check_virtual()
+        n = math.ceil(timeout / self.period - 1e-9)
+        for _ in range(n):
+            if condition():
+                return True
+            self.step()
+        return bool(condition())
+
+    def wait_motion_done(self, axes: Sequence[int | str] | None = None,
+                         timeout: float = 60.0) -> bool:
+        """run_until every given axis (default all) reports motion_done == 0."""
+        sel = self.axes if axes is None else tuple(self.axis(k) for k in axes)
+        return self.run_until(lambda: all(a.motion_done == 0 for a in sel), timeout)
+
+    def _check_virtual(self) -> None:
+        if self._pacer.running:
+            raise MotionError("virtual-time calls are not allowed while real-time mode runs")
+
+    # ------------------------------------------------------------------ recording
+    def start_recording(self, capacity: int = 600_000, channels: Sequence[str] | None = None,
+                        *, spill_path: str | None = None) -> Recorder:
+        """Record every cycle into a new `Recorder` (ring buffer of `capacity` cycles;
+        default 10 min at 1 ms). Channels as in openmotion.recording (default all)."""
+        kwargs: dict[str, Any] = {"spill_path": spill_path}
+        if channels is not None:
+            kwargs["channels"] = channels
+        rec = Recorder(len(self.axes), capacity, **kwargs)
+        with self._lock:
+            self.recorder = rec
+        return rec
+
+    def stop_recording(self) -> Recorder | None:
+        """Stop recording; returns the recorder (its data stays readable)."""
+        with self._lock:
+            rec, self.recorder = self.recorder, None
+        return rec
+
+    def _record(self, t: float) -> None:
+        axes = self.axes
+        io = [_io_word(self, ax.index) for ax in axes] if "io" in self.recorder.channels \
+            else None
+        self.recorder.record(
+            t,
+            cmd_pos=[ax.position for ax in axes],
+            fb_pos=[ax.counters.feedback for ax in axes],
+            cmd_vel=[ax.velocity for ax in axes],
+            state=[STATE_CODES[ax.state] for ax in axes],
+            io=io,
+        )
+
+    # ------------------------------------------------------------------ real time
+    def start_realtime(self) -> Controller:
+        """Pace the cycle to the wall clock on a thread; returns self (a context manager)."""
+        self._pacer.start()
+        return self
+
+    def stop_realtime(self) -> None:
+        """Stop the real-time thread (re-raises an exception the cycle raised there)."""
+        self._pacer.stop()
+        if self._pacer.error is not None:
+            err, self._pacer.error = self._pacer.error, None
+            raise MotionError(f"real-time cycle failed: {err!r}") from err
+
+    @property
+    def realtime(self) -> bool:
+        return self._pacer.running
+
+    def cycle_stats(self) -> CycleStats:
+        """Statistics of the real-time cycles (mean, p99, max jitter, overruns)."""
+        return self._pacer.stats()
+
+    def __enter__(self) -> Controller:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._pacer.running:
+            self.stop_realtime()
+
+    # ------------------------------------------------------------------ bookkeeping
+    def _motion_changed(self, axis: Axis, motion: ActiveMotion | None) -> None:
+        """An axis started, re-planned or killed its motion: keep the history in step."""
+        if motion is None:
+            self.history.truncate(axis.index, self._time)
+        else:
+            self.history.append(axis.index, motion.t_start, motion.profile)
+
+    def sleep_until(self, t: float) -> None:
+        """Virtual time: run cycles until controller time >= t."""
+        t = check_finite("t", t)
+        self.advance(max(0.0, t - self._time))
+
+
+# -- built-in edge hooks -------------------------------------------------------------------
+def _estop_hook(ctl: Controller, edge: InputEdge) -> None:
+    """E-stop input: every axis stops immediately and goes to ErrorStop "emergency stop"."""
+    if edge.axis is None and edge.signal == "emg":
+        active = ctl._emg_level_active(edge.level)
+        ctl._estop = active
+        if active:
+            for ax in ctl.axes:
+                ax.fault_stop("emergency stop")
+
+
+def _alarm_hook(ctl: Controller, edge: InputEdge) -> None:
+    """Servo alarm (ALM) on an axis: that axis stops immediately, ErrorStop "servo alarm"."""
+    if (edge.axis is not None and edge.signal == "alm"
+            and edge.level != ("alm" in ctl._nc[edge.axis])):
+        ctl.axes[edge.axis].fault_stop("servo alarm")
+
+
+def _io_word(ctl: Controller, axis: int) -> int:
+    """get_io_status-style bit field of an axis's logical input levels (+ EMG bit 6)."""
+    word = 0
+    for sig, bit in IO_BITS:
+        if ctl.input_active(axis, sig):
+            word |= 1 << bit
+    if ctl._estop:
+        word |= 1 << 6
+    return word

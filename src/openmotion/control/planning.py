@@ -1,0 +1,65 @@
+"""Thin adapters from axis commands to the profile planners (openmotion.profile).
+
+All the motion math lives in `profile`; this module only picks the planner for a command,
+passes the running motion's profile and local time, and hands back a Profile anchored like
+the running one (time 0 = the motion's t_start). Each function raises MotionError /
+InfeasibleError before anything is changed when the planner refuses.
+"""
+
+from __future__ import annotations
+
+from ..profile.jerk import jerk_limited
+from ..profile.pcl import MoveSpec
+from ..profile.retarget import retarget_velocity
+from ..profile.segments import Profile
+from .motion import ActiveMotion
+
+
+def position_move(spec: MoveSpec, start: float, target: float) -> Profile:
+    """PCL6045 T/S move from rest at `start` to exactly `target` (raw pulse frame)."""
+    return spec.plan(target - start, start).profile
+
+
+def jerk_move(start: float, target: float, v_max: float, a_max: float, j_max: float,
+              d_max: float | None) -> Profile:
+    """Time-optimal jerk-limited rest-to-rest move to exactly `target`."""
+    return jerk_limited(target - start, v_max, a_max, j_max, d_max=d_max, start=start)
+
+
+def velocity_move(spec: MoveSpec, direction: float, start: float) -> Profile:
+    """Velocity mode from rest: StrVel jump, ramp to MaxVel in Tacc, hold (tv/sv_move)."""
+    from ..profile import velocity
+
+    return velocity.velocity_ramp(spec, direction, start=start)
+
+
+def change_speed(m: ActiveMotion, t: float, new_vel: float, tacc: float,
+                 v_limit: float) -> tuple[Profile, MoveSpec]:
+    """v_change at absolute time t; returns the spliced profile and the spec it now runs."""
+    from ..profile import onthefly
+
+    res = onthefly.change_speed(m.profile, t - m.t_start, m.spec, new_vel, tacc,
+                                target=m.target, v_limit=v_limit)
+    return res, m.spec
+
+
+def change_position(m: ActiveMotion, t: float, new_target: float) -> Profile:
+    """p_change at absolute time t to `new_target` (raw pulse frame)."""
+    from ..profile import onthefly
+
+    return onthefly.change_position(m.profile, t - m.t_start, m.spec, new_target)
+
+
+def decel_stop(m: ActiveMotion, t: float, tdec: float | None) -> Profile:
+    """sd_stop at absolute time t (deceleration of the move's spec, or `tdec`)."""
+    from dataclasses import replace
+
+    from ..profile import velocity
+
+    if m.limits is not None:  # jerk-limited move: fastest jerk-limited ramp to rest
+        u = t - m.t_start
+        _, a_max, j_max = m.limits
+        tail = retarget_velocity(m.profile.state_at(u), 0.0, a_max, j_max)
+        return m.profile.splice(u, tail)
+    spec = m.spec if tdec is None else replace(m.spec, tdec=tdec)
+    return velocity.decel_stop(m.profile, t - m.t_start, spec)
