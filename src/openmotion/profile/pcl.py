@@ -31,7 +31,6 @@ from ..errors import (
     check_nonnegative,
     check_positive,
 )
-from .ramps import ramp_jerk
 from .segments import Profile, ProfileBuilder, empty_profile
 
 # S-curve ramp algebra (one ramp covering dv = MaxVel - StrVel in time Tacc):
@@ -163,7 +162,7 @@ def _peak_excess(dist: float, s: float, dv: float, r: Rates) -> float:
     D(x) = (2s + x)/2 * (Ta(x) + Td(x)) is continuous and strictly increasing, so a Newton
     iteration kept inside a shrinking bracket [lo, hi] converges to double precision.
     """
-    if r.jerk_acc == math.inf:
+    if math.isinf(r.jerk_acc) and math.isinf(r.jerk_dec):
         k = 1.0 / r.accel + 1.0 / r.decel
         v = math.sqrt(s * s + 2.0 * dist / k)
         return min(max(v - s, 0.0), dv)
@@ -194,15 +193,33 @@ def _peak_excess(dist: float, s: float, dv: float, r: Rates) -> float:
 
 def append_ramp(b: ProfileBuilder, v1: float, accel: float, jerk: float,
                 label: str) -> ProfileBuilder:
-    """Append a PCL ramp from b's velocity (acceleration 0) to v1 (move frame)."""
-    if math.isinf(jerk):
-        v0 = b.state.v
-        if v1 != v0:
-            b.segment(abs(v1 - v0) / accel, 0.0, accel=math.copysign(accel, v1 - v0),
-                      label=label)
-        b.set_acceleration(0.0)
-        return b
-    return ramp_jerk(b, v1, accel, jerk, label=label)
+    """Append a PCL ramp from b's velocity (acceleration 0) to v1 (move frame).
+
+    T: one constant-acceleration segment. S: jerk region, linear region (if the velocity
+    change exceeds 2*VS = accel**2/jerk), jerk region; the peak acceleration is lowered to
+    sqrt(jerk*dv) otherwise. Ends with acceleration 0.
+    """
+    v0 = b.state.v
+    x = abs(v1 - v0)
+    sg = 1.0 if v1 >= v0 else -1.0
+    if x == 0.0:
+        pass
+    elif math.isinf(jerk):
+        b.segment(x / accel, 0.0, accel=sg * accel, label=label)
+    else:
+        if x >= accel * accel / jerk:
+            tj, tl = accel / jerk, x / accel - accel / jerk
+        else:
+            tj, tl = math.sqrt(x / jerk), 0.0
+        b.segment(tj, sg * jerk, accel=0.0, label=f"{label} jerk-in")
+        b.segment(tl, 0.0, label=f"{label} const-acc")
+        b.segment(tj, -sg * jerk, label=f"{label} jerk-out")
+    b.set_acceleration(0.0)
+    return b
+
+
+def _ramps_distance(s: float, v: float, r: Rates) -> float:
+    return ramp_distance(s, v, r.accel, r.jerk_acc) + ramp_distance(s, v, r.decel, r.jerk_dec)
 
 
 def _plan(spec: MoveSpec, dist: float, p0: float) -> MovePlan:
@@ -217,14 +234,23 @@ def _plan(spec: MoveSpec, dist: float, p0: float) -> MovePlan:
     if dv == 0.0 or full <= d:
         x, t_cruise, eff, reduced = dv, (d - full) / spec.max_vel, spec, False
     else:
-        eff = _reduced_spec(spec, r, s + _peak_excess(d, s, dv, r))
+        v = s + _peak_excess(d, s, dv, r)
+        # V - StrVel in floats differs from the root by up to ulp(StrVel); step V down
+        # until the ramps do not overshoot, and let a (near-zero) cruise take the rest
+        for _ in range(64):
+            used = _ramps_distance(s, v, r)
+            if used <= d or v <= s:
+                break
+            v = math.nextafter(v, -math.inf)
+        eff = _reduced_spec(spec, r, max(v, s))
         x, reduced = eff.max_vel - s, True
-        # the root leaves a rounding-level residual; a (near-zero) cruise absorbs it
-        used = ramp_distance(s, s + x, r.accel, r.jerk_acc) + ramp_distance(
-            s, s + x, r.decel, r.jerk_dec)
+        used = _ramps_distance(s, s + x, r)
         t_cruise = max(0.0, d - used) / (s + x) if s + x > 0.0 else 0.0
     v = s + x
     append_ramp(b, v, r.accel, r.jerk_acc, "accel")
+    # snap off the integration rounding so the decel ramp covers exactly V - StrVel
+    # (matters when V - StrVel is tiny next to StrVel)
+    b.set_velocity(v)
     b.segment(t_cruise, 0.0, accel=0.0, label="cruise")
     t_decel = b.time
     append_ramp(b, s, r.decel, r.jerk_dec, "decel")
@@ -240,11 +266,12 @@ def _reduced_spec(spec: MoveSpec, r: Rates, v: float) -> MoveSpec:
         return replace(spec, max_vel=s, vs_acc=0.0, vs_dec=0.0)
     tacc = ramp_time(x, r.accel, r.jerk_acc)
     tdec = ramp_time(x, r.decel, r.jerk_dec)
-    if spec.shape == "T":
-        return replace(spec, max_vel=v, tacc=tacc, tdec=tdec)
+    half = x / 2.0
+    if spec.shape == "T":  # VS is ignored by a T-curve; keep it valid
+        return replace(spec, max_vel=v, tacc=tacc, tdec=tdec,
+                       vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
     vs_a = r.accel * r.accel / (2.0 * r.jerk_acc)
     vs_d = r.decel * r.decel / (2.0 * r.jerk_dec)
-    half = x / 2.0
     return replace(
         spec, max_vel=v, tacc=tacc, tdec=tdec,
         vs_acc=spec.vs_acc if vs_a <= half else half,
