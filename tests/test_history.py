@@ -407,3 +407,48 @@ def test_bad_input_refused_and_changes_nothing(call, match) -> None:
 def test_bad_construction(kwargs) -> None:
     with pytest.raises(MotionError):
         MotionHistory(**kwargs)
+
+
+@st.composite
+def multi_record_cases(draw):
+    """Several spliced profiles, a level near the motion and a query window."""
+    h = MotionHistory(1, window_s=1e6)
+    t = 0.0
+    p = 0.0
+    for _ in range(draw(st.integers(1, 4))):
+        pr = draw(profiles(p))
+        h.append(0, t, pr)
+        cut = draw(st.floats(0.0, pr.duration + 0.2))
+        t += cut
+        p = h.state_at(0, t).p
+    span = h.end_time(0) + 0.5
+    t0 = draw(st.floats(-0.5, span))
+    t1 = draw(st.floats(t0, span + 0.5))
+    if draw(st.booleans()):  # a level the motion certainly reaches inside the window
+        level = float(h.position_at(0, t0 + draw(st.floats(0.0, 1.0)) * (t1 - t0)))
+    else:
+        probe = h.position_at(0, np.linspace(t0, t1, 50))
+        level = draw(st.floats(float(probe.min()) - 1.0, float(probe.max()) + 1.0))
+    return h, level, t0, t1
+
+
+@settings(max_examples=150, deadline=None)
+@given(case=multi_record_cases())
+def test_scalar_and_vector_crossings_agree(case) -> None:
+    import openmotion.history as hist
+
+    h, level, t0, t1 = case
+    old = hist._SCALAR_RECORDS
+    try:
+        hist._SCALAR_RECORDS = 10**9
+        ts, ds = h.crossing_events(0, level, t0, t1)
+        hist._SCALAR_RECORDS = 0
+        tv, dv = h.crossing_events(0, level, t0, t1)
+    finally:
+        hist._SCALAR_RECORDS = old
+    event(f"{min(ts.size, 3)}+ events")
+    np.testing.assert_array_equal(ts, tv)
+    np.testing.assert_array_equal(ds, dv)
+    # Every event is in the window, in time order.
+    assert np.all((ts >= t0) & (ts <= t1))
+    assert np.all(np.diff(ts) >= 0)
