@@ -133,6 +133,15 @@ def test_no_blend_for_collinear_or_reversal(end, why):
     assert blend_corner(first, Line([10.0, 0.0], end), 0.5) is None, why
 
 
+@pytest.mark.parametrize("turn", [1e-7, math.pi - 1e-7])
+def test_no_blend_within_a_microradian_of_straight_or_reversal(turn):
+    first = Line([0.0, 0.0], [10.0, 0.0])
+    end = [10.0 + 5.0 * math.cos(turn), 5.0 * math.sin(turn)]
+    assert blend_corner(first, Line([10.0, 0.0], end), 0.5) is None
+    assert blend_corner(first, Line([10.0, 0.0], [10.0 + 5.0 * math.cos(2e-6),
+                                                  5.0 * math.sin(2e-6)]), 0.5) is not None
+
+
 def test_no_blend_for_zero_tolerance_or_zero_length():
     first = Line([0.0, 0.0], [10.0, 0.0])
     assert blend_corner(first, Line([10.0, 0.0], [10.0, 5.0]), 0.0) is None

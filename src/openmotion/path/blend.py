@@ -35,9 +35,11 @@ from .geometry import Line, as_point
 #: A blend may use at most this fraction of each line (LinuxCNC BLEND_DIST_FRACTION).
 BLEND_DIST_FRACTION = 0.5
 #: Turn angles below this (radians) are treated as straight: no blend, no corner limit.
-TANGENT_ANGLE = 1e-9
+#: Generous on purpose: the directions of short lines far from the origin carry rounding
+#: of eps*|coordinate|/length, and a kink of 1e-6 rad changes the velocity by 1e-6*v.
+TANGENT_ANGLE = 1e-6
 #: Corners whose lines are within this angle (radians) of a full reversal need an exact stop.
-REVERSAL_ANGLE = 1e-9
+REVERSAL_ANGLE = 1e-6
 _SQRT2_M1 = math.sqrt(2.0) - 1.0
 
 
