@@ -33,6 +33,11 @@ from .jerk import PHASE_LABELS, phase_times
 from .ramps import ramp_jerk
 from .segments import Profile, ProfileBuilder, State
 
+# Relative slack under which two velocities or distances count as equal. Near such a tie a
+# ramp's duration depends on the difference through a square root, so rounding noise of
+# 1e-16 would otherwise add spurious ~1e-8 s micro-phases (or a micro-reversal).
+SNAP = 1e-12
+
 # (duration, jerk, acceleration pinned at the phase start or None)
 Phase = tuple[float, float, float | None]
 
@@ -43,7 +48,7 @@ def ramp_phases(v0: float, a0: float, v1: float, a_up: float, a_dn: float,
     """Fastest (v0, a0) -> (v1, 0) with acceleration in [-a_dn, a_up] (see module notes)."""
     v_stop = v0 + a0 * abs(a0) / (2.0 * j)
     diff = v1 - v_stop
-    if abs(diff) <= 4e-16 * max(abs(v0), abs(v1), a0 * a0 / j):
+    if abs(diff) <= SNAP * max(abs(v0), abs(v1), a0 * a0 / j):
         return [(abs(a0) / j, -math.copysign(j, a0), None)] if a0 else []
     s = 1.0 if diff > 0.0 else -1.0
     lim = a_up if s > 0.0 else a_dn
@@ -121,20 +126,26 @@ def _brake_to_vmax(v: float, a: float, v_max: float, d_max: float, j: float) -> 
 
 
 def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_max: float,
-               j: float) -> list[Phase] | None:
-    """Phases to rest after exactly `length` ahead (frame of motion), or None if the
-    target lies behind the stopping point (an overshoot is needed)."""
+               j: float, *, pos_scale: float = 0.0, reversal: bool = False
+               ) -> list[Phase] | None:
+    """Phases to rest after exactly `length` ahead (in this frame), or None if the target
+    lies behind the stopping point. `pos_scale` (|absolute position|) sets the rounding
+    slack; with `reversal` the target must lie strictly beyond the stopping point (the
+    approach must really come from this frame's direction)."""
     stop = ramp_phases(v, a, 0.0, a_max, d_max, j)
     d_stop = advance(v, a, stop)[0]
-    if length < d_stop:
+    tol = SNAP * max(abs(length), abs(d_stop), pos_scale)
+    if length < d_stop - tol or (reversal and length <= d_stop + tol):
         return None
+    if length <= d_stop + tol:
+        return stop  # the fastest stop ends on the target (end_p makes it exact)
     pre: list[Phase] = []
     v_stop = v + a * abs(a) / (2.0 * j)
     if v_stop > v_max:
         pre = _brake_to_vmax(v, a, v_max, d_max, j)
         d_pre, v_b, a_b = advance(v, a, pre)
         d_rest = length - d_pre
-        if d_rest < advance(v_b, a_b, ramp_phases(v_b, a_b, 0.0, a_max, d_max, j))[0]:
+        if d_rest < advance(v_b, a_b, ramp_phases(v_b, a_b, 0.0, a_max, d_max, j))[0] - tol:
             # the target lies inside the braking: stop, then move on rest-to-rest
             return stop + _rest_to_rest(length - d_stop, v_max, a_max, d_max, j)
         v, a, length = v_b, a_b, d_rest
@@ -153,6 +164,8 @@ def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_
         down = ramp_phases(v_max, 0.0, 0.0, a_max, d_max, j)
         cruise = -d1(v_max) / v_max
         return pre + up + [(cruise, 0.0, 0.0)] + down
+    if abs(d1(v_lo)) <= tol:
+        return pre + f1(v_lo)
     if d1(v_lo) <= 0.0:
         return pre + f1(_solve(d1, v_lo, v_max))
     if a < 0.0:
@@ -212,10 +225,11 @@ def retarget(state: State, target: float, v_max: float, a_max: float, j_max: flo
     m = 1.0 if v_stop > 0.0 or (v_stop == 0.0 and tgt >= p) else -1.0
     vf, af, length = m * v, m * a, m * (tgt - p)
     labels: list[str] = []
-    phases = plan_ahead(vf, af, length, vm, am, dm, jm)
+    scale = max(abs(p), abs(tgt))
+    phases = plan_ahead(vf, af, length, vm, am, dm, jm, pos_scale=scale)
     if phases is None:  # reverse through zero velocity, planned in the frame of approach
         m, vf, af, length = -m, -vf, -af, -length
-        phases = plan_ahead(vf, af, length, vm, am, dm, jm)
+        phases = plan_ahead(vf, af, length, vm, am, dm, jm, pos_scale=scale, reversal=True)
     if phases is None:
         # Only with a_max > d_max: the target is behind the stopping point braking at d_max
         # but ahead of it braking at a_max. Stop (at d_max), then move back rest-to-rest.
