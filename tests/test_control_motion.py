@@ -171,19 +171,22 @@ def test_stop_in_every_phase(ctl, shape, phase, kind):
         while ax.motion_done:
             ctl.step()
             speeds.append(ax.speed)
-        assert max(speeds) <= v_before * (1 + 1e-9)
-        assert len(speeds) <= 0.1 / ctl.period + 2
+        # a T stop never speeds up; an S stop while accelerating first brings the
+        # acceleration to zero at the move's jerk, which may reach (never pass) MaxVel
+        assert max(speeds) <= (v_before if shape == "T" else 20_000) * (1 + 1e-9)
+        assert len(speeds) * ctl.period <= 0.15 + 2 * ctl.period
     else:
         ax.stop_immediately()
     assert ax.state is S.STANDSTILL and ax.speed == 0.0 and ax.motion_done == 0
     ctl.advance(0.01)
     assert ax.counters.command == ax.counters.feedback
-    assert abs(ax.counters.command) < 10_000
+    assert 0 < ax.counters.command <= 10_000
     # the axis moves again and ends exactly
+    expected = round(ax.position - 500)  # a stop may end between two counts
     ax.move_relative(-500, max_vel=20_000, tacc=0.01)
-    start = ax.counters.command
     run_move(ctl, ax)
-    assert ax.counters.command == start - 500 or abs(ax.counters.command - (start - 500)) <= 1
+    assert ax.counters.command == expected
+    assert ax.position == expected
 
 
 def test_stop_during_velocity_mode_and_at_rest(ctl):
@@ -192,8 +195,8 @@ def test_stop_during_velocity_mode_and_at_rest(ctl):
     assert ax.state is S.STANDSTILL
     ax.move_velocity(5000, tacc=0.05)
     ctl.advance(0.02)
-    ax.stop(tdec=0.2)
-    ctl.advance(0.1)
+    ax.stop(tdec=0.2)  # 5000 pps -> 0 in 0.2 s: from 2000 pps it takes 0.08 s
+    ctl.advance(0.05)
     assert ax.state is S.STOPPING
     run_move(ctl, ax)
     assert ax.state is S.STANDSTILL

@@ -51,7 +51,7 @@ class Axis:
         self.name = config.name
         self.config = config
         self.units = AxisUnits.from_axis(config)
-        self.counters = Counters(config.move_ratio)
+        self.counters = Counters(config.move_ratio, lambda: controller._sync(index))
         self._ctl = controller
         self._state = S.DISABLED
         self._fault: str | None = None
@@ -421,9 +421,7 @@ class Axis:
         self._vel = v1 if t1 < m.t_end or m.kind == "velocity" else 0.0
         return AxisCommand(t0, t1 - t0, p0, v0, a0, j)
 
-    def _cycle_end(self, t1: float, pulses_out: int, encoder: int,
-                   inputs: dict[str, bool]) -> None:
-        self.counters.update(pulses_out, encoder, t1)
+    def _cycle_end(self, t1: float) -> None:
         m = self._motion
         if m is not None and m.finished(t1):
             self._motion = None
@@ -433,7 +431,7 @@ class Axis:
                 self._waiting_inp = True
             else:
                 self._state = transition(self._state, S.STANDSTILL, self.name)
-        if self._waiting_inp and self._ctl.input_active(self.index, "inp", inputs):
+        if self._waiting_inp and self._ctl.input_active(self.index, "inp"):
             self._waiting_inp = False
             self._state = transition(self._state, S.STANDSTILL, self.name)
 

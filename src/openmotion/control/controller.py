@@ -7,7 +7,8 @@ One cycle (period T, from t0 to t1 = t0 + T):
 2. `hardware.advance(t1)` moves the machine and returns the input edges, time-ordered;
 3. each edge goes through the edge-hook list (E-stop and servo alarm are the first two;
    limits, latches and compare subscribe with `add_edge_hook`);
-4. every axis reads back its counters and finishes a motion that reached its end;
+4. every axis finishes a motion that reached its end (counters and input levels are read
+   back from the hardware lazily, at most once per cycle, when first looked at);
 5. cycle hooks run (`add_cycle_hook`), then the recorder if recording is on.
 
 Virtual time: `step()`, `advance(dt)`, `run_until(condition, timeout)` - deterministic, as
@@ -88,7 +89,7 @@ class Controller:
         self._emg_nc = any(ax.signal_logic("emg") == "nc" for ax in config.axes)
         self.recorder: Any = None
         self._pacer = RealtimePacer(self.step, self.period)
-        self._read_back()
+        self._rb_cycle = [-1] * len(self.axes)
         self._estop = self._emg_level_active(hardware.read_input("emg"))
 
     # ------------------------------------------------------------------ lookup
@@ -122,11 +123,10 @@ class Controller:
         return self._estop
 
     # ------------------------------------------------------------------ inputs
-    def input_active(self, axis: int, signal: str, inputs: dict[str, bool] | None = None
-                     ) -> bool:
+    def input_active(self, axis: int, signal: str) -> bool:
         """Logical level of an axis input (configured NO/NC logic applied)."""
-        level = (self._inputs[axis] if inputs is None else inputs).get(signal, False)
-        return level != (signal in self._nc[axis])
+        self._sync(axis)
+        return self._inputs[axis].get(signal, False) != (signal in self._nc[axis])
 
     def alarm_active(self, axis: int) -> bool:
         return self.input_active(axis, "alm")
@@ -199,19 +199,26 @@ class Controller:
                 for e in edges:
                     for h in hooks:
                         h(self, e)
-            self._read_back()
+            for ax in self.axes:
+                ax._cycle_end(t1)
             for h in self._cycle_hooks:
                 h(self, t1)
             if self.recorder is not None:
                 self._record(t1)
 
-    def _read_back(self) -> None:
-        hw = self.hardware
-        t = self._time
-        for ax in self.axes:
-            rb = hw.read_axis(ax.index)
-            self._inputs[ax.index] = rb.inputs
-            ax._cycle_end(t, rb.pulses_out, rb.encoder, rb.inputs)
+    def _sync(self, axis: int) -> None:
+        """Read an axis back from the hardware if not done since the last cycle.
+
+        Counters and input levels are read lazily, at most once per cycle and only when
+        someone looks: the values are those at the current controller time either way, and
+        the hot path skips a hardware call per idle axis per cycle.
+        """
+        if self._rb_cycle[axis] != self._n:
+            with self._lock:
+                rb = self.hardware.read_axis(axis)
+                self._rb_cycle[axis] = self._n
+                self._inputs[axis] = rb.inputs
+                self.axes[axis].counters.update(rb.pulses_out, rb.encoder, self._time)
 
     def advance(self, dt: float) -> None:
         """Run the cycles covering `dt` seconds of virtual time (rounded up to whole cycles)."""

@@ -19,6 +19,8 @@ other counters or the motion.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ..errors import MotionError, check_finite
 
 COUNTER_BITS = 28
@@ -29,6 +31,10 @@ COUNTER_MAX = _HALF - 1
 #: General counter clock source: CLK/2 of the 19.6608 MHz reference (HSL 4.9 "9.8 MHz").
 CLOCK_HZ = 9_830_400
 GENERAL_SOURCES = ("command", "feedback", "manual", "clock")
+
+
+def _nothing() -> None:
+    pass
 
 
 def wrap28(x: int) -> int:
@@ -51,9 +57,13 @@ class Counters:
     """Command, feedback, error and general counters plus the target recorder of one axis."""
 
     __slots__ = ("_pulses", "_encoder", "_time", "_ratio", "_cmd_off", "_fb_off", "_err_off",
-                 "_gen_off", "_gen_src", "_target")
+                 "_gen_off", "_gen_src", "_target", "_fresh")
 
-    def __init__(self, move_ratio: float = 1.0) -> None:
+    def __init__(self, move_ratio: float = 1.0,
+                 refresh: Callable[[], None] | None = None) -> None:
+        # `refresh` brings the raw totals up to date before any read (the controller reads
+        # the hardware lazily, at most once per cycle, only when someone looks).
+        self._fresh = refresh or _nothing
         self._pulses = 0
         self._encoder = 0
         self._time = 0.0
@@ -65,7 +75,7 @@ class Counters:
         self._gen_src = "manual"
         self._target = 0.0
 
-    # -- fed by the controller once per cycle --------------------------------------------
+    # -- fed by the controller (through `refresh`) ---------------------------------------
     def update(self, pulses_out: int, encoder: int, time: float) -> None:
         """Latest raw hardware totals (unwrapped) and controller time."""
         self._pulses = pulses_out
@@ -80,6 +90,7 @@ class Counters:
 
     def set_move_ratio(self, ratio: float) -> None:
         """Set the feedback-to-command ratio, keeping the error counter's reading."""
+        self._fresh()
         r = check_finite("move_ratio", ratio)
         if r <= 0.0:
             raise MotionError(f"move_ratio must be > 0, got {ratio!r}")
@@ -88,9 +99,11 @@ class Counters:
         self._err_off += before - self.error
 
     def command_unwrapped(self) -> int:
+        self._fresh()
         return self._pulses + self._cmd_off
 
     def feedback_unwrapped(self) -> int:
+        self._fresh()
         return self._encoder + self._fb_off
 
     def feedback_in_pulses(self) -> float:
@@ -104,19 +117,24 @@ class Counters:
     # -- the four counters ------------------------------------------------------------------
     @property
     def command(self) -> int:
+        self._fresh()
         return wrap28(self._pulses + self._cmd_off)
 
     def set_command(self, value: int) -> None:
+        self._fresh()
         self._cmd_off = _check_count("command", value) - self._pulses
 
     @property
     def feedback(self) -> int:
+        self._fresh()
         return wrap28(self._encoder + self._fb_off)
 
     def set_feedback(self, value: int) -> None:
+        self._fresh()
         self._fb_off = _check_count("position", value) - self._encoder
 
     def _raw_error(self) -> int:
+        self._fresh()
         return round(self._pulses - self._encoder / self._ratio)
 
     @property
@@ -127,6 +145,7 @@ class Counters:
         self._err_off = -self._raw_error()
 
     def _raw_general(self) -> int:
+        self._fresh()
         src = self._gen_src
         if src == "command":
             return self._pulses
@@ -166,6 +185,7 @@ class Counters:
 
     def reset_all(self) -> None:
         """Clear command, feedback, error and general counters (home completion)."""
+        self._fresh()
         self.set_command(0)
         self.set_feedback(0)
         self.reset_error()
@@ -173,5 +193,6 @@ class Counters:
 
     def snapshot(self) -> tuple:
         """Every counter value and offset (tests compare snapshots before and after)."""
+        self._fresh()
         return (self.command, self.feedback, self.error, self.general, self._gen_src,
                 self._target, self._ratio)

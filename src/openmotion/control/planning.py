@@ -8,6 +8,9 @@ InfeasibleError before anything is changed when the planner refuses.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
+from ..profile import velocity
 from ..profile.jerk import jerk_limited
 from ..profile.pcl import MoveSpec
 from ..profile.retarget import retarget_velocity
@@ -28,9 +31,7 @@ def jerk_move(start: float, target: float, v_max: float, a_max: float, j_max: fl
 
 def velocity_move(spec: MoveSpec, direction: float, start: float) -> Profile:
     """Velocity mode from rest: StrVel jump, ramp to MaxVel in Tacc, hold (tv/sv_move)."""
-    from ..profile import velocity
-
-    return velocity.velocity_ramp(spec, direction, start=start)
+    return velocity.velocity_move(spec, direction, start=start)
 
 
 def change_speed(m: ActiveMotion, t: float, new_vel: float, tacc: float,
@@ -52,10 +53,6 @@ def change_position(m: ActiveMotion, t: float, new_target: float) -> Profile:
 
 def decel_stop(m: ActiveMotion, t: float, tdec: float | None) -> Profile:
     """sd_stop at absolute time t (deceleration of the move's spec, or `tdec`)."""
-    from dataclasses import replace
-
-    from ..profile import velocity
-
     if m.limits is not None:  # jerk-limited move: fastest jerk-limited ramp to rest
         u = t - m.t_start
         _, a_max, j_max = m.limits
