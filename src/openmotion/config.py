@@ -45,6 +45,8 @@ ENCODER_MULTIPLIER = {"ab_x1": 1, "ab_x2": 2, "ab_x4": 4, "cw_ccw": 1, "pulse_di
 CYCLE_RANGE_S = (0.001, 1.0)
 MAX_PULSE_WIDTH_US = 1000.0
 MAX_GENERAL_IO = 4096
+#: Switch position/width/hysteresis are kept on a 1e-6 pulse grid (see SwitchConfig).
+SWITCH_DECIMALS = 6
 
 
 # -- field checks: each names the field path and the rule ------------------------------
@@ -115,14 +117,21 @@ class SwitchConfig:
         self.validate("switch")
 
     def validate(self, path: str) -> None:
-        """Check the fields; `path` prefixes error messages (e.g. "axes.x.pel")."""
-        _set(self, "position", check_distance(f"{path}.position", _real(f"{path}.position",
-                                                                          self.position)))
-        w = _real(f"{path}.width", self.width)
+        """Check the fields; `path` prefixes error messages (e.g. "axes.x.pel").
+
+        Values are rounded to SWITCH_DECIMALS decimals of a pulse: a file holds them in user
+        units, and x -> x / scale -> x * scale is not exact in floating point for every
+        scale; on this grid the save/load round trip is exact (|x| < 2**28).
+        """
+        pos = check_distance(f"{path}.position", _real(f"{path}.position", self.position))
+        _set(self, "position", round(pos, SWITCH_DECIMALS) + 0.0)
+        w = round(_real(f"{path}.width", self.width), SWITCH_DECIMALS)
         if w == 0.0:
-            raise MotionError(f"{path}.width must be non-zero, got {self.width!r}")
+            raise MotionError(f"{path}.width must be non-zero (at 1e-{SWITCH_DECIMALS} pulse), "
+                              f"got {self.width!r}")
         _set(self, "width", w)
-        _set(self, "hysteresis", _nonneg(f"{path}.hysteresis", self.hysteresis))
+        h = _nonneg(f"{path}.hysteresis", self.hysteresis)
+        _set(self, "hysteresis", round(h, SWITCH_DECIMALS) + 0.0)
 
 
 @dataclass(frozen=True)
