@@ -5,7 +5,7 @@ from dataclasses import replace
 import pytest
 
 from openmotion.config import DriveConfig, default_machine
-from openmotion.control import AxisState, Controller
+from openmotion.control import AxisState, Controller, MotionDone
 from openmotion.errors import MotionError
 
 S = AxisState
@@ -254,3 +254,23 @@ def test_recording(ctl):
     ctl.stop_recording()
     ctl.advance(0.01)
     assert ctl.recorder is None
+
+
+def test_servo_waits_for_inp_after_the_profile_ends():
+    m = default_machine()
+    x = replace(m.axes[0], drive=DriveConfig(type="servo", bandwidth_hz=20.0, inp_band=2.0))
+    c = Controller(m.with_axis(x))
+    c.enable_all()
+    ax = c.axis("x")
+    ax.set_inp(True)
+    ax.move_relative(20_000, max_vel=100_000, tacc=0.05)
+    end = ax.motion.t_end
+    codes = set()
+    while ax.motion_done:
+        codes.add(ax.motion_done)
+        c.step()
+        assert c.time < end + 2.0
+    assert MotionDone.WAITING_INP in codes
+    assert c.time > end + c.period  # the servo lags the command
+    assert ax.state is S.STANDSTILL
+    assert abs(ax.counters.error) <= 2

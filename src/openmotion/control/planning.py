@@ -14,19 +14,28 @@ from ..profile import velocity
 from ..profile.jerk import jerk_limited
 from ..profile.pcl import MoveSpec
 from ..profile.retarget import retarget_velocity
-from ..profile.segments import Profile
+from ..profile.segments import Profile, State
 from .motion import ActiveMotion
 
 
 def position_move(spec: MoveSpec, start: float, target: float) -> Profile:
     """PCL6045 T/S move from rest at `start` to exactly `target` (raw pulse frame)."""
-    return spec.plan(target - start, start).profile
+    return _ending_on(spec.plan(target - start, start).profile, target)
+
+
+def _ending_on(profile: Profile, target: float) -> Profile:
+    """The profile with its end state pinned to `target`: start + (target - start) need
+    not round back to target in floating point when start is fractional."""
+    if profile.end.p == target:
+        return profile
+    return replace(profile, end=State(target, 0.0, 0.0))
 
 
 def jerk_move(start: float, target: float, v_max: float, a_max: float, j_max: float,
               d_max: float | None) -> Profile:
     """Time-optimal jerk-limited rest-to-rest move to exactly `target`."""
-    return jerk_limited(target - start, v_max, a_max, j_max, d_max=d_max, start=start)
+    return _ending_on(jerk_limited(target - start, v_max, a_max, j_max, d_max=d_max,
+                                   start=start), target)
 
 
 def velocity_move(spec: MoveSpec, direction: float, start: float) -> Profile:
