@@ -2,7 +2,10 @@
 simulated plant behind each axis. Built in code or loaded from / saved to TOML.
 
 Units: mechanism-related lengths are in the axis's user unit; speeds in user units per
-second; the simulator section is in command pulses unless a name says otherwise.
+second; the simulator section (DriveConfig) is in command pulses unless a name says
+otherwise. Switches (SwitchConfig) are in command pulses in code but in the axis's USER
+units in a TOML file (people measure switches in mm or degrees): load converts them with
+`pulses = user * pulses_per_unit * (-1 if reverse else 1)` and save converts back.
 
 Every dataclass validates itself on construction (also through `dataclasses.replace`), so a
 MachineConfig that exists is valid. Errors are MotionError naming the path of the bad field,
