@@ -200,6 +200,17 @@ def test_stop_during_velocity_mode_and_at_rest(ctl):
     assert ax.state is S.STOPPING
     run_move(ctl, ax)
     assert ax.state is S.STANDSTILL
+    # an immediate stop also ends a decelerating stop
+    ax.move_velocity(-5000, tacc=0.05)
+    ctl.advance(0.1)
+    ax.stop()
+    ctl.advance(0.01)
+    assert ax.state is S.STOPPING
+    ax.stop_immediately()
+    assert ax.state is S.STANDSTILL and ax.motion_done == 0
+    p = ax.counters.command
+    ctl.advance(0.05)
+    assert ax.counters.command == p
 
 
 def test_jerk_limited_move(ctl):

@@ -24,7 +24,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..config import MachineConfig, default_machine
-from ..errors import MotionError, check_finite, check_nonnegative
+from ..errors import MotionError, check_nonnegative
 from ..history import MotionHistory
 from ..hw.interface import Hardware, InputEdge
 from ..recording import Recorder
@@ -253,10 +253,11 @@ class Controller:
             raise MotionError("virtual-time calls are not allowed while real-time mode runs")
 
     # ------------------------------------------------------------------ recording
-    def start_recording(self, capacity: int = 600_000, channels: Sequence[str] | None = None,
+    def start_recording(self, capacity: int = 60_000, channels: Sequence[str] | None = None,
                         *, spill_path: str | None = None) -> Recorder:
-        """Record every cycle into a new `Recorder` (ring buffer of `capacity` cycles;
-        default 10 min at 1 ms). Channels as in openmotion.recording (default all)."""
+        """Record every cycle into a new `Recorder` (ring buffer of `capacity` cycles,
+        default 1 min at 1 ms; `spill_path` keeps older rows in a file). Channels as in
+        openmotion.recording (default all)."""
         kwargs: dict[str, Any] = {"spill_path": spill_path}
         if channels is not None:
             kwargs["channels"] = channels
@@ -319,11 +320,6 @@ class Controller:
             self.history.truncate(axis.index, self._time)
         else:
             self.history.append(axis.index, motion.t_start, motion.profile)
-
-    def sleep_until(self, t: float) -> None:
-        """Virtual time: run cycles until controller time >= t."""
-        t = check_finite("t", t)
-        self.advance(max(0.0, t - self._time))
 
 
 # -- built-in edge hooks -------------------------------------------------------------------
