@@ -445,7 +445,9 @@ def _rebased(err: MotionError, local: str, path: str) -> MotionError:
 
 
 def _exact_units(p: float, scale: float) -> float:
-    """A user-unit value u with u * scale == p exactly, so save -> load is lossless."""
+    """The user-unit value to write for pulses p: one with u * scale == p exactly when such
+    a float exists (tidier files); otherwise p / scale, and the 1e-6 pulse grid of
+    SwitchConfig absorbs the last-bit error on load."""
     u = p / scale
     for direction in (math.inf, -math.inf):
         c = u
