@@ -132,6 +132,27 @@ def test_append_splices_onto_running_motion() -> None:
     assert h.n_records(0) == 4
 
 
+def test_append_spliced_profile_at_its_original_start() -> None:
+    # The controller re-appends a Profile.splice(...) result at the move's start time.
+    first = velocity_ramp(0.0, 100.0, 0.5)
+    h = MotionHistory(1)
+    h.append(0, 1.0, first)
+    st_change = first.state_at(0.3)
+    tail = ProfileBuilder(st_change.p, st_change.v, st_change.a).segment(0.2, accel=-100.0)
+    spliced = first.splice(0.3, tail.build(end_v=st_change.v - 20.0))
+    h.append(0, 1.0, spliced)
+    t = np.linspace(0.0, 3.0, 301)
+    np.testing.assert_allclose(h.sample(0, 1.0 + t).p, spliced.sample(t).p, rtol=1e-14,
+                               atol=1e-12)
+    assert h.state_at(0, 10.0).v == spliced.end.v
+
+
+def test_truncate_before_all_records() -> None:
+    h = MotionHistory(1, positions=[4.0], t_start=5.0)
+    assert h.truncate(0, 2.0) == State(4.0, 0.0, 0.0)
+    assert h.start_time(0) == 2.0 and h.n_records(0) == 1
+
+
 def test_append_after_end_leaves_standstill_gap() -> None:
     h = MotionHistory(1)
     a = scurve(0.0, 7.0)

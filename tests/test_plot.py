@@ -8,7 +8,7 @@ import pytest
 from openmotion.errors import MotionError
 from openmotion.plot import envelope, plot_profile, plot_trace, profile_times
 from openmotion.profile.segments import ProfileBuilder, empty_profile
-from openmotion.recording import Recorder
+from openmotion.recording import Recorder, load_trace
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -82,6 +82,15 @@ def test_plot_trace_png_and_html(tmp_path) -> None:
     assert [p.name for p in out] == ["trace.png", "trace.html"]
     assert_png(out[0])
     assert_html(out[1], "run 1")
+
+
+def test_plot_trace_accepts_recorder_and_loaded_file(tmp_path) -> None:
+    rec = Recorder(1, 50)
+    for k in range(50):
+        rec.record(k * 1e-3, [k], [k], [1000.0], [1], [k % 2])
+    assert_png(plot_trace(rec, tmp_path / "rec.png")[0])
+    path = rec.save(tmp_path / "rec.csv")
+    assert_png(plot_trace(load_trace(path), tmp_path / "loaded.png")[0])
 
 
 def test_plot_trace_axis_subset_and_missing_channels(tmp_path) -> None:

@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 
 from .errors import MotionError
 from .profile.segments import Profile
+from .recording import Recorder
 
 IMAGE_SUFFIXES = (".png", ".svg", ".pdf")
 MAX_TRACE_POINTS = 20_000  # per line; longer traces are reduced to a min/max envelope
@@ -144,16 +145,19 @@ def _check_arrays(arrays: Mapping[str, Any]) -> tuple[NDArray[Any], int]:
     return t, n_axes
 
 
-def plot_trace(recorder_arrays: Mapping[str, Any], path: str | Path,
+def plot_trace(recorder_arrays: Mapping[str, Any] | Recorder, path: str | Path,
                axes: Sequence[int] | None = None, *, title: str | None = None,
                html: bool = False) -> list[Path]:
     """Velocity curve (velocity vs time) of a recorded trace, with position and I/O lanes.
 
-    `recorder_arrays` is `Recorder.arrays()` (or `recording.load_trace`); `axes` selects axes
+    `recorder_arrays` is `Recorder.arrays()`, `recording.load_trace(...)` or a Recorder;
+    `axes` selects axes
     (default all). Velocity is `cmd_vel`, or the gradient of `cmd_pos` when it was not
     recorded. I/O lanes show each bit of the `io` word that is ever set, and the state code.
     Returns the paths written.
     """
+    if isinstance(recorder_arrays, Recorder):
+        recorder_arrays = recorder_arrays.arrays()
     t, n_axes = _check_arrays(recorder_arrays)
     p = _check_path(path)
     if axes is None:
