@@ -58,12 +58,15 @@ def test_retarget_from_above_v_max_brakes_and_stays_valid(case):
     s, target, v, a, j, d = case
     prof = retarget(s, target, v, a, j, d_max=d)
     check(prof, s, target, v, a, j, d)
-    # once at or below v_max, the speed stays there
+    # after the peak speed (unavoidable while a is brought down), once at or below v_max
+    # the speed stays there
     sm = prof.sample(np.linspace(0, prof.duration, 2001))
-    below = np.abs(sm.v) <= v * (1 + 1e-9) + 1e-12
+    speed = np.abs(sm.v)
+    k = int(np.argmax(speed))
+    below = speed[k:] <= v * (1 + 1e-9)
     if below.any():
-        first = int(np.argmax(below))
-        assert (np.abs(sm.v[first:]) <= v * (1 + 1e-9) + abs(s.a) * 1e-12).all()
+        first = k + int(np.argmax(below))
+        assert (speed[first:] <= v * (1 + 1e-9) + abs(s.a) * 1e-12).all()
 
 
 @settings(max_examples=40, deadline=None)

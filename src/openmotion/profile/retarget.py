@@ -12,11 +12,15 @@ down. In that frame, with L = m*(target - p) and d_stop the distance of the fast
     F2  if a < 0 and even F1 at V = v_stop overshoots: brake softer. Jerk +J for t1,
         then the fastest stop; the distance grows with t1 in [0, -a/J] (t1 = 0 is the
         fastest stop, t1 = -a/J is F1 at V = v_stop).
-    If the stop point itself lies beyond v_max (v_stop > v_max), first brake at full jerk
-    (and d_max) until v = v_max, as ruckig does, then F1/F2 from there.
-  L < d_stop: brake to rest (overshooting), then a rest-to-rest move back.
-Any remaining corner (the target inside the braking that gets below v_max) stops and then
-moves on rest-to-rest: valid, not optimal.
+    If v_stop > v_max, F1 ramps down to V <= v_max; if even V = v_max overshoots, V is
+    searched in [0, v_max] (a braking dip at V; d(0) is the fastest stop). Valid, but
+    ruckig (which brakes until v = v_max with a < 0, then plans) may differ either way.
+  L < d_stop: reverse through v = 0. Planned in the opposite frame, where the target now
+    lies ahead of the stopping point (F1 with V > 0 from a negative velocity).
+Limits are in the frame of the final approach: a_max towards it, d_max against it (as
+ruckig's max/min acceleration; for a rest-to-rest move, d_max is the deceleration). With
+a_max > d_max a target may lie behind the stop point braking at d_max but ahead of it
+braking at a_max; then neither frame fits and we stop (at d_max) and move back.
 
 The fastest ramp (v0, a0) -> (v1, 0) with separate limits up/down, see `ramps.py` for the
 symmetric derivation; if a0 already exceeds the limit in the ramp's direction, the first
@@ -108,23 +112,6 @@ def _solve(f: Callable[[float], float], lo: float, hi: float) -> float:
     return lo if -flo <= fhi else hi  # keeps the root side that undershoots least
 
 
-def _brake_to_vmax(v: float, a: float, v_max: float, d_max: float, j: float) -> list[Phase]:
-    """Full-jerk braking (holding -d_max) until v = v_max; needs v_stop > v_max."""
-    if a < -d_max:  # beyond the braking limit: ease back to it while braking
-        t1 = (-d_max - a) / j
-        _, v_end, _ = advance(v, a, [(t1, j, None)])
-        if v_end <= v_max:  # v + a t + j t^2/2 = v_max, first crossing
-            t = (-a - math.sqrt(max(0.0, a * a - 2.0 * j * (v - v_max)))) / j
-            return [(t, j, None)]
-        return [(t1, j, None), ((v_end - v_max) / d_max, 0.0, -d_max)]
-    t = (a + math.sqrt(a * a + 2.0 * j * (v - v_max))) / j  # v + a t - j t^2/2 = v_max
-    if a - j * t >= -d_max:
-        return [(t, -j, None)]
-    t1 = (a + d_max) / j
-    _, v1, _ = advance(v, a, [(t1, -j, None)])
-    return [(t1, -j, None), (max(0.0, (v1 - v_max) / d_max), 0.0, -d_max)]
-
-
 def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_max: float,
                j: float, *, pos_scale: float = 0.0, reversal: bool = False
                ) -> list[Phase] | None:
@@ -139,17 +126,7 @@ def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_
         return None
     if length <= d_stop + tol:
         return stop  # the fastest stop ends on the target (end_p makes it exact)
-    pre: list[Phase] = []
     v_stop = v + a * abs(a) / (2.0 * j)
-    if v_stop > v_max:
-        pre = _brake_to_vmax(v, a, v_max, d_max, j)
-        d_pre, v_b, a_b = advance(v, a, pre)
-        d_rest = length - d_pre
-        if d_rest < advance(v_b, a_b, ramp_phases(v_b, a_b, 0.0, a_max, d_max, j))[0] - tol:
-            # the target lies inside the braking: stop, then move on rest-to-rest
-            return stop + _rest_to_rest(length - d_stop, v_max, a_max, d_max, j)
-        v, a, length = v_b, a_b, d_rest
-        v_stop = v + a * abs(a) / (2.0 * j)
 
     def f1(vc: float) -> list[Phase]:
         return ramp_phases(v, a, vc, a_max, d_max, j) + ramp_phases(vc, 0.0, 0.0, a_max,
@@ -158,25 +135,27 @@ def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_
     def d1(vc: float) -> float:
         return advance(v, a, f1(vc))[0] - length
 
-    v_lo = min(max(v_stop, 0.0), v_max)
+    # Above v_max the ramp to V brakes (with a dip at V): d(V) is continuous but not
+    # monotone there, so search all of [0, v_max]; d(0) is the fastest stop.
+    v_lo = max(v_stop, 0.0) if v_stop <= v_max else 0.0
     if d1(v_max) <= 0.0:
         up = ramp_phases(v, a, v_max, a_max, d_max, j)
         down = ramp_phases(v_max, 0.0, 0.0, a_max, d_max, j)
         cruise = -d1(v_max) / v_max
-        return pre + up + [(cruise, 0.0, 0.0)] + down
+        return up + [(cruise, 0.0, 0.0)] + down
     if abs(d1(v_lo)) <= tol:
-        return pre + f1(v_lo)
+        return f1(v_lo)
     if d1(v_lo) <= 0.0:
-        return pre + f1(_solve(d1, v_lo, v_max))
+        return f1(_solve(d1, v_lo, v_max))
     if a < 0.0:
         def f2(t1: float) -> list[Phase]:
             _, v1, a1 = advance(v, a, [(t1, j, None)])
             return [(t1, j, None)] + ramp_phases(v1, a1, 0.0, a_max, d_max, j)
 
         t1 = _solve(lambda t: advance(v, a, f2(t))[0] - length, 0.0, -a / j)
-        return pre + f2(t1)
+        return f2(t1)
     # not reached for a >= 0 (then d1(v_stop) is the stopping distance); kept for safety
-    return pre + ramp_phases(v, a, 0.0, a_max, d_max, j) + _rest_to_rest(
+    return ramp_phases(v, a, 0.0, a_max, d_max, j) + _rest_to_rest(
         length - advance(v, a, ramp_phases(v, a, 0.0, a_max, d_max, j))[0],
         v_max, a_max, d_max, j)
 
