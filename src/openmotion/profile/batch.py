@@ -16,6 +16,8 @@ from .jerk import NEWTON_STEPS
 
 Array = NDArray[np.float64]
 
+CHUNK = 16384  # moves per vectorized pass
+
 
 def _arr(name: str, value: ArrayLike, *, positive: bool) -> Array:
     try:
@@ -49,23 +51,49 @@ def _peak_velocity(length: Array, v_max: Array, a_max: Array, d_max: Array,
     v_both = 2.0 * length / (c + np.sqrt(c * c + 4.0 * k * length))
     v_neither = (length * np.sqrt(j_max) / 2.0) ** (2.0 / 3.0)
 
-    sj = np.sqrt(j_max)
-    u = np.minimum.reduce([np.sqrt(v2), (2.0 * lo * length) ** 0.25,
-                           np.cbrt(length * sj), np.sqrt(2.0 * j_max * length / lo)])
-    for _ in range(NEWTON_STEPS):
-        u2 = u * u
-        g = u2 * u2 / (2.0 * lo) + u2 * u / sj + u2 * lo / (2.0 * j_max) - length
-        dg = 2.0 * u2 * u / lo + 3.0 * u2 / sj + u * lo / j_max
-        step = np.where((g > 0.0) & (dg > 0.0), g / np.where(dg > 0.0, dg, 1.0), 0.0)
-        u = np.minimum(u, u - step)  # monotone from above, as in the scalar code
-    v_mixed = np.minimum(u * u, v_max)
+    vp = np.where(cruise, v_max, np.where(both, v_both, v_neither))
+    mixed = np.flatnonzero(~(cruise | both | neither))
+    if mixed.size:  # only these need the Newton iteration
+        L, h, jm = length[mixed], lo[mixed], j_max[mixed]
+        sj = np.sqrt(jm)
+        u = np.minimum.reduce([np.sqrt(v2[mixed]), (2.0 * h * L) ** 0.25, np.cbrt(L * sj),
+                               np.sqrt(2.0 * jm * L / h)])
+        for _ in range(NEWTON_STEPS):
+            u2 = u * u
+            g = u2 * u2 / (2.0 * h) + u2 * u / sj + u2 * h / (2.0 * jm) - L
+            dg = 2.0 * u2 * u / h + 3.0 * u2 / sj + u * h / jm
+            step = np.where((g > 0.0) & (dg > 0.0), g / np.where(dg > 0.0, dg, 1.0), 0.0)
+            u = np.minimum(u, u - step)  # monotone from above, as in the scalar code
+        vp[mixed] = np.minimum(u * u, v_max[mixed])
+    return vp
 
-    return np.where(cruise, v_max,
-                    np.where(both, v_both, np.where(neither, v_neither, v_mixed)))
+
+def _chunk_phases(length: Array, v: Array, a: Array, d: Array, j: Array) -> Array:
+    moving = length > 0.0
+    safe_len = np.where(moving, length, 1.0)
+    vp = _peak_velocity(safe_len, v, a, d, j)
+    out = np.empty((length.size, 7))
+    for col_j, col_c, x in ((0, 1, a), (4, 5, d)):
+        sat = vp * j >= x * x
+        tj = np.where(sat, x / j, np.sqrt(vp / j))
+        out[:, col_j] = tj
+        out[:, col_j + 2] = tj
+        out[:, col_c] = np.where(sat, vp / x - x / j, 0.0)
+    rest = safe_len - _ramp_distance(vp, a, j) - _ramp_distance(vp, d, j)
+    out[:, 3] = np.maximum(rest / vp, 0.0)
+    out[~moving] = 0.0
+    return out
+
+
+def _total(ph: Array) -> Array:
+    tj1, ta, _, tv, tj2, td, _ = ph.T
+    # The scalar code sums with math.fsum; this plain sum differs by a few ulps at most.
+    return 2.0 * tj1 + ta + tv + 2.0 * tj2 + td
 
 
 def _phases(distance: ArrayLike, v_max: ArrayLike, a_max: ArrayLike, j_max: ArrayLike,
-            d_max: ArrayLike | None) -> tuple[Array, tuple[int, ...]]:
+            d_max: ArrayLike | None, *, totals: bool = False) -> tuple[Array, tuple[int, ...]]:
+    """(N, 7) phase times, or with `totals` only the (N,) durations (8 bytes per move)."""
     dist = _arr("distance", distance, positive=False)
     if (np.abs(dist) > COUNTER28_MAX).any():
         raise MotionError(f"distance must satisfy |distance| <= {COUNTER28_MAX} everywhere")
@@ -80,19 +108,11 @@ def _phases(distance: ArrayLike, v_max: ArrayLike, a_max: ArrayLike, j_max: Arra
     shape = length.shape
     length, v, a, d, j = (x.reshape(-1) for x in (length, v, a, d, j))
 
-    moving = length > 0.0
-    safe_len = np.where(moving, length, 1.0)
-    vp = _peak_velocity(safe_len, v, a, d, j)
-    out = np.zeros((length.size, 7))
-    for col_j, col_c, x in ((0, 1, a), (4, 5, d)):
-        sat = vp * j >= x * x
-        tj = np.where(sat, x / j, np.sqrt(vp / j))
-        out[:, col_j] = tj
-        out[:, col_j + 2] = tj
-        out[:, col_c] = np.where(sat, vp / x - x / j, 0.0)
-    rest = safe_len - _ramp_distance(vp, a, j) - _ramp_distance(vp, d, j)
-    out[:, 3] = np.maximum(rest / vp, 0.0)
-    out[~moving] = 0.0
+    out = np.zeros(length.size if totals else (length.size, 7))
+    for k in range(0, length.size, CHUNK):  # chunks keep the temporaries in cache
+        sl = slice(k, k + CHUNK)
+        ph = _chunk_phases(length[sl], v[sl], a[sl], d[sl], j[sl])
+        out[sl] = _total(ph) if totals else ph
     return out, shape
 
 
@@ -109,7 +129,5 @@ def jerk_limited_phases(distance: ArrayLike, v_max: ArrayLike, a_max: ArrayLike,
 def jerk_limited_durations(distance: ArrayLike, v_max: ArrayLike, a_max: ArrayLike,
                            j_max: ArrayLike, d_max: ArrayLike | None = None) -> Array:
     """Durations of the time-optimal rest-to-rest moves, shaped like the broadcast inputs."""
-    ph, shape = _phases(distance, v_max, a_max, j_max, d_max)
-    tj1, ta, _, tv, tj2, td, _ = ph.T
-    # The scalar code sums with math.fsum; this plain sum differs by a few ulps at most.
-    return (2.0 * tj1 + ta + tv + 2.0 * tj2 + td).reshape(shape)
+    total, shape = _phases(distance, v_max, a_max, j_max, d_max, totals=True)
+    return total.reshape(shape)

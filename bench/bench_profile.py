@@ -1,0 +1,163 @@
+"""Benchmark: openmotion's jerk-limited planner against ruckig on random rest-to-rest moves.
+
+Plans the same N seeded random moves (distances 1e-3..1.3e8 pulses, v 1..1e7, a 1..1e9,
+j 1..1e12, half of them with a separate deceleration limit) with both libraries and prints
+agreement of durations, ruckig's failures, throughputs and the batch planner's peak memory.
+
+    python bench/bench_profile.py            # N = 100 000, batch of 1 000 000 (< 60 s)
+    python bench/bench_profile.py --quick    # a few seconds
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+import tracemalloc
+
+import numpy as np
+
+from openmotion.profile.batch import jerk_limited_durations
+from openmotion.profile.jerk import jerk_limited, jerk_limited_duration
+
+try:
+    import ruckig
+except ImportError:  # pragma: no cover - ruckig is a dev dependency
+    ruckig = None
+
+
+def random_moves(n: int, seed: int) -> tuple[np.ndarray, ...]:
+    rng = np.random.default_rng(seed)
+    dist = rng.choice([-1.0, 1.0], n) * np.minimum(10 ** rng.uniform(-3, 8.13, n), 2**27 - 1)
+    v = 10 ** rng.uniform(0, 7, n)
+    a = 10 ** rng.uniform(0, 9, n)
+    j = 10 ** rng.uniform(0, 12, n)
+    d = np.where(np.arange(n) % 2 == 0, a, 10 ** rng.uniform(0, 9, n))
+    return dist, v, a, j, d
+
+
+def ruckig_inputs(dist, v, a, j, d) -> list:
+    """One InputParameter per move (built outside the timed loop). d_max is the limit
+    against the direction of travel, so it maps onto ruckig's min or max acceleration."""
+    out = []
+    for i in range(dist.size):
+        inp = ruckig.InputParameter(1)
+        inp.current_position = [0.0]
+        inp.target_position = [float(dist[i])]
+        inp.max_velocity = [float(v[i])]
+        inp.max_jerk = [float(j[i])]
+        if dist[i] >= 0:
+            inp.max_acceleration, inp.min_acceleration = [float(a[i])], [-float(d[i])]
+        else:
+            inp.max_acceleration, inp.min_acceleration = [float(d[i])], [-float(a[i])]
+        out.append(inp)
+    return out
+
+
+def rate(n: int, seconds: float) -> float:
+    return n / seconds if seconds > 0 else float("inf")
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="small sizes, a few seconds")
+    ap.add_argument("--n", type=int, default=None, help="moves compared one by one")
+    ap.add_argument("--batch", type=int, default=None, help="moves in the batch run")
+    ap.add_argument("--seed", type=int, default=2026)
+    args = ap.parse_args(argv)
+    n = args.n or (5_000 if args.quick else 100_000)
+    n_batch = args.batch or (100_000 if args.quick else 1_000_000)
+    if ruckig is None:
+        raise SystemExit("ruckig is not installed (pip install ruckig)")
+
+    dist, v, a, j, d = random_moves(n, args.seed)
+    inputs = ruckig_inputs(dist, v, a, j, d)
+    otg, traj = ruckig.Ruckig(1), ruckig.Trajectory(1)
+
+    # correctness pass: durations, and which cases ruckig rejects
+    ref = np.full(n, np.nan)
+    for i, inp in enumerate(inputs):
+        try:
+            otg.calculate(inp, traj)
+            ref[i] = traj.duration
+        except ruckig.RuckigError:
+            pass
+    ours = np.array([jerk_limited_duration(dist[i], v[i], a[i], j[i], d_max=d[i])
+                     for i in range(n)])
+    batch = jerk_limited_durations(dist, v, a, j, d)
+    ok = np.isfinite(ref)
+    rel = np.abs(ours[ok] - ref[ok]) / ref[ok]
+    rel_batch = np.abs(batch - ours) / ours
+    ours_valid = np.isfinite(ours) & (ours > 0)
+
+    # throughput: ruckig on the cases it solves (no exceptions in the timed loop)
+    solvable = [inp for inp, good in zip(inputs, ok, strict=True) if good]
+    t0 = time.perf_counter()
+    for inp in solvable:
+        otg.calculate(inp, traj)
+    t_ruckig = time.perf_counter() - t0
+
+    # the same with one reused InputParameter whose fields are set per move (a user's loop)
+    one = ruckig.InputParameter(1)
+    one.current_position = [0.0]
+    fields = [(inp.target_position, inp.max_velocity, inp.max_acceleration,
+               inp.min_acceleration, inp.max_jerk) for inp in solvable]
+    t0 = time.perf_counter()
+    for tp, mv, ma, mi, mj in fields:
+        one.target_position, one.max_velocity, one.max_acceleration = tp, mv, ma
+        one.min_acceleration, one.max_jerk = mi, mj
+        otg.calculate(one, traj)
+    t_ruckig_set = time.perf_counter() - t0
+
+    args_list = list(zip(dist.tolist(), v.tolist(), a.tolist(), j.tolist(), d.tolist(),
+                         strict=True))
+    t0 = time.perf_counter()
+    for dd, vv, aa, jj, de in args_list:
+        jerk_limited(dd, vv, aa, jj, d_max=de)
+    t_profile = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    for dd, vv, aa, jj, de in args_list:
+        jerk_limited_duration(dd, vv, aa, jj, d_max=de)
+    t_duration = time.perf_counter() - t0
+
+    bd, bv, ba, bj, bdd = random_moves(n_batch, args.seed + 1)
+    jerk_limited_durations(bd[:1000], bv[:1000], ba[:1000], bj[:1000], bdd[:1000])  # warm-up
+    t0 = time.perf_counter()
+    jerk_limited_durations(bd, bv, ba, bj, bdd)
+    t_batch = time.perf_counter() - t0
+    tracemalloc.start()
+    jerk_limited_durations(bd, bv, ba, bj, bdd)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+
+    r_ruckig = rate(len(solvable), t_ruckig)
+    r_ruckig_set = rate(len(solvable), t_ruckig_set)
+    r_profile = rate(n, t_profile)
+    r_duration = rate(n, t_duration)
+    r_batch = rate(n_batch, t_batch)
+    print(f"jerk-limited rest-to-rest, N = {n} random moves (seed {args.seed}), "
+          f"batch of {n_batch}")
+    print("-" * 78)
+    print(f"{'cases ruckig solves':44s} {ok.sum():>12d} ({100 * ok.mean():.2f} %)")
+    print(f"{'cases ruckig failed, openmotion solved':44s} {(~ok & ours_valid).sum():>12d}")
+    print(f"{'cases openmotion failed':44s} {(~ours_valid).sum():>12d}")
+    print(f"{'max rel. duration diff vs ruckig':44s} {rel.max():>12.2e}")
+    print(f"{'median rel. duration diff vs ruckig':44s} {np.median(rel):>12.2e}")
+    print(f"{'max rel. diff batch vs scalar':44s} {rel_batch.max():>12.2e}")
+    print("-" * 78)
+    print(f"{'planner':44s} {'profiles/s':>12s} {'vs ruckig':>12s}")
+    print(f"{'ruckig calculate() (reused objects)':44s} {r_ruckig:>12.0f} {1.0:>12.2f}")
+    print(f"{'ruckig, setting fields of one InputParameter':44s} {r_ruckig_set:>12.0f} "
+          f"{r_ruckig_set / r_ruckig:>12.3f}")
+    print(f"{'openmotion jerk_limited -> Profile':44s} {r_profile:>12.0f} "
+          f"{r_profile / r_ruckig:>12.3f}")
+    print(f"{'openmotion jerk_limited_duration (scalar)':44s} {r_duration:>12.0f} "
+          f"{r_duration / r_ruckig:>12.3f}")
+    print(f"{'openmotion jerk_limited_durations (batch)':44s} {r_batch:>12.0f} "
+          f"{r_batch / r_ruckig:>12.3f}")
+    print("-" * 78)
+    print(f"{'batch peak memory (tracemalloc)':44s} {peak / 2**20:>9.1f} MiB "
+          f"({peak / n_batch:.0f} B/move)")
+
+
+if __name__ == "__main__":
+    main()
