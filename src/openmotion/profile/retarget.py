@@ -13,8 +13,8 @@ down. In that frame, with L = m*(target - p) and d_stop the distance of the fast
         then the fastest stop; the distance grows with t1 in [0, -a/J] (t1 = 0 is the
         fastest stop, t1 = -a/J is F1 at V = v_stop).
     If v_stop > v_max, F1 ramps down to V <= v_max; if even V = v_max overshoots, V is
-    searched in [0, v_max] (a braking dip at V; d(0) is the fastest stop). Valid, but
-    ruckig (which brakes until v = v_max with a < 0, then plans) may differ either way.
+    searched in [0, v_max] (a braking dip at V; d(0) is the fastest stop). This competes
+    with ruckig's way (brake at full jerk until v = v_max, then F1/F2): the faster wins.
   L < d_stop: reverse through v = 0. Planned in the opposite frame, where the target now
     lies ahead of the stopping point (F1 with V > 0 from a negative velocity).
 Limits are in the frame of the final approach: a_max towards it, d_max against it (as
@@ -112,13 +112,56 @@ def _solve(f: Callable[[float], float], lo: float, hi: float) -> float:
     return lo if -flo <= fhi else hi  # keeps the root side that undershoots least
 
 
+def _brake_to_vmax(v: float, a: float, v_max: float, d_max: float, j: float) -> list[Phase]:
+    """Full-jerk braking (holding -d_max) until v = v_max, as ruckig's brake; needs
+    v_stop > v_max. Ends with a <= 0."""
+    if a < -d_max:  # beyond the braking limit: ease back to it while braking
+        t1 = (-d_max - a) / j
+        _, v_end, _ = advance(v, a, [(t1, j, None)])
+        if v_end <= v_max:  # v + a t + j t^2/2 = v_max, first crossing
+            t = (-a - math.sqrt(max(0.0, a * a - 2.0 * j * (v - v_max)))) / j
+            return [(t, j, None)]
+        return [(t1, j, None), ((v_end - v_max) / d_max, 0.0, -d_max)]
+    t = (a + math.sqrt(a * a + 2.0 * j * (v - v_max))) / j  # v + a t - j t^2/2 = v_max
+    if a - j * t >= -d_max:
+        return [(t, -j, None)]
+    t1 = (a + d_max) / j
+    _, v1, _ = advance(v, a, [(t1, -j, None)])
+    return [(t1, -j, None), (max(0.0, (v1 - v_max) / d_max), 0.0, -d_max)]
+
+
+def _duration(phases: list[Phase]) -> float:
+    return math.fsum(max(dt, 0.0) for dt, _, _ in phases)
+
+
 def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_max: float,
                j: float, *, pos_scale: float = 0.0, reversal: bool = False
                ) -> list[Phase] | None:
     """Phases to rest after exactly `length` ahead (in this frame), or None if the target
     lies behind the stopping point. `pos_scale` (|absolute position|) sets the rounding
     slack; with `reversal` the target must lie strictly beyond the stopping point (the
-    approach must really come from this frame's direction)."""
+    approach must really come from this frame's direction).
+
+    Above v_max (v_stop > v_max) two valid plans compete and the faster wins: ramping
+    straight down to V <= v_max, or ruckig's way, braking at full jerk until v = v_max
+    (a < 0 there) and planning from that state (used only if that state cannot swing
+    past -v_max)."""
+    direct = _plan(v, a, length, v_max, a_max, d_max, j, pos_scale, reversal)
+    if direct is None or v + a * abs(a) / (2.0 * j) <= v_max:
+        return direct
+    brake = _brake_to_vmax(v, a, v_max, d_max, j)
+    d_b, v_b, a_b = advance(v, a, brake)
+    if v_b + a_b * abs(a_b) / (2.0 * j) < -v_max:
+        return direct
+    rest = _plan(v_b, a_b, length - d_b, v_max, a_max, d_max, j, pos_scale, reversal)
+    if rest is None or _duration(brake + rest) >= _duration(direct):
+        return direct
+    return brake + rest
+
+
+def _plan(v: float, a: float, length: float, v_max: float, a_max: float, d_max: float,
+          j: float, pos_scale: float, reversal: bool) -> list[Phase] | None:
+    """`plan_ahead` without the ruckig-style brake candidate."""
     stop = ramp_phases(v, a, 0.0, a_max, d_max, j)
     d_stop = advance(v, a, stop)[0]
     tol = SNAP * max(abs(length), abs(d_stop), pos_scale)
