@@ -76,6 +76,13 @@ def ramp_from_state(b: ProfileBuilder, v1: float, accel: float, jerk: float,
     return ramp_jerk(b, v1, accel, jerk, label=label)
 
 
+def segment_durations(profile: Profile) -> np.ndarray:
+    """The profile's exact segment durations (its `dt`, else differences of t0)."""
+    if profile.dt is not None:
+        return profile.dt
+    return np.array([profile.segment_duration(k) for k in range(profile.n_segments)])
+
+
 def extend_to(profile: Profile, t: float) -> Profile:
     """`profile`, with its final constant velocity written out as a segment up to `t`.
 
@@ -86,6 +93,7 @@ def extend_to(profile: Profile, t: float) -> Profile:
         return profile
     e = profile.end
     return Profile(
+        dt=np.append(segment_durations(profile), t - profile.duration),
         t0=np.append(profile.t0, profile.duration), p0=np.append(profile.p0, e.p),
         v0=np.append(profile.v0, e.v), a0=np.append(profile.a0, 0.0),
         j=np.append(profile.j, 0.0), duration=float(t),
@@ -94,7 +102,8 @@ def extend_to(profile: Profile, t: float) -> Profile:
     )
 
 
-def _check_profile(profile: Profile, t: float) -> float:
+def check_profile_time(profile: Profile, t: float) -> float:
+    """Validate a (profile, t >= 0) pair for the stop and on-the-fly entry points."""
     if not isinstance(profile, Profile):
         raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
     t = check_finite("t", t)
@@ -165,11 +174,12 @@ def velocity_move(spec: MoveSpec, direction: float, *, start: float = 0.0) -> Pr
 def stop_distance(spec: MoveSpec, v: float, a: float = 0.0) -> float:
     """Distance (>= 0, along v) a `decel_stop` from (v, a) covers."""
     b = ProfileBuilder(0.0, v, a)
-    _append_stop(b, spec)
+    append_stop(b, spec)
     return abs(b.state.p)
 
 
-def _append_stop(b: ProfileBuilder, spec: MoveSpec) -> None:
+def append_stop(b: ProfileBuilder, spec: MoveSpec, label: str = "decel") -> None:
+    """Append the sd_stop deceleration (to StrVel, acceleration 0) from b's state."""
     st = b.state
     if abs(st.v) <= spec.str_vel or (st.v == 0.0 and st.a == 0.0):
         b.set_acceleration(0.0)
@@ -177,7 +187,7 @@ def _append_stop(b: ProfileBuilder, spec: MoveSpec) -> None:
     r = spec.rates
     sgn = 1.0 if st.v > 0.0 else -1.0
     j_zero = r.jerk_acc if st.a * sgn > 0.0 else r.jerk_dec
-    ramp_from_state(b, sgn * spec.str_vel, r.decel, r.jerk_dec, "decel", j_zero=j_zero)
+    ramp_from_state(b, sgn * spec.str_vel, r.decel, r.jerk_dec, label, j_zero=j_zero)
 
 
 def decel_stop(profile: Profile, t: float, spec: MoveSpec) -> Profile:
@@ -188,19 +198,19 @@ def decel_stop(profile: Profile, t: float, spec: MoveSpec) -> Profile:
     accelerating first removes the acceleration at the acceleration jerk, as the move
     itself would have.
     """
-    t = _check_profile(profile, t)
+    t = check_profile_time(profile, t)
     if not isinstance(spec, MoveSpec):
         raise MotionError(f"spec must be a MoveSpec, got {type(spec).__name__}")
     base = extend_to(profile, t)
     st = base.state_at(t) if t < base.duration else base.end
     b = ProfileBuilder(st.p, st.v, st.a)
-    _append_stop(b, spec)
+    append_stop(b, spec)
     return base.splice(t, b.build(end_v=0.0))
 
 
 def immediate_stop(profile: Profile, t: float) -> Profile:
     """Emergency stop at time `t` (HSL_M_emg_stop): the rate drops to 0 at `t`."""
-    t = _check_profile(profile, t)
+    t = check_profile_time(profile, t)
     base = extend_to(profile, t)
     p = base.state_at(t).p if t < base.duration else base.end.p
     return base.splice(t, ProfileBuilder(p).build(end_p=p))
