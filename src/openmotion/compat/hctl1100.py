@@ -1,0 +1,557 @@
+"""HCTL-1100 motion control chip emulation, run in virtual time sample by sample.
+
+Register reads/writes follow the AIM104-MOTION-1 manual appendices 1-2 (and seed-facts
+section 3 where the manual is silent); docs/hctl1100.md lists what is modelled and what is
+simplified. The chip drives a plant with `counts` (quadrature counts) and
+`advance(dt, duty)` (duty in [-1, 1]), e.g. `openmotion.hw.sim.dcmotor.DCMotor`.
+
+Per sample (at the sample boundary): latch LIMIT/STOP, read the encoder, run the mode's
+generator and filter, write the motor command to R09H; the PWM duty min(|MC|, 100)/100 is
+then held over the whole sample while the plant moves.
+
+Python-API errors (MotionError, nothing changed): unknown register addresses, values
+outside 0..255, a 7-bit register written above 7FH, a sample timer below the current
+mode's minimum, entering a mode whose minimum the sample timer does not meet, two control
+flags at once, an integral velocity step above 127. Writes the chip itself ignores (preset
+outside Init/Idle, command data during a profile, PC 02H/03H outside Init/Idle, F1) are
+ignored and counted in `ignored_writes`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from openmotion.control.servo import LeadFilter
+from openmotion.errors import MotionError, check_nonnegative
+
+from . import hctl1100_regs as R
+from .hctl1100_profile import IntegralVelocity, trapezoid_commands
+from .hctl1100_regs import Mode
+
+
+class Plant(Protocol):
+    """What the chip drives: an encoder count and a duty-driven motion."""
+
+    @property
+    def counts(self) -> int: ...
+
+    def advance(self, dt: float, duty: float) -> None: ...
+
+
+@dataclass(frozen=True)
+class ChipEvent:
+    """A status change the board turns into an interrupt: 'limit', 'stop', 'profile_done'."""
+
+    time: float
+    kind: str
+
+
+@dataclass(frozen=True)
+class Trace:
+    """Per-sample record: sample start time (s), command/actual position (counts), MC."""
+
+    t: np.ndarray
+    command: np.ndarray
+    actual: np.ndarray
+    mc: np.ndarray
+
+
+_CONTROL_FLAGS = {R.F0: Mode.TRAPEZOID, R.F3: Mode.PROP_VELOCITY, R.F5: Mode.INTEGRAL_VELOCITY}
+_SEVEN_BIT = frozenset({R.R_COMM_RING, R.R_COMM_X, R.R_COMM_Y, R.R_COMM_ADVANCE,
+                        R.R_ACCEL_MSB, R.R_MAX_VEL})
+_PROFILE_DATA = frozenset({R.R_CMD_POS_MSB, R.R_CMD_POS_MID, R.R_CMD_POS_LSB, R.R_ACCEL_LSB,
+                           R.R_ACCEL_MSB, R.R_MAX_VEL, R.R_FINAL_LSB, R.R_FINAL_MID,
+                           R.R_FINAL_MSB})
+
+
+class HCTL1100:
+    """One chip with its plant. `advance(dt)` / `run_samples(n)` move virtual time."""
+
+    def __init__(self, plant: Plant, *, clock_hz: float = R.CLOCK_HZ) -> None:
+        self.plant = plant
+        self.clock_hz = float(clock_hz)
+        self.time = 0.0
+        self.listeners: list[Callable[[ChipEvent], None]] = []
+        self.limit_pin = False   # True = LIMIT input active (pin low)
+        self.stop_pin = False
+        self.ignored_writes = 0
+        self._filter = LeadFilter(limit=127.0, quantize=True)
+        self._into = 0.0
+        self._soft_reset(hard=True)
+
+    # ------------------------------------------------------------------ reset / modes
+    def _soft_reset(self, hard: bool = False) -> None:
+        if hard:
+            self._flags = 0
+            self._regs: dict[int, int] = {}
+        self._pos_offset = -self.plant.counts  # actual position counters set to 0
+        self._filter.set_parameters(R.DEFAULT_A, R.DEFAULT_B, R.DEFAULT_K)
+        self._t_reg = R.DEFAULT_SAMPLE_TIMER
+        self._t_buffer = R.DEFAULT_SAMPLE_TIMER
+        self._period = R.sample_time(self._t_reg, self.clock_hz)
+        self._status_low = 0
+        self._limit_latched = False
+        self._stop_latched = False
+        self._cmd = 0
+        self._cmd_buf = [0, 0]
+        self._preset_buf = [0, 0]
+        self._final = 0
+        self._accel = 0
+        self._vmax = 0
+        self._prop_vel = 0
+        self._int_vel = 0
+        self._act_vel = 0
+        self._act_latch = (0, 0)
+        self._last_actual = 0
+        self._prev_actual = 0
+        self._comm = {R.R_COMM_RING: 0, R.R_COMM_VEL_TIMER: 0, R.R_COMM_X: 0, R.R_COMM_Y: 0,
+                      R.R_COMM_OFFSET: 0, R.R_COMM_ADVANCE: 0}
+        self._enter_idle()
+
+    def _enter_idle(self) -> None:
+        self.mode = Mode.INIT_IDLE
+        self._mc = 0
+        self._duty = 0.0
+        self._filter.reset()
+        self._traj: np.ndarray | None = None
+        self._traj_k = 0
+        self._iv: IntegralVelocity | None = None
+        self._align_k = 0
+        self._flags &= ~(1 << R.F0)
+
+    def _enter_control(self) -> None:
+        mode = Mode.POSITION
+        for f, m in _CONTROL_FLAGS.items():
+            if self._flags & (1 << f):
+                mode = m
+        self._require_timer(mode, self._t_buffer)
+        self._filter.reset()
+        if mode is Mode.TRAPEZOID:
+            self._start_profile()
+        elif mode is Mode.INTEGRAL_VELOCITY:
+            self._iv = IntegralVelocity(self._cmd)
+        self._prev_actual = self.actual_position
+        self.mode = mode
+
+    def _require_timer(self, mode: Mode, t_reg: int) -> None:
+        lo = R.MIN_SAMPLE_TIMER[mode]
+        if t_reg < lo:
+            raise MotionError(f"sample timer {t_reg:#04x} is below the {mode.value} minimum "
+                              f"{lo:#04x}")
+
+    def _start_profile(self) -> None:
+        dist = R.wrap24(self._final - self._cmd)
+        acc = self._accel / 256.0
+        if dist != 0 and (acc <= 0.0 or self._vmax <= 0):
+            raise MotionError("a trapezoidal move needs acceleration (R26H/R27H) > 0 and "
+                              "maximum velocity (R28H) > 0")
+        self._traj = trapezoid_commands(self._cmd, dist, acc, float(self._vmax))
+        self._traj_k = 0
+        self.mode = Mode.TRAPEZOID
+
+    # ------------------------------------------------------------------ positions
+    @property
+    def actual_position(self) -> int:
+        """24-bit two's-complement actual position (quadrature counts)."""
+        return R.wrap24(self.plant.counts + self._pos_offset)
+
+    @property
+    def command_position(self) -> int:
+        return R.wrap24(self._cmd)
+
+    @property
+    def sample_period(self) -> float:
+        """The sample time now in use, in seconds."""
+        return self._period
+
+    @property
+    def flags(self) -> int:
+        f = self._flags & ~(1 << R.F1)
+        return f | ((1 << R.F1) if self.mode is Mode.INIT_IDLE else 0)
+
+    @property
+    def motor_command(self) -> int:
+        """The signed 8-bit motor command now output (R09H as a signed value)."""
+        return self._mc
+
+    @property
+    def limit_latched(self) -> bool:
+        return self._limit_latched
+
+    @property
+    def stop_latched(self) -> bool:
+        return self._stop_latched
+
+    # ------------------------------------------------------------------ register access
+    def write(self, reg: int, value: int) -> None:
+        """Write one 8-bit register (refused with MotionError before any change if invalid)."""
+        R.check_register("reg", reg, R.WRITABLE)
+        R.check_byte("value", value)
+        if reg in _SEVEN_BIT and value > 0x7F:
+            raise MotionError(f"value for register {reg:#04x} must be in 0x00..0x7f, "
+                              f"got {value:#04x}")
+        if reg in _PROFILE_DATA and self._flags & (1 << R.F0) and self.mode is Mode.TRAPEZOID:
+            self.ignored_writes += 1  # "no new command data while in Profile"
+            return
+        handler = _WRITERS.get(reg)
+        if handler is not None:
+            handler(self, reg, value)
+        else:  # commutator registers
+            self._comm[reg] = value
+
+    def _w_flag(self, reg: int, value: int) -> None:
+        flag = value & 0x07
+        on = bool(value & R.FLAG_SET)
+        if flag in (R.F1, 6, 7):
+            self.ignored_writes += 1  # F1 belongs to the chip; 6/7 are not flags
+            return
+        new = (self._flags | (1 << flag)) if on else (self._flags & ~(1 << flag))
+        ctrl = [f for f in _CONTROL_FLAGS if new & (1 << f)]
+        if len(ctrl) > 1:
+            raise MotionError("only one control flag (F0, F3, F5) may be set at a time")
+        mode = self.mode
+        if mode is Mode.INIT_IDLE or mode is Mode.ALIGN or new == self._flags:
+            self._flags = new
+            return
+        # in a control mode the flags switch modes at once (datasheet mode flowchart)
+        target = _CONTROL_FLAGS[ctrl[0]] if ctrl else Mode.POSITION
+        if target is not Mode.POSITION:
+            if mode is not Mode.POSITION:
+                raise MotionError(f"{target.value} can only be entered from position control"
+                                  f" (now in {mode.value})")
+            self._require_timer(target, self._t_buffer)
+        old_flags = self._flags
+        self._flags = new
+        try:
+            if target is Mode.TRAPEZOID:
+                self._start_profile()
+            elif target is Mode.INTEGRAL_VELOCITY:
+                self._iv = IntegralVelocity(self._cmd)
+                self.mode = target
+            elif target is Mode.PROP_VELOCITY:
+                self._prev_actual = self.actual_position
+                self.mode = target
+            else:  # back to position control, holding where the generator is
+                if mode is Mode.PROP_VELOCITY:
+                    self._cmd = self.actual_position
+                self._traj = None
+                self._iv = None
+                self.mode = Mode.POSITION
+        except MotionError:
+            self._flags = old_flags
+            raise
+
+    def _w_program(self, reg: int, value: int) -> None:
+        if value == R.PC_RESET:
+            self._soft_reset()
+        elif value == R.PC_INIT_IDLE:
+            self._enter_idle()
+        elif value in (R.PC_ALIGN, R.PC_CONTROL):
+            if self.mode is not Mode.INIT_IDLE or self.limit_pin:
+                self.ignored_writes += 1  # only from Init/Idle, not while LIMIT holds
+                return
+            if value == R.PC_ALIGN:
+                self._require_timer(Mode.ALIGN, self._t_buffer)
+                self._flags |= 1 << R.F4
+                self._align_k = 0
+                self.mode = Mode.ALIGN
+            else:
+                self._enter_control()
+        else:
+            raise MotionError(f"program counter command must be 00h..03h, got {value:#04x}")
+
+    def _w_status(self, reg: int, value: int) -> None:
+        if value & R.ST_RESERVED:
+            raise MotionError("status register bit 3 must be written as 0")
+        self._status_low = value & 0x07
+        # [low] a status write clears the LIMIT/STOP latches once the pins are inactive
+        if not self.limit_pin:
+            self._limit_latched = False
+        if not self.stop_pin:
+            self._stop_latched = False
+
+    def _w_pwm(self, reg: int, value: int) -> None:
+        if self.mode is not Mode.INIT_IDLE:
+            self.ignored_writes += 1  # the control modes overwrite R09H every sample
+            return
+        self._mc = R.signed8(value)
+        self._duty = _duty(self._mc)
+
+    def _w_cmd(self, reg: int, value: int) -> None:
+        if reg == R.R_CMD_POS_LSB:
+            if self.mode is Mode.INTEGRAL_VELOCITY:
+                self.ignored_writes += 1  # the profiler owns the command position
+                return
+            self._cmd = R.join24(self._cmd_buf[0], self._cmd_buf[1], value)
+        else:
+            self._cmd_buf[reg - R.R_CMD_POS_MSB] = value
+
+    def _w_timer(self, reg: int, value: int) -> None:
+        self._require_timer(self.mode, value)
+        self._t_buffer = value  # used from the next sample on
+
+    def _w_act_clear(self, reg: int, value: int) -> None:
+        self._pos_offset = -self.plant.counts
+
+    def _w_preset(self, reg: int, value: int) -> None:
+        if self.mode is not Mode.INIT_IDLE:
+            self.ignored_writes += 1  # preset only in Init/Idle
+            return
+        if reg == R.R_PRESET_LSB:
+            target = R.join24(self._preset_buf[0], self._preset_buf[1], value)
+            self._pos_offset = target - self.plant.counts
+        else:
+            self._preset_buf[reg - R.R_PRESET_MSB] = value
+
+    def _w_filter(self, reg: int, value: int) -> None:
+        f = self._filter
+        a, b, k = f.a, f.b, f.k
+        if reg == R.R_FILTER_A:
+            a = value
+        elif reg == R.R_FILTER_B:
+            b = value
+        else:
+            k = value
+        f.set_parameters(a, b, k)
+
+    def _w_prop_vel(self, reg: int, value: int) -> None:
+        v = self._prop_vel & 0xFFFF
+        v = (v & 0xFF00) | value if reg == R.R_PROP_VEL_LSB else (v & 0x00FF) | (value << 8)
+        self._prop_vel = R.signed16(v)
+
+    def _w_accel(self, reg: int, value: int) -> None:
+        a = self._accel
+        self._accel = (a & 0xFF00) | value if reg == R.R_ACCEL_LSB else (a & 0xFF) | (value << 8)
+
+    def _w_max_vel(self, reg: int, value: int) -> None:
+        self._vmax = value
+
+    def _w_final(self, reg: int, value: int) -> None:
+        shift = 8 * (reg - R.R_FINAL_LSB)
+        f = self._final & 0xFFFFFF
+        f = (f & ~(0xFF << shift)) | (value << shift)
+        self._final = R.wrap24(f)
+
+    def _w_int_vel(self, reg: int, value: int) -> None:
+        v = R.signed8(value)
+        if abs(v - self._int_vel) > 127:
+            raise MotionError(f"integral velocity may change by at most 127 per command, "
+                              f"{self._int_vel} -> {v}")
+        self._int_vel = v
+
+    def read(self, reg: int) -> int:
+        """Read one 8-bit register (reading R14H latches R12H/R13H)."""
+        R.check_register("reg", reg, R.READABLE)
+        if reg == R.R_FLAG:
+            return self.flags
+        if reg == R.R_STATUS:
+            return self.status
+        if reg == R.R_PWM:
+            return self._mc & 0xFF
+        if reg in (R.R_CMD_POS_MSB, R.R_CMD_POS_MID, R.R_CMD_POS_LSB):
+            return R.split24(self._cmd)[reg - R.R_CMD_POS_MSB]
+        if reg == R.R_SAMPLE_TIMER:
+            frac = self._into / self._period
+            return max(0, self._t_reg - int(frac * (self._t_reg + 1)))
+        if reg == R.R_ACT_POS_LSB:
+            msb, mid, lsb = R.split24(self.actual_position)
+            self._act_latch = (msb, mid)
+            return lsb
+        if reg in (R.R_ACT_POS_MSB, R.R_ACT_POS_MID):
+            return self._act_latch[reg - R.R_ACT_POS_MSB]
+        if reg in self._comm:
+            return self._comm[reg]
+        if reg in (R.R_FILTER_A, R.R_FILTER_B, R.R_FILTER_K):
+            return (self._filter.a, self._filter.b, self._filter.k)[reg - R.R_FILTER_A]
+        if reg in (R.R_PROP_VEL_LSB, R.R_PROP_VEL_MSB):
+            return (self._prop_vel >> (8 * (reg - R.R_PROP_VEL_LSB))) & 0xFF
+        if reg in (R.R_ACCEL_LSB, R.R_ACCEL_MSB):
+            return (self._accel >> (8 * (reg - R.R_ACCEL_LSB))) & 0xFF
+        if reg == R.R_MAX_VEL:
+            return self._vmax
+        if reg in (R.R_FINAL_LSB, R.R_FINAL_MID, R.R_FINAL_MSB):
+            return (self._final >> (8 * (reg - R.R_FINAL_LSB))) & 0xFF
+        if reg in (R.R_ACT_VEL_LSB, R.R_ACT_VEL_MSB):
+            return (self._act_vel >> (8 * (reg - R.R_ACT_VEL_LSB))) & 0xFF
+        return self._int_vel & 0xFF  # R3CH
+
+    @property
+    def status(self) -> int:
+        """R07H: low 4 bits as written, F0, F1, STOP and LIMIT (0 = triggered)."""
+        s = self._status_low
+        if self._flags & (1 << R.F0):
+            s |= R.ST_PROFILE
+        if self.mode is Mode.INIT_IDLE:
+            s |= R.ST_INIT
+        if not self._stop_latched:
+            s |= R.ST_STOP_CLEAR
+        if not self._limit_latched:
+            s |= R.ST_LIMIT_CLEAR
+        return s
+
+    @property
+    def ring_config(self) -> dict[int, int]:
+        """Commutator registers and whether they count in full counts (status bit 2)."""
+        return dict(self._comm)
+
+    # ------------------------------------------------------------------ inputs
+    def set_limit(self, active: bool) -> None:
+        """Drive the LIMIT input; going active enters Init/Idle at once (and latches)."""
+        active = bool(active)
+        if active and not self.limit_pin:
+            self._limit_latched = True
+            self._enter_idle()
+            self._emit("limit")
+        self.limit_pin = active
+
+    def set_stop(self, active: bool) -> None:
+        """Drive the STOP input (acts in integral velocity mode only; always latches)."""
+        active = bool(active)
+        if active and not self.stop_pin:
+            self._stop_latched = True
+            self._emit("stop")
+        self.stop_pin = active
+
+    def sync(self) -> None:
+        """SYNC pulse: restart the sample timer now (a new sample begins at this instant)."""
+        self._into = 0.0
+        self._sample()
+
+    def _emit(self, kind: str) -> None:
+        ev = ChipEvent(self.time, kind)
+        for cb in self.listeners:
+            cb(ev)
+
+    # ------------------------------------------------------------------ virtual time
+    def advance(self, dt: float) -> None:
+        """Move virtual time by `dt` seconds, running every sample that falls due."""
+        left = check_nonnegative("dt", dt)
+        plant = self.plant
+        while left > 0.0:
+            to_next = self._period - self._into
+            if left + 1e-15 >= to_next:
+                plant.advance(to_next, self._duty)
+                self.time += to_next
+                left -= to_next
+                self._into = 0.0
+                self._sample()
+            else:
+                plant.advance(left, self._duty)
+                self.time += left
+                self._into += left
+                left = 0.0
+
+    def run_samples(self, n: int, *, record: bool = False) -> Trace | None:
+        """Run `n` whole samples from the next boundary; optionally record each one."""
+        if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+            raise MotionError(f"n must be an int >= 0, got {n!r}")
+        if not record:
+            for _ in range(n):
+                self.advance(self._period - self._into)
+            return None
+        t = np.empty(n)
+        cmd = np.empty(n, dtype=np.int64)
+        act = np.empty(n, dtype=np.int64)
+        mc = np.empty(n, dtype=np.int64)
+        for i in range(n):
+            self.advance(self._period - self._into)
+            t[i] = self.time
+            cmd[i] = self._cmd
+            act[i] = self._last_actual
+            mc[i] = self._mc
+        return Trace(t, cmd, act, mc)
+
+    def _sample(self) -> None:
+        """The chip's work at one sample boundary."""
+        self._t_reg = self._t_buffer
+        self._period = R.sample_time(self._t_reg, self.clock_hz)
+        actual = self.actual_position
+        self._last_actual = actual
+        mode = self.mode
+        if mode is Mode.INIT_IDLE:
+            return  # R09H (written by the user) drives the motor open loop
+        if mode is Mode.ALIGN:
+            self._align_step()
+            return
+        if mode is Mode.PROP_VELOCITY:
+            vact = R.wrap24(actual - self._prev_actual)
+            self._prev_actual = actual
+            self._act_vel = vact
+            k4 = self._filter.k * 0.25
+            mc = int(k4 * (self._prop_vel / 16.0 - vact))
+            self._set_mc(mc)
+            return
+        if mode is Mode.TRAPEZOID:
+            traj = self._traj
+            self._cmd = R.wrap24(int(traj[self._traj_k]))
+            self._traj_k += 1
+            if self._traj_k >= traj.size:
+                self._flags &= ~(1 << R.F0)
+                self._traj = None
+                self.mode = Mode.POSITION
+                self._emit("profile_done")
+        elif mode is Mode.INTEGRAL_VELOCITY:
+            target = 0.0 if self._stop_latched else float(self._int_vel)
+            self._cmd = R.wrap24(self._iv.step(target, self._accel / 256.0))
+        err = R.wrap24(self._cmd - actual)
+        self._set_mc(int(self._filter.step_error(float(err))))
+
+    def _set_mc(self, mc: int) -> None:
+        mc = 127 if mc > 127 else (-128 if mc < -128 else mc)
+        self._mc = mc
+        self._duty = _duty(mc)
+
+    def _align_step(self) -> None:
+        # PHA for 2048 samples, then PHD for 2048, then position control at 0 [seed, app. 1]
+        self._align_k += 1
+        self._mc = 100
+        self._duty = 1.0
+        if self._align_k >= 2 * R.ALIGN_SAMPLES:
+            self._flags &= ~(1 << R.F4)
+            self._cmd = 0
+            self._filter.reset()
+            self.mode = Mode.POSITION
+
+    @property
+    def align_phase(self) -> str | None:
+        """'A' or 'D' while align energises that phase, else None."""
+        if self.mode is not Mode.ALIGN:
+            return None
+        return "A" if self._align_k < R.ALIGN_SAMPLES else "D"
+
+
+def _duty(mc: int) -> float:
+    """PWM duty from the motor command: 100 parts, saturating at 100% [seed, R09H]."""
+    return max(-100, min(100, mc)) / 100.0
+
+
+_WRITERS: dict[int, Callable[[HCTL1100, int, int], None]] = {
+    R.R_FLAG: HCTL1100._w_flag,
+    R.R_PROGRAM: HCTL1100._w_program,
+    R.R_STATUS: HCTL1100._w_status,
+    R.R_PWM: HCTL1100._w_pwm,
+    R.R_CMD_POS_MSB: HCTL1100._w_cmd,
+    R.R_CMD_POS_MID: HCTL1100._w_cmd,
+    R.R_CMD_POS_LSB: HCTL1100._w_cmd,
+    R.R_SAMPLE_TIMER: HCTL1100._w_timer,
+    R.R_ACT_POS_MID: HCTL1100._w_act_clear,
+    R.R_PRESET_MSB: HCTL1100._w_preset,
+    R.R_PRESET_MID: HCTL1100._w_preset,
+    R.R_PRESET_LSB: HCTL1100._w_preset,
+    R.R_FILTER_A: HCTL1100._w_filter,
+    R.R_FILTER_B: HCTL1100._w_filter,
+    R.R_FILTER_K: HCTL1100._w_filter,
+    R.R_PROP_VEL_LSB: HCTL1100._w_prop_vel,
+    R.R_PROP_VEL_MSB: HCTL1100._w_prop_vel,
+    R.R_ACCEL_LSB: HCTL1100._w_accel,
+    R.R_ACCEL_MSB: HCTL1100._w_accel,
+    R.R_MAX_VEL: HCTL1100._w_max_vel,
+    R.R_FINAL_LSB: HCTL1100._w_final,
+    R.R_FINAL_MID: HCTL1100._w_final,
+    R.R_FINAL_MSB: HCTL1100._w_final,
+    R.R_INT_VEL: HCTL1100._w_int_vel,
+}
