@@ -284,3 +284,21 @@ def test_sync_invalid_arguments():
         jerk_limited_sync([1.0, 2.0], 1.0, [1.0, 0.0], 1.0)
     with pytest.raises(MotionError, match=r"distances\[0\]"):
         jerk_limited_sync([float("inf")], 1.0, 1.0, 1.0)
+
+
+def test_tiny_distances_and_extreme_magnitudes_never_fail():
+    from openmotion.profile.batch import jerk_limited_durations
+
+    for dist in (5e-324, 1e-310, 1e-100):
+        prof = jerk_limited(dist, 1e4, 1e-9, 1e-3)
+        assert math.isfinite(prof.duration) and prof.duration > 0
+        assert prof.end.p == dist
+        # the pure jerk triangle: L = 2*J*tj**3, T = 4*tj
+        assert prof.duration == pytest.approx(4 * (dist / 2e-3) ** (1 / 3), rel=1e-12)
+    rng = np.random.default_rng(5)
+    e = 10 ** rng.uniform(-100, 100, (500, 5))
+    e[:, 0] = np.minimum(e[:, 0], 2**27 - 1)
+    batch = jerk_limited_durations(*e.T)
+    for row, tb in zip(e, batch, strict=True):
+        t = jerk_limited_duration(*row[:4], d_max=row[4])
+        assert math.isfinite(t) and t == pytest.approx(tb, rel=1e-12)

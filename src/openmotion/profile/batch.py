@@ -44,7 +44,7 @@ def _peak_velocity(length: Array, v_max: Array, a_max: Array, d_max: Array,
     v2 = hi * hi / j_max
     cruise = _ramp_distance(v_max, a_max, j_max) + _ramp_distance(v_max, d_max, j_max) <= length
     both = _ramp_distance(v2, hi, j_max) + _ramp_distance(v2, lo, j_max) <= length
-    neither = length <= 2.0 * lo**3 / (j_max * j_max)
+    neither = length <= 2.0 * lo * lo * lo / (j_max * j_max)
 
     k = (1.0 / a_max + 1.0 / d_max) / 2.0
     c = (a_max + d_max) / (2.0 * j_max)
@@ -81,6 +81,12 @@ def _chunk_phases(length: Array, v: Array, a: Array, d: Array, j: Array) -> Arra
         out[:, col_c] = np.where(sat, vp / x - x / j, 0.0)
     rest = safe_len - _ramp_distance(vp, a, j) - _ramp_distance(vp, d, j)
     out[:, 3] = np.maximum(rest / vp, 0.0)
+    # pure jerk triangle: tj straight from L = 2*J*tj**3, as the scalar code does
+    tri = (vp < v) & (vp * j < np.minimum(a, d) ** 2)
+    if tri.any():
+        tj = (safe_len[tri] / (2.0 * j[tri])) ** (1.0 / 3.0)
+        out[tri] = 0.0
+        out[tri, 0] = out[tri, 2] = out[tri, 4] = out[tri, 6] = tj
     out[~moving] = 0.0
     return out
 
@@ -111,8 +117,13 @@ def _phases(distance: ArrayLike, v_max: ArrayLike, a_max: ArrayLike, j_max: Arra
     out = np.zeros(length.size if totals else (length.size, 7))
     for k in range(0, length.size, CHUNK):  # chunks keep the temporaries in cache
         sl = slice(k, k + CHUNK)
-        ph = _chunk_phases(length[sl], v[sl], a[sl], d[sl], j[sl])
+        # np.where evaluates every branch; overflow in an unselected one is harmless
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            ph = _chunk_phases(length[sl], v[sl], a[sl], d[sl], j[sl])
         out[sl] = _total(ph) if totals else ph
+    if not np.isfinite(out).all():
+        raise MotionError("distance, v_max, a_max, d_max and j_max must be within a numeric "
+                          "range where the phase times are finite (magnitudes ~1e-100..1e100)")
     return out, shape
 
 

@@ -82,7 +82,7 @@ def peak_velocity(length: float, v_max: float, a_max: float, d_max: float,
         k = (1.0 / a_max + 1.0 / d_max) / 2.0
         c = (a_max + d_max) / (2.0 * j_max)
         return 2.0 * length / (c + math.sqrt(c * c + 4.0 * k * length))
-    if length <= 2.0 * lo**3 / (j_max * j_max):
+    if length <= 2.0 * lo * lo * lo / (j_max * j_max):
         return (length * math.sqrt(j_max) / 2.0) ** (2.0 / 3.0)
     u = _mixed_root(length, lo, j_max, math.sqrt(v2))
     return min(u * u, v_max)
@@ -96,6 +96,10 @@ def phase_times(length: float, v_max: float, a_max: float, d_max: float,
     vp = peak_velocity(length, v_max, a_max, d_max, j_max)
     if v_cap is not None and v_cap < vp:
         vp = v_cap
+    elif vp < v_max and vp * j_max < min(a_max, d_max) ** 2:
+        # pure jerk triangle: tj straight from L = 2*J*tj**3 (no underflow for tiny L)
+        tj = (length / (2.0 * j_max)) ** (1.0 / 3.0)
+        return (tj, 0.0, tj, 0.0, tj, 0.0, tj)
     tj1, ta = _ramp(vp, a_max, j_max)
     tj2, td = _ramp(vp, d_max, j_max)
     rest = length - _ramp_distance(vp, a_max, j_max) - _ramp_distance(vp, d_max, j_max)
@@ -150,6 +154,12 @@ def _limits(v_max: float, a_max: float, j_max: float,
     return v, a, d, j
 
 
+def _check_times(times: Sequence[float]) -> None:
+    if not all(math.isfinite(t) for t in times):
+        raise MotionError("distance, v_max, a_max, d_max and j_max must be within a numeric "
+                          "range where the phase times are finite (magnitudes ~1e-100..1e100)")
+
+
 def _build(start: float, distance: float, times: Sequence[float], a_max: float,
            d_max: float, j_max: float) -> Profile:
     b = ProfileBuilder(start, direction=1.0 if distance >= 0.0 else -1.0)
@@ -179,6 +189,7 @@ def jerk_limited(distance: float, v_max: float, a_max: float, j_max: float, *,
     st = check_finite("start", start)
     v, a, d, j = _limits(v_max, a_max, j_max, d_max)
     times = phase_times(abs(dist), v, a, d, j)
+    _check_times(times)
     return _build(st, dist, times, a, d, j)
 
 
@@ -187,7 +198,9 @@ def jerk_limited_duration(distance: float, v_max: float, a_max: float, j_max: fl
     """Duration of `jerk_limited` without building the profile."""
     dist = check_distance("distance", distance)
     v, a, d, j = _limits(v_max, a_max, j_max, d_max)
-    return math.fsum(phase_times(abs(dist), v, a, d, j))
+    times = phase_times(abs(dist), v, a, d, j)
+    _check_times(times)
+    return math.fsum(times)
 
 
 def _per_axis(name: str, value: float | Sequence[float] | None, n: int) -> list:
@@ -233,6 +246,8 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
         except MotionError as e:
             raise MotionError(f"axis {i}: {e}") from None
     times = [phase_times(abs(x), *lim) for x, lim in zip(dists, lims, strict=True)]
+    for t in times:
+        _check_times(t)
     durs = [math.fsum(t) for t in times]
     t_sync = max(durs)
     out = []
