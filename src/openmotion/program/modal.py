@@ -1,0 +1,663 @@
+"""Modal state machine: executes one parsed line (a `Block`) into canonical commands.
+
+The order of execution within a line is RS-274/NGC's (LinuxCNC "G-code order of
+execution"): comments/messages, feed mode G93/G94, F, S, T, M6, M3/M4/M5, M7/M8/M9, M62-M65,
+G4, plane, units, cutter compensation, tool length, coordinate system, path control,
+distance modes, G10/G28/G30/G92, motion (G0-G3, G53, G80), M0/M1/M2/M30.
+
+Positions are held in machine coordinates (machine units). A program coordinate p of axis
+letter L maps to machine coordinate  p * scale(L) + work(L) + g92(L) + tool(L)  where scale
+converts the program unit (G20/G21) to the machine unit for linear axes (1 for A/B/C),
+work is the selected G54..G59.3 origin, g92 the G92 offset and tool the G43 length (Z only).
+Offsets live in LinuxCNC's parameters: G54 X..W = #5221..#5229 (+20 per system), G92 =
+#5211..#5219, G28 = #5161.., G30 = #5181..; all in machine units.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from ..path import Direction
+from . import canon
+from .arcgeom import (
+    CENTRE_TOL,
+    RADIUS_TOL,
+    ArcGeometryError,
+    arc_extent,
+    centre_from_radius,
+    check_radii,
+    sweep_angle,
+)
+from .expr import EvalError, Node
+from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
+from .params import Parameters
+from .parser import Block, Value
+
+# G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
+G_GROUP = {
+    40: 0, 100: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
+    0: 1, 10: 1, 20: 1, 30: 1, 800: 1,
+    170: 2, 180: 2, 190: 2,
+    900: 3, 910: 3,
+    901: 4, 911: 4,
+    930: 5, 940: 5,
+    200: 6, 210: 6,
+    400: 7,
+    430: 8, 490: 8,
+    540: 12, 550: 12, 560: 12, 570: 12, 580: 12, 590: 12, 591: 12, 592: 12, 593: 12,
+    610: 13, 611: 13, 640: 13,
+}
+#: Why some well-known codes are refused (others get a generic "unsupported").
+G_REFUSED = {
+    410: "cutter radius compensation (G41) is not supported",
+    420: "cutter radius compensation (G42) is not supported",
+    330: "spindle-synchronized motion (G33) is not supported",
+    382: "probing (G38.x) is not supported",
+    950: "feed per revolution (G95) is not supported",
+    810: "canned cycles (G81) are not supported",
+}
+M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
+           62: 5, 63: 5, 64: 5, 65: 5}
+COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
+#: Plane -> (first, second, helix) axis letters and the centre-offset letters.
+PLANES = {170: ("X", "Y", "Z", "I", "J", "K"), 180: ("Z", "X", "Y", "K", "I", "J"),
+          190: ("Y", "Z", "X", "J", "K", "I")}
+AXIS_SET = frozenset(AXIS_LETTERS)
+_DEBUG_PARAM = re.compile(r"#<([^>]*)>|#(\d+)")
+
+
+class _Word:
+    """A word's evaluated value and where it was (for error messages)."""
+
+    __slots__ = ("value", "pos")
+
+    def __init__(self, value: float, pos: int) -> None:
+        self.value = value
+        self.pos = pos
+
+
+def _fmt(letter: str, v: float) -> str:
+    return f"{letter}{v:g}"
+
+
+class Modal:
+    """Modal state + positions; `execute(block, out)` appends the line's commands to out.
+
+    Returns False when the line ended the program (M2/M30).
+    """
+
+    def __init__(self, options: GCodeOptions, params: Parameters) -> None:
+        self.opt = options
+        self.params = params
+        self.pos: list[float] = list(options.start or ())
+        self.machine_mm = options.machine_units == "mm"
+        self.units = options.machine_units  # program units, "mm" or "inch"
+        self.lscale = 1.0
+        self.incremental = False
+        self.arc_incremental = True
+        self.plane = 170
+        self.inverse_time = False
+        self.feed = 0.0  # machine units per minute (G94) or the F number (G93)
+        self.motion: int | None = None  # G80: no motion mode until G0..G3
+        self.coord = 1
+        self.tool_z = 0.0
+        self.selected_tool = 0
+        self.tool = 0
+        self.spindle_on = False
+        self.spindle_cw = True
+        self.speed = 0.0
+        self.mist = False
+        self.flood = False
+        self.ended = False
+        # letter -> (machine axis, parameter offset k)
+        self.letters = {L: (options.axes[L], AXIS_LETTERS.index(L)) for L in options.axes}
+        self.g92 = [params.numbers[5211 + k] for k in range(9)]
+        if any(self.g92):
+            params.set_number(5210, 1.0)
+        params.set_number(5220, 1.0)
+        self.off = [0.0] * 9
+        self._update_offsets()
+        params.position_hook = self.program_position
+
+    # -- coordinates -----------------------------------------------------------------
+    def _update_offsets(self) -> None:
+        base = 5221 + 20 * (self.coord - 1)
+        nums = self.params.numbers
+        for k in range(9):
+            self.off[k] = nums[base + k] + self.g92[k]
+        self.off[2] += self.tool_z
+
+    def scale(self, letter: str) -> float:
+        return 1.0 if letter in ROTARY_LETTERS else self.lscale
+
+    def program_position(self, k: int) -> float:
+        """Current position of axis letter number k (X=0..W=8) in program coordinates."""
+        letter = AXIS_LETTERS[k]
+        info = self.letters.get(letter)
+        if info is None:
+            return 0.0
+        return (self.pos[info[0]] - self.off[k]) / self.scale(letter)
+
+    def _axis(self, b: Block, letter: str, w: _Word) -> int:
+        info = self.letters.get(letter)
+        if info is None:
+            raise b.error(f"axis letter {letter} has no machine axis (axes: "
+                          f"{', '.join(sorted(self.letters))})", w.pos, _fmt(letter, w.value))
+        return info[0]
+
+    def _target(self, b: Block, axes: dict[str, _Word], machine: bool = False,
+                incremental: bool | None = None) -> list[float]:
+        inc = self.incremental if incremental is None else incremental
+        target = self.pos[:]
+        for letter, w in axes.items():
+            ax = self._axis(b, letter, w)
+            s = self.scale(letter)
+            if machine:
+                target[ax] = w.value * s
+            elif inc:
+                target[ax] = self.pos[ax] + w.value * s
+            else:
+                target[ax] = w.value * s + self.off[self.letters[letter][1]]
+        return target
+
+    def _check_limits(self, b: Block, lo: list[float], hi: list[float], word: str,
+                      pos: int) -> None:
+        limits = self.opt.soft_limits
+        if limits is None:
+            return
+        for ax, lim in enumerate(limits):
+            if lim is None:
+                continue
+            if lo[ax] < lim[0] - 1e-9 * max(1.0, abs(lim[0])):
+                raise b.error(f"move beyond soft limit: machine axis {ax} would reach "
+                              f"{lo[ax]:.6g} < min {lim[0]:g}", pos, word)
+            if hi[ax] > lim[1] + 1e-9 * max(1.0, abs(lim[1])):
+                raise b.error(f"move beyond soft limit: machine axis {ax} would reach "
+                              f"{hi[ax]:.6g} > max {lim[1]:g}", pos, word)
+
+    # -- evaluation ------------------------------------------------------------------
+    def evaluate(self, b: Block, v: Value, word: str = "") -> float:
+        if type(v) is float:
+            return v
+        assert isinstance(v, Node)
+        try:
+            x = v.ev(self.params)
+        except EvalError as exc:
+            raise b.error(exc.message, exc.pos, exc.word or word) from None
+        if not math.isfinite(x):
+            raise b.error(f"value is not finite ({x})", v.pos, word)
+        return x
+
+    def debug_text(self, text: str) -> str:
+        """(DEBUG,...) text with #n and #<name> replaced by their values."""
+
+        def sub(m: re.Match[str]) -> str:
+            if m.group(1) is not None:
+                name = "".join(m.group(1).split()).upper()
+                table = self.params.globals if name.startswith("_") else \
+                    self.params.locals[-1]
+                return f"{table[name]:.6f}" if name in table else "######"
+            n = int(m.group(2))
+            if 1 <= n < len(self.params.numbers):
+                return f"{self.params.get_number(n, 0):.6f}"
+            return "######"
+
+        return _DEBUG_PARAM.sub(sub, text)
+
+    # -- one line --------------------------------------------------------------------
+    def execute(self, b: Block, out: list[canon.Command]) -> bool:  # noqa: C901
+        line, file = b.line, b.file
+        gs: dict[int, tuple[int, int]] = {}  # group -> (code, pos)
+        ms: dict[int, tuple[int, int]] = {}
+        words: dict[str, _Word] = {}
+        coolant: set[int] = set()
+        for letter, v, pos in b.words:
+            x = v if type(v) is float else self.evaluate(b, v, letter)
+            if letter == "G":
+                code = round(x * 10)
+                if abs(x * 10 - code) > 1e-6 or code not in G_GROUP:
+                    msg = G_REFUSED.get(code, f"unsupported G-code G{x:g}")
+                    raise b.error(msg, pos, _fmt("G", x))
+                grp = G_GROUP[code]
+                if grp in gs:
+                    raise b.error(f"two G-codes of the same modal group on one line "
+                                  f"(G{gs[grp][0] / 10:g} and G{x:g})", pos, _fmt("G", x))
+                gs[grp] = (code, pos)
+            elif letter == "M":
+                code = round(x)
+                if abs(x - code) > 1e-6 or code not in M_GROUP:
+                    raise b.error(f"unsupported M-code M{x:g}", pos, _fmt("M", x))
+                grp = M_GROUP[code]
+                if grp == 8 and code != 9 and grp in ms and ms[grp][0] != 9:
+                    coolant.add(code)  # M7 and M8 may share a line
+                    continue
+                if grp in ms:
+                    raise b.error(f"two M-codes of the same modal group on one line "
+                                  f"(M{ms[grp][0]} and M{code})", pos, _fmt("M", x))
+                ms[grp] = (code, pos)
+                if grp == 8:
+                    coolant.add(code)
+            else:
+                if letter in words:
+                    raise b.error(f"word {letter} appears twice on one line", pos,
+                                  _fmt(letter, x))
+                words[letter] = _Word(x, pos)
+        if b.assigns:
+            self._assign(b)
+        used: set[str] = set()
+        if b.comments:
+            self._messages(b, out)
+        # feed mode, F, S, T
+        if 5 in gs:
+            inv = gs[5][0] == 930
+            if inv != self.inverse_time:
+                self.inverse_time = inv
+                self.feed = 0.0
+        f = words.get("F")
+        if f is not None:
+            used.add("F")
+            if f.value < 0:
+                raise b.error(f"feed rate must be >= 0, got {f.value:g}", f.pos,
+                              _fmt("F", f.value))
+            self.feed = f.value if self.inverse_time else f.value * self.lscale
+        s = words.get("S")
+        if s is not None:
+            used.add("S")
+            if s.value < 0:
+                raise b.error(f"spindle speed must be >= 0, got {s.value:g}", s.pos,
+                              _fmt("S", s.value))
+            self.speed = s.value
+            if self.spindle_on and 7 not in ms:
+                out.append(canon.Spindle(True, self.spindle_cw, self.speed,
+                                         self.opt.spindle_output, line, file))
+        t = words.get("T")
+        if t is not None:
+            used.add("T")
+            self.selected_tool = self._int_word(b, "T", t, 0)
+        if 6 in ms:
+            self.tool = self.selected_tool
+            out.append(canon.ToolChange(self.tool, line, file))
+        if 7 in ms:
+            code = ms[7][0]
+            self.spindle_on = code != 5
+            if code != 5:
+                self.spindle_cw = code == 3
+            out.append(canon.Spindle(self.spindle_on, self.spindle_cw, self.speed,
+                                     self.opt.spindle_output, line, file))
+        if coolant:
+            if 9 in coolant:
+                self.mist = self.flood = False
+            self.mist = self.mist or 7 in coolant
+            self.flood = self.flood or 8 in coolant
+            out.append(canon.Coolant(self.mist, self.flood, self.opt.mist_output,
+                                     self.opt.flood_output, line, file))
+        if 5 in ms:
+            code, pos = ms[5]
+            p = words.get("P")
+            if p is None:
+                raise b.error(f"M{code} needs P (the output number)", pos, f"M{code}")
+            used.add("P")
+            idx = self._int_word(b, "P", p, 0)
+            if idx >= self.opt.n_outputs:
+                raise b.error(f"output number must be < {self.opt.n_outputs}, got {idx}",
+                              p.pos, _fmt("P", p.value))
+            out.append(canon.SetOutput(idx, code in (62, 64), code in (62, 63), line, file))
+        g0 = gs.get(0)
+        if g0 is not None and g0[0] == 40:
+            p = words.get("P")
+            if p is None:
+                raise b.error("G4 needs P (dwell time in seconds)", g0[1], "G4")
+            used.add("P")
+            if p.value < 0:
+                raise b.error(f"dwell time must be >= 0, got {p.value:g}", p.pos,
+                              _fmt("P", p.value))
+            out.append(canon.Dwell(p.value, line, file))
+        if 2 in gs:
+            self.plane = gs[2][0]
+        if 6 in gs:
+            self._set_units("inch" if gs[6][0] == 200 else "mm")
+        if 8 in gs:
+            self._tool_length(b, gs[8], words, used)
+        if 12 in gs:
+            self.coord = COORD_SYSTEMS[gs[12][0]]
+            self.params.set_number(5220, float(self.coord))
+            self._update_offsets()
+        if 13 in gs:
+            self._path_control(b, gs[13][0], words, used, out)
+        if 3 in gs:
+            self.incremental = gs[3][0] == 910
+        if 4 in gs:
+            self.arc_incremental = gs[4][0] == 911
+        axes = {L: w for L, w in words.items() if L in AXIS_SET}
+        if g0 is not None and g0[0] in (100, 280, 281, 300, 301, 920, 921, 922, 923):
+            if axes and 1 in gs and gs[1][0] != 800:
+                raise b.error("axis words are used by two commands on this line "
+                              f"(G{g0[0] / 10:g} and G{gs[1][0] / 10:g})", gs[1][1],
+                              f"G{gs[1][0] / 10:g}")
+            self._group0(b, g0, axes, words, used, out)
+            used.update(axes)
+        elif 1 in gs or axes or (g0 is not None and g0[0] == 530):
+            if 1 in gs:
+                self.motion = None if gs[1][0] == 800 else gs[1][0]
+            if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")):
+                self._motion(b, gs, axes, words, used, out, machine=g0 is not None)
+                used.update(axes)
+        for letter, w in words.items():
+            if letter not in used:
+                raise b.error(f"word {letter} is not used by any command on this line",
+                              w.pos, _fmt(letter, w.value))
+        if 4 in ms:
+            code = ms[4][0]
+            if code in (0, 1):
+                out.append(canon.Pause(code == 1, line, file))
+            else:
+                out.append(canon.End(code == 30, line, file))
+                self.ended = True
+                return False
+        return True
+
+    # -- pieces ----------------------------------------------------------------------
+    def _int_word(self, b: Block, letter: str, w: _Word, lo: int) -> int:
+        n = round(w.value)
+        if abs(w.value - n) > 1e-4 or n < lo:
+            raise b.error(f"{letter} must be an integer >= {lo}, got {w.value:g}", w.pos,
+                          _fmt(letter, w.value))
+        return int(n)
+
+    def _assign(self, b: Block) -> None:
+        # All values on the line are read before any parameter is set (RS-274/NGC).
+        pending = []
+        for target, v, pos in b.assigns:
+            value = self.evaluate(b, v, "#")
+            if isinstance(target, Node):
+                idx = self.evaluate(b, target, "#")
+                n = round(idx)
+                if abs(idx - n) > 1e-4 or not 1 <= n < len(self.params.numbers):
+                    raise b.error(f"parameter number must be an integer in [1, "
+                                  f"{len(self.params.numbers) - 1}], got {idx:g}", pos,
+                                  f"#{idx:g}")
+                target = int(n)
+            pending.append((target, value))
+        for target, value in pending:
+            if isinstance(target, int):
+                self.params.set_number(target, value)
+            else:
+                self.params.set_named(target, value)
+        # Offsets are read from parameters: a program may set #5221.. directly.
+        self._update_offsets()
+
+    def _messages(self, b: Block, out: list[canon.Command]) -> None:
+        for _col, text in b.comments:
+            body = text.lstrip()
+            head = body[:6].upper()
+            if head.startswith("MSG,"):
+                out.append(canon.Message(body[4:].strip(), "msg", b.line, b.file))
+            elif head.startswith("DEBUG,"):
+                out.append(canon.Message(self.debug_text(body[6:].strip()), "debug", b.line,
+                                         b.file))
+            elif head.startswith("PRINT,"):
+                out.append(canon.Message(self.debug_text(body[6:].strip()), "print", b.line,
+                                         b.file))
+            elif self.opt.keep_comments:
+                out.append(canon.Message(text, "comment", b.line, b.file))
+
+    def _set_units(self, units: str) -> None:
+        self.units = units
+        if units == self.opt.machine_units:
+            self.lscale = 1.0
+        else:
+            self.lscale = MM_PER_INCH if units == "inch" else 1.0 / MM_PER_INCH
+
+    def _tool_length(self, b: Block, g: tuple[int, int], words: dict[str, _Word],
+                     used: set[str]) -> None:
+        if g[0] == 490:
+            self.tool_z = 0.0
+        else:
+            h = words.get("H")
+            tool = self.tool
+            if h is not None:
+                used.add("H")
+                tool = self._int_word(b, "H", h, 0)
+            self.tool_z = float(self.opt.tool_lengths.get(tool, 0.0))
+        self._update_offsets()
+
+    def _path_control(self, b: Block, code: int, words: dict[str, _Word], used: set[str],
+                      out: list[canon.Command]) -> None:
+        if code != 640:
+            mode = "exact_path" if code == 610 else "exact_stop"
+            out.append(canon.SetBlend(mode, None, b.line, b.file))
+            return
+        tol = cam = None
+        p = words.get("P")
+        if p is not None:
+            used.add("P")
+            if p.value < 0:
+                raise b.error(f"G64 P must be >= 0, got {p.value:g}", p.pos, _fmt("P", p.value))
+            tol = p.value * self.lscale
+        q = words.get("Q")
+        if q is not None:
+            used.add("Q")
+            if q.value < 0:
+                raise b.error(f"G64 Q must be >= 0, got {q.value:g}", q.pos, _fmt("Q", q.value))
+            cam = q.value * self.lscale
+        out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
+
+    def _group0(self, b: Block, g: tuple[int, int], axes: dict[str, _Word],
+                words: dict[str, _Word], used: set[str], out: list[canon.Command]) -> None:
+        code, gpos = g
+        gword = f"G{code / 10:g}"
+        nums = self.params.numbers
+        if code in (280, 300):
+            base = 5161 if code == 280 else 5181
+            if axes:
+                mid = self._target(b, axes)
+                self._check_limits(b, mid, mid, gword, gpos)
+                out.append(canon.Rapid(tuple(mid), b.line, b.file))
+                self.pos = mid
+                letters = list(axes)
+            else:
+                letters = list(self.letters)
+            end = self.pos[:]
+            for L in letters:
+                ax, k = self.letters[L]
+                end[ax] = nums[base + k]
+            self._check_limits(b, end, end, gword, gpos)
+            out.append(canon.Rapid(tuple(end), b.line, b.file))
+            self.pos = end
+        elif code in (281, 301):
+            base = 5161 if code == 281 else 5181
+            for ax, k in self.letters.values():
+                self.params.set_number(base + k, self.pos[ax])
+        elif code == 920:
+            if not axes:
+                raise b.error("G92 needs at least one axis word", gpos, gword)
+            for L, w in axes.items():
+                ax = self._axis(b, L, w)
+                k = self.letters[L][1]
+                base = self.off[k] - self.g92[k]
+                self.g92[k] = self.pos[ax] - base - w.value * self.scale(L)
+                self.params.set_number(5211 + k, self.g92[k])
+            self.params.set_number(5210, 1.0)
+            self._update_offsets()
+        elif code in (921, 922):
+            self.g92 = [0.0] * 9
+            if code == 921:
+                for k in range(9):
+                    self.params.set_number(5211 + k, 0.0)
+            self.params.set_number(5210, 0.0)
+            self._update_offsets()
+        elif code == 923:
+            self.g92 = [nums[5211 + k] for k in range(9)]
+            self.params.set_number(5210, 1.0)
+            self._update_offsets()
+        elif code == 100:
+            self._g10(b, gpos, axes, words, used)
+
+    def _g10(self, b: Block, gpos: int, axes: dict[str, _Word], words: dict[str, _Word],
+             used: set[str]) -> None:
+        lw = words.get("L")
+        if lw is None:
+            raise b.error("G10 needs L (L2 or L20)", gpos, "G10")
+        used.add("L")
+        L = self._int_word(b, "L", lw, 0)
+        if L not in (2, 20):
+            raise b.error(f"G10 L{L} is not supported (only L2 and L20)", lw.pos, f"L{L}")
+        if "R" in words:
+            raise b.error("G10 R (coordinate system rotation) is not supported",
+                          words["R"].pos, "R")
+        pw = words.get("P")
+        if pw is None:
+            raise b.error("G10 needs P (coordinate system 1..9, 0 = current)", gpos, "G10")
+        used.add("P")
+        p = self._int_word(b, "P", pw, 0)
+        if p > 9:
+            raise b.error(f"G10 P must be in [0, 9], got {p}", pw.pos, _fmt("P", pw.value))
+        system = p or self.coord
+        base = 5221 + 20 * (system - 1)
+        for letter, w in axes.items():
+            ax = self._axis(b, letter, w)
+            k = self.letters[letter][1]
+            v = w.value * self.scale(letter)
+            if L == 2:
+                self.params.set_number(base + k, v)
+            else:  # L20: the current position becomes v in that system
+                extra = self.g92[k] + (self.tool_z if k == 2 else 0.0)
+                self.params.set_number(base + k, self.pos[ax] - extra - v)
+        self._update_offsets()
+
+    def _feed_rate(self, b: Block, words: dict[str, _Word], gword: str, gpos: int
+                   ) -> tuple[float, float | None]:
+        """(feed_per_s, duration) for a feed move; errors when F is missing."""
+        if self.inverse_time:
+            f = words.get("F")
+            if f is None or f.value <= 0:
+                raise b.error("inverse time feed (G93) needs F > 0 on every G1/G2/G3 line",
+                              gpos, gword)
+            return 0.0, 60.0 / f.value
+        if self.feed <= 0.0:
+            raise b.error("feed rate is zero or not set: give F before or with "
+                          f"{gword}", gpos, gword)
+        return self.feed / 60.0, None
+
+    def _motion(self, b: Block, gs: dict[int, tuple[int, int]], axes: dict[str, _Word],
+                words: dict[str, _Word], used: set[str], out: list[canon.Command],
+                machine: bool) -> None:
+        mode = self.motion
+        gpos = gs[1][1] if 1 in gs else (axes[next(iter(axes))].pos if axes else 0)
+        if mode is None:
+            if 1 in gs:
+                raise b.error("axis words cannot be used with G80", gs[1][1], "G80")
+            w = next(iter(axes.values()))
+            raise b.error("axis words without a motion mode (G0, G1, G2 or G3)", w.pos,
+                          _fmt(next(iter(axes)), w.value))
+        gword = f"G{mode // 10}"
+        if machine:
+            if mode not in (0, 10):
+                raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
+            if self.incremental:
+                raise b.error("G53 cannot be used in incremental mode (G91)", gs[0][1], "G53")
+        target = self._target(b, axes, machine=machine)
+        if mode == 0:
+            self._check_limits(b, target, target, gword, gpos)
+            out.append(canon.Rapid(tuple(target), b.line, b.file))
+        elif mode == 10:
+            feed, duration = self._feed_rate(b, words, gword, gpos)
+            if duration is not None:
+                feed = _feed_length(self.pos, target, self.letters) / duration
+            self._check_limits(b, target, target, gword, gpos)
+            out.append(canon.Feed(tuple(target), feed, b.line, b.file, duration))
+        else:
+            self._arc(b, mode, gpos, target, words, used, out)
+        self.pos = target
+
+    def _arc(self, b: Block, mode: int, gpos: int, target: list[float],
+             words: dict[str, _Word], used: set[str], out: list[canon.Command]) -> None:
+        gword = f"G{mode // 10}"
+        la, lb, _lh, oa, ob, oh = PLANES[self.plane]
+        for L in (la, lb):
+            if L not in self.letters:
+                raise b.error(f"arc in the {la}{lb} plane needs a machine axis for {L}", gpos,
+                              gword)
+        if oh in words:
+            w = words[oh]
+            raise b.error(f"{oh} is not allowed for an arc in the {la}{lb} plane", w.pos,
+                          _fmt(oh, w.value))
+        feed, duration = self._feed_rate(b, words, gword, gpos)
+        ax_a, ka = self.letters[la]
+        ax_b, kb = self.letters[lb]
+        s = self.lscale
+        sa, sb = self.pos[ax_a], self.pos[ax_b]
+        ea, eb = target[ax_a], target[ax_b]
+        ccw = mode == 30
+        rtol = RADIUS_TOL[self.units] * s
+        turns = 0
+        pw = words.get("P")
+        if pw is not None:
+            used.add("P")
+            turns = self._int_word(b, "P", pw, 1) - 1
+        try:
+            if "R" in words:
+                rw = words["R"]
+                used.add("R")
+                for L in (oa, ob):
+                    if L in words:
+                        raise b.error("an arc takes either R or I/J/K, not both",
+                                      words[L].pos, _fmt(L, words[L].value))
+                if rw.value == 0:
+                    raise b.error("arc radius R must not be 0", rw.pos, "R0")
+                ca, cb = centre_from_radius(sa, sb, ea, eb, rw.value * s, ccw, rtol)
+                r1 = r2 = math.hypot(sa - ca, sb - cb)
+            else:
+                wa, wb = words.get(oa), words.get(ob)
+                if wa is None and wb is None:
+                    raise b.error(f"{gword} needs R or a centre ({oa}/{ob})", gpos, gword)
+                used.update(L for L in (oa, ob) if L in words)
+                if self.arc_incremental:
+                    ca = sa + (wa.value * s if wa is not None else 0.0)
+                    cb = sb + (wb.value * s if wb is not None else 0.0)
+                else:
+                    if wa is None or wb is None:
+                        missing = oa if wa is None else ob
+                        raise b.error(f"absolute arc centre (G90.1) needs both {oa} and {ob}",
+                                      gpos, missing)
+                    ca = wa.value * s + self.off[ka]
+                    cb = wb.value * s + self.off[kb]
+                r1, r2 = check_radii(sa, sb, ea, eb, ca, cb, CENTRE_TOL[self.units] * s, rtol)
+        except ArcGeometryError as exc:
+            w = words.get("R") or words.get(oa) or words.get(ob)
+            pos = w.pos if w is not None else gpos
+            raise b.error(f"{gword}: {exc.message}", pos, exc.word) from None
+        sweep = sweep_angle(sa, sb, ea, eb, ca, cb, ccw, turns)
+        if self.opt.soft_limits is not None:
+            a0 = math.atan2(sb - cb, sa - ca)
+            amin, amax, bmin, bmax = arc_extent(ca, cb, max(r1, r2), a0, sweep, ccw,
+                                                sa, sb, ea, eb)
+            lo = [min(p, q) for p, q in zip(self.pos, target, strict=True)]
+            hi = [max(p, q) for p, q in zip(self.pos, target, strict=True)]
+            lo[ax_a], hi[ax_a], lo[ax_b], hi[ax_b] = amin, amax, bmin, bmax
+            self._check_limits(b, lo, hi, gword, gpos)
+        centre = self.pos[:]
+        centre[ax_a], centre[ax_b] = ca, cb
+        if duration is not None:
+            r = 0.5 * (r1 + r2)
+            helix = _feed_length(self.pos, target, self.letters, skip=(ax_a, ax_b))
+            feed = math.hypot(r * sweep, helix) / duration
+        out.append(canon.ArcMove(tuple(self.pos), tuple(target), tuple(centre), (ax_a, ax_b),
+                                 Direction.CCW if ccw else Direction.CW, turns, sweep, r1, r2,
+                                 feed, b.line, b.file, duration))
+
+
+def _feed_length(start: list[float], end: list[float], letters: dict[str, tuple[int, int]],
+                 skip: tuple[int, ...] = ()) -> float:
+    """Move length as LinuxCNC measures feed: linear axes if any moves, else rotary."""
+    lin = rot = 0.0
+    for L, (ax, _k) in letters.items():
+        if ax in skip:
+            continue
+        d = (end[ax] - start[ax]) ** 2
+        if L in ROTARY_LETTERS:
+            rot += d
+        else:
+            lin += d
+    return math.sqrt(lin) if lin > 0.0 else math.sqrt(rot)

@@ -1,0 +1,149 @@
+"""What the interpreter needs to know about the machine: `GCodeOptions`.
+
+Axis letters map to machine axis indices; the machine's length unit, start position, soft
+limits, stored parameters (work offsets, G28/G30 positions), tool lengths, output numbers for
+spindle/coolant and the safety limits of interpretation. Validated on construction.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+from ..errors import MotionError, check_finite
+from .parser import MAX_PARAMETER
+from .source import MAX_LINE_LENGTH, MAX_PROGRAM_BYTES
+
+#: RS-274/NGC axis letters in parameter order (#5221 = X of G54, #5222 = Y, ...).
+AXIS_LETTERS = "XYZABCUVW"
+#: Rotary axes: degrees, never scaled by G20/G21.
+ROTARY_LETTERS = frozenset("ABC")
+MM_PER_INCH = 25.4
+
+
+def _opt_index(name: str, value: int | None) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise MotionError(f"{name} must be an integer >= 0 or None, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class GCodeOptions:
+    """Machine description for the G-code interpreter.
+
+    axes: letter -> machine axis index, e.g. {"X": 0, "Y": 1, "Z": 2, "A": 3}.
+    n_axes: number of machine axes (default: highest mapped index + 1).
+    machine_units: "mm" or "inch": the unit of canonical positions for linear axes.
+    start: machine position at program start (default all zero).
+    soft_limits: per machine axis (lo, hi) in machine units, or None for no limit.
+    parameters: initial numbered parameters (work offsets #5221.., G28 #5161.., G30 #5181..,
+        G92 #5211..), positions in machine units.
+    tool_lengths: tool number -> length offset (machine units) applied to Z by G43.
+    n_outputs: M62-M65 P must be in [0, n_outputs).
+    spindle_output / mist_output / flood_output: outputs carried by Spindle/Coolant.
+    block_delete: skip lines starting with '/' (the block-delete switch is on).
+    keep_comments: also emit plain comments as Message(kind="comment").
+    max_call_depth: subroutine nesting limit; max_blocks: executed-line limit (loops).
+    """
+
+    axes: Mapping[str, int]
+    n_axes: int | None = None
+    machine_units: str = "mm"
+    start: Sequence[float] | None = None
+    soft_limits: Sequence[tuple[float, float] | None] | None = None
+    parameters: Mapping[int, float] = field(default_factory=dict)
+    tool_lengths: Mapping[int, float] = field(default_factory=dict)
+    n_outputs: int = 16
+    spindle_output: int | None = None
+    mist_output: int | None = None
+    flood_output: int | None = None
+    block_delete: bool = True
+    keep_comments: bool = False
+    max_call_depth: int = 64
+    max_blocks: int = 10_000_000
+    max_line_length: int = MAX_LINE_LENGTH
+    max_bytes: int = MAX_PROGRAM_BYTES
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.axes, Mapping) or not self.axes:
+            raise MotionError(f"axes must be a non-empty mapping letter -> index, "
+                              f"got {self.axes!r}")
+        axes: dict[str, int] = {}
+        for letter, idx in self.axes.items():
+            up = letter.upper() if isinstance(letter, str) else letter
+            if up not in tuple(AXIS_LETTERS):
+                raise MotionError(f"axes keys must be letters of {AXIS_LETTERS}, got {letter!r}")
+            if isinstance(idx, bool) or not isinstance(idx, int) or idx < 0:
+                raise MotionError(f"axes[{letter!r}] must be an integer >= 0, got {idx!r}")
+            if idx in axes.values():
+                raise MotionError(f"axes: machine axis {idx} is mapped twice")
+            axes[up] = idx
+        n = max(axes.values()) + 1
+        if self.n_axes is not None:
+            if isinstance(self.n_axes, bool) or not isinstance(self.n_axes, int) \
+                    or self.n_axes < n:
+                raise MotionError(f"n_axes must be an integer >= {n} (highest mapped axis + 1)"
+                                  f", got {self.n_axes!r}")
+            n = self.n_axes
+        if self.machine_units not in ("mm", "inch"):
+            raise MotionError(f"machine_units must be 'mm' or 'inch', got "
+                              f"{self.machine_units!r}")
+        start = tuple(0.0 for _ in range(n)) if self.start is None else tuple(
+            check_finite(f"start[{k}]", v) for k, v in enumerate(self.start))
+        if len(start) != n:
+            raise MotionError(f"start must have {n} values (one per machine axis), "
+                              f"got {len(start)}")
+        limits: tuple[tuple[float, float] | None, ...] | None = None
+        if self.soft_limits is not None:
+            if len(self.soft_limits) != n:
+                raise MotionError(f"soft_limits must have {n} entries (one per machine axis),"
+                                  f" got {len(self.soft_limits)}")
+            out = []
+            for k, lim in enumerate(self.soft_limits):
+                if lim is None:
+                    out.append(None)
+                    continue
+                try:
+                    lo_raw, hi_raw = lim
+                except (TypeError, ValueError):
+                    raise MotionError(f"soft_limits[{k}] must be (lo, hi) or None, "
+                                      f"got {lim!r}") from None
+                lo = -math.inf if lo_raw is None else float(lo_raw)
+                hi = math.inf if hi_raw is None else float(hi_raw)
+                if math.isnan(lo) or math.isnan(hi) or lo > hi:
+                    raise MotionError(f"soft_limits[{k}] must satisfy lo <= hi, got {lim!r}")
+                if not lo <= start[k] <= hi:
+                    raise MotionError(f"start[{k}] = {start[k]:g} is outside soft_limits[{k}]"
+                                      f" = {lim!r}")
+                out.append((lo, hi))
+            limits = tuple(out)
+        for key, v in self.parameters.items():
+            if isinstance(key, bool) or not isinstance(key, int) \
+                    or not 1 <= key <= MAX_PARAMETER:
+                raise MotionError(f"parameters keys must be integers in [1, {MAX_PARAMETER}],"
+                                  f" got {key!r}")
+            check_finite(f"parameters[{key}]", v)
+        for key, v in self.tool_lengths.items():
+            if isinstance(key, bool) or not isinstance(key, int) or key < 0:
+                raise MotionError(f"tool_lengths keys must be integers >= 0, got {key!r}")
+            check_finite(f"tool_lengths[{key}]", v)
+        if isinstance(self.n_outputs, bool) or not isinstance(self.n_outputs, int) \
+                or self.n_outputs < 0:
+            raise MotionError(f"n_outputs must be an integer >= 0, got {self.n_outputs!r}")
+        for name in ("spindle_output", "mist_output", "flood_output"):
+            _opt_index(name, getattr(self, name))
+        for name, lo in (("max_call_depth", 1), ("max_blocks", 1), ("max_line_length", 16),
+                         ("max_bytes", 1)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+                raise MotionError(f"{name} must be an integer >= {lo}, got {v!r}")
+        for name in ("block_delete", "keep_comments"):
+            if not isinstance(getattr(self, name), bool):
+                raise MotionError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        object.__setattr__(self, "axes", axes)
+        object.__setattr__(self, "n_axes", n)
+        object.__setattr__(self, "start", start)
+        object.__setattr__(self, "soft_limits", limits)
