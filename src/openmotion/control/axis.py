@@ -353,8 +353,8 @@ class Axis:
             raise MotionError(f"axis {self.name}: change_position applies to absolute moves "
                               "only (HSL 4.11)")
         new_target = round(m.target + (p - m.abs_target))
-        profile = planning.change_position(m, self._ctl.time, new_target)
-        self._replace(m, profile, m.spec, float(new_target), abs_target=p)
+        profile, spec = planning.change_position(m, self._ctl.time, new_target)
+        self._replace(m, profile, spec, float(new_target), abs_target=p)
         self.counters.add_target(p - self.counters.target)
 
     @_locked

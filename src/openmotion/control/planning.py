@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..profile import velocity
+from ..profile import onthefly, velocity
 from ..profile.jerk import jerk_limited
 from ..profile.pcl import MoveSpec
 from ..profile.retarget import retarget_velocity
@@ -46,18 +46,15 @@ def velocity_move(spec: MoveSpec, direction: float, start: float) -> Profile:
 def change_speed(m: ActiveMotion, t: float, new_vel: float, tacc: float,
                  v_limit: float) -> tuple[Profile, MoveSpec]:
     """v_change at absolute time t; returns the spliced profile and the spec it now runs."""
-    from ..profile import onthefly
-
-    res = onthefly.change_speed(m.profile, t - m.t_start, m.spec, new_vel, tacc,
-                                target=m.target, v_limit=v_limit)
-    return res, m.spec
+    ch = onthefly.change_speed(m.profile, t - m.t_start, m.spec, new_vel, tacc,
+                               target=m.target, v_limit=v_limit)
+    return ch.profile, ch.spec
 
 
-def change_position(m: ActiveMotion, t: float, new_target: float) -> Profile:
+def change_position(m: ActiveMotion, t: float, new_target: float) -> tuple[Profile, MoveSpec]:
     """p_change at absolute time t to `new_target` (raw pulse frame)."""
-    from ..profile import onthefly
-
-    return onthefly.change_position(m.profile, t - m.t_start, m.spec, new_target)
+    ch = onthefly.change_position(m.profile, t - m.t_start, m.spec, new_target)
+    return _ending_on(ch.profile, new_target), ch.spec
 
 
 def decel_stop(m: ActiveMotion, t: float, tdec: float | None) -> Profile:
