@@ -45,12 +45,15 @@ def assert_valid_move(prof: Profile, *, start: State | tuple, target: float, v_m
     initial state that already exceeds them."""
     d_max = a_max if d_max is None else d_max
     p_s, v_s, a_s = (tuple(start) + (0.0, 0.0))[:3]
-    scale = max(abs(target - p_s), abs(v_s) * prof.duration, 1e-300) + 1.0
     assert prof.end.p == target
     assert prof.end.v == end_v
     if prof.n_segments == 0:
         assert prof.duration == 0.0
         return
+    smp = prof.sample(np.linspace(0.0, prof.duration, 4001))
+    # positions are compared relative to the largest excursion of the motion
+    scale = max(abs(target - p_s), np.abs(smp.p - p_s).max(), np.abs(prof.p0 - p_s).max(),
+                abs(v_s) * prof.duration) + 1.0
     a_big = max(a_max, d_max, abs(a_s), a_allow or 0.0)
     v_big = max(v_max, abs(v_s), v_allow or 0.0)
     # Segment times are absolute, so a time inside a segment is known to ~1 ulp of the
@@ -81,7 +84,6 @@ def assert_valid_move(prof: Profile, *, start: State | tuple, target: float, v_m
     assert np.abs(prof.j).max() <= j_max * (1 + REL)
     # evaluated motion: at segment extremes and on a dense sampling
     vs, accs = segment_extremes(prof)
-    smp = prof.sample(np.linspace(0.0, prof.duration, 4001))
     vs = np.concatenate([vs, smp.v])
     accs = np.concatenate([accs, smp.a])
     assert np.abs(vs).max() <= vlim * (1 + REL) + v_tol
