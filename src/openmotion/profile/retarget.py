@@ -1,9 +1,9 @@
 """Re-planning from any state: to rest at a new target, or to a new velocity.
 
-`retarget` takes an axis that is moving (p, v, a) to rest exactly on `target`. Limits apply
-in the frame of motion m (the sign of v_stop = v + a*|a|/(2J), the velocity reached by
-bringing the acceleration to zero at once): up to a_max speeding up, up to d_max slowing
-down. In that frame, with L = m*(target - p) and d_stop the distance of the fastest stop:
+`retarget` takes an axis that is moving (p, v, a) to rest exactly on `target`. Planning
+happens in the frame of motion m, the sign of v_stop = v + a*|a|/(2J) (the velocity
+reached by bringing the acceleration to zero at once). With L = m*(target - p) and d_stop
+the distance of the fastest stop (a ramp to v = 0):
 
   L >= d_stop (target ahead of the stopping point, the common case), one of
     F1  ramp (v, a) -> V, cruise at V, ramp V -> 0, with V in [v_stop, v_max]. The
@@ -227,9 +227,10 @@ def retarget(state: State, target: float, v_max: float, a_max: float, j_max: flo
              d_max: float | None = None) -> Profile:
     """From any state (p, v, a) to rest exactly on `target`, within the limits.
 
-    |v| may exceed v_max (the profile brakes to v_max first); |a| must be within
-    max(a_max, d_max). Overshoots (brakes, then comes back) only when the target lies
-    behind the stopping point.
+    a_max limits acceleration towards the final approach direction, d_max (default
+    a_max) against it, so d_max is the final deceleration. |v| may exceed v_max (the
+    profile brakes below it first); |a| must be within max(a_max, d_max). Reverses
+    through zero velocity only when the target lies behind the stopping point.
     """
     p, v, a = _check_state(state)
     tgt = check_finite("target", target)
