@@ -29,6 +29,7 @@ from openmotion.control.servo import LeadFilter
 from openmotion.errors import MotionError, check_nonnegative
 
 from . import hctl1100_regs as R
+from .hctl1100_commutator import PHASE_A, PHASE_D, commutator_mask
 from .hctl1100_profile import IntegralVelocity, trapezoid_commands
 from .hctl1100_regs import Mode
 
@@ -108,6 +109,8 @@ class HCTL1100:
         self._act_latch = (0, 0)
         self._last_actual = 0
         self._prev_actual = 0
+        self._ring_origin = self.plant.counts  # commutator logic cleared
+        self._ring_hold = 0
         self._comm = {R.R_COMM_RING: 0, R.R_COMM_VEL_TIMER: 0, R.R_COMM_X: 0, R.R_COMM_Y: 0,
                       R.R_COMM_OFFSET: 0, R.R_COMM_ADVANCE: 0}
         self._enter_idle()
@@ -213,6 +216,8 @@ class HCTL1100:
         ctrl = [f for f in _CONTROL_FLAGS if new & (1 << f)]
         if len(ctrl) > 1:
             raise MotionError("only one control flag (F0, F3, F5) may be set at a time")
+        if new & (1 << R.F4) and not self._flags & (1 << R.F4):
+            self._ring_hold = self.plant.counts - self._ring_origin  # freeze the ring counter
         mode = self.mode
         if mode is Mode.INIT_IDLE or mode is Mode.ALIGN or new == self._flags:
             self._flags = new
@@ -256,6 +261,7 @@ class HCTL1100:
                 return
             if value == R.PC_ALIGN:
                 self._require_timer(Mode.ALIGN, self._t_buffer)
+                self._ring_hold = self.plant.counts - self._ring_origin
                 self._flags |= 1 << R.F4
                 self._align_k = 0
                 self.mode = Mode.ALIGN
@@ -512,9 +518,23 @@ class HCTL1100:
         self._duty = 1.0
         if self._align_k >= 2 * R.ALIGN_SAMPLES:
             self._flags &= ~(1 << R.F4)
+            self._ring_origin = self.plant.counts  # rotor on the PHD detent: ring position 0
             self._cmd = 0
             self._filter.reset()
             self.mode = Mode.POSITION
+
+    def commutator_output(self, rotor_counts: int, sign: int) -> int:
+        """Phases on (bit mask A=1, B=2, C=4, D=8) for the rotor at `rotor_counts` (plant
+        counts) and motor command sign `sign`; the board turns them into winding currents."""
+        if self.mode is Mode.ALIGN:
+            return PHASE_A if self._align_k < R.ALIGN_SAMPLES else PHASE_D
+        frozen = self._flags & (1 << R.F4)
+        pos = self._ring_hold if frozen else rotor_counts - self._ring_origin
+        if self._status_low & R.ST_FULL_COUNTS:
+            pos //= 4
+        c = self._comm
+        return commutator_mask(pos, c[R.R_COMM_RING], c[R.R_COMM_X], c[R.R_COMM_Y],
+                               R.signed8(c[R.R_COMM_OFFSET]), sign)
 
     @property
     def align_phase(self) -> str | None:
