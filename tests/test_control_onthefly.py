@@ -135,3 +135,43 @@ def test_on_the_fly_needs_a_running_move():
     with pytest.raises(MotionError, match="running move"):
         ax.change_position(100)
     assert ax.snapshot() == before
+
+
+def test_velocity_mode_change_speed_keeps_the_original_range():
+    c = controller()
+    ax = c.axis("x")
+    ax.move_velocity(8000, tacc=0.05)
+    c.advance(0.1)
+    ax.change_speed(2000, 0.05)  # down: fine
+    c.advance(0.1)
+    assert ax.speed == pytest.approx(2000)
+    ax.change_speed(8000, 0.05)  # back up to the original MaxVel: still within range
+    c.advance(0.1)
+    assert ax.speed == pytest.approx(8000)
+    before = ax.snapshot()
+    with pytest.raises(InfeasibleError, match="speed range"):
+        ax.change_speed(8001, 0.05)
+    assert ax.snapshot() == before
+    ax.stop()
+    assert c.wait_motion_done(timeout=2)
+
+
+def test_stop_during_a_jerk_limited_move():
+    c = controller()
+    ax = c.axis("y")
+    ax.move_jerk_limited(100_000, v_max=50_000, a_max=200_000, j_max=4e6)
+    c.advance(0.4)
+    v = ax.speed
+    assert v > 0
+    ax.stop()
+    assert ax.state is S.STOPPING
+    top = 0.0
+    while ax.motion_done:
+        c.step()
+        top = max(top, ax.speed)
+    assert top <= 50_000 * (1 + 1e-9)
+    assert ax.state is S.STANDSTILL and 0 < ax.counters.command < 100_000
+    before = ax.snapshot()
+    with pytest.raises(MotionError, match="running move"):
+        ax.change_speed(100, 0.1)
+    assert ax.snapshot() == before

@@ -326,7 +326,7 @@ class Axis:
         if m.spec is None:
             raise MotionError(f"axis {self.name}: change_speed applies to T/S and velocity "
                               "moves, not jerk-limited ones")
-        limit = self._speed_range if self._speed_range is not None else m.spec.max_vel
+        limit = self._speed_range if self._speed_range is not None else m.v_range
         if v > limit * (1.0 + 1e-12):
             raise InfeasibleError(
                 f"new_vel must be <= the speed range {limit:g} pps "
@@ -397,7 +397,7 @@ class Axis:
                  abs_target: float | None = None) -> None:
         m = ActiveMotion(profile, old.t_start, kind or old.kind, spec, target,
                          abs_target if abs_target is not None else old.abs_target,
-                         old.limits)
+                         old.limits, old.v_range)
         self._motion = m
         self._ctl._motion_changed(self, m)
 

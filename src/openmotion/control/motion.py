@@ -42,6 +42,7 @@ class ActiveMotion:
     target: float | None = None     # end position, raw pulse frame (discrete moves)
     abs_target: float | None = None  # the absolute target as commanded (absolute moves)
     limits: tuple[float, float, float] | None = None  # (v, a, j) of a jerk-limited move
+    v_range: float = 0.0  # MaxVel as first commanded: the change_speed cap when not fixed
     _t0: list[float] = field(init=False, repr=False)
     _p0: list[float] = field(init=False, repr=False)
     _v0: list[float] = field(init=False, repr=False)
@@ -50,6 +51,8 @@ class ActiveMotion:
     _k: int = field(init=False, default=0, repr=False)
 
     def __post_init__(self) -> None:
+        if not self.v_range and self.spec is not None:
+            self.v_range = self.spec.max_vel
         pr = self.profile
         self._t0 = pr.t0.tolist()
         self._p0 = pr.p0.tolist()
