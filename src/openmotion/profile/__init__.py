@@ -10,6 +10,7 @@ from .jerk import jerk_limited, jerk_limited_duration, jerk_limited_sync
 from .onthefly import Change, change_position, change_speed
 from .pcl import MovePlan, MoveSpec, Rates, scurve, trapezoid
 from .quantize import check_quantized, quantize
+from .retarget import retarget, retarget_velocity
 from .segments import Phase, Profile, ProfileBuilder, Samples, State, empty_profile
 from .velocity import decel_stop, immediate_stop, stop_distance, velocity_move, velocity_ramp
 
@@ -19,5 +20,6 @@ __all__ = [
     "MovePlan", "MoveSpec", "Phase", "Profile", "ProfileBuilder", "Samples", "State",
     "check_quantized", "empty_profile", "jerk_limited", "jerk_limited_duration",
     "jerk_limited_durations", "jerk_limited_phases", "jerk_limited_sync", "quantize",
+    "retarget", "retarget_velocity",
     "scurve", "trapezoid",
 ]
