@@ -264,3 +264,39 @@ def test_28bit_wrap_during_a_move(ctl):
     ax.move_relative(-300, max_vel=10_000, tacc=0.01)
     run_move(ctl, ax)
     assert ax.counters.command == 2**27 - 100
+
+
+@given(
+    distance=st.integers(-100_000, 100_000).filter(lambda d: abs(d) > 100),
+    max_vel=st.floats(5_000, 100_000),
+    tacc=st.floats(0.01, 0.2),
+    shape=st.sampled_from("TS"),
+    frac=st.floats(0.0, 1.0),
+    immediate=st.booleans(),
+)
+@settings(max_examples=25, deadline=None)
+def test_stop_at_any_time_property(distance, max_vel, tacc, shape, frac, immediate):
+    c = Controller()
+    c.enable_all()
+    ax = c.axis("x")
+    ax.move_relative(distance, max_vel=max_vel, tacc=tacc, shape=shape)
+    c.advance(frac * ax.motion.profile.duration)
+    if ax.motion_done == 0:
+        return
+    at = ax.position
+    if immediate:
+        ax.stop_immediately()
+    else:
+        ax.stop()
+    top = 0.0
+    while ax.motion_done:
+        c.step()
+        top = max(top, ax.speed)
+    assert top <= max_vel * (1 + 1e-9)
+    assert ax.state is S.STANDSTILL
+    end = ax.position
+    sgn = 1 if distance > 0 else -1
+    assert sgn * (end - at) >= -1e-6  # never backs up
+    assert sgn * (end - distance) <= 1e-6  # never passes the target
+    c.step()
+    assert ax.counters.command == ax.counters.feedback
