@@ -235,6 +235,21 @@ def test_units_wrapper(ctl):
     assert ax.units.to_units(ax.position) == pytest.approx(-1.0)
 
 
+def test_units_velocity_mode_on_a_reversed_axis():
+    from dataclasses import replace
+
+    from openmotion.config import default_machine
+
+    m = default_machine()
+    c = Controller(m.with_axis(replace(m.axes[0], reverse=True)))
+    c.enable_all()
+    ax = c.axis("x")
+    ax.move_velocity(10.0, tacc=0.01, units=True)  # +10 mm/s = -10000 pps
+    c.advance(0.05)
+    assert ax.velocity == pytest.approx(-10_000)
+    ax.stop_immediately()
+
+
 def test_setting_counters_mid_move_does_not_disturb_motion(ctl):
     ax = ctl.axis("x")
     ax.move_relative(6000, max_vel=20_000, tacc=0.05)

@@ -239,7 +239,10 @@ class Axis:
                       shape: str = "T", vs_acc: float = 0.0, units: bool = False) -> None:
         """Velocity mode (HSL tv_move / sv_move): ramp from StrVel to `velocity` (signed,
         pps) in `tacc` and hold it until changed or stopped."""
-        v = self._speed_in("velocity", velocity, units)
+        v = check_finite("velocity", velocity)
+        if units:  # signed: a reversed axis runs the other way in pulses
+            v = float(self.units.velocity_to_pps(v))
+        v = self._speed_in("velocity", v, False)
         if v == 0.0:
             raise MotionError("velocity must be non-zero (its sign gives the direction)")
         spec = self._spec(shape, str_vel, abs(v), tacc, None, vs_acc, vs_acc, units)
