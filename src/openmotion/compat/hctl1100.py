@@ -45,7 +45,7 @@ class Plant(Protocol):
 
 @dataclass(frozen=True)
 class ChipEvent:
-    """A status change the board turns into an interrupt: 'limit', 'stop', 'profile_done'."""
+    """A chip status change: 'limit', 'stop', 'profile_start', 'profile_done'."""
 
     time: float
     kind: str
@@ -155,6 +155,7 @@ class HCTL1100:
         self._traj = trapezoid_commands(self._cmd, dist, acc, float(self._vmax))
         self._traj_k = 0
         self.mode = Mode.TRAPEZOID
+        self._emit("profile_start")
 
     # ------------------------------------------------------------------ positions
     @property
@@ -521,6 +522,7 @@ class HCTL1100:
             self._ring_origin = self.plant.counts  # rotor on the PHD detent: ring position 0
             self._cmd = 0
             self._filter.reset()
+            self._set_mc(0)
             self.mode = Mode.POSITION
 
     def commutator_output(self, rotor_counts: int, sign: int) -> int:

@@ -14,9 +14,10 @@ Board drive logic (configuration bits 0-1): one-phase-on maps A/B/C/D to winding
 shifts the sequence by half a step); half-step passes the chip's overlapped sequence
 A, AB, B, BC, ... through (X = Y). The electrical angle atan2(ib, ia) fixes the detent.
 
-`IdealStepper` is a quasi-static rotor: within a sample it steps from detent to detent
-toward the energised state, at most `max_step_rate * |duty|` full steps per second, and
-holds when the drive is off. No resonance, no torque curve: a documented simplification.
+`IdealStepper` is a quasi-static rotor: it steps from detent to detent toward the
+energised state; its step rate follows duty * `max_step_rate` through a first-order lag
+`tau` (a stand-in for inertia), and it holds when the drive is off. No resonance, no torque
+curve, no missed steps: a documented simplification.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ PHASE_A, PHASE_B, PHASE_C, PHASE_D = 1, 2, 4, 8
 _PHASE_BITS = (PHASE_A, PHASE_B, PHASE_C, PHASE_D)
 
 DRIVE_DC, DRIVE_FULL_ONE, DRIVE_FULL_TWO, DRIVE_HALF = 0, 1, 2, 3
+_MAX_SAMPLE = 16 * 256 / 2.0e6
 
 
 def _positive_detent(r: int, x: int, q: int) -> int:
@@ -108,7 +110,7 @@ class IdealStepper:
     """
 
     def __init__(self, steps_per_rev: int = 200, counts_per_rev: int = 2000, *,
-                 max_step_rate: float = 4000.0) -> None:
+                 max_step_rate: float = 4000.0, tau: float = 0.01) -> None:
         if not isinstance(steps_per_rev, int) or steps_per_rev <= 0 or steps_per_rev % 4:
             raise MotionError(f"steps_per_rev must be a positive multiple of 4, "
                               f"got {steps_per_rev!r}")
@@ -119,7 +121,11 @@ class IdealStepper:
             raise MotionError(f"max_step_rate must be > 0, got {max_step_rate!r}")
         self.counts_per_step = counts_per_rev // steps_per_rev
         self.cycle = 4 * self.counts_per_step  # one electrical cycle in counts
+        if not (tau > 0.0 and math.isfinite(tau)):
+            raise MotionError(f"tau must be > 0, got {tau!r}")
         self.max_step_rate = float(max_step_rate)
+        self.tau = float(tau)
+        self._rate = 0.0
         self.position = 0.0  # quadrature counts
         self.drive: Callable[[int, int], float | None] = lambda counts, sign: None
         self._budget = 0.0
@@ -138,8 +144,22 @@ class IdealStepper:
         return self.position + d
 
     def advance(self, dt: float, duty: float) -> None:
-        sign = (duty > 0.0) - (duty < 0.0)
-        self._budget = min(self._budget + abs(duty) * self.max_step_rate * dt, 64.0)
+        # step rate r (full steps/s) lags duty*max_step_rate with time constant tau; its
+        # mean over dt sets the step budget and its sign the commutation direction:
+        #   r(t) = r_inf + (r0 - r_inf) exp(-t/tau),  mean = r_inf + (r0 - r_inf) tau/dt (1 - e)
+        r_inf = duty * self.max_step_rate
+        r0 = self._rate
+        if dt > 0.0:
+            em1 = -math.expm1(-dt / self.tau)
+            mean = r_inf + (r0 - r_inf) * self.tau / dt * em1
+            self._rate = r_inf + (r0 - r_inf) * (1.0 - em1)
+        else:
+            mean = r0
+        sign = (mean > 0.0) - (mean < 0.0)
+        if duty == 0.0:
+            sign = 0
+        self._budget = min(self._budget + abs(mean) * dt,
+                           1.0 + self.max_step_rate * _MAX_SAMPLE)
         for _ in range(64):
             angle = self.drive(self.counts, sign)
             if angle is None:
@@ -147,11 +167,10 @@ class IdealStepper:
             target = self._target(angle)
             dist = target - self.position
             if abs(dist) < 1e-9:
+                self._rate = 0.0  # held on the detent of the energised phases
                 break
             need = abs(dist) / self.counts_per_step
             if need > self._budget:
-                if sign == 0:  # an open-loop hold: the rotor settles on the detent anyway
-                    self.position = target
                 break
             self._budget -= need
             self.position = target
