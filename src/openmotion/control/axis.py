@@ -245,7 +245,9 @@ class Axis:
         v = self._speed_in("velocity", v, False)
         if v == 0.0:
             raise MotionError("velocity must be non-zero (its sign gives the direction)")
-        spec = self._spec(shape, str_vel, abs(v), tacc, None, vs_acc, vs_acc, units)
+        sv = self._speed_in("str_vel", str_vel, units)
+        va = self._speed_in("vs_acc", vs_acc, units)
+        spec = MoveSpec(shape, sv, abs(v), tacc, tacc, va, va)
         self._check_can_start()
         profile = planning.velocity_move(spec, 1.0 if v > 0 else -1.0, self._pos)
         self._start(ActiveMotion(profile, self._ctl.time, "velocity", spec),
