@@ -269,6 +269,8 @@ def interpret(program: Program, options: GCodeOptions) -> list[canon.Command]:
 
 def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon.Command]:
     """Parse and interpret G-code text into canonical commands (machine coordinates)."""
+    if not isinstance(options, GCodeOptions):
+        raise GCodeError(f"options must be GCodeOptions, got {type(options).__name__}")
     if isinstance(text, bytes):
         text = decode_program(text, file, options.max_bytes)
     if not isinstance(text, str):
@@ -282,5 +284,7 @@ def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon
 
 def compile_file(path: str | os.PathLike[str], options: GCodeOptions) -> list[canon.Command]:
     """Read (text check, size limit), parse and interpret a G-code file."""
+    if not isinstance(options, GCodeOptions):
+        raise GCodeError(f"options must be GCodeOptions, got {type(options).__name__}")
     text = read_program(path, options.max_bytes)
     return compile_text(text, options, os.fspath(path))

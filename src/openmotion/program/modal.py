@@ -93,7 +93,8 @@ class Modal:
         self.pos: list[float] = list(options.start or ())
         self.machine_mm = options.machine_units == "mm"
         self.units = options.machine_units  # program units, "mm" or "inch"
-        self.lscale = 1.0
+        self.lscale = 1.0  # program length unit -> machine unit: v * lscale / ldiv
+        self.ldiv = 1.0
         self.incremental = False
         self.arc_incremental = True
         self.plane = 170
@@ -128,8 +129,13 @@ class Modal:
             self.off[k] = nums[base + k] + self.g92[k]
         self.off[2] += self.tool_z
 
-    def scale(self, letter: str) -> float:
-        return 1.0 if letter in ROTARY_LETTERS else self.lscale
+    def lin(self, v: float) -> float:
+        """A program length in machine units (exact when the units agree or 1 in = 25.4 mm)."""
+        return v * self.lscale / self.ldiv
+
+    def conv(self, v: float, letter: str) -> float:
+        """Program value of axis `letter` in machine units (rotary axes are degrees)."""
+        return v if letter in ROTARY_LETTERS else v * self.lscale / self.ldiv
 
     def program_position(self, k: int) -> float:
         """Current position of axis letter number k (X=0..W=8) in program coordinates."""
@@ -137,7 +143,8 @@ class Modal:
         info = self.letters.get(letter)
         if info is None:
             return 0.0
-        return (self.pos[info[0]] - self.off[k]) / self.scale(letter)
+        d = self.pos[info[0]] - self.off[k]
+        return d if letter in ROTARY_LETTERS else d * self.ldiv / self.lscale
 
     def _axis(self, b: Block, letter: str, w: _Word) -> int:
         info = self.letters.get(letter)
@@ -152,13 +159,13 @@ class Modal:
         target = self.pos[:]
         for letter, w in axes.items():
             ax = self._axis(b, letter, w)
-            s = self.scale(letter)
+            v = self.conv(w.value, letter)
             if machine:
-                target[ax] = w.value * s
+                target[ax] = v
             elif inc:
-                target[ax] = self.pos[ax] + w.value * s
+                target[ax] = self.pos[ax] + v
             else:
-                target[ax] = w.value * s + self.off[self.letters[letter][1]]
+                target[ax] = v + self.off[self.letters[letter][1]]
         return target
 
     def _check_limits(self, b: Block, lo: list[float], hi: list[float], word: str,
@@ -260,7 +267,7 @@ class Modal:
             if f.value < 0:
                 raise b.error(f"feed rate must be >= 0, got {f.value:g}", f.pos,
                               _fmt("F", f.value))
-            self.feed = f.value if self.inverse_time else f.value * self.lscale
+            self.feed = f.value if self.inverse_time else self.lin(f.value)
         s = words.get("S")
         if s is not None:
             used.add("S")
@@ -404,10 +411,12 @@ class Modal:
 
     def _set_units(self, units: str) -> None:
         self.units = units
-        if units == self.opt.machine_units:
-            self.lscale = 1.0
-        else:
-            self.lscale = MM_PER_INCH if units == "inch" else 1.0 / MM_PER_INCH
+        self.lscale = self.ldiv = 1.0
+        if units != self.opt.machine_units:
+            if units == "inch":
+                self.lscale = MM_PER_INCH
+            else:
+                self.ldiv = MM_PER_INCH
 
     def _tool_length(self, b: Block, g: tuple[int, int], words: dict[str, _Word],
                      used: set[str]) -> None:
@@ -434,13 +443,13 @@ class Modal:
             used.add("P")
             if p.value < 0:
                 raise b.error(f"G64 P must be >= 0, got {p.value:g}", p.pos, _fmt("P", p.value))
-            tol = p.value * self.lscale
+            tol = self.lin(p.value)
         q = words.get("Q")
         if q is not None:
             used.add("Q")
             if q.value < 0:
                 raise b.error(f"G64 Q must be >= 0, got {q.value:g}", q.pos, _fmt("Q", q.value))
-            cam = q.value * self.lscale
+            cam = self.lin(q.value)
         out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
 
     def _group0(self, b: Block, g: tuple[int, int], axes: dict[str, _Word],
@@ -476,7 +485,7 @@ class Modal:
                 ax = self._axis(b, L, w)
                 k = self.letters[L][1]
                 base = self.off[k] - self.g92[k]
-                self.g92[k] = self.pos[ax] - base - w.value * self.scale(L)
+                self.g92[k] = self.pos[ax] - base - self.conv(w.value, L)
                 self.params.set_number(5211 + k, self.g92[k])
             self.params.set_number(5210, 1.0)
             self._update_offsets()
@@ -518,7 +527,7 @@ class Modal:
         for letter, w in axes.items():
             ax = self._axis(b, letter, w)
             k = self.letters[letter][1]
-            v = w.value * self.scale(letter)
+            v = self.conv(w.value, letter)
             if L == 2:
                 self.params.set_number(base + k, v)
             else:  # L20: the current position becomes v in that system
@@ -586,11 +595,11 @@ class Modal:
         feed, duration = self._feed_rate(b, words, gword, gpos)
         ax_a, ka = self.letters[la]
         ax_b, kb = self.letters[lb]
-        s = self.lscale
+        s = self.lin
         sa, sb = self.pos[ax_a], self.pos[ax_b]
         ea, eb = target[ax_a], target[ax_b]
         ccw = mode == 30
-        rtol = RADIUS_TOL[self.units] * s
+        rtol = s(RADIUS_TOL[self.units])
         turns = 0
         pw = words.get("P")
         if pw is not None:
@@ -606,7 +615,7 @@ class Modal:
                                       words[L].pos, _fmt(L, words[L].value))
                 if rw.value == 0:
                     raise b.error("arc radius R must not be 0", rw.pos, "R0")
-                ca, cb = centre_from_radius(sa, sb, ea, eb, rw.value * s, ccw, rtol)
+                ca, cb = centre_from_radius(sa, sb, ea, eb, s(rw.value), ccw, rtol)
                 r1 = r2 = math.hypot(sa - ca, sb - cb)
             else:
                 wa, wb = words.get(oa), words.get(ob)
@@ -614,16 +623,16 @@ class Modal:
                     raise b.error(f"{gword} needs R or a centre ({oa}/{ob})", gpos, gword)
                 used.update(L for L in (oa, ob) if L in words)
                 if self.arc_incremental:
-                    ca = sa + (wa.value * s if wa is not None else 0.0)
-                    cb = sb + (wb.value * s if wb is not None else 0.0)
+                    ca = sa + (s(wa.value) if wa is not None else 0.0)
+                    cb = sb + (s(wb.value) if wb is not None else 0.0)
                 else:
                     if wa is None or wb is None:
                         missing = oa if wa is None else ob
                         raise b.error(f"absolute arc centre (G90.1) needs both {oa} and {ob}",
                                       gpos, missing)
-                    ca = wa.value * s + self.off[ka]
-                    cb = wb.value * s + self.off[kb]
-                r1, r2 = check_radii(sa, sb, ea, eb, ca, cb, CENTRE_TOL[self.units] * s, rtol)
+                    ca = s(wa.value) + self.off[ka]
+                    cb = s(wb.value) + self.off[kb]
+                r1, r2 = check_radii(sa, sb, ea, eb, ca, cb, s(CENTRE_TOL[self.units]), rtol)
         except ArcGeometryError as exc:
             w = words.get("R") or words.get(oa) or words.get(ob)
             pos = w.pos if w is not None else gpos

@@ -362,8 +362,11 @@ def parse_line(text: str, line: int, file: str = "",
         i = m.end()
     rest = code[i:] if i else code
     if "O" not in rest and _SIMPLE_LINE.match(rest):
-        block.words = [(m.group(1), float(m.group(2)), m.start() + i)
-                       for m in _SIMPLE_WORD.finditer(rest)]
+        words = block.words
+        p = i  # fast-path words are contiguous: each starts where the last one ended
+        for letter, num in _SIMPLE_WORD.findall(rest):
+            words.append((letter, float(num), p))
+            p += 1 + len(num)
         return block
     p = _LineParser(code, block)
     p.i = i
