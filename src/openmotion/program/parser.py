@@ -308,11 +308,12 @@ class _LineParser:
                               "with '='", pos, s[pos:self.i])
                 self.i += 1
                 b.assigns.append((target, self.value(), pos))
+            elif ch == "O":
+                self.fail("an O-word must be alone on its line (after an optional N)", pos,
+                          "O")
             elif ch in WORD_LETTERS:
                 if ch == "N":
                     self.fail("line number N must come first on the line", pos, "N")
-                if ch == "O":
-                    self.fail("O-word must start the line", pos, "O")
                 self.i += 1
                 if self.i >= len(s):
                     self.fail(f"word {ch} has no value", pos, ch)
