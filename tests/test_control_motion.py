@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from openmotion.control import AxisState, Controller, MotionDone
+from openmotion.errors import MotionError
 from openmotion.profile.pcl import MoveSpec
 
 S = AxisState
@@ -315,3 +316,37 @@ def test_stop_at_any_time_property(distance, max_vel, tacc, shape, frac, immedia
     assert sgn * (end - distance) <= 1e-6  # never passes the target
     c.step()
     assert ax.counters.command == ax.counters.feedback
+
+
+def test_run_profile_executes_an_external_profile(ctl):
+    from openmotion.profile.jerk import jerk_limited
+
+    ax = ctl.axis("x")
+    ax.counters.set_command(100)
+    prof = jerk_limited(5000, 40_000, 400_000, 8e6, start=100.0)
+    before = ax.snapshot()
+    with pytest.raises(MotionError, match="start at the axis position"):
+        ax.run_profile(jerk_limited(5000, 40_000, 400_000, 8e6), stop_accel=1e5, stop_jerk=1e7)
+    with pytest.raises(MotionError, match="stop_accel"):
+        ax.run_profile(prof, stop_accel=0, stop_jerk=1e7)
+    assert ax.snapshot() == before
+    ax.run_profile(prof, stop_accel=400_000, stop_jerk=8e6)
+    assert ax.state is S.DISCRETE_MOTION
+    run_move(ctl, ax)
+    assert ax.counters.command == 5100 and ax.state is S.STANDSTILL
+    # replace a running external profile mid-way, then stop it
+    ax.run_profile(jerk_limited(-5000, 40_000, 400_000, 8e6, start=5100.0),
+                   stop_accel=400_000, stop_jerk=8e6)
+    ctl.advance(0.1)
+    st = ax.motion.profile.state_at(ctl.time - ax.motion.t_start)
+    p_cmd = ax.position
+    from openmotion.profile.retarget import retarget
+
+    new = retarget(type(st)(p_cmd, st.v, st.a), -20_000.0, 40_000, 400_000, 8e6)
+    ax.run_profile(new, stop_accel=400_000, stop_jerk=8e6, replace_running=True)
+    ctl.advance(0.05)
+    ax.stop()
+    assert ax.state is S.STOPPING
+    run_move(ctl, ax)
+    assert ax.state is S.STANDSTILL and -20_000 < ax.counters.command < 5100
+    assert ax.speed == 0.0

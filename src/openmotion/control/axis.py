@@ -11,6 +11,7 @@ Every command validates and plans completely before it changes anything: a refus
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import wraps
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -18,6 +19,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from ..errors import InfeasibleError, MotionError, check_finite, check_positive
 from ..hw.interface import AxisCommand
 from ..profile.pcl import MoveSpec
+from ..profile.segments import Profile
 from ..units import MAX_PULSE_RATE, AxisUnits
 from . import planning
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters
@@ -316,6 +318,47 @@ class Axis:
         self._start(ActiveMotion(profile, self._ctl.time, "jerk", None, float(target),
                                  limits=(vm, max(am, dm or 0.0), jm)), S.DISCRETE_MOTION)
         self.counters.add_target(d - self.counters.target if absolute else round(d))
+
+    @_locked
+    def run_profile(self, profile: Profile, *, stop_accel: float, stop_jerk: float,
+                    replace_running: bool = False) -> None:
+        """Execute an externally planned Profile from now (for groups, homing, scripts).
+
+        Positions are in the command-counter frame; the profile must start where the axis
+        is (within 1e-6 pulse) and, when replacing a running `run_profile` motion
+        (`replace_running=True`), at its current velocity. A decelerating `stop()` uses
+        `stop_accel` (pps^2) and `stop_jerk` (pps^3). The profile's end state is held.
+        """
+        if not isinstance(profile, Profile):
+            raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
+        if profile.end.v != 0.0:
+            raise MotionError(f"profile must end at rest (end.v == 0), got {profile.end.v!r}")
+        sa = check_positive("stop_accel", stop_accel)
+        sj = check_positive("stop_jerk", stop_jerk)
+        m = self._motion
+        if replace_running and m is not None:
+            if m.kind != "profile" or self._state is not S.DISCRETE_MOTION:
+                raise MotionError(f"axis {self.name}: replace_running needs a running "
+                                  "run_profile motion")
+        else:
+            self._check_can_start()
+        shifted = profile.shifted(-self.counters._cmd_off)
+        st = shifted.state_at(0.0)
+        if abs(st.p - self._pos) > 1e-6:
+            raise MotionError(f"profile must start at the axis position {self.position!r}, "
+                              f"starts at {profile.state_at(0.0).p!r}")
+        if abs(st.v - self._vel) > 1e-6 * max(1.0, abs(self._vel)):
+            raise MotionError(f"profile must start at the axis velocity {self._vel!r}, "
+                              f"starts at {st.v!r}")
+        kind = "profile"
+        motion = ActiveMotion(shifted, self._ctl.time, kind, None, shifted.end.p,
+                              limits=(math.inf, sa, sj))
+        if m is not None:
+            self._motion = motion
+            self._ctl._motion_changed(self, motion)
+        else:
+            self._start(motion, S.DISCRETE_MOTION)
+        self.counters.add_target(shifted.end.p - st.p)
 
     @_locked
     def change_speed(self, new_vel: float, tacc: float, *, units: bool = False) -> None:

@@ -26,9 +26,9 @@ from ..profile.segments import Profile
 from .states import MotionDone
 
 #: Motion kinds. velocity: runs until changed or stopped (ContinuousMotion); relative,
-#: absolute and jerk (jerk-limited): end at `target` (DiscreteMotion); stop: a decelerating
-#: stop (Stopping).
-KINDS = ("velocity", "relative", "absolute", "jerk", "stop")
+#: absolute, jerk (jerk-limited) and profile (an external Profile, `Axis.run_profile`): end
+#: at `target` (DiscreteMotion); stop: a decelerating stop (Stopping).
+KINDS = ("velocity", "relative", "absolute", "jerk", "profile", "stop")
 
 
 @dataclass(eq=False)

@@ -59,10 +59,12 @@ def change_position(m: ActiveMotion, t: float, new_target: float) -> tuple[Profi
 
 def decel_stop(m: ActiveMotion, t: float, tdec: float | None) -> Profile:
     """sd_stop at absolute time t (deceleration of the move's spec, or `tdec`)."""
-    if m.limits is not None:  # jerk-limited move: fastest jerk-limited ramp to rest
+    if m.limits is not None:  # jerk-limited or external: fastest jerk-limited ramp to rest
         u = t - m.t_start
         _, a_max, j_max = m.limits
-        tail = retarget_velocity(m.profile.state_at(u), 0.0, a_max, j_max)
+        st = m.profile.state_at(u)
+        # never refuse a stop: an external profile may be accelerating harder than a_max
+        tail = retarget_velocity(st, 0.0, max(a_max, abs(st.a)), j_max)
         return m.profile.splice(u, tail)
     spec = m.spec if tdec is None else replace(m.spec, tdec=tdec)
     return velocity.decel_stop(m.profile, t - m.t_start, spec)
