@@ -266,17 +266,23 @@ class MotionLibrary:
         _int_in("drive", drive, 1, 100)
         x = self._read(base, R.R_COMM_X)
         y = self._read(base, R.R_COMM_Y)
+        ring = self._read(base, R.R_COMM_RING)
         inc = x if y == 0 else math.gcd(x, y)  # a full step, or a half step when Y = X
-        if inc == 0:
-            raise MotionError("program the commutator (X, Y) before stepping open loop")
+        if inc == 0 or ring == 0:
+            raise MotionError("program the commutator (ring, X, Y) before stepping open loop")
+        direction = 1 if steps > 0 else -1
         self._write(base, R.R_PROGRAM, R.PC_INIT_IDLE)
         self._write(base, R.R_FLAG, R.FLAG_SET | R.F4)
-        self._write(base, R.R_PWM, drive)
-        offset = R.signed8(self._read(base, R.R_COMM_OFFSET))
-        direction = 1 if steps > 0 else -1
+        # the commutator leads the held position by about a step in the drive direction;
+        # start one step (X + Y) back so the first state is the detent the rotor is on
+        start = R.signed8(self._read(base, R.R_COMM_OFFSET))
+        offset = (start - direction * (x + y)) % ring
+        self._write(base, R.R_COMM_OFFSET, offset)
+        self._write(base, R.R_PWM, (direction * drive) & 0xFF)
         for _ in range(abs(steps)):
-            offset = (offset + direction * inc + 128) % 256 - 128
-            self._write(base, R.R_COMM_OFFSET, offset & 0xFF)
+            offset = (offset + direction * inc) % ring  # stays within the 8-bit range
+            self._write(base, R.R_COMM_OFFSET, offset)
             self.delay(step_time)
         self._write(base, R.R_PWM, 0)
         self._write(base, R.R_FLAG, R.F4)
+        self._write(base, R.R_COMM_OFFSET, start & 0xFF)  # the ring counter follows again

@@ -300,6 +300,7 @@ class HCTL1100(RegisterAccess):
         if self._align_k >= 2 * R.ALIGN_SAMPLES:
             self._flags &= ~(1 << R.F4)
             self._ring_origin = self.plant.counts  # rotor on the PHD detent: ring position 0
+            self._pos_offset = -self.plant.counts  # [low] actual position cleared too
             self._cmd = 0
             self._filter.reset()
             self._set_mc(0)

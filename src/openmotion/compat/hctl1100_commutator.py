@@ -14,10 +14,11 @@ Board drive logic (configuration bits 0-1): one-phase-on maps A/B/C/D to winding
 shifts the sequence by half a step); half-step passes the chip's overlapped sequence
 A, AB, B, BC, ... through (X = Y). The electrical angle atan2(ib, ia) fixes the detent.
 
-`IdealStepper` is a quasi-static rotor: it steps from detent to detent toward the
-energised state; its step rate follows duty * `max_step_rate` through a first-order lag
-`tau` (a stand-in for inertia), and it holds when the drive is off. No resonance, no torque
-curve, no missed steps: a documented simplification.
+`IdealStepper` is a quasi-static rotor: it moves in half-step increments toward the
+detent of the energised state, re-reading the commutator after each; its step rate follows
+duty * `max_step_rate` through a first-order lag `tau` (a stand-in for inertia), and it
+holds when the drive is off. No resonance, no torque curve, no missed steps: a documented
+simplification.
 """
 
 from __future__ import annotations
@@ -60,10 +61,11 @@ def commutator_mask(position: int, ring: int, x: int, y: int, offset: int, sign:
     if sign == 0 or ring <= 0 or q <= 0:
         return 0
     r = (position + offset) % ring
+    c = (x - y) // 2  # centre the lead on one step: full step (q/2, 3q/2], half (q/2, q]
     if sign > 0:
-        return detent_mask(_positive_detent(r, x, q))
+        return detent_mask(_positive_detent((r + c) % (4 * q), x, q))
     # mirror: run the + rule on -r within the 4q cycle and mirror the detent back
-    d = _positive_detent((-r) % (4 * q), x, q)
+    d = _positive_detent((c - r) % (4 * q), x, q)
     return detent_mask(-d)
 
 
@@ -134,12 +136,14 @@ class IdealStepper:
     def counts(self) -> int:
         return math.floor(self.position + 1e-9)
 
-    def _target(self, angle: float) -> float:
-        """Nearest detent of electrical angle `angle` to the rotor (counts, unwrapped)."""
+    def _target(self, angle: float, sign: int = 1) -> float:
+        """Nearest detent of electrical angle `angle` to the rotor (counts, unwrapped); a
+        detent half a cycle away (zero static torque) is taken in the direction `sign`."""
         q = self.counts_per_step
         phase = q + angle / 360.0 * self.cycle  # ring position of the detent
         d = (phase - self.position) % self.cycle
-        if d > self.cycle / 2:
+        half = self.cycle / 2
+        if d > half + 1e-9 or (abs(d - half) <= 1e-9 and sign < 0):
             d -= self.cycle
         return self.position + d
 
@@ -160,19 +164,21 @@ class IdealStepper:
             sign = 0
         self._budget = min(self._budget + abs(mean) * dt,
                            1.0 + self.max_step_rate * _MAX_SAMPLE)
-        for _ in range(64):
+        for _ in range(256):
             angle = self.drive(self.counts, sign)
             if angle is None:
                 break
-            target = self._target(angle)
+            target = self._target(angle, sign)
             dist = target - self.position
             if abs(dist) < 1e-9:
                 self._rate = 0.0  # held on the detent of the energised phases
                 break
-            need = abs(dist) / self.counts_per_step
-            if need > self._budget:
+            # move by at most half a step per go, re-reading the commutator on the way
+            move = min(abs(dist), 0.5 * self.counts_per_step)
+            need = move / self.counts_per_step
+            if need > self._budget + 1e-12:
                 break
             self._budget -= need
-            self.position = target
+            self.position += math.copysign(move, dist)
         if sign == 0:
             self._budget = 0.0
