@@ -18,17 +18,8 @@ from __future__ import annotations
 import math
 import re
 
-from ..path import Direction
 from . import canon
-from .arcgeom import (
-    CENTRE_TOL,
-    RADIUS_TOL,
-    ArcGeometryError,
-    arc_extent,
-    centre_from_radius,
-    check_radii,
-    sweep_angle,
-)
+from .arcmove import arc_move
 from .expr import EvalError, Node
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
@@ -60,14 +51,11 @@ G_REFUSED = {
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
            62: 5, 63: 5, 64: 5, 65: 5}
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
-#: Plane -> (first, second, helix) axis letters and the centre-offset letters.
-PLANES = {170: ("X", "Y", "Z", "I", "J", "K"), 180: ("Z", "X", "Y", "K", "I", "J"),
-          190: ("Y", "Z", "X", "J", "K", "I")}
 AXIS_SET = frozenset(AXIS_LETTERS)
 _DEBUG_PARAM = re.compile(r"#<([^>]*)>|#(\d+)")
 
 
-class _Word:
+class Word:
     """A word's evaluated value and where it was (for error messages)."""
 
     __slots__ = ("value", "pos")
@@ -77,7 +65,7 @@ class _Word:
         self.pos = pos
 
 
-def _fmt(letter: str, v: float) -> str:
+def fmt(letter: str, v: float) -> str:
     return f"{letter}{v:g}"
 
 
@@ -146,14 +134,14 @@ class Modal:
         d = self.pos[info[0]] - self.off[k]
         return d if letter in ROTARY_LETTERS else d * self.ldiv / self.lscale
 
-    def _axis(self, b: Block, letter: str, w: _Word) -> int:
+    def _axis(self, b: Block, letter: str, w: Word) -> int:
         info = self.letters.get(letter)
         if info is None:
             raise b.error(f"axis letter {letter} has no machine axis (axes: "
-                          f"{', '.join(sorted(self.letters))})", w.pos, _fmt(letter, w.value))
+                          f"{', '.join(sorted(self.letters))})", w.pos, fmt(letter, w.value))
         return info[0]
 
-    def _target(self, b: Block, axes: dict[str, _Word], machine: bool = False,
+    def _target(self, b: Block, axes: dict[str, Word], machine: bool = False,
                 incremental: bool | None = None) -> list[float]:
         inc = self.incremental if incremental is None else incremental
         target = self.pos[:]
@@ -217,7 +205,7 @@ class Modal:
         line, file = b.line, b.file
         gs: dict[int, tuple[int, int]] = {}  # group -> (code, pos)
         ms: dict[int, tuple[int, int]] = {}
-        words: dict[str, _Word] = {}
+        words: dict[str, Word] = {}
         coolant: set[int] = set()
         for letter, v, pos in b.words:
             x = v if type(v) is float else self.evaluate(b, v, letter)
@@ -225,31 +213,31 @@ class Modal:
                 code = round(x * 10)
                 if abs(x * 10 - code) > 1e-6 or code not in G_GROUP:
                     msg = G_REFUSED.get(code, f"unsupported G-code G{x:g}")
-                    raise b.error(msg, pos, _fmt("G", x))
+                    raise b.error(msg, pos, fmt("G", x))
                 grp = G_GROUP[code]
                 if grp in gs:
                     raise b.error(f"two G-codes of the same modal group on one line "
-                                  f"(G{gs[grp][0] / 10:g} and G{x:g})", pos, _fmt("G", x))
+                                  f"(G{gs[grp][0] / 10:g} and G{x:g})", pos, fmt("G", x))
                 gs[grp] = (code, pos)
             elif letter == "M":
                 code = round(x)
                 if abs(x - code) > 1e-6 or code not in M_GROUP:
-                    raise b.error(f"unsupported M-code M{x:g}", pos, _fmt("M", x))
+                    raise b.error(f"unsupported M-code M{x:g}", pos, fmt("M", x))
                 grp = M_GROUP[code]
                 if grp == 8 and code != 9 and grp in ms and ms[grp][0] != 9:
                     coolant.add(code)  # M7 and M8 may share a line
                     continue
                 if grp in ms:
                     raise b.error(f"two M-codes of the same modal group on one line "
-                                  f"(M{ms[grp][0]} and M{code})", pos, _fmt("M", x))
+                                  f"(M{ms[grp][0]} and M{code})", pos, fmt("M", x))
                 ms[grp] = (code, pos)
                 if grp == 8:
                     coolant.add(code)
             else:
                 if letter in words:
                     raise b.error(f"word {letter} appears twice on one line", pos,
-                                  _fmt(letter, x))
-                words[letter] = _Word(x, pos)
+                                  fmt(letter, x))
+                words[letter] = Word(x, pos)
         if b.assigns:
             self._assign(b)
         used: set[str] = set()
@@ -266,14 +254,14 @@ class Modal:
             used.add("F")
             if f.value < 0:
                 raise b.error(f"feed rate must be >= 0, got {f.value:g}", f.pos,
-                              _fmt("F", f.value))
+                              fmt("F", f.value))
             self.feed = f.value if self.inverse_time else self.lin(f.value)
         s = words.get("S")
         if s is not None:
             used.add("S")
             if s.value < 0:
                 raise b.error(f"spindle speed must be >= 0, got {s.value:g}", s.pos,
-                              _fmt("S", s.value))
+                              fmt("S", s.value))
             self.speed = s.value
             if self.spindle_on and 7 not in ms:
                 out.append(canon.Spindle(True, self.spindle_cw, self.speed,
@@ -308,7 +296,7 @@ class Modal:
             idx = self._int_word(b, "P", p, 0)
             if idx >= self.opt.n_outputs:
                 raise b.error(f"output number must be < {self.opt.n_outputs}, got {idx}",
-                              p.pos, _fmt("P", p.value))
+                              p.pos, fmt("P", p.value))
             out.append(canon.SetOutput(idx, code in (62, 64), code in (62, 63), line, file))
         g0 = gs.get(0)
         if g0 is not None and g0[0] == 40:
@@ -318,7 +306,7 @@ class Modal:
             used.add("P")
             if p.value < 0:
                 raise b.error(f"dwell time must be >= 0, got {p.value:g}", p.pos,
-                              _fmt("P", p.value))
+                              fmt("P", p.value))
             out.append(canon.Dwell(p.value, line, file))
         if 2 in gs:
             self.plane = gs[2][0]
@@ -353,7 +341,7 @@ class Modal:
         for letter, w in words.items():
             if letter not in used:
                 raise b.error(f"word {letter} is not used by any command on this line",
-                              w.pos, _fmt(letter, w.value))
+                              w.pos, fmt(letter, w.value))
         if 4 in ms:
             code = ms[4][0]
             if code in (0, 1):
@@ -365,11 +353,11 @@ class Modal:
         return True
 
     # -- pieces ----------------------------------------------------------------------
-    def _int_word(self, b: Block, letter: str, w: _Word, lo: int) -> int:
+    def _int_word(self, b: Block, letter: str, w: Word, lo: int) -> int:
         n = round(w.value)
         if abs(w.value - n) > 1e-4 or n < lo:
             raise b.error(f"{letter} must be an integer >= {lo}, got {w.value:g}", w.pos,
-                          _fmt(letter, w.value))
+                          fmt(letter, w.value))
         return int(n)
 
     def _assign(self, b: Block) -> None:
@@ -418,7 +406,7 @@ class Modal:
             else:
                 self.ldiv = MM_PER_INCH
 
-    def _tool_length(self, b: Block, g: tuple[int, int], words: dict[str, _Word],
+    def _tool_length(self, b: Block, g: tuple[int, int], words: dict[str, Word],
                      used: set[str]) -> None:
         if g[0] == 490:
             self.tool_z = 0.0
@@ -431,7 +419,7 @@ class Modal:
             self.tool_z = float(self.opt.tool_lengths.get(tool, 0.0))
         self._update_offsets()
 
-    def _path_control(self, b: Block, code: int, words: dict[str, _Word], used: set[str],
+    def _path_control(self, b: Block, code: int, words: dict[str, Word], used: set[str],
                       out: list[canon.Command]) -> None:
         if code != 640:
             mode = "exact_path" if code == 610 else "exact_stop"
@@ -442,18 +430,18 @@ class Modal:
         if p is not None:
             used.add("P")
             if p.value < 0:
-                raise b.error(f"G64 P must be >= 0, got {p.value:g}", p.pos, _fmt("P", p.value))
+                raise b.error(f"G64 P must be >= 0, got {p.value:g}", p.pos, fmt("P", p.value))
             tol = self.lin(p.value)
         q = words.get("Q")
         if q is not None:
             used.add("Q")
             if q.value < 0:
-                raise b.error(f"G64 Q must be >= 0, got {q.value:g}", q.pos, _fmt("Q", q.value))
+                raise b.error(f"G64 Q must be >= 0, got {q.value:g}", q.pos, fmt("Q", q.value))
             cam = self.lin(q.value)
         out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
 
-    def _group0(self, b: Block, g: tuple[int, int], axes: dict[str, _Word],
-                words: dict[str, _Word], used: set[str], out: list[canon.Command]) -> None:
+    def _group0(self, b: Block, g: tuple[int, int], axes: dict[str, Word],
+                words: dict[str, Word], used: set[str], out: list[canon.Command]) -> None:
         code, gpos = g
         gword = f"G{code / 10:g}"
         nums = self.params.numbers
@@ -503,7 +491,7 @@ class Modal:
         elif code == 100:
             self._g10(b, gpos, axes, words, used)
 
-    def _g10(self, b: Block, gpos: int, axes: dict[str, _Word], words: dict[str, _Word],
+    def _g10(self, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, Word],
              used: set[str]) -> None:
         lw = words.get("L")
         if lw is None:
@@ -521,7 +509,7 @@ class Modal:
         used.add("P")
         p = self._int_word(b, "P", pw, 0)
         if p > 9:
-            raise b.error(f"G10 P must be in [0, 9], got {p}", pw.pos, _fmt("P", pw.value))
+            raise b.error(f"G10 P must be in [0, 9], got {p}", pw.pos, fmt("P", pw.value))
         system = p or self.coord
         base = 5221 + 20 * (system - 1)
         for letter, w in axes.items():
@@ -535,7 +523,7 @@ class Modal:
                 self.params.set_number(base + k, self.pos[ax] - extra - v)
         self._update_offsets()
 
-    def _feed_rate(self, b: Block, words: dict[str, _Word], gword: str, gpos: int
+    def _feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int
                    ) -> tuple[float, float | None]:
         """(feed_per_s, duration) for a feed move; errors when F is missing."""
         if self.inverse_time:
@@ -549,8 +537,8 @@ class Modal:
                           f"{gword}", gpos, gword)
         return self.feed / 60.0, None
 
-    def _motion(self, b: Block, gs: dict[int, tuple[int, int]], axes: dict[str, _Word],
-                words: dict[str, _Word], used: set[str], out: list[canon.Command],
+    def _motion(self, b: Block, gs: dict[int, tuple[int, int]], axes: dict[str, Word],
+                words: dict[str, Word], used: set[str], out: list[canon.Command],
                 machine: bool) -> None:
         mode = self.motion
         gpos = gs[1][1] if 1 in gs else (axes[next(iter(axes))].pos if axes else 0)
@@ -559,7 +547,7 @@ class Modal:
                 raise b.error("axis words cannot be used with G80", gs[1][1], "G80")
             w = next(iter(axes.values()))
             raise b.error("axis words without a motion mode (G0, G1, G2 or G3)", w.pos,
-                          _fmt(next(iter(axes)), w.value))
+                          fmt(next(iter(axes)), w.value))
         gword = f"G{mode // 10}"
         if machine:
             if mode not in (0, 10):
@@ -573,91 +561,15 @@ class Modal:
         elif mode == 10:
             feed, duration = self._feed_rate(b, words, gword, gpos)
             if duration is not None:
-                feed = _feed_length(self.pos, target, self.letters) / duration
+                feed = feed_length(self.pos, target, self.letters) / duration
             self._check_limits(b, target, target, gword, gpos)
             out.append(canon.Feed(tuple(target), feed, b.line, b.file, duration))
         else:
-            self._arc(b, mode, gpos, target, words, used, out)
+            out.append(arc_move(self, b, mode, gpos, target, words, used))
         self.pos = target
 
-    def _arc(self, b: Block, mode: int, gpos: int, target: list[float],
-             words: dict[str, _Word], used: set[str], out: list[canon.Command]) -> None:
-        gword = f"G{mode // 10}"
-        la, lb, _lh, oa, ob, oh = PLANES[self.plane]
-        for L in (la, lb):
-            if L not in self.letters:
-                raise b.error(f"arc in the {la}{lb} plane needs a machine axis for {L}", gpos,
-                              gword)
-        if oh in words:
-            w = words[oh]
-            raise b.error(f"{oh} is not allowed for an arc in the {la}{lb} plane", w.pos,
-                          _fmt(oh, w.value))
-        feed, duration = self._feed_rate(b, words, gword, gpos)
-        ax_a, ka = self.letters[la]
-        ax_b, kb = self.letters[lb]
-        s = self.lin
-        sa, sb = self.pos[ax_a], self.pos[ax_b]
-        ea, eb = target[ax_a], target[ax_b]
-        ccw = mode == 30
-        rtol = s(RADIUS_TOL[self.units])
-        turns = 0
-        pw = words.get("P")
-        if pw is not None:
-            used.add("P")
-            turns = self._int_word(b, "P", pw, 1) - 1
-        try:
-            if "R" in words:
-                rw = words["R"]
-                used.add("R")
-                for L in (oa, ob):
-                    if L in words:
-                        raise b.error("an arc takes either R or I/J/K, not both",
-                                      words[L].pos, _fmt(L, words[L].value))
-                if rw.value == 0:
-                    raise b.error("arc radius R must not be 0", rw.pos, "R0")
-                ca, cb = centre_from_radius(sa, sb, ea, eb, s(rw.value), ccw, rtol)
-                r1 = r2 = math.hypot(sa - ca, sb - cb)
-            else:
-                wa, wb = words.get(oa), words.get(ob)
-                if wa is None and wb is None:
-                    raise b.error(f"{gword} needs R or a centre ({oa}/{ob})", gpos, gword)
-                used.update(L for L in (oa, ob) if L in words)
-                if self.arc_incremental:
-                    ca = sa + (s(wa.value) if wa is not None else 0.0)
-                    cb = sb + (s(wb.value) if wb is not None else 0.0)
-                else:
-                    if wa is None or wb is None:
-                        missing = oa if wa is None else ob
-                        raise b.error(f"absolute arc centre (G90.1) needs both {oa} and {ob}",
-                                      gpos, missing)
-                    ca = s(wa.value) + self.off[ka]
-                    cb = s(wb.value) + self.off[kb]
-                r1, r2 = check_radii(sa, sb, ea, eb, ca, cb, s(CENTRE_TOL[self.units]), rtol)
-        except ArcGeometryError as exc:
-            w = words.get("R") or words.get(oa) or words.get(ob)
-            pos = w.pos if w is not None else gpos
-            raise b.error(f"{gword}: {exc.message}", pos, exc.word) from None
-        sweep = sweep_angle(sa, sb, ea, eb, ca, cb, ccw, turns)
-        if self.opt.soft_limits is not None:
-            a0 = math.atan2(sb - cb, sa - ca)
-            amin, amax, bmin, bmax = arc_extent(ca, cb, max(r1, r2), a0, sweep, ccw,
-                                                sa, sb, ea, eb)
-            lo = [min(p, q) for p, q in zip(self.pos, target, strict=True)]
-            hi = [max(p, q) for p, q in zip(self.pos, target, strict=True)]
-            lo[ax_a], hi[ax_a], lo[ax_b], hi[ax_b] = amin, amax, bmin, bmax
-            self._check_limits(b, lo, hi, gword, gpos)
-        centre = self.pos[:]
-        centre[ax_a], centre[ax_b] = ca, cb
-        if duration is not None:
-            r = 0.5 * (r1 + r2)
-            helix = _feed_length(self.pos, target, self.letters, skip=(ax_a, ax_b))
-            feed = math.hypot(r * sweep, helix) / duration
-        out.append(canon.ArcMove(tuple(self.pos), tuple(target), tuple(centre), (ax_a, ax_b),
-                                 Direction.CCW if ccw else Direction.CW, turns, sweep, r1, r2,
-                                 feed, b.line, b.file, duration))
 
-
-def _feed_length(start: list[float], end: list[float], letters: dict[str, tuple[int, int]],
+def feed_length(start: list[float], end: list[float], letters: dict[str, tuple[int, int]],
                  skip: tuple[int, ...] = ()) -> float:
     """Move length as LinuxCNC measures feed: linear axes if any moves, else rotary."""
     lin = rot = 0.0
