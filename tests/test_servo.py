@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from openmotion.control.servo import FollowingErrorMonitor, LeadFilter, PIDFF
+from openmotion.control.servo import PIDFF, FollowingErrorMonitor, LeadFilter
 from openmotion.errors import MotionError
 
 byte = st.integers(0, 255)
@@ -125,7 +125,8 @@ def test_pid_output_clamp_and_anti_windup():
     assert out == 3.0
 
 
-@pytest.mark.parametrize("kwargs", [dict(kp=-1, dt=1), dict(kp=1, dt=0), dict(kp=1, dt=1, ki=math.nan),
+@pytest.mark.parametrize("kwargs", [dict(kp=-1, dt=1), dict(kp=1, dt=0),
+                                    dict(kp=1, dt=1, ki=math.nan),
                                     dict(kp=1, dt=1, output_limit=0),
                                     dict(kp=1, dt=1, integral_limit="x"),
                                     dict(kp=1, dt=1, kvff=math.inf)])
