@@ -94,8 +94,10 @@ def cmd_profile(args: argparse.Namespace) -> int:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    from .demo import run_demo
+    from .demo import run_demo, run_realtime_demo
 
+    if args.realtime:
+        return run_realtime_demo(args.seconds)
     return run_demo(Path(args.out))
 
 
@@ -114,6 +116,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_profile_parser(sub)
     d = sub.add_parser("demo", help="run the demo on the simulated XYZU table")
     d.add_argument("--out", default="out", help="folder for plots and traces")
+    d.add_argument("--realtime", action="store_true",
+                   help="instead: run a 4-axis job paced to the wall clock, print jitter")
+    d.add_argument("--seconds", type=float, default=2.0, help="length of the real-time run")
     c = sub.add_parser("config", help="validate a machine file and print the resolved machine")
     c.add_argument("file", nargs="?", help="TOML machine file (default: the XYZU table)")
     return ap

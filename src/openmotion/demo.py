@@ -126,3 +126,31 @@ def run_demo(out: Path) -> int:
     for p in written:
         print(f"wrote {p}")
     return 0
+
+
+def run_realtime_demo(seconds: float = 2.0) -> int:
+    """Run a 4-axis job paced to the wall clock at 1 ms and print the cycle statistics."""
+    import time
+
+    ctl = Controller()
+    ctl.enable_all()
+    with ctl.start_realtime():
+        t_end = time.monotonic() + seconds
+        direction = 1.0
+        while time.monotonic() < t_end:
+            for k, ax in enumerate(ctl.axes):
+                if not ax.is_moving:
+                    ax.move_relative(direction * (5.0 + k), max_vel=50.0, tacc=0.1,
+                                     shape="S" if k % 2 else "T", units=True)
+            direction = -direction
+            time.sleep(0.02)
+        stats = ctl.cycle_stats()
+    ctl.stop_realtime()
+    us = 1e6
+    print(f"real time: {stats.cycles} cycles of {stats.period * 1e3:g} ms, 4 axes moving")
+    print(f"busy    mean {stats.mean_busy * us:8.1f} us  p99 {stats.p99_busy * us:8.1f} us  "
+          f"max {stats.max_busy * us:8.1f} us")
+    print(f"jitter  mean {stats.mean_jitter * us:8.1f} us  p99 {stats.p99_jitter * us:8.1f} us"
+          f"  max {stats.max_jitter * us:8.1f} us")
+    print(f"overruns {stats.overruns}")
+    return 0

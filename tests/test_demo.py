@@ -1,0 +1,34 @@
+"""The README's demo: every step runs and ends where it should."""
+
+from openmotion.cli import main
+from openmotion.control import Controller
+from openmotion.demo import run_steps
+
+
+def test_demo_steps_end_on_their_targets():
+    ctl = Controller()
+    steps = run_steps(ctl)
+    assert len(steps) == 6
+    x, y, z, u = (ctl.axis(n) for n in "xyzu")
+    assert x.counters.command == round(x.units.to_pulses(30.0))   # after the go-back
+    assert z.counters.command == round(z.units.to_pulses(20.0))
+    assert "changed at" in steps[4].note
+    # y stopped immediately mid-move: short of the 80 mm target, and at rest.
+    assert 30.0 < y.units.to_units(y.position) < 80.0
+    assert all(not a.is_moving for a in ctl.axes)
+    for a in ctl.axes:
+        assert a.counters.error == 0            # ideal steppers follow every pulse
+
+
+def test_demo_command_writes_plots(tmp_path, capsys):
+    assert main(["demo", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "Standstill" in out
+    assert (tmp_path / "demo_trace.png").stat().st_size > 1000
+    assert (tmp_path / "demo_trace.html").exists()
+
+
+def test_realtime_demo_prints_statistics(capsys):
+    assert main(["demo", "--realtime", "--seconds", "0.2"]) == 0
+    out = capsys.readouterr().out
+    assert "jitter" in out and "overruns" in out
