@@ -153,3 +153,30 @@ def test_following_error_nan_trips_and_bad_limit():
     for bad in (0, -1, math.nan, "a"):
         with pytest.raises(MotionError, match="limit"):
             FollowingErrorMonitor(bad)
+
+
+def test_pid_ff_closes_a_loop_on_the_dc_motor_and_monitor_watches_it():
+    """Ramp-and-hold under a load torque: the integral removes the final error, the velocity
+    feed-forward keeps the ramp lag small; a tight monitor trips, a loose one does not."""
+    from openmotion.hw.sim.dcmotor import DCMotor, DCMotorParams
+
+    def run(kvff, limit):
+        m = DCMotor(DCMotorParams(load_torque=0.005))
+        dt = 2.5e-4
+        c = PIDFF(0.02, ki=0.5, kd=0.0004, dt=dt, kvff=kvff, output_limit=1.0)
+        mon = FollowingErrorMonitor(limit)
+        worst = 0.0
+        for n in range(8000):
+            cmd = min(n * dt, 0.5) * 4000.0
+            u = c.step(cmd, m.counts)
+            if 0.1 < n * dt < 0.5:  # on the ramp
+                worst = max(worst, abs(cmd - m.counts))
+            mon.check(cmd, m.counts)
+            m.advance(dt, u)
+        return m.counts, worst, mon.tripped
+
+    # back-EMF feed-forward: ke * (2 pi / 4000 counts) / 24 V duty per count/s
+    final, lag_ff, tripped = run(0.03 * 2 * 3.141592653589793 / 4000 / 24, 100.0)
+    assert final == 2000 and not tripped
+    _, lag_noff, tripped = run(0.0, 20.0)
+    assert lag_noff > lag_ff and tripped
