@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from openmotion.compat import hctl1100_regs as R
 from openmotion.compat.hctl1100 import HCTL1100
@@ -228,19 +230,37 @@ def test_step_responses_default_tuned_and_gain_too_high(tmp_path):
 
 
 # ---------------------------------------------------------------- trapezoid
-@pytest.mark.parametrize("dist,acc,vmax", [(10000, 0.5, 40), (300, 0.5, 40), (-777, 0.25, 7),
-                                           (1, 1 / 256, 127), (0x7FFFFF, 127.99, 127)])
-def test_trapezoid_commands_end_exactly_and_respect_limits(dist, acc, vmax):
+@settings(max_examples=60, deadline=None)
+@given(dist=st.integers(-200000, 200000) | st.sampled_from([1, -1, 0x7FFFFF, -0x800000]),
+       acc_raw=st.integers(1, 0x7FFF), vmax=st.integers(1, 127))
+def test_trapezoid_commands_end_exactly_and_respect_limits(dist, acc_raw, vmax):
+    acc = acc_raw / 256.0
+    vpeak = min(vmax, (abs(dist) * acc) ** 0.5)
+    assume(vpeak == 0 or abs(dist) / vpeak + vpeak / acc < 20000)  # keep examples fast
     pos = trapezoid_commands(100, dist, acc, vmax)
     assert pos[-1] == 100 + dist
     v = np.diff(np.concatenate(([100], pos)))
     assert np.all(np.abs(v) <= vmax + 1)  # one count of rounding
     assert np.all(np.sign(v) * np.sign(dist) >= 0)  # never backwards
     peak = np.abs(v).max()
-    if vmax * vmax / acc <= abs(dist):  # Vmax reached before halfway: a trapezoid
+    if abs(dist) / vmax - vmax / acc >= 2:  # Vmax reached well before halfway: cruise
         assert peak >= vmax - 1
-    else:
+    if vmax * vmax / acc > abs(dist):  # triangle: the peak is sqrt(dist * acc)
         assert peak <= (abs(dist) * acc) ** 0.5 + 1
+
+
+def test_positions_wrap_at_24_bits_during_a_move():
+    c = chip()
+    put24(c, (R.R_PRESET_MSB, R.R_PRESET_MID, R.R_PRESET_LSB), 0x7FFF00)
+    put24(c, CMD, 0x7FFF00)
+    c.write(R.R_PROGRAM, R.PC_CONTROL)
+    c.write(R.R_ACCEL_MSB, 1)
+    c.write(R.R_MAX_VEL, 20)
+    put24(c, FINAL, 0x7FFF00 + 0x300)  # wraps to a negative final position
+    c.write(R.R_FLAG, R.FLAG_SET | R.F0)
+    c.run_samples(300)
+    assert c.command_position == R.wrap24(0x7FFF00 + 0x300) < 0
+    assert abs(R.wrap24(c.actual_position - c.command_position)) <= 1
 
 
 def test_trapezoid_move_on_the_chip():

@@ -26,7 +26,7 @@ from typing import Protocol
 import numpy as np
 
 from openmotion.control.servo import LeadFilter
-from openmotion.errors import MotionError, check_nonnegative
+from openmotion.errors import MotionError, check_nonnegative, check_positive
 
 from . import hctl1100_regs as R
 from .hctl1100_commutator import PHASE_A, PHASE_D, commutator_mask
@@ -54,7 +54,7 @@ class ChipEvent:
 
 @dataclass(frozen=True)
 class Trace:
-    """Per-sample record: sample start time (s), command/actual position (counts), MC."""
+    """Per-sample record: boundary time (s), command/actual position (counts), MC."""
 
     t: np.ndarray
     command: np.ndarray
@@ -62,14 +62,14 @@ class Trace:
     mc: np.ndarray
 
 
-
-
 class HCTL1100(RegisterAccess):
     """One chip with its plant. `advance(dt)` / `run_samples(n)` move virtual time."""
 
     def __init__(self, plant: Plant, *, clock_hz: float = R.CLOCK_HZ) -> None:
+        if not (hasattr(plant, "counts") and callable(getattr(plant, "advance", None))):
+            raise MotionError("plant must have `counts` and `advance(dt, duty)`")
         self.plant = plant
-        self.clock_hz = float(clock_hz)
+        self.clock_hz = check_positive("clock_hz", clock_hz)
         self.time = 0.0
         self.listeners: list[Callable[[ChipEvent], None]] = []
         self.limit_pin = False   # True = LIMIT input active (pin low)
@@ -83,7 +83,6 @@ class HCTL1100(RegisterAccess):
     def _soft_reset(self, hard: bool = False) -> None:
         if hard:
             self._flags = 0
-            self._regs: dict[int, int] = {}
         self._pos_offset = -self.plant.counts  # actual position counters set to 0
         self._filter.set_parameters(R.DEFAULT_A, R.DEFAULT_B, R.DEFAULT_K)
         self._t_reg = R.DEFAULT_SAMPLE_TIMER

@@ -81,6 +81,7 @@ class RegisterAccess:
             else:  # back to position control, holding where the generator is
                 if mode is Mode.PROP_VELOCITY:
                     self._cmd = self.actual_position
+                    self._filter.reset()  # its history predates the velocity mode
                 self._traj = None
                 self._iv = None
                 self.mode = Mode.POSITION
