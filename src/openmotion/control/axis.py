@@ -65,6 +65,8 @@ class Axis:
         self._inp_enabled = False
         self._waiting_inp = False
         self._speed_range: float | None = None
+        #: ALM reaction: False = stop at once (default), True = decelerate (HSL set_alm mode)
+        self.alarm_decelerate = False
         self._max_speed = min(config.max_speed_pps, MAX_PULSE_RATE)
 
     # ------------------------------------------------------------------ status
@@ -159,15 +161,32 @@ class Axis:
             raise MotionError(f"axis {self.name}: emergency stop still active; release it first")
         if self._ctl.alarm_active(self.index):
             raise MotionError(f"axis {self.name}: servo alarm still active")
+        if self._motion is not None:
+            raise MotionError(f"axis {self.name}: still stopping; wait for the stop to end")
         self._state = transition(self._state, S.STANDSTILL if self._powered else S.DISABLED,
                                  self.name)
 
-    def fault_stop(self, reason: str) -> None:
-        """Stop immediately and go to ErrorStop with `reason` (used by edge hooks)."""
+    def fault_stop(self, reason: str, *, decelerate: bool = False,
+                   at: float | None = None) -> None:
+        """Stop and go to ErrorStop with `reason` (used by edge hooks and safety).
+
+        Immediate by default. `decelerate=True`: decelerate to StrVel and stop (the running
+        move's deceleration; jerk-limited/external: its stop limits), the stop spliced into
+        the plan at absolute time `at` (an input edge's exact time, <= now; default now).
+        The axis stays in ErrorStop when the stop ends. Then every fault hook runs.
+        """
         with self._ctl._lock:
-            self._kill_motion()
+            m = self._motion
+            if decelerate and m is not None:
+                now = self._ctl.time
+                t = now if at is None else min(max(float(at), m.t_start), now)
+                self._replace(m, planning.decel_stop(m, t, None), m.spec, None, kind="stop")
+            else:
+                self._kill_motion()
             self._fault = reason
             self._state = transition(self._state, S.ERROR_STOP, self.name)
+            for hook in tuple(self._ctl._fault_hooks):
+                hook(self, reason)
 
     # ------------------------------------------------------------------ settings
     @_locked
@@ -354,6 +373,7 @@ class Axis:
         motion = ActiveMotion(shifted, self._ctl.time, kind, None, shifted.end.p,
                               limits=(math.inf, sa, sj))
         if m is not None:
+            self._ctl._vet_motion(self, motion)
             self._motion = motion
             self._ctl._motion_changed(self, motion)
         else:
@@ -436,6 +456,7 @@ class Axis:
                                  abs_target), S.DISCRETE_MOTION)
 
     def _start(self, motion: ActiveMotion, state: AxisState) -> None:
+        self._ctl._vet_motion(self, motion)
         self._state = transition(self._state, state, self.name)
         self._motion = motion
         self._ctl._motion_changed(self, motion)
@@ -446,6 +467,8 @@ class Axis:
         m = ActiveMotion(profile, old.t_start, kind or old.kind, spec, target,
                          abs_target if abs_target is not None else old.abs_target,
                          old.limits, old.v_range)
+        if m.kind != "stop":
+            self._ctl._vet_motion(self, m)
         self._motion = m
         self._ctl._motion_changed(self, m)
 
@@ -475,7 +498,9 @@ class Axis:
             self._motion = None
             self._vel = 0.0
             self._pos = m.profile.end.p
-            if self._inp_enabled and m.kind != "stop":
+            if self._state is S.ERROR_STOP:
+                pass  # a fault's decelerating stop ended: the axis stays in ErrorStop
+            elif self._inp_enabled and m.kind != "stop":
                 self._waiting_inp = True
             else:
                 self._state = transition(self._state, S.STANDSTILL, self.name)
