@@ -41,6 +41,8 @@ IO_BITS = (("rdy", 0), ("alm", 1), ("pel", 2), ("mel", 3), ("org", 4), ("ez", 9)
 
 EdgeHook = Callable[["Controller", InputEdge], None]
 CycleHook = Callable[["Controller", float], None]
+FaultHook = Callable[[Axis, str], None]
+MotionCheck = Callable[[Axis, ActiveMotion], None]
 
 
 class Controller:
@@ -82,6 +84,8 @@ class Controller:
         self.history = MotionHistory(len(self.axes), history_window_s, t_start=self._time)
         self._edge_hooks: list[EdgeHook] = [_estop_hook, _alarm_hook]
         self._cycle_hooks: list[CycleHook] = []
+        self._fault_hooks: list[FaultHook] = []
+        self._motion_checks: list[MotionCheck] = []
         self._estop = False
         self._inputs: list[dict[str, bool]] = [{} for _ in self.axes]
         self._nc = [{s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy")
@@ -158,6 +162,36 @@ class Controller:
         with self._lock:
             if hook in self._cycle_hooks:
                 self._cycle_hooks.remove(hook)
+
+    def add_fault_hook(self, hook: FaultHook) -> None:
+        """Call `hook(axis, reason)` whenever an axis goes to ErrorStop (`fault_stop`):
+        limits, alarms, E-stop, safety reactions. A group engine subscribes here."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._fault_hooks.append(hook)
+
+    def remove_fault_hook(self, hook: FaultHook) -> None:
+        with self._lock:
+            if hook in self._fault_hooks:
+                self._fault_hooks.remove(hook)
+
+    def add_motion_check(self, check: MotionCheck) -> None:
+        """Call `check(axis, motion)` before a motion starts or is re-planned (not for
+        stops); it refuses by raising MotionError, which leaves the axis unchanged."""
+        if not callable(check):
+            raise MotionError(f"check must be callable, got {check!r}")
+        with self._lock:
+            self._motion_checks.append(check)
+
+    def remove_motion_check(self, check: MotionCheck) -> None:
+        with self._lock:
+            if check in self._motion_checks:
+                self._motion_checks.remove(check)
+
+    def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
+        for check in tuple(self._motion_checks):
+            check(axis, motion)
 
     # ------------------------------------------------------------------ convenience
     def enable_all(self) -> None:
@@ -334,10 +368,12 @@ def _estop_hook(ctl: Controller, edge: InputEdge) -> None:
 
 
 def _alarm_hook(ctl: Controller, edge: InputEdge) -> None:
-    """Servo alarm (ALM) on an axis: that axis stops immediately, ErrorStop "servo alarm"."""
+    """Servo alarm (ALM) on an axis: that axis stops (immediately, or decelerating from the
+    edge time when `axis.alarm_decelerate`), ErrorStop "servo alarm"."""
     if (edge.axis is not None and edge.signal == "alm"
             and edge.level != ("alm" in ctl._nc[edge.axis])):
-        ctl.axes[edge.axis].fault_stop("servo alarm")
+        ax = ctl.axes[edge.axis]
+        ax.fault_stop("servo alarm", decelerate=ax.alarm_decelerate, at=edge.time)
 
 
 def _io_word(ctl: Controller, axis: int) -> int:
