@@ -1,8 +1,9 @@
 """openmotion.hw.sim: a simulated machine (drives, motors, encoders, switches, I/O) behind
 the hardware boundary, with a scenario API for faults and events at chosen times."""
 
+from .dcmotor import DCMotor, DCMotorParams
 from .encoder import EncoderWiring
 from .machine import SimMachine
 from .scenario import Scenario
 
-__all__ = ["EncoderWiring", "Scenario", "SimMachine"]
+__all__ = ["DCMotor", "DCMotorParams", "EncoderWiring", "Scenario", "SimMachine"]
