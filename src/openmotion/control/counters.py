@@ -15,6 +15,10 @@ other counters or the motion.
             counts of controller time). The default is "manual", as on the HSL-4XMO.
 - target:   the software target-position recorder (not a hardware counter, not wrapped):
             every new motion command adds its displacement; `reset_target_pos` sets it.
+
+`out_offset` (whole pulses) is what command transforms (control.compensation) add to the
+pulse output on top of the planned motion; it is taken off the raw pulses_out, so command,
+error and the general counter's "command" source show the *planned* position.
 """
 
 from __future__ import annotations
@@ -57,7 +61,7 @@ class Counters:
     """Command, feedback, error and general counters plus the target recorder of one axis."""
 
     __slots__ = ("_pulses", "_encoder", "_time", "_ratio", "_cmd_off", "_fb_off", "_err_off",
-                 "_gen_off", "_gen_src", "_target", "_fresh")
+                 "_gen_off", "_gen_src", "_target", "_fresh", "out_offset")
 
     def __init__(self, move_ratio: float = 1.0,
                  refresh: Callable[[], None] | None = None) -> None:
@@ -74,11 +78,12 @@ class Counters:
         self._gen_off = 0
         self._gen_src = "manual"
         self._target = 0.0
+        self.out_offset = 0
 
     # -- fed by the controller (through `refresh`) ---------------------------------------
     def update(self, pulses_out: int, encoder: int, time: float) -> None:
         """Latest raw hardware totals (unwrapped) and controller time."""
-        self._pulses = pulses_out
+        self._pulses = pulses_out - self.out_offset
         self._encoder = encoder
         self._time = time
 
