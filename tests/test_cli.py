@@ -38,3 +38,15 @@ def test_profile_bad_input_is_a_clear_error(capsys):
 def test_unknown_command_exits():
     with pytest.raises(SystemExit):
         main(["fly"])
+
+
+def test_config_validates_and_prints(capsys, tmp_path):
+    assert main(["config", "examples/xyzu.toml"]) == 0
+    captured = capsys.readouterr()
+    assert "[axes.x]" in captured.out and "is valid" in captured.err
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "m"\n[axes.x]\nlead = -2\n')
+    assert main(["config", str(bad)]) == 2
+    assert "axes.x.lead" in capsys.readouterr().err
+    assert main(["config", str(tmp_path / "missing.toml")]) == 2
+    assert "missing.toml" in capsys.readouterr().err

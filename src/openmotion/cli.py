@@ -129,7 +129,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     handler = {"profile": cmd_profile, "demo": cmd_demo, "config": cmd_config}[args.command]
     try:
         return handler(args)
-    except MotionError as exc:
+    except (MotionError, OSError) as exc:
         print(f"openmotion: error: {exc}", file=sys.stderr)
         return 2
 
