@@ -68,6 +68,13 @@ class Axis:
         #: ALM reaction: False = stop at once (default), True = decelerate (HSL set_alm mode)
         self.alarm_decelerate = False
         self._max_speed = min(config.max_speed_pps, MAX_PULSE_RATE)
+        # Additive hooks (control.compensation, control.inposition): each transform maps
+        # the planned cubic piece to what the hardware gets (called every cycle, also at
+        # rest, once any is installed); a gate holds a finished move "moving" while it
+        # returns a non-zero motion_done code (0 = done).
+        self.command_transforms: list[Callable[[Axis, AxisCommand], AxisCommand]] = []
+        self.done_gates: list[Callable[[Axis], int]] = []
+        self._gated = False
 
     # ------------------------------------------------------------------ status
     @property
@@ -81,7 +88,7 @@ class Axis:
 
     @property
     def is_moving(self) -> bool:
-        return self._motion is not None or self._waiting_inp
+        return self._motion is not None or self._waiting_inp or self._gated
 
     @property
     def position(self) -> float:
@@ -104,7 +111,9 @@ class Axis:
         m = self._motion
         if m is not None:
             return m.done_code(self._ctl.time)
-        return MotionDone.WAITING_INP if self._waiting_inp else MotionDone.STOPPED
+        if self._waiting_inp:
+            return MotionDone.WAITING_INP
+        return self._gate_code() if self._gated else MotionDone.STOPPED
 
     @property
     def motion(self) -> ActiveMotion | None:
@@ -242,7 +251,7 @@ class Axis:
             raise MotionError(f"axis {self.name}: stopping; wait for Standstill")
         if st is S.HOMING:
             raise MotionError(f"axis {self.name}: homing in progress")
-        if self._motion is not None or self._waiting_inp:
+        if self._motion is not None or self._waiting_inp or self._gated:
             raise MotionError(
                 f"axis {self.name}: a motion is running; use change_speed / change_position "
                 "or stop it first")
@@ -476,6 +485,7 @@ class Axis:
         """End any motion at the current commanded position, at rest."""
         m = self._motion
         self._waiting_inp = False
+        self._gated = False
         if m is None:
             return
         self._motion = None
@@ -486,11 +496,24 @@ class Axis:
     def _command(self, t0: float, t1: float) -> AxisCommand | None:
         m = self._motion
         if m is None:
-            return None  # the pulse generator holds its last end position
-        p0, v0, a0, j, p1, v1 = m.piece(t0, t1)
-        self._pos = p1
-        self._vel = v1 if t1 < m.t_end or m.kind == "velocity" else 0.0
-        return AxisCommand(t0, t1 - t0, p0, v0, a0, j)
+            if not self.command_transforms:
+                return None  # the pulse generator holds its last end position
+            cmd = AxisCommand(t0, t1 - t0, self._pos)
+        else:
+            p0, v0, a0, j, p1, v1 = m.piece(t0, t1)
+            self._pos = p1
+            self._vel = v1 if t1 < m.t_end or m.kind == "velocity" else 0.0
+            cmd = AxisCommand(t0, t1 - t0, p0, v0, a0, j)
+        for tr in self.command_transforms:
+            cmd = tr(self, cmd)
+        return cmd
+
+    def _gate_code(self) -> int:
+        for g in self.done_gates:
+            code = g(self)
+            if code:
+                return code
+        return MotionDone.STOPPED
 
     def _cycle_end(self, t1: float) -> None:
         m = self._motion
@@ -500,12 +523,18 @@ class Axis:
             self._pos = m.profile.end.p
             if self._state is S.ERROR_STOP:
                 pass  # a fault's decelerating stop ended: the axis stays in ErrorStop
-            elif self._inp_enabled and m.kind != "stop":
-                self._waiting_inp = True
             else:
-                self._state = transition(self._state, S.STANDSTILL, self.name)
+                held = m.kind != "stop"
+                self._waiting_inp = held and self._inp_enabled
+                self._gated = held and bool(self.done_gates)
+                if not (self._waiting_inp or self._gated):
+                    self._state = transition(self._state, S.STANDSTILL, self.name)
         if self._waiting_inp and self._ctl.input_active(self.index, "inp"):
             self._waiting_inp = False
+            if not self._gated:
+                self._state = transition(self._state, S.STANDSTILL, self.name)
+        if self._gated and not self._waiting_inp and self._gate_code() == 0:
+            self._gated = False
             self._state = transition(self._state, S.STANDSTILL, self.name)
 
     def snapshot(self) -> tuple:
