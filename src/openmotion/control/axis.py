@@ -364,11 +364,12 @@ class Axis:
         sa = check_positive("stop_accel", stop_accel)
         sj = check_positive("stop_jerk", stop_jerk)
         m = self._motion
+        homing = self._state is S.HOMING
         if replace_running and m is not None:
-            if m.kind != "profile" or self._state is not S.DISCRETE_MOTION:
+            if m.kind != "profile" or self._state not in (S.DISCRETE_MOTION, S.HOMING):
                 raise MotionError(f"axis {self.name}: replace_running needs a running "
                                   "run_profile motion")
-        else:
+        elif not (homing and m is None and not self._waiting_inp and not self._gated):
             self._check_can_start()
         shifted = profile.shifted(-self.counters._cmd_off)
         st = shifted.state_at(0.0)
@@ -381,13 +382,28 @@ class Axis:
         kind = "profile"
         motion = ActiveMotion(shifted, self._ctl.time, kind, None, shifted.end.p,
                               limits=(math.inf, sa, sj))
-        if m is not None:
+        if m is not None or homing:  # homing moves keep the axis in Homing
             self._ctl._vet_motion(self, motion)
             self._motion = motion
             self._ctl._motion_changed(self, motion)
         else:
             self._start(motion, S.DISCRETE_MOTION)
         self.counters.add_target(shifted.end.p - st.p)
+
+    @_locked
+    def begin_homing(self) -> None:
+        """Standstill -> Homing (used by control.homing). While homing, motion commands are
+        refused, `run_profile` runs the homing moves and a finished move leaves the axis in
+        Homing; `end_homing` returns it to Standstill. stop/stop_immediately/faults end it."""
+        self._check_can_start()
+        self._state = transition(self._state, S.HOMING, self.name)
+
+    @_locked
+    def end_homing(self) -> None:
+        """Homing -> Standstill (any homing move still running is cut at once)."""
+        if self._state is S.HOMING:
+            self._kill_motion()
+            self._state = transition(self._state, S.STANDSTILL, self.name)
 
     @_locked
     def change_speed(self, new_vel: float, tacc: float, *, units: bool = False) -> None:
@@ -443,6 +459,9 @@ class Axis:
         """
         td = None if tdec is None else check_positive("tdec", tdec)
         m = self._motion
+        if m is None and self._state is S.HOMING:  # homing between two moves: abort it
+            self.end_homing()
+            return
         if m is None or self._state is S.STOPPING and td is None:
             return
         t = self._ctl.time
@@ -528,13 +547,18 @@ class Axis:
                 self._waiting_inp = held and self._inp_enabled
                 self._gated = held and bool(self.done_gates)
                 if not (self._waiting_inp or self._gated):
-                    self._state = transition(self._state, S.STANDSTILL, self.name)
+                    self._settle()
         if self._waiting_inp and self._ctl.input_active(self.index, "inp"):
             self._waiting_inp = False
             if not self._gated:
-                self._state = transition(self._state, S.STANDSTILL, self.name)
+                self._settle()
         if self._gated and not self._waiting_inp and self._gate_code() == 0:
             self._gated = False
+            self._settle()
+
+    def _settle(self) -> None:
+        """A move is done: Standstill, except in Homing (the homing sequence goes on)."""
+        if self._state is not S.HOMING:
             self._state = transition(self._state, S.STANDSTILL, self.name)
 
     def snapshot(self) -> tuple:
