@@ -39,7 +39,9 @@ PULSE_MODES = (
 ENCODER_MODES = ("ab_x1", "ab_x2", "ab_x4", "cw_ccw", "pulse_dir")
 SIGNAL_LOGIC = ("no", "nc")  # normally open / normally closed contacts
 LOGIC_SIGNALS = ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy", "emg")
-DRIVE_TYPES = ("ideal_stepper", "stepper", "servo")
+DRIVE_TYPES = ("ideal_stepper", "stepper", "servo", "dc_servo")
+#: Compensators of a control-layer servo loop (LoopConfig.compensator).
+COMPENSATORS = ("lead", "pid")
 SWITCHES = ("pel", "mel", "org", "sd")
 
 #: Counts per encoder line for each input mode (CW/CCW and pulse/dir count every pulse).
@@ -138,6 +140,81 @@ class SwitchConfig:
 
 
 @dataclass(frozen=True)
+class DCMotorConfig:
+    """DC motor + PWM amplifier of a "dc_servo" drive, SI units (see hw/sim/dcmotor.py).
+
+    `ke` = 0 means "equal to kt" (an SI motor). The defaults are DCMotorParams' defaults:
+    a small unloaded 24 V motor on a 1 A driver.
+    """
+
+    supply_v: float = 24.0
+    resistance: float = 4.0
+    kt: float = 0.03           # N*m/A
+    ke: float = 0.0            # V*s/rad; 0 = kt
+    inertia: float = 2.0e-6    # kg*m^2
+    viscous: float = 1.0e-5    # N*m*s/rad
+    current_limit: float = 1.0  # A
+    load_torque: float = 0.0   # N*m, constant external torque
+
+    def __post_init__(self) -> None:
+        self.validate("motor")
+
+    def validate(self, path: str) -> None:
+        """Check the fields; `path` prefixes error messages (e.g. "axes.x.drive.motor")."""
+        for name in ("supply_v", "resistance", "kt", "inertia", "current_limit"):
+            _set(self, name, _positive(f"{path}.{name}", getattr(self, name)))
+        for name in ("ke", "viscous"):
+            _set(self, name, _nonneg(f"{path}.{name}", getattr(self, name)))
+        _set(self, "load_torque", _real(f"{path}.load_torque", self.load_torque))
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    """A position loop closed in the control layer (control/servoloop.py).
+
+    compensator "lead": the HCTL-1100 filter with zero `a`, pole `b`, gain `k` (0..255), its
+    8-bit output MC giving the duty min(|MC|, 100)/100 as on the chip. "pid": PIDFF with
+    `kp` (> 0), `ki`, `kd` (>= 0), `kvff`, `kaff`, output in duty units (per count, count/s,
+    count/s^2). `samples_per_cycle` (>= 1): loop samples per controller cycle.
+    `following_error` (encoder counts, > 0, inf = off): the limit that trips ErrorStop.
+    """
+
+    compensator: str = "lead"
+    a: int = 0xE5
+    b: int = 0x40
+    k: int = 0x40
+    kp: float = 0.0
+    ki: float = 0.0
+    kd: float = 0.0
+    kvff: float = 0.0
+    kaff: float = 0.0
+    samples_per_cycle: int = 1
+    following_error: float = 1000.0
+
+    def __post_init__(self) -> None:
+        self.validate("loop")
+
+    def validate(self, path: str) -> None:
+        """Check the fields; `path` prefixes error messages (e.g. "axes.x.loop")."""
+        _choice(f"{path}.compensator", self.compensator, COMPENSATORS)
+        for name in ("a", "b", "k"):
+            _int(f"{path}.{name}", getattr(self, name), 0, 255)
+        for name in ("kp", "ki", "kd"):
+            _set(self, name, _nonneg(f"{path}.{name}", getattr(self, name)))
+        for name in ("kvff", "kaff"):
+            _set(self, name, _real(f"{path}.{name}", getattr(self, name)))
+        if self.compensator == "pid" and self.kp <= 0.0:
+            raise MotionError(f"{path}.kp must be > 0 for the pid compensator, got {self.kp!r}")
+        _int(f"{path}.samples_per_cycle", self.samples_per_cycle, 1, 1000)
+        fe = self.following_error
+        if isinstance(fe, bool) or not isinstance(fe, (int, float)) or math.isnan(fe) \
+                or fe <= 0.0:
+            raise MotionError(f"{path}.following_error must be > 0 counts (inf = off), "
+                              f"got {fe!r}")
+        _set(self, "following_error", float(fe))
+
+
+@dataclass(frozen=True)
 class DriveConfig:
     """The simulated drive/motor behind one axis.
 
@@ -145,6 +222,8 @@ class DriveConfig:
     exceeds `pullout_speed` (pps) or the acceleration exceeds `pullout_accel` (pps/s).
     servo: tracks the command with a second-order lag (`bandwidth_hz`, `damping`), reports
     INP within `inp_band` pulses, READY after servo-on, ALM on `alarm` scenarios.
+    dc_servo: a DC motor (`motor`) on a PWM amplifier, driven by the control layer's servo
+    loop (AxisConfig.loop); the amplifier is on while SVON is on and no alarm.
     """
 
     type: str = "ideal_stepper"
@@ -155,6 +234,7 @@ class DriveConfig:
     inp_band: float = 5.0
     backlash: float = 0.0          # mechanical backlash (command pulses), feedback side
     pitch_error: tuple[float, ...] = ()  # lead-screw error table (pulses), see docs
+    motor: DCMotorConfig = field(default_factory=DCMotorConfig)  # dc_servo only
 
     def __post_init__(self) -> None:
         self.validate("drive")
@@ -177,6 +257,9 @@ class DriveConfig:
                               f"got {self.pitch_error!r}")
         _set(self, "pitch_error", tuple(
             _real(f"{path}.pitch_error[{i}]", e) for i, e in enumerate(self.pitch_error)))
+        if not isinstance(self.motor, DCMotorConfig):
+            raise MotionError(f"{path}.motor must be a DCMotorConfig, got {self.motor!r}")
+        self.motor.validate(f"{path}.motor")
 
 
 @dataclass(frozen=True)
@@ -205,6 +288,7 @@ class AxisConfig:
     mel: SwitchConfig | None = None
     org: SwitchConfig | None = None
     sd: SwitchConfig | None = None
+    loop: LoopConfig | None = None  # control-layer servo loop; dc_servo drives get a default
 
     def __post_init__(self) -> None:
         self.validate()
@@ -249,6 +333,12 @@ class AxisConfig:
         if not isinstance(self.drive, DriveConfig):
             raise MotionError(f"{p}.drive must be a DriveConfig, got {self.drive!r}")
         self.drive.validate(f"{p}.drive")
+        if self.loop is None and self.drive.type == "dc_servo":
+            _set(self, "loop", LoopConfig())
+        if self.loop is not None:
+            if not isinstance(self.loop, LoopConfig):
+                raise MotionError(f"{p}.loop must be a LoopConfig or None, got {self.loop!r}")
+            self.loop.validate(f"{p}.loop")
         for sw in SWITCHES:
             s = getattr(self, sw)
             if s is not None:
@@ -407,11 +497,13 @@ def default_machine() -> MachineConfig:
 # pulses on load, back on save; `reverse` flips the sign of position and width.
 
 _TOP_KEYS = ("name", "cycle_s", "digital_inputs", "digital_outputs", "axes")
-_AXIS_TABLES = ("logic", "drive") + SWITCHES
+_AXIS_TABLES = ("logic", "drive", "loop") + SWITCHES
 _AXIS_KEYS = tuple(f for f in AxisConfig.__dataclass_fields__ if f != "name")
 _AXIS_SCALARS = tuple(k for k in _AXIS_KEYS if k not in _AXIS_TABLES)
 _DRIVE_KEYS = tuple(DriveConfig.__dataclass_fields__)
 _SWITCH_KEYS = tuple(SwitchConfig.__dataclass_fields__)
+_MOTOR_KEYS = tuple(DCMotorConfig.__dataclass_fields__)
+_LOOP_KEYS = tuple(LoopConfig.__dataclass_fields__)
 
 _HEADER = """\
 # openmotion machine file. Lengths and speeds are in each axis's user unit (`unit`);
@@ -468,10 +560,25 @@ def _axis_from_toml(name: str, data: dict[str, Any]) -> AxisConfig:
     if "drive" in data:
         drive = _table(f"{path}.drive", data["drive"])
         _check_keys(f"{path}.drive", drive, _DRIVE_KEYS)
+        drive = dict(drive)
+        if "motor" in drive:
+            motor = _table(f"{path}.drive.motor", drive["motor"])
+            _check_keys(f"{path}.drive.motor", motor, _MOTOR_KEYS)
+            try:
+                drive["motor"] = DCMotorConfig(**motor)
+            except MotionError as e:
+                raise _rebased(e, "motor", f"{path}.drive.motor") from None
         try:
             kw["drive"] = DriveConfig(**drive)
         except MotionError as e:
             raise _rebased(e, "drive", f"{path}.drive") from None
+    if "loop" in data:
+        loop = _table(f"{path}.loop", data["loop"])
+        _check_keys(f"{path}.loop", loop, _LOOP_KEYS)
+        try:
+            kw["loop"] = LoopConfig(**loop)
+        except MotionError as e:
+            raise _rebased(e, "loop", f"{path}.loop") from None
     if not name.isidentifier():
         raise MotionError(f"axes name must be an identifier (letters, digits, _), got {name!r}")
     base = AxisConfig(name=name, **kw)   # validates the mechanism before we use its scale
@@ -524,7 +631,13 @@ def machine_to_dict(cfg: MachineConfig) -> dict[str, Any]:
             t["logic"] = dict(ax.logic)
         d = {k: getattr(ax.drive, k) for k in _DRIVE_KEYS}
         d["pitch_error"] = list(ax.drive.pitch_error)
+        if ax.drive.type == "dc_servo" or ax.drive.motor != DCMotorConfig():
+            d["motor"] = {k: getattr(ax.drive.motor, k) for k in _MOTOR_KEYS}
+        else:
+            del d["motor"]
         t["drive"] = d
+        if ax.loop is not None:
+            t["loop"] = {k: getattr(ax.loop, k) for k in _LOOP_KEYS}
         signed = ax.pulses_per_unit * (-1.0 if ax.reverse else 1.0)
         for sw in SWITCHES:
             s = getattr(ax, sw)
