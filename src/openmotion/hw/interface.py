@@ -85,3 +85,18 @@ class Hardware(Protocol):
 
     def read_input(self, signal: str) -> bool:
         """Board-level input level: `emg` or `di<n>`."""
+
+
+@runtime_checkable
+class EffortHardware(Protocol):
+    """Optional extension: a back end with motor-effort outputs (PWM duty / analog torque
+    command) for axes whose position loop is closed in the control layer (dc_servo).
+
+    Not part of `Hardware`, so back ends without such outputs stay valid; the control layer
+    checks `isinstance(hw, EffortHardware)` before attaching a servo loop.
+    """
+
+    def command_effort(self, axis: int, t0: float, value: float) -> None:
+        """Hold motor effort `value` (duty, clamped to [-1, 1]) from time t0 (>= the
+        hardware time) until the next call. MotionError for an axis without an effort
+        output (not a dc_servo axis) or a bad value; nothing changes then."""
