@@ -1,0 +1,524 @@
+"""Homing: one table-driven state machine for the 13 HSL home modes and MCCL phased homing.
+
+A `Homing` runs the phases of control.homing_modes on one axis, inside the controller's
+cycle (an edge hook finds the triggers at their exact time, a cycle hook sequences the
+phases), with the axis in the PLCopen Homing state. Run stages (LinuxCNC homing.c style):
+
+  SEARCH   moving in the phase's direction; entered when a phase starts (from rest: a ramp
+           to the phase speed, a cruise of at most `search_range`, a stop); left on the
+           wanted edge (-> the phase's reaction) or when the move ends without it (fault
+           "not found").
+  STOP     decelerating after a trigger; left at rest (+ settle_s) -> next phase.
+  MOVE     a positioning move (escape offset, final move to home); left at rest.
+  DONE / ERROR / ABORTED   final; counters cleared on DONE.
+
+Before the table: if the first phase's signal is already active, the axis first leaves it
+(StrVel, against the search) and backs off by `org_offset` - "back off until the switch
+releases, then by the offset" (anchors.md, b9). An end limit met while searching (not part of
+the mode) faults the axis, unless `auto_search` (HSL home_search, figure 4-29): then the
+axis reverses, passes ORG, backs off by `org_offset` and runs the table again.
+
+Deceleration budget: after a trigger the axis runs at most one cycle at speed, then a ramp;
+`overrun(v) = v*T + stop distance(v)` must not exceed `max_overrun` when given (refused at
+start otherwise), so a trigger never runs the axis into a hard stop. Moves ramp from rest at
+a = (MaxVel - StrVel)/Tacc (or with `jerk` as S-curves); no StrVel jump.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
+
+from ..errors import MotionError, check_finite, check_nonnegative, check_positive
+from ..hw.interface import InputEdge
+from ..profile.pcl import MoveSpec
+from ..profile.ramps import ramp_accel, ramp_jerk
+from ..profile.segments import Profile, ProfileBuilder
+from . import planning
+from .homing_modes import (
+    EZ_COUNT_BASE,
+    EZ_COUNT_MAX,
+    HSL_MODES,
+    MCCL_TYPES,
+    Phase,
+    mccl_phases,
+    uses,
+)
+from .states import AxisState
+
+if TYPE_CHECKING:
+    from .axis import Axis
+    from .controller import Controller
+
+S = AxisState
+EL_STOPS = ("decel", "immediate")
+FINALS = ("mark", "stay")
+
+
+@dataclass(frozen=True)
+class HomeConfig:
+    """Home settings of one axis (HSL set_home_config + home_move speeds, MCCL HOME_CONFIG).
+
+    mode: 0..12 (HSL home_mode) or "mccl_normal" / "mccl_home_only" / "mccl_index_only".
+    direction: +1/-1 home direction (HSL: the sign of MaxVel; MCCL: wPhase0Dir).
+    phase1_same_direction: MCCL wPhase1Dir == wPhase0Dir. str_vel, max_vel (pps), tacc (s),
+    jerk (pps^3, None = T-curve). ez_count 0..15. org_offset: back-off after leaving ORG
+    (HSL ORG_ESC_Offset). home_offset: final position relative to the mechanical home (MCCL
+    dfOffset; where the counters read 0). final: "mark" = move to home_offset and clear the
+    counters there; "stay" = stop where the mode stops, counters set so the home reads 0.
+    el_stop: reaction to an end limit used by the mode. auto_search: reverse on an end limit
+    (HSL home_search). max_overrun: deceleration budget after any trigger (pulses).
+    """
+
+    mode: int | str = 0
+    direction: int = -1
+    str_vel: float = 500.0
+    max_vel: float = 5000.0
+    tacc: float = 0.1
+    jerk: float | None = None
+    ez_count: int = 0
+    org_offset: float = 0.0
+    home_offset: float = 0.0
+    final: str = "mark"
+    el_stop: str = "decel"
+    auto_search: bool = False
+    phase1_same_direction: bool = False
+    search_range: float = 2.0**27
+    max_overrun: float | None = None
+    settle_s: float = 0.0
+    timeout_s: float = 600.0
+
+    def __post_init__(self) -> None:
+        m = self.mode
+        if not (isinstance(m, int) and not isinstance(m, bool) and m in HSL_MODES) and \
+                m not in tuple(f"mccl_{k}" for k in MCCL_TYPES):
+            raise MotionError(f"mode must be 0..12 or mccl_normal/mccl_home_only/"
+                              f"mccl_index_only, got {m!r}")
+        if self.direction not in (1, -1) or isinstance(self.direction, bool):
+            raise MotionError(f"direction must be +1 or -1, got {self.direction!r}")
+        sv = check_nonnegative("str_vel", self.str_vel)
+        mv = check_positive("max_vel", self.max_vel)
+        if sv > mv:
+            raise MotionError(f"str_vel must be <= max_vel ({mv!r}), got {sv!r}")
+        if sv == 0.0:
+            raise MotionError("str_vel must be > 0 (the slow search speed)")
+        check_positive("tacc", self.tacc)
+        if self.jerk is not None:
+            check_positive("jerk", self.jerk)
+        e = self.ez_count
+        if isinstance(e, bool) or not isinstance(e, int) or not 0 <= e <= EZ_COUNT_MAX:
+            raise MotionError(f"ez_count must be an int in [0, {EZ_COUNT_MAX}], got {e!r}")
+        check_nonnegative("org_offset", self.org_offset)
+        if check_finite("home_offset", self.home_offset) != round(self.home_offset):
+            raise MotionError(f"home_offset must be a whole number of pulses, got "
+                              f"{self.home_offset!r}")
+        if self.final not in FINALS:
+            raise MotionError(f"final must be one of {FINALS}, got {self.final!r}")
+        if self.el_stop not in EL_STOPS:
+            raise MotionError(f"el_stop must be one of {EL_STOPS}, got {self.el_stop!r}")
+        check_positive("search_range", self.search_range)
+        if self.max_overrun is not None:
+            check_positive("max_overrun", self.max_overrun)
+        check_nonnegative("settle_s", self.settle_s)
+        check_positive("timeout_s", self.timeout_s)
+
+    @property
+    def accel(self) -> float:
+        """Ramp acceleration (pps^2): (MaxVel - StrVel) / Tacc, or MaxVel/Tacc if equal."""
+        dv = self.max_vel - self.str_vel
+        return (dv if dv > 0.0 else self.max_vel) / self.tacc
+
+    def phases(self) -> tuple[Phase, ...]:
+        if isinstance(self.mode, int):
+            return HSL_MODES[self.mode]
+        return mccl_phases(self.mode[5:], self.phase1_same_direction)
+
+    def speed(self, name: str) -> float:
+        return {"max": self.max_vel, "str": self.str_vel, "creep": self.max_vel / 10.0}[name]
+
+
+@dataclass
+class HomeStatus:
+    """Where a homing run is. `code` is MCC_GetGoHomeStatus-like: -1 running, 1 done,
+    0 not started / failed."""
+
+    state: str = "idle"          # idle, running, done, error, aborted
+    phase: str = ""
+    mark: float | None = None    # mechanical home, command-counter frame before the reset
+    mark_time: float | None = None
+    mark_encoder: int | None = None
+    reason: str | None = None
+    history: list[str] = field(default_factory=list)
+
+    @property
+    def code(self) -> int:
+        return -1 if self.state == "running" else 1 if self.state == "done" else 0
+
+
+def _has_index(axis: Axis) -> bool:
+    # [low] assumption: quadrature (A/B) encoders carry the Z index; pulse inputs do not.
+    return axis.config.encoder_mode.startswith("ab")
+
+
+class Homing:
+    """The home sequence of one axis. `start()`, then run the controller; `status`."""
+
+    def __init__(self, ctl: Controller, axis: int | str, config: HomeConfig) -> None:
+        if not isinstance(config, HomeConfig):
+            raise MotionError(f"config must be a HomeConfig, got {type(config).__name__}")
+        self.ctl = ctl
+        self.axis = ctl.axis(axis)
+        self.config = config
+        self.status = HomeStatus()
+        table = config.phases()
+        if uses(table, "ez") and not _has_index(self.axis):
+            raise MotionError(f"mode {config.mode!r} needs the EZ index; axis "
+                              f"{self.axis.name} has encoder_mode "
+                              f"{self.axis.config.encoder_mode!r} (no index)")
+        self._table = table
+        self._plan: list[Phase] = []
+        self._k = 0
+        self._stage = "idle"
+        self._hits = 0
+        self._wait_on = False
+        self._t_rest = 0.0
+        self._t_begin = 0.0
+        self._recovered = False
+        self._after_move: str = ""
+
+    # ------------------------------------------------------------------ public
+    @property
+    def running(self) -> bool:
+        return self.status.state == "running"
+
+    @property
+    def done(self) -> bool:
+        return self.status.state == "done"
+
+    def overrun(self, speed: float) -> float:
+        """Travel after a trigger at `speed`: one cycle at speed + the stop distance."""
+        c = self.config
+        b = ProfileBuilder(0.0, speed)
+        if c.jerk is None:
+            ramp_accel(b, 0.0, c.accel)
+        else:
+            ramp_jerk(b, 0.0, c.accel, c.jerk)
+        return speed * self.ctl.period + b.state.p
+
+    def start(self) -> None:
+        """Validate, enter Homing and start the first phase. Refused (MotionError, nothing
+        changed) if the axis cannot move, the budget is exceeded or a speed is too high."""
+        c = self.config
+        ax = self.axis
+        for name in ("str_vel", "max_vel"):
+            ax._speed_in(name, getattr(c, name), False)
+        if c.max_overrun is not None:
+            worst = self.overrun(c.max_vel)
+            if worst > c.max_overrun:
+                raise MotionError(
+                    f"max_vel {c.max_vel:g} pps overruns a trigger by {worst:.1f} pulses, "
+                    f"more than max_overrun {c.max_overrun:g}: lower max_vel or tacc")
+        if self.running:
+            raise MotionError(f"axis {ax.name}: homing already running")
+        ax.begin_homing()
+        self.status = HomeStatus(state="running")
+        self._t_begin = self.ctl.time
+        self._plan = list(self._table)
+        self._k = 0
+        self._recovered = False
+        self.ctl.add_edge_hook(self._on_edge)
+        self.ctl.add_cycle_hook(self._on_cycle)
+        first = self._plan[0]
+        ahead = self._el_name(first.direction)
+        if first.signal != "el" and self._active(ahead):
+            if not c.auto_search:
+                self._fail(f"homing: starts on the {ahead.upper()} limit (auto_search off)")
+                return
+            self._recover()
+            return
+        if first.edge == "on" and self._active(self._sig(first)):
+            self._escape_then_table(first)
+            return
+        self._begin_phase()
+
+    def abort(self) -> None:
+        """Abort homing (MCC_AbortGoHome): decelerating stop, status 'aborted'."""
+        if self.running:
+            self._finish("aborted", "aborted by abort()")
+            self.axis.stop()
+
+    # ------------------------------------------------------------------ helpers
+    def _abs(self, d: int) -> int:
+        return d * self.config.direction
+
+    def _el_name(self, d: int) -> str:
+        return "pel" if self._abs(d) > 0 else "mel"
+
+    def _sig(self, ph: Phase) -> str:
+        # "el" is always the limit in the home direction (escapes move away from it)
+        return self._el_name(1) if ph.signal == "el" else ph.signal
+
+    def _active(self, sig: str) -> bool:
+        return self.ctl.input_active(self.axis.index, sig)
+
+    def _logical(self, e: InputEdge) -> bool:
+        return e.level != (self.axis.config.signal_logic(e.signal) == "nc")
+
+    def _state_now(self) -> tuple[float, float, float]:
+        """(p, v, a) of the axis now, command-counter frame."""
+        ax = self.axis
+        m = ax.motion
+        off = ax.position - ax._pos
+        if m is None:
+            return ax.position, 0.0, 0.0
+        p, v, a = m.state(self.ctl.time)
+        return p + off, v, a
+
+    def _run(self, profile: Profile) -> None:
+        c = self.config
+        j = c.jerk if c.jerk is not None else c.accel / self.ctl.period
+        self.axis.run_profile(profile, stop_accel=c.accel, stop_jerk=j,
+                              replace_running=self.axis.motion is not None)
+
+    def _ramp(self, b: ProfileBuilder, v1: float) -> None:
+        c = self.config
+        if c.jerk is None:
+            ramp_accel(b, v1, c.accel, label="homing ramp")
+        else:
+            ramp_jerk(b, v1, c.accel, c.jerk, label="homing ramp")
+
+    def _cruise(self, v: float) -> None:
+        """From the current state: ramp to v (signed), cruise search_range, stop."""
+        p, v0, a = self._state_now()
+        b = ProfileBuilder(p, v0, a if self.config.jerk is not None else 0.0)
+        self._ramp(b, v)
+        b.segment(self.config.search_range / abs(v), label="homing search")
+        self._ramp(b, 0.0)
+        self._run(b.build())
+
+    def _decelerate(self) -> None:
+        p, v, a = self._state_now()
+        b = ProfileBuilder(p, v, a if self.config.jerk is not None else 0.0)
+        self._ramp(b, 0.0)
+        self._run(b.build())
+
+    def _move_to(self, target: float) -> None:
+        c = self.config
+        p = self.axis.position
+        if target == p:
+            return
+        if c.jerk is None:
+            spec = MoveSpec("T", 0.0, c.str_vel, c.tacc, c.tacc, 0.0, 0.0)
+            # StrVel reached at the homing acceleration, not in Tacc
+            spec = replace(spec, tacc=c.str_vel / c.accel, tdec=c.str_vel / c.accel)
+            prof = planning.position_move(spec, p, target)
+        else:
+            prof = planning.jerk_move(p, target, c.str_vel, c.accel, c.jerk, None)
+        self._run(prof)
+
+    # ------------------------------------------------------------------ sequencing
+    def _log(self, text: str) -> None:
+        self.status.phase = text
+        self.status.history.append(text)
+
+    def _begin_phase(self) -> None:
+        ph = self._plan[self._k]
+        self._log(ph.name)
+        self._hits = 0
+        sig = self._sig(ph)
+        self._wait_on = ph.edge == "off" and not self._active(sig)
+        self._stage = "search"
+        v = self._abs(ph.direction) * self.config.speed(ph.speed)
+        _, v_now, _ = self._state_now()
+        if v_now == 0.0 or math.copysign(1.0, v_now) != math.copysign(1.0, v):
+            self._cruise(v)
+
+    def _escape_then_table(self, first: Phase) -> None:
+        """Leave the active switch against the search, back off, then run the table."""
+        esc = Phase(f"escape {first.signal.upper()}", first.signal, "off", -1, "str", "stop")
+        self._plan = [esc, *self._table]
+        self._after_move = ""
+        self._begin_phase()
+
+    def _recover(self) -> None:
+        """Auto search (HSL figure 4-29): reverse at MaxVel, pass ORG, back off, restart."""
+        self._recovered = True
+        table = list(self._table)
+        rev = [Phase("reverse to ORG", "org", "on", -1, "max", "pass"),
+               Phase("pass ORG", "org", "off", -1, "max", "stop")]
+        self._plan = [*rev, *table]
+        self._k = 0
+        self._stage = "search"
+        _, v, _ = self._state_now()
+        if v != 0.0:
+            self._decelerate()
+            self._stage = "stop"
+            self._log("limit: slow down")
+            self._k = -1  # the stop leads to phase 0 of the new plan
+            return
+        self._begin_phase()
+
+    def _next(self) -> None:
+        ph = self._plan[self._k] if self._k >= 0 else None
+        if ph is not None and ph.name.startswith(("escape", "pass ORG")) and \
+                self.config.org_offset > 0.0 and self._after_move != ph.name:
+            self._after_move = ph.name
+            self._stage = "move"
+            self._log("back off by org_offset")
+            d = self._abs(ph.direction)
+            self._move_to(round(self.axis.position + d * self.config.org_offset))
+            if self.axis.motion is not None:
+                return
+        self._after_move = ""
+        self._k += 1
+        if self._k < len(self._plan):
+            self._begin_phase()
+        else:
+            self._final()
+
+    def _final(self) -> None:
+        st = self.status
+        if st.mark is None:
+            self._fail("homing: sequence ended without a home mark")
+            return
+        c = self.config
+        self._stage = "final"
+        if c.final == "mark":
+            self._log("move to home")
+            self._move_to(float(round(st.mark) + round(c.home_offset)))
+            if self.axis.motion is None:
+                self._complete()
+        else:
+            self._complete()
+
+    def _complete(self) -> None:
+        """Clear command, feedback, error and general counters (not the target recorder)."""
+        ax = self.axis
+        cnt = ax.counters
+        st = self.status
+        c = self.config
+        rel = 0
+        enc_rel = 0
+        if c.final == "stay":  # the home (mark + offset) reads 0; the axis rests elsewhere
+            home = st.mark + c.home_offset
+            rel = round(ax.position - home)
+            enc_rel = round(rel * cnt.move_ratio)
+            if st.mark_encoder is not None:
+                raw_enc = cnt.feedback_unwrapped() - cnt._fb_off
+                enc_rel = raw_enc - st.mark_encoder - round(c.home_offset * cnt.move_ratio)
+        cnt.reset_all()
+        if rel:
+            cnt.set_command(rel)
+        if enc_rel:
+            cnt.set_feedback(enc_rel)
+        cnt.reset_error()
+        ax.end_homing()
+        self._finish("done", None)
+
+    def _finish(self, state: str, reason: str | None) -> None:
+        self.status.state = state
+        self.status.reason = reason
+        self._stage = state
+        self.ctl.remove_edge_hook(self._on_edge)
+        self.ctl.remove_cycle_hook(self._on_cycle)
+
+    def _fail(self, reason: str) -> None:
+        self._finish("error", reason)
+        self.axis.fault_stop(reason)
+
+    # ------------------------------------------------------------------ hooks
+    def _trigger(self, ph: Phase, e: InputEdge) -> None:
+        ax = self.axis
+        if ph.mark:
+            off = ax.position - ax._pos
+            self.status.mark = self.ctl.history.state_at(ax.index, e.time).p + off
+            self.status.mark_time = e.time
+            self.status.mark_encoder = e.encoders[ax.index] if e.encoders else None
+        then = ph.then
+        if then == "el":
+            then = "stop" if self.config.el_stop == "decel" else "halt"
+        if then == "pass":
+            self._next()
+        elif then == "slow":
+            v = self._abs(ph.direction) * self.config.str_vel
+            self._cruise(v)
+            self._next()
+        elif then == "halt":
+            ax.stop_immediately()
+            ax.begin_homing()
+            self._stage = "stop"
+            self._t_rest = -1.0
+        else:
+            self._decelerate()
+            self._stage = "stop"
+            self._t_rest = -1.0
+
+    def _on_edge(self, ctl: Controller, e: InputEdge) -> None:
+        if e.axis != self.axis.index or not self.running or self.axis.state is not S.HOMING:
+            return
+        active = self._logical(e)
+        v = ctl.history.state_at(e.axis, e.time).v
+        moving = 0 if v == 0.0 else (1 if v > 0 else -1)
+        ph = self._plan[self._k] if 0 <= self._k < len(self._plan) else None
+        searching = self._stage == "search" and ph is not None
+        if e.signal in ("pel", "mel") and active and moving == (1 if e.signal == "pel" else -1):
+            if searching and ph.signal == "el" and self._sig(ph) == e.signal:
+                self._trigger(ph, e)
+                return
+            if self.config.auto_search and not self._recovered and searching and \
+                    self._abs(ph.direction) == self.config.direction and \
+                    uses(self._table, "org"):
+                self._log(f"{e.signal.upper()} hit: reverse")
+                self._recover()
+                return
+            self._fail(f"homing: {e.signal.upper()} limit hit in phase "
+                       f"{self.status.phase!r}")
+            return
+        if not searching or self._sig(ph) != e.signal or moving != self._abs(ph.direction):
+            return
+        if self._wait_on:
+            if active:
+                self._wait_on = False
+            return
+        if active != (ph.edge == "on"):
+            return
+        self._hits += 1
+        need = self.config.ez_count + EZ_COUNT_BASE if ph.ez_counted else 1
+        if self._hits >= need:
+            self._trigger(ph, e)
+
+    def _on_cycle(self, ctl: Controller, t: float) -> None:
+        if not self.running:
+            return
+        ax = self.axis
+        if ax.state is not S.HOMING:
+            why = ax.fault if ax.state is S.ERROR_STOP else f"axis {ax.state.value}"
+            self._finish("aborted", f"homing aborted: {why}")
+            return
+        if t - self._t_begin > self.config.timeout_s:
+            self._fail(f"homing: timeout after {self.config.timeout_s:g} s in phase "
+                       f"{self.status.phase!r}")
+            return
+        if ax.is_moving:
+            return
+        stage = self._stage
+        if stage == "search":
+            ph = self._plan[self._k]
+            self._fail(f"homing: {ph.signal.upper()} not found within search_range "
+                       f"in phase {ph.name!r}")
+        elif stage == "stop":
+            if self._t_rest < 0.0:
+                self._t_rest = t
+            if t - self._t_rest + 1e-12 < self.config.settle_s:
+                return
+            ph = self._plan[self._k] if self._k >= 0 else None
+            if ph is not None and ph.must_stay_on and not self._active(self._sig(ph)):
+                self._fail("homing: stopped past the home sensor (MCCL phase 0): lower "
+                           "the homing speed")
+                return
+            self._next()
+        elif stage == "move":
+            self._next()
+        elif stage == "final":
+            self._complete()
