@@ -1,0 +1,489 @@
+"""Groups: logical axes of a controller moving together from a command queue (MCCL 2.5-2.6).
+
+A `Group` maps logical axes (x, y, z, ...) onto controller axes; an axis belongs to one open
+group at a time. Commands (point-to-point, line, arc, circle, helix, 3-D arc, delay) are
+validated and queued; each accepted command gets the next command index (>= 0). A refused
+command raises `GroupError` (a MotionError) carrying a negative `code` that vendor facades
+return as their own negative value; the queue and the running motion are then unchanged.
+The run-time side (queue execution, hold/continue/override re-planning, faults) is in
+groupexec.py; the path math in pathexec.py. Positions, speeds and accelerations are command
+pulses, pps and pps^2 of the controller axes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections import deque
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
+from ..path import Arc, Arc3D, Line
+from ..path.geometry import PathElement
+from ..profile.pcl import MoveSpec
+from . import pathexec as px
+from .groupexec import (
+    ERR_ACCEL,
+    ERR_ARC,
+    ERR_ARGUMENT,
+    ERR_AXIS_BUSY,
+    ERR_AXIS_FAULT,
+    ERR_AXIS_STATE,
+    ERR_GROUP,
+    ERR_LIMIT,
+    ERR_QUEUE_FULL,
+    ERR_SPEED,
+    ERR_STATE,
+    OWNERS,
+    GroupEngine,
+    GroupError,
+    GroupState,
+    _Cmd,
+    _Run,
+)
+from .states import AxisState
+
+if TYPE_CHECKING:
+    from .axis import Axis
+    from .controller import Controller
+
+__all__ = [
+    "ERR_ACCEL", "ERR_ARC", "ERR_ARGUMENT", "ERR_AXIS_BUSY", "ERR_AXIS_FAULT", "ERR_AXIS_STATE",
+    "ERR_GROUP", "ERR_LIMIT", "ERR_QUEUE_FULL", "ERR_SPEED", "ERR_STATE", "Group", "GroupError",
+    "GroupState",
+]
+
+
+class Group(GroupEngine):
+    """Coordinated axes of `controller` with a command queue.
+
+    axes: logical name -> controller axis (name or index), or a sequence of controller axes
+    (logical names are then the axis names). feed: vector speed (pps); acc_time: time to
+    reach the feed (path acceleration = feed / acc_time, default 20 periods as in MCCL).
+    """
+
+    def __init__(self, controller: Controller, axes: Mapping[str, int | str] | Sequence[int | str],
+                 *, feed: float = 10_000.0, acc_time: float | None = None,
+                 queue_size: int = 1024) -> None:
+        if isinstance(axes, Mapping):
+            names, keys = list(axes.keys()), list(axes.values())
+        elif isinstance(axes, Sequence) and not isinstance(axes, (str, bytes)):
+            keys = list(axes)
+            names = [controller.axis(k).name for k in keys]
+        else:
+            raise MotionError(f"axes must be a mapping or a sequence of axes, got {axes!r}")
+        if len(keys) < 1:
+            raise MotionError("axes must name at least one axis")
+        ax = [controller.axis(k) for k in keys]
+        if len({a.index for a in ax}) != len(ax):
+            raise MotionError("axes must be different controller axes")
+        if isinstance(queue_size, bool) or not isinstance(queue_size, int) or queue_size < 1:
+            raise MotionError(f"queue_size must be an integer >= 1, got {queue_size!r}")
+        owners = OWNERS.setdefault(controller, {})
+        for a in ax:
+            if a.index in owners:
+                raise GroupError(ERR_AXIS_BUSY, f"axis {a.name} already belongs to an open group")
+        self._ctl = controller
+        self.names = tuple(str(n) for n in names)
+        self.axes: tuple[Axis, ...] = tuple(ax)
+        self._queue: deque[_Cmd] = deque()
+        self._queue_size = queue_size
+        self._next_index = 0
+        self._state = GroupState.IDLE
+        self._run: _Run | None = None
+        self._held: _Run | None = None
+        self._aborting = False
+        self._error = 0
+        self._error_msg = ""
+        self._override = 1.0
+        self._ptp_override = 1.0
+        self._dry = False
+        self._dry_pos = np.array([a.position for a in ax])
+        self._tail: np.ndarray | None = None   # end position of the last queued command
+        self._blend_tol = 0.0
+        self._blend = False
+        self._feed = 0.0
+        self._acc_time = 20.0 * controller.period
+        self._sys_max = float(max(a._max_speed for a in ax))
+        self.set_feed(feed)
+        if acc_time is not None:
+            self.set_acc_time(acc_time)
+        self._vmax = np.array([a._max_speed for a in ax], dtype=float)
+        self._amax = np.full(len(ax), math.inf)
+        self._ptp_ratio = 10.0
+        self._ptp_shape = "T"
+        for a in ax:
+            owners[a.index] = self
+        controller.add_cycle_hook(self._on_cycle)
+        if hasattr(controller, "add_fault_hook"):  # immediate reaction to axis faults
+            controller.add_fault_hook(self._on_axis_fault)
+
+    # ------------------------------------------------------------------ status
+    @property
+    def state(self) -> GroupState:
+        return self._state
+
+    @property
+    def error_code(self) -> int:
+        """0, or the negative code of the run-time error that stopped the group."""
+        return self._error
+
+    @property
+    def error_message(self) -> str:
+        return self._error_msg
+
+    @property
+    def queue_length(self) -> int:
+        return len(self._queue)
+
+    @property
+    def current_index(self) -> int:
+        """Index of the command being executed (-1 when none)."""
+        r = self._run or self._held
+        if r is None:
+            return -1
+        if r.kind == "path" and r.sprof is not None and r.chain is not None:
+            s = r.sprof.state_at(max(0.0, self._ctl.time - r.t0)).p
+            return r.chain.owners[r.chain.locate(s)]
+        return r.cmds[0].index
+
+    @property
+    def position(self) -> np.ndarray:
+        """Logical positions (pulses): the axes' command positions, or in dry run the
+        planned positions the pulses would have reached."""
+        if not self._dry:
+            return np.array([a.position for a in self.axes])
+        r = self._run
+        if r is not None and r.profiles:
+            u = self._ctl.time - r.t0
+            return np.array([p.state_at(min(max(u, 0.0), p.duration)).p for p in r.profiles])
+        return self._dry_pos.copy()
+
+    @property
+    def override(self) -> float:
+        return self._override * 100.0
+
+    @property
+    def dry_run(self) -> bool:
+        return self._dry
+
+    def clear_error(self) -> None:
+        """MCC_ClearError: leave the error state (axes in ErrorStop still need reset())."""
+        self._error, self._error_msg = 0, ""
+        if self._state is GroupState.ERROR:
+            self._state = GroupState.IDLE
+            self._tail = None
+
+    def close(self) -> None:
+        """Abort everything immediately and release the axes for other groups."""
+        self._stop_axes()
+        self._queue.clear()
+        self._run = self._held = None
+        self._ctl.remove_cycle_hook(self._on_cycle)
+        if hasattr(self._ctl, "remove_fault_hook"):
+            self._ctl.remove_fault_hook(self._on_axis_fault)
+        owners = OWNERS.get(self._ctl, {})
+        for a in self.axes:
+            if owners.get(a.index) is self:
+                del owners[a.index]
+
+    # ------------------------------------------------------------------ settings
+    def set_feed(self, feed: float) -> None:
+        """MCC_SetFeedSpeed: vector speed (pps) of the following path commands."""
+        f = check_finite("feed", feed)
+        if f <= 0.0:
+            raise GroupError(ERR_SPEED, f"feed must be > 0, got {feed!r}")
+        if hasattr(self, "_sys_max") and f > self._sys_max * (1 + 1e-12):
+            raise GroupError(ERR_SPEED, f"feed must be <= the system maximum speed "
+                                        f"{self._sys_max:g} pps, got {feed!r}")
+        self._feed = f
+
+    def set_sys_max_speed(self, speed: float) -> None:
+        """MCC_SetSysMaxSpeed: the largest feed accepted (pps)."""
+        v = check_finite("speed", speed)
+        if v <= 0.0:
+            raise MotionError(f"speed must be > 0, got {speed!r}")
+        self._sys_max = v
+
+    def set_acc_time(self, seconds: float) -> None:
+        """Time to accelerate from rest to the feed (MCC_SetAccStep x interpolation time)."""
+        t = check_finite("seconds", seconds)
+        if t <= 0.0:
+            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        self._acc_time = t
+
+    def set_max_pulse_speed(self, pps: Sequence[float]) -> None:
+        """MCC_SetMaxPulseSpeed per logical axis (pps); default the axes' maximum speed."""
+        self._vmax = self._axis_values("pps", pps)
+
+    def set_max_pulse_acc(self, pps2: Sequence[float]) -> None:
+        """MCC_SetMaxPulseAcc per logical axis (pps^2, inf = unlimited, the default)."""
+        self._amax = self._axis_values("pps2", pps2)
+
+    def _axis_values(self, name: str, values: Sequence[float]) -> np.ndarray:
+        try:
+            arr = np.array(values, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise MotionError(f"{name} must be {len(self.axes)} numbers") from None
+        if arr.size != len(self.axes) or np.any(np.isnan(arr)) or np.any(arr <= 0.0):
+            raise MotionError(f"{name} must be {len(self.axes)} numbers > 0, got {values!r}")
+        return arr
+
+    def enable_blend(self, tolerance: float) -> None:
+        """Blend consecutive path commands; line-line corners are rounded so that the path
+        passes within `tolerance` pulses of the programmed corner (0: exact stop)."""
+        self._blend_tol = check_nonnegative("tolerance", tolerance)
+        self._blend = True
+
+    def disable_blend(self) -> None:
+        self._blend = False
+
+    def set_ptp_speed(self, ratio: float, *, shape: str = "T") -> None:
+        """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10)."""
+        r = check_finite("ratio", ratio)
+        if not 0.0 < r <= 100.0:
+            raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
+        if shape not in ("T", "S"):
+            raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
+        self._ptp_ratio, self._ptp_shape = r, shape
+
+    def enable_dry_run(self, on: bool = True) -> None:
+        """Plan and report positions without sending pulses (only while idle)."""
+        if not isinstance(on, bool):
+            raise MotionError(f"on must be a bool, got {on!r}")
+        if self._run is not None or self._queue:
+            raise GroupError(ERR_STATE, "dry run can only be switched while the group is idle")
+        self._dry = on
+        self._dry_pos = np.array([a.position for a in self.axes])
+        self._tail = None
+
+    # ------------------------------------------------------------------ commands
+    def ptp(self, target: Sequence[float], *, relative: bool = False) -> int:
+        """Point-to-point: every axis to its target with its own T/S profile at the PtP
+        speed ratio; the next command waits for all axes."""
+        start = self._start_point()
+        p = self._point("target", target, start if relative else None)
+        if np.all(p == start):
+            raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
+        specs = []
+        for k, a in enumerate(self.axes):
+            v = min(a._max_speed, self._vmax[k]) * self._ptp_ratio / 100.0
+            specs.append(MoveSpec(self._ptp_shape, 0.0, v, self._acc_time, self._acc_time,
+                                  0.0, 0.0))
+        return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
+
+    def line(self, target: Sequence[float], *, relative: bool = False) -> int:
+        """Linear interpolation to `target` (all logical axes) at the feed."""
+        start = self._start_point()
+        p = self._point("target", target, start if relative else None)
+        el = Line(start, p)
+        if el.length == 0.0:
+            raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
+        return self._push_path(el, p)
+
+    def arc(self, centre: Sequence[float], end: Sequence[float], *, plane: tuple[int, int] = (0, 1),
+            direction: str = "CCW", relative: bool = False, turns: int = 0) -> int:
+        """Circular arc in the plane of logical axes `plane` around `centre` (2 plane values)
+        to `end` (all axes; other axes move linearly: a helix). relative: centre and end are
+        offsets from the start point."""
+        start = self._start_point()
+        c = self._point2("centre", centre, start if relative else None, plane)
+        e = self._point("end", end, start if relative else None)
+        try:
+            el = Arc(start, c, e, plane=plane, direction=direction, turns=turns)
+        except MotionError as err:
+            code = ERR_ARC if "arc command error" in str(err) else ERR_ARGUMENT
+            raise GroupError(code, str(err)) from None
+        return self._push_path(el, np.array(el.end))
+
+    def circle(self, centre: Sequence[float], *, plane: tuple[int, int] = (0, 1),
+               direction: str = "CCW", relative: bool = False) -> int:
+        """Full circle around `centre` (MCC_CircleXY), back to the start."""
+        start = self._start_point()
+        return self.arc(centre, start, plane=plane, direction=direction, relative=False) \
+            if not relative else self.arc(np.asarray(centre, float) + start[list(plane)],
+                                          start, plane=plane, direction=direction)
+
+    def helix(self, centre: Sequence[float], end: Sequence[float], **kw: Any) -> int:
+        """An arc whose other axes move linearly to their `end` values (same as arc)."""
+        return self.arc(centre, end, **kw)
+
+    def arc3d(self, via: Sequence[float], end: Sequence[float], *, relative: bool = False) -> int:
+        """3-D arc through a reference point (MCC_ArcXYZ)."""
+        start = self._start_point()
+        v = self._point("via", via, start if relative else None)
+        e = self._point("end", end, start if relative else None)
+        try:
+            el = Arc3D(start, v, e)
+        except MotionError as err:
+            raise GroupError(ERR_ARC, str(err)) from None
+        return self._push_path(el, np.array(el.end))
+
+    def delay(self, seconds: float) -> int:
+        """MCC_DelayMotion: wait `seconds` after the previous command ends."""
+        t = check_finite("seconds", seconds)
+        if t < 0.0:
+            raise GroupError(ERR_ARGUMENT, f"seconds must be >= 0, got {seconds!r}")
+        return self._push(_Cmd(-1, "delay", seconds=t), None)
+
+    def reset_command_index(self) -> None:
+        self._next_index = 0
+
+    # ------------------------------------------------------------------ hold / continue / abort
+    def hold(self) -> None:
+        """MCC_HoldMotion: decelerate along the path and stop; continue() resumes."""
+        if self._state is not GroupState.MOVING or self._run is None:
+            raise GroupError(ERR_STATE, f"hold needs a moving group (state {self._state.value})")
+        r = self._run
+        if r.kind == "path":
+            self._replan(r, hold=True)
+        elif r.kind == "ptp" and not self._dry:
+            for a in self.axes:
+                a.stop()
+        self._state = GroupState.HOLDING
+
+    def cont(self) -> None:
+        """MCC_ContiMotion: resume the remaining motion of a held group."""
+        if self._state is not GroupState.HELD or self._held is None:
+            raise GroupError(ERR_STATE, f"continue needs a held group (state {self._state.value})")
+        r, self._held = self._held, None
+        t = self._ctl.time
+        if r.kind == "path":
+            assert r.chain is not None and r.sprof is not None and r.limits is not None
+            s0 = r.sprof.end.p
+            lim = self._limits(r.cmds[0])
+            curve = px.plan_curve(r.chain, s0, 0.0, lim)
+            self._launch_path(r.chain, curve, r.cmds, lim, t)
+        elif r.kind == "ptp":
+            self._launch_ptp(r.cmds[0], t)
+        else:
+            self._run = _Run("delay", r.cmds, t, t_until=t + r.t_until)
+        self._state = GroupState.MOVING
+
+    def abort(self) -> None:
+        """MCC_AbortMotion: stop along the path (or discard a hold) and empty the queue."""
+        self._queue.clear()
+        if self._state is GroupState.HELD:
+            self._held = None
+            self._state = GroupState.IDLE
+            self._tail = None
+            return
+        if self._state is GroupState.MOVING and self._run is not None:
+            if self._run.kind == "delay":
+                self._run = None
+                self._state = GroupState.IDLE
+                self._tail = None
+                return
+            self.hold()
+        self._aborting = self._state is GroupState.HOLDING
+        self._tail = None
+
+    def set_override(self, percent: float) -> None:
+        """MCC_SetOverSpeed: feed override in % of the programmed feed (1 .. 200). A running
+        path re-plans at once: it accelerates or decelerates to the new speed (figure 11)."""
+        p = check_finite("percent", percent)
+        if not 0.0 < p <= 200.0:
+            raise MotionError(f"percent must be in (0, 200], got {percent!r}")
+        r = self._run
+        old = self._override
+        self._override = p / 100.0
+        if r is not None and r.kind == "path" and self._state is GroupState.MOVING:
+            try:
+                self._replan(r, hold=False)
+            except Exception:
+                self._override = old
+                raise
+
+    def set_ptp_override(self, percent: float) -> None:
+        """MCC_SetPtPOverSpeed: change the speed of running point-to-point axes."""
+        p = check_finite("percent", percent)
+        if not 0.0 < p <= 200.0:
+            raise MotionError(f"percent must be in (0, 200], got {percent!r}")
+        self._ptp_override = p / 100.0
+        r = self._run
+        if r is not None and r.kind == "ptp" and not self._dry:
+            for a, spec in zip(self.axes, r.cmds[0].specs, strict=True):
+                if a.motion is not None and a.state is AxisState.DISCRETE_MOTION:
+                    a.fix_speed_range(min(a._max_speed, spec.max_vel * 2.0))
+                    # too close to the target: the move finishes at its speed
+                    with contextlib.suppress(InfeasibleError):
+                        a.change_speed(min(a._max_speed, spec.max_vel * self._ptp_override),
+                                       spec.tacc)
+
+    # ------------------------------------------------------------------ queue helpers
+    def _check_accepting(self) -> None:
+        if self._state is GroupState.ERROR:
+            raise GroupError(ERR_GROUP, f"group in error {self._error} ({self._error_msg}); "
+                                        "clear_error() first")
+        if len(self._queue) >= self._queue_size:
+            raise GroupError(ERR_QUEUE_FULL, f"queue full ({self._queue_size} commands)")
+        for a in self.axes:
+            if a.state is AxisState.ERROR_STOP:
+                raise GroupError(ERR_AXIS_STATE, f"axis {a.name} is in ErrorStop ({a.fault})")
+            if a.state is AxisState.DISABLED and not self._dry:
+                raise GroupError(ERR_AXIS_STATE, f"axis {a.name} is disabled; enable() first")
+            if self._run is None and not self._dry and a.is_moving:
+                raise GroupError(ERR_AXIS_BUSY, f"axis {a.name} is moving outside the group")
+
+    def _start_point(self) -> np.ndarray:
+        self._check_accepting()
+        if self._tail is None or (self._run is None and not self._queue
+                                  and self._held is None):
+            self._tail = self.position
+        return self._tail.copy()
+
+    def _point(self, name: str, value: Sequence[float], base: np.ndarray | None) -> np.ndarray:
+        try:
+            arr = np.array(value, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} numbers") from None
+        if arr.size != len(self.axes) or not np.all(np.isfinite(arr)):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} finite numbers, "
+                                           f"got {value!r}")
+        return arr + base if base is not None else arr
+
+    def _point2(self, name: str, value: Sequence[float], base: np.ndarray | None,
+                plane: tuple[int, int]) -> np.ndarray:
+        try:
+            arr = np.array(value, dtype=float).reshape(-1)
+            i, j = (int(k) for k in plane)
+            if not (0 <= i < len(self.axes) and 0 <= j < len(self.axes)):
+                raise IndexError
+        except (TypeError, ValueError, IndexError):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 numbers and plane two axis "
+                                           f"indices, got {value!r}, {plane!r}") from None
+        if arr.size != 2 or not np.all(np.isfinite(arr)):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 finite numbers, got {value!r}")
+        return arr + base[[i, j]] if base is not None else arr
+
+    def _push_path(self, el: PathElement, end: np.ndarray) -> int:
+        feed = self._feed
+        tan = el.max_abs_tangent
+        need = feed * tan
+        bad = np.nonzero(need > self._vmax * (1 + 1e-12))[0]
+        if len(bad):
+            k = int(bad[0])
+            raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps at "
+                                        f"feed {feed:g}, above its maximum pulse speed "
+                                        f"{self._vmax[k]:g} pps")
+        accel = feed / self._acc_time
+        needa = accel * tan
+        bad = np.nonzero(needa > self._amax * (1 + 1e-12))[0]
+        if len(bad):
+            k = int(bad[0])
+            raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} pps^2, "
+                                        f"above its maximum pulse acceleration "
+                                        f"{self._amax[k]:g} pps^2")
+        return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel), end)
+
+    def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
+        self._check_accepting()
+        cmd.index = self._next_index
+        self._next_index += 1
+        self._queue.append(cmd)
+        if end is not None:
+            self._tail = end.copy()
+        return cmd.index

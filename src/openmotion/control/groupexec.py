@@ -1,0 +1,326 @@
+"""The run-time side of a `Group`: executing its queue from a controller cycle hook.
+
+Point-to-point commands start every axis with its own T/S profile and the next command
+waits for all of them. Consecutive path commands with the same feed and acceleration are
+planned as one chain by the look-ahead (`path.plan_speeds`) and executed by pathexec.py:
+with blending on, line-line corners are rounded (`path.blend_corner`) within the tolerance
+and the chain runs through them; with blending off every corner is an exact stop. Hold,
+continue, abort and the feed override re-plan the running chain from the current path
+state. A group axis going to ErrorStop (the controller's fault hooks, when present, and a
+check every cycle) or reaching the limit switch ahead of it stops every axis of the group
+at once and puts the group in error (MCCL 2.6.3 VI: all motion commands stop).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections import deque
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import MotionError
+from ..path import Line, blend_corner, plan_speeds
+from ..path.geometry import PathElement
+from ..profile.pcl import MoveSpec
+from ..profile.segments import Profile, State
+from . import pathexec as px
+from . import planning
+from .states import AxisState
+
+if TYPE_CHECKING:
+    from .axis import Axis
+    from .controller import Controller
+
+
+class GroupError(MotionError):
+    """A refused group command or a group fault; `code` is the negative error code."""
+
+    def __init__(self, code: int, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+#: Negative error codes (returned by facades on rejection; `Group.error_code` at run time).
+ERR_ARGUMENT = -1      # NaN, zero-length move, bad shape/plane/direction, ...
+ERR_QUEUE_FULL = -2
+ERR_AXIS_BUSY = -3     # axis in another group or moving outside the group
+ERR_AXIS_STATE = -4    # axis disabled or in ErrorStop
+ERR_SPEED = -5         # feed beyond the system maximum or an axis's maximum pulse speed
+ERR_ACCEL = -6         # acceleration beyond an axis's maximum pulse acceleration
+ERR_ARC = -7           # arc command error (end not on the circle, collinear 3-D arc)
+ERR_GROUP = -8         # the group is in error: clear_error() first
+ERR_LIMIT = -9         # run time: limit switch reached by a group axis
+ERR_AXIS_FAULT = -10   # run time: a group axis went to ErrorStop
+ERR_STATE = -11        # command not allowed in the group's state (e.g. continue when not held)
+
+
+class GroupState(Enum):
+    IDLE = "idle"
+    MOVING = "moving"
+    HOLDING = "holding"   # decelerating along the path after hold()
+    HELD = "held"
+    ERROR = "error"
+
+
+OWNERS: weakref.WeakKeyDictionary[Any, dict[int, GroupEngine]] = weakref.WeakKeyDictionary()
+
+
+@dataclass
+class _Cmd:
+    index: int
+    kind: str                      # ptp, path, delay
+    target: np.ndarray | None = None
+    elements: tuple[PathElement, ...] = ()
+    feed: float = 0.0
+    accel: float = 0.0
+    specs: tuple[MoveSpec, ...] = ()
+    seconds: float = 0.0
+
+
+@dataclass
+class _Run:
+    """What the group is executing now."""
+
+    kind: str
+    cmds: list[_Cmd]
+    t0: float
+    chain: px.Chain | None = None
+    curve: px.SpeedCurve | None = None
+    sprof: Profile | None = None
+    profiles: list[Profile] = field(default_factory=list)
+    limits: px.Limits | None = None
+    a_min: float = 0.0
+    t_until: float = 0.0
+    target: np.ndarray | None = None
+
+    @property
+    def t_end(self) -> float:
+        if self.kind == "delay":
+            return self.t_until
+        if self.sprof is not None:
+            return self.t0 + self.sprof.duration
+        return self.t0 + max((p.duration for p in self.profiles), default=0.0)
+
+
+class GroupEngine:
+    """Queue execution and re-planning; `Group` adds the commands and settings."""
+
+    _ctl: Controller
+    axes: tuple[Axis, ...]
+    names: tuple[str, ...]
+    _queue: deque[_Cmd]
+    _state: GroupState
+    _run: _Run | None
+    _held: _Run | None
+    _aborting: bool
+    _error: int
+    _error_msg: str
+    _override: float
+    _ptp_override: float
+    _dry: bool
+    _dry_pos: np.ndarray
+    _tail: np.ndarray | None
+    _blend: bool
+    _blend_tol: float
+    _sys_max: float
+    _vmax: np.ndarray
+    _amax: np.ndarray
+
+    @property
+    def position(self) -> np.ndarray:  # defined by Group
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ execution
+    def _limits(self, cmd: _Cmd) -> px.Limits:
+        return px.Limits(min(cmd.feed * self._override, self._sys_max), cmd.accel,
+                         self._vmax, self._amax)
+
+    def _on_cycle(self, ctl: Controller, t: float) -> None:
+        if self._state is GroupState.ERROR:
+            return
+        if self._run is not None and not self._dry and self._check_faults():
+            return
+        r = self._run
+        if r is not None and t >= r.t_end - 1e-12 and (self._dry or not any(
+                a.is_moving for a in self.axes)):
+            self._run = None
+            if r.kind in ("path", "ptp") and r.target is not None and self._dry:
+                self._dry_pos = r.target.copy()
+            if self._state is GroupState.HOLDING:
+                if self._aborting:
+                    self._aborting = False
+                    self._state = GroupState.IDLE
+                    self._tail = None
+                    if self._dry and r.profiles:
+                        self._dry_pos = np.array([p.end.p for p in r.profiles])
+                    return
+                self._held = r
+                if self._dry and r.profiles:
+                    self._dry_pos = np.array([p.end.p for p in r.profiles])
+                self._state = GroupState.HELD
+                return
+            if r.kind == "path" and r.sprof is not None and r.chain is not None \
+                    and r.sprof.end.p < r.chain.length:
+                # a run that stopped short (should not happen) is kept as held
+                self._held, self._state = r, GroupState.HELD
+                return
+        if self._run is None and self._state in (GroupState.MOVING, GroupState.IDLE):
+            if self._queue:
+                self._start_next(t)
+            else:
+                self._state = GroupState.IDLE
+
+    def _start_next(self, t: float) -> None:
+        cmd = self._queue.popleft()
+        if cmd.kind == "delay":
+            self._run = _Run("delay", [cmd], t, t_until=t + cmd.seconds)
+        elif cmd.kind == "ptp":
+            self._launch_ptp(cmd, t)
+        else:
+            cmds = [cmd]
+            while self._queue and self._queue[0].kind == "path" \
+                    and self._queue[0].feed == cmd.feed and self._queue[0].accel == cmd.accel:
+                cmds.append(self._queue.popleft())
+            chain = self._chain(cmds)
+            lim = self._limits(cmd)
+            curve = px.plan_curve(chain, 0.0, 0.0, lim)
+            self._launch_path(chain, curve, cmds, lim, t)
+        self._state = GroupState.MOVING
+
+    def _chain(self, cmds: list[_Cmd]) -> px.Chain:
+        els: list[PathElement] = []
+        owners: list[int] = []
+        for c in cmds:
+            el = c.elements[0]
+            if self._blend and self._blend_tol > 0.0 and els and isinstance(els[-1], Line) \
+                    and isinstance(el, Line):
+                b = blend_corner(els[-1], el, self._blend_tol)
+                if b is not None:
+                    els[-1] = b.first
+                    els.append(b.arc)
+                    owners.append(c.index)
+                    el = b.second
+            els.append(el)
+            owners.append(c.index)
+        return px.Chain(els, owners)
+
+    def _launch_ptp(self, cmd: _Cmd, t: float) -> None:
+        assert cmd.target is not None
+        profiles = []
+        start = self.position
+        for k, a in enumerate(self.axes):
+            spec = cmd.specs[k]
+            if self._ptp_override != 1.0:
+                spec = MoveSpec(spec.shape, spec.str_vel,
+                                min(a._max_speed, spec.max_vel * self._ptp_override),
+                                spec.tacc, spec.tdec, spec.vs_acc, spec.vs_dec)
+            if self._dry:
+                profiles.append(planning.position_move(spec, float(start[k]),
+                                                       float(cmd.target[k])))
+            elif cmd.target[k] != a.position:
+                a.move_absolute(float(cmd.target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
+                                shape=spec.shape)
+        self._run = _Run("ptp", [cmd], t, profiles=profiles, target=cmd.target)
+
+    def _launch_path(self, chain: px.Chain, curve: px.SpeedCurve, cmds: list[_Cmd],
+                     lim: px.Limits, t: float) -> None:
+        s_end = chain.length
+        sprof = px.s_profile(curve, s_end, chain.cum[1:-1].tolist())
+        starts = self.position
+        profiles = px.axis_profiles(chain, sprof, self._ctl.period, starts)
+        if not self._dry:
+            self._run_profiles(profiles)
+        a_min = min((lim.accel,) + tuple(
+            x for x in _accels(chain, lim)))
+        self._run = _Run("path", cmds, t, chain, curve, sprof, profiles, lim, a_min,
+                         target=np.array(chain.elements[-1].end))
+
+    def _run_profiles(self, profiles: list[Profile]) -> None:
+        for a, p in zip(self.axes, profiles, strict=True):
+            acc = max(1.0, float(np.max(np.abs(p.a0)))) if p.n_segments else 1.0
+            a.run_profile(p, stop_accel=acc, stop_jerk=acc * 1000.0,
+                          replace_running=a.motion is not None)
+
+    def _replan(self, r: _Run, *, hold: bool) -> None:
+        """Re-plan the running chain from now: a hold (to rest) or a new override."""
+        assert r.chain is not None and r.sprof is not None and r.curve is not None
+        t = self._ctl.time
+        u = t - r.t0
+        st = r.sprof.state_at(min(max(u, 0.0), r.sprof.duration))
+        s0, v0 = st.p, max(0.0, st.v)
+        if u >= r.sprof.duration:
+            return
+        if hold:
+            curve = px.hold_curve(r.curve, s0, v0, r.a_min)
+            lim = r.limits
+        else:
+            lim = self._limits(r.cmds[0])
+            curve = px.plan_curve(r.chain, s0, v0, lim, old=r.curve.tail(s0))
+        if v0 == 0.0 and hold:
+            curve = px.SpeedCurve(np.array([s0, s0]), np.array([0.0, 0.0]))
+        s_end = r.chain.length
+        if curve.s[-1] <= s0:
+            s_end = s0
+        elif hold:
+            s_end = px.stop_point(curve)
+        if s_end <= s0:
+            sprof = px.s_profile(px.SpeedCurve(np.array([s0]), np.array([0.0])), s0, [])
+            profiles = [Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
+                                np.zeros(0), 0.0, p_state, p_state) for p_state in
+                        [_rest(x) for x in self.position]]
+        else:
+            sprof = px.s_profile(curve, s_end, r.chain.cum[1:-1].tolist())
+            profiles = px.axis_profiles(r.chain, sprof, self._ctl.period, self.position)
+        if not self._dry:
+            self._run_profiles(profiles)
+        assert lim is not None
+        self._run = _Run("path", r.cmds, t, r.chain, curve, sprof, profiles, lim, r.a_min,
+                         target=r.target)
+
+    def _on_axis_fault(self, axis: Axis, reason: str) -> None:
+        """Controller fault hook: a group axis went to ErrorStop."""
+        if axis in self.axes and not self._dry and self._state in (
+                GroupState.MOVING, GroupState.HOLDING, GroupState.HELD):
+            code = ERR_LIMIT if "EL" in reason else ERR_AXIS_FAULT
+            self._fault(code, f"axis {axis.name}: {reason}")
+
+    def _check_faults(self) -> bool:
+        for k, a in enumerate(self.axes):
+            if a.state is AxisState.ERROR_STOP:
+                self._fault(ERR_AXIS_FAULT, f"axis {a.name} in ErrorStop ({a.fault})")
+                return True
+            v = a.velocity
+            if (v > 0.0 and self._ctl.input_active(a.index, "pel")) or \
+                    (v < 0.0 and self._ctl.input_active(a.index, "mel")):
+                self._fault(ERR_LIMIT, f"limit switch reached on axis {self.names[k]}")
+                return True
+        return False
+
+    def _fault(self, code: int, message: str) -> None:
+        """Stop every axis of the group at once and drop the queue (MCCL 2.6.3 VI)."""
+        self._stop_axes()
+        self._queue.clear()
+        self._run = self._held = None
+        self._error, self._error_msg = code, message
+        self._state = GroupState.ERROR
+        self._tail = None
+
+    def _stop_axes(self) -> None:
+        if self._dry:
+            return
+        for a in self.axes:
+            if a.state is not AxisState.ERROR_STOP:
+                a.stop_immediately()
+
+
+def _rest(p: float) -> State:
+    return State(float(p), 0.0, 0.0)
+
+
+def _accels(chain: px.Chain, lim: px.Limits) -> list[float]:
+    sp = plan_speeds(chain.elements, lim.feed, lim.accel, axis_vmax=lim.axis_vmax,
+                     axis_amax=lim.axis_amax)
+    return [x.accel for x in sp if x.length > 0.0]

@@ -1,0 +1,344 @@
+"""Path execution: a chain of path elements -> a path-speed curve -> per-axis Profiles.
+
+Three steps, all pure functions of geometry, limits and the interpolation period:
+
+1. **Speed curve.** The look-ahead (`path.plan_speeds`) gives each element a trapezoid
+   along its arc length. We keep it as a `SpeedCurve`: v**2 piecewise linear in the global
+   path position s (constant tangential acceleration on each piece: d(v**2)/ds = 2a).
+   Hold, continue and override are operations on such curves (min, max, a constant
+   deceleration ramp); the pointwise min or max of two curves that each respect
+   |d(v**2)/ds| <= 2*a_k on element k respects it too, and the min also keeps every speed
+   cap both respect. So a re-planned curve never asks for more than the limits allow.
+2. **s(t).** Each piece of the curve is one constant-acceleration segment of a Profile in
+   s (time of a piece: (v1 - v0)/a, or ds/v when a = 0). The end is pinned to the exact
+   path length.
+3. **Axis profiles.** Knots: every interpolation period from t = 0, plus every break of
+   s(t) (phase changes and element boundaries). At each knot the axis position is
+   element.point(s) and its velocity tangent(s)*ds/dt; between knots each axis gets the
+   cubic Hermite interpolant (the same formula as control/motion.py). On a line with a
+   constant-acceleration s(t) the axis motion is a quadratic, so the cubic is exact; on an
+   arc the deviation is the Hermite error, O(h**4) in position and O(h**2) relative in
+   acceleration (about 1e-6 at 1 ms and 2 rad/s). The last knot is the element's end point,
+   bit for bit, so a path ends exactly on its target.
+
+Why Axis.run_profile and not a path-evaluating motion in control/motion.py: the knots are
+cycle aligned, so the controller emits exactly these cubics; it needs no core change and
+hold/override swap the profiles with `run_profile(replace_running=True)`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InfeasibleError
+from ..path import ElementSpeeds, plan_speeds
+from ..path.geometry import PathElement
+from ..profile.segments import Profile, ProfileBuilder, State
+
+
+# -------------------------------------------------------------------------- speed curves
+@dataclass(frozen=True)
+class SpeedCurve:
+    """v**2 piecewise linear in s over knots `s` (increasing) with values `v2` (>= 0)."""
+
+    s: np.ndarray
+    v2: np.ndarray
+
+    def at(self, s: float) -> float:
+        return float(np.interp(s, self.s, self.v2))
+
+    def tail(self, s0: float) -> SpeedCurve:
+        """The curve from s0 on."""
+        keep = self.s > s0
+        return SpeedCurve(np.concatenate([[s0], self.s[keep]]),
+                          np.concatenate([[self.at(s0)], self.v2[keep]]))
+
+
+def curve_from_speeds(speeds: Sequence[ElementSpeeds], s0: float = 0.0) -> SpeedCurve:
+    """The trapezoids of the look-ahead as one curve, starting at path position s0."""
+    ss: list[float] = [s0]
+    vv: list[float] = [speeds[0].entry ** 2 if speeds else 0.0]
+    pos = s0
+    for sp in speeds:
+        if sp.length == 0.0:
+            continue
+        a, vc2 = sp.accel, sp.cruise ** 2
+        d_acc = max(0.0, (vc2 - sp.entry ** 2) / (2.0 * a))
+        d_dec = max(0.0, (vc2 - sp.exit ** 2) / (2.0 * a))
+        if d_acc + d_dec > sp.length:  # rounding: no cruise
+            d_acc = max(0.0, min(sp.length, d_acc))
+            d_dec = sp.length - d_acc
+        for d, v2 in ((d_acc, vc2), (sp.length - d_acc - d_dec, vc2)):
+            if d > 0.0:
+                ss.append(ss[-1] + d)
+                vv.append(v2)
+        pos += sp.length
+        ss.append(pos)
+        vv.append(sp.exit ** 2)
+    s = np.array(ss)
+    v2 = np.maximum(np.array(vv), 0.0)
+    keep = np.concatenate([[True], np.diff(s) > 0.0])  # drop zero-length pieces
+    keep[-1] = True
+    s, v2 = s[keep], v2[keep]
+    if len(s) > 1 and s[-2] >= s[-1]:
+        s, v2 = np.delete(s, -2), np.delete(v2, -2)
+    return SpeedCurve(s, v2)
+
+
+def _combine(a: SpeedCurve, b: SpeedCurve, fn) -> SpeedCurve:
+    """Pointwise fn (np.minimum/np.maximum) of two curves over a's range of s."""
+    lo, hi = a.s[0], a.s[-1]
+    grid = np.union1d(a.s, b.s[(b.s > lo) & (b.s < hi)])
+    ya = np.interp(grid, a.s, a.v2)
+    yb = np.interp(grid, b.s, b.v2, right=b.v2[-1])
+    d = ya - yb
+    cross = np.nonzero(d[:-1] * d[1:] < 0.0)[0]
+    if len(cross):  # insert the crossings of two straight pieces
+        f = d[cross] / (d[cross] - d[cross + 1])
+        sx = grid[cross] + f * (grid[cross + 1] - grid[cross])
+        grid = np.union1d(grid, sx)
+        ya = np.interp(grid, a.s, a.v2)
+        yb = np.interp(grid, b.s, b.v2, right=b.v2[-1])
+    return SpeedCurve(grid, np.maximum(fn(ya, yb), 0.0))
+
+
+def curve_min(a: SpeedCurve, b: SpeedCurve) -> SpeedCurve:
+    return _combine(a, b, np.minimum)
+
+
+def curve_max(a: SpeedCurve, b: SpeedCurve) -> SpeedCurve:
+    return _combine(a, b, np.maximum)
+
+
+def ramp(s0: float, v0: float, accel: float, s_end: float, floor: float = 0.0) -> SpeedCurve:
+    """Decelerate at `accel` from v0 at s0 down to `floor`, then hold it, up to s_end."""
+    v02, f2 = v0 * v0, floor * floor
+    d = max(0.0, (v02 - f2) / (2.0 * accel))
+    if s0 + d >= s_end:
+        return SpeedCurve(np.array([s0, s_end]),
+                          np.array([v02, max(0.0, v02 - 2.0 * accel * (s_end - s0))]))
+    return SpeedCurve(np.array([s0, s0 + d, s_end]), np.array([v02, f2, f2]))
+
+
+def stop_point(curve: SpeedCurve) -> float:
+    """First s > s[0] where the curve reaches 0 (its end if it never does before)."""
+    z = np.nonzero(curve.v2[1:] <= 0.0)[0]
+    return float(curve.s[z[0] + 1]) if len(z) else float(curve.s[-1])
+
+
+# -------------------------------------------------------------------------- s(t)
+def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float]) -> Profile:
+    """Constant-acceleration Profile of s following `curve` from its start to `s_end`
+    (where the curve must be 0). `breaks` (element boundaries) become segment boundaries."""
+    knots = np.union1d(curve.s, [b for b in breaks if curve.s[0] < b < s_end])
+    knots = knots[(knots >= curve.s[0]) & (knots <= s_end)]
+    v2 = np.maximum(np.interp(knots, curve.s, curve.v2), 0.0)
+    v = np.sqrt(v2)
+    ds = np.diff(knots)
+    dv2 = np.diff(v2)
+    b = ProfileBuilder(float(knots[0]), float(v[0]))
+    for k in range(len(ds)):
+        if ds[k] <= 0.0:
+            continue
+        a = dv2[k] / (2.0 * ds[k])
+        vm = v[k] + v[k + 1]
+        if vm <= 0.0:
+            raise InfeasibleError("path speed curve stalls at rest before its end")
+        dt = 2.0 * ds[k] / vm  # exact for constant acceleration, also when a = 0
+        b.set_velocity(float(v[k]))
+        b.segment(dt, 0.0, accel=float(a))
+    return b.build(end_p=float(s_end))
+
+
+# -------------------------------------------------------------------------- chains
+class Chain:
+    """Elements laid end to end along a global path position s."""
+
+    def __init__(self, elements: Sequence[PathElement], owners: Sequence[int]) -> None:
+        self.elements = tuple(elements)
+        self.owners = tuple(owners)  # command index of each element
+        self.cum = np.concatenate([[0.0], np.cumsum([el.length for el in self.elements])])
+
+    @property
+    def length(self) -> float:
+        return float(self.cum[-1])
+
+    def locate(self, s: float) -> int:
+        k = int(np.searchsorted(self.cum, s, side="right")) - 1
+        return min(max(k, 0), len(self.elements) - 1)
+
+    def point(self, s: float) -> np.ndarray:
+        k = self.locate(s)
+        el = self.elements[k]
+        if s >= self.cum[-1]:
+            return np.array(self.elements[-1].end)
+        return el.point(min(max(s - self.cum[k], 0.0), el.length))
+
+    def tail_elements(self, s0: float) -> tuple[list[PathElement], float]:
+        """Elements from s0 on (the first trimmed) and the global s of their start."""
+        k = self.locate(s0)
+        el = self.elements[k]
+        local = s0 - float(self.cum[k])
+        first: PathElement = el if local <= 0.0 else Trimmed(el, local)
+        return [first, *self.elements[k + 1:]], s0
+
+
+class Trimmed:
+    """An element from local position `offset` on (for re-planning mid-element). The
+    look-ahead bounds (max curvature, per-axis weights) are the whole element's: valid."""
+
+    def __init__(self, base: PathElement, offset: float) -> None:
+        self.base = base
+        self.offset = float(offset)
+        self.length = max(0.0, base.length - self.offset)
+        self.dim = base.dim
+        self.start = base.point(self.offset)
+        self.end = base.end
+        self.start_tangent = base.tangent(self.offset)
+        self.end_tangent = base.end_tangent
+        self.max_curvature = base.max_curvature
+        self.max_abs_tangent = base.max_abs_tangent
+        self.axis_accel_weight = base.axis_accel_weight
+
+    def point(self, s):  # noqa: ANN001, ANN201 - same contract as PathElement
+        return self.base.point(np.minimum(np.asarray(s, dtype=float) + self.offset,
+                                          self.base.length))
+
+    def tangent(self, s):  # noqa: ANN001, ANN201
+        return self.base.tangent(np.minimum(np.asarray(s, dtype=float) + self.offset,
+                                            self.base.length))
+
+    def curvature(self, s):  # noqa: ANN001, ANN201
+        return self.base.curvature(np.minimum(np.asarray(s, dtype=float) + self.offset,
+                                              self.base.length))
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Path limits: feed (vector speed), tangential accel, per-axis speed/accel caps."""
+
+    feed: float
+    accel: float
+    axis_vmax: np.ndarray
+    axis_amax: np.ndarray
+    square_corner_velocity: float = 0.0
+
+
+def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
+               old: SpeedCurve | None = None) -> SpeedCurve:
+    """Speed curve for the rest of `chain` from s0 at speed v0, ending at rest.
+
+    When v0 is above what the new limits allow (a lower override), the path decelerates at
+    the smallest tangential acceleration of the remaining elements until it meets the new
+    plan, and never exceeds the `old` curve it was following (see the module doc).
+    """
+    els, _ = chain.tail_elements(s0)
+    kw = dict(square_corner_velocity=lim.square_corner_velocity,
+              axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax)
+    try:
+        return _pinned(curve_from_speeds(
+            plan_speeds(els, lim.feed, lim.accel, start_speed=v0, **kw), s0), chain.length)
+    except InfeasibleError:
+        if old is None:
+            raise
+    lo, hi = 0.0, v0  # highest feasible start speed, by bisection
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        try:
+            plan_speeds(els, lim.feed, lim.accel, start_speed=mid, **kw)
+            lo = mid
+        except InfeasibleError:
+            hi = mid
+    sp = plan_speeds(els, lim.feed, lim.accel, start_speed=lo, **kw)
+    a_min = min(x.accel for x in sp if x.length > 0.0)
+    new = curve_from_speeds(sp, s0)
+    # the new plan starts at lo < v0: join it with a ramp from v0 (max), under the old curve
+    down = ramp(s0, v0, a_min, chain.length)
+    joined = curve_max(down, new)
+    return _pinned(curve_min(joined, old.tail(s0)), chain.length)
+
+
+def _pinned(curve: SpeedCurve, length: float) -> SpeedCurve:
+    """The curve with its last knot exactly at the chain length (sums round differently)."""
+    s = curve.s.copy()
+    s[-1] = length
+    keep = np.concatenate([np.diff(s) > 0.0, [True]])
+    keep[0] = True
+    return SpeedCurve(s[keep], curve.v2[keep])
+
+
+def hold_curve(old: SpeedCurve, s0: float, v0: float, accel: float) -> SpeedCurve:
+    """Decelerate from (s0, v0) at `accel` to rest, never faster than `old`."""
+    return curve_min(old.tail(s0), ramp(s0, v0, accel, float(old.s[-1])))
+
+
+# -------------------------------------------------------------------------- axis profiles
+def axis_profiles(chain: Chain, sp: Profile, period: float,
+                  starts: Sequence[float]) -> list[Profile]:
+    """Per-axis Profiles (positions in the element frame plus nothing else) following
+    chain.point(s(t)); see the module doc. `starts` are the axis positions at t = 0 (the
+    first knot uses them, so a replacement starts exactly where the axis is)."""
+    dur = sp.duration
+    n = int(math.floor(dur / period + 1e-9))
+    grid = np.arange(n + 1) * period
+    t = np.union1d(grid[grid < dur], np.concatenate([sp.t0, [dur]]))
+    t = t[np.concatenate([[True], np.diff(t) > 1e-12])]
+    if t[-1] != dur:
+        t[-1] = dur
+    smp = sp.sample(t)
+    s = np.clip(smp.p, sp.start.p, sp.end.p)
+    sd = smp.v
+    s[-1] = sp.end.p
+    dim = chain.elements[0].dim
+    pos = np.empty((len(t), dim))
+    vel = np.empty((len(t), dim))
+    k = np.clip(np.searchsorted(chain.cum, s, side="right") - 1, 0, len(chain.elements) - 1)
+    # a knot exactly on an element boundary belongs to the element it ends (left side)
+    for i in np.unique(k):
+        m = k == i
+        el = chain.elements[i]
+        local = np.clip(s[m] - chain.cum[i], 0.0, el.length)
+        pos[m] = el.point(local)
+        vel[m] = el.tangent(local) * sd[m][:, None]
+    pos[0] = starts
+    vel[0] = sp.start.v * _tangent_at(chain, float(s[0]))
+    last = chain.locate(float(s[-1]) - 1e-12 * max(1.0, chain.length))
+    pos[-1] = chain.elements[last].point(
+        min(max(float(s[-1]) - float(chain.cum[last]), 0.0), chain.elements[last].length))
+    if s[-1] >= chain.length:
+        pos[-1] = chain.elements[-1].end
+    vel[-1] = 0.0
+    h = np.diff(t)[:, None]
+    dp = np.diff(pos, axis=0)
+    v0, v1 = vel[:-1], vel[1:]
+    a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
+    jj = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
+    out = []
+    dts = np.diff(t)
+    labels = ("path",) * len(dts)
+    for i in range(dim):
+        out.append(Profile(
+            t0=t[:-1].copy(), p0=pos[:-1, i].copy(), v0=v0[:, i].copy(), a0=a0[:, i].copy(),
+            j=jj[:, i].copy(), duration=float(dur),
+            start=State(float(pos[0, i]), float(vel[0, i]), 0.0),
+            end=State(float(pos[-1, i]), 0.0, 0.0), labels=labels, dt=dts.copy()))
+    return out
+
+
+def _tangent_at(chain: Chain, s: float) -> np.ndarray:
+    k = chain.locate(s)
+    el = chain.elements[k]
+    return np.asarray(el.tangent(min(max(s - float(chain.cum[k]), 0.0), el.length)))
+
+
+def travel_time(curve: SpeedCurve) -> float:
+    """Duration of following `curve` from its start to its end."""
+    v = np.sqrt(np.maximum(curve.v2, 0.0))
+    vm = v[:-1] + v[1:]
+    ds = np.diff(curve.s)
+    ok = ds > 0.0
+    return float(np.sum(2.0 * ds[ok] / vm[ok]))
