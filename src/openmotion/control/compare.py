@@ -1,0 +1,544 @@
+"""Compare engine: position-compare triggers located exactly on the analytic motion.
+
+Attached to a Controller through a cycle hook. At the end of each cycle [t0, t1] it takes
+the motion just executed from the MotionHistory and finds, for every active job, every
+trigger in (t0, t1] at its exact time (architecture.md "Events are located exactly"):
+
+- sources: `AxisSource(axis, "dpos")` = command position in the command-counter frame;
+  `AxisSource(axis, "mpos")` = feedback position in the feedback-counter frame (see
+  `feedback model` below); `VectorSource(axes, scale)` = accumulated path length of the
+  axes (ZMotion VECTOR_MOVED) in pulses, or in user units with `scale` pulses per unit;
+- jobs: `LevelJob` compares against a sequence of values one at a time, the "Value block"
+  of HSL-4XMO 4.12 / the HW_PSWITCH2 buffer (a value fires once, then the next is loaded, so
+  nothing fires twice when the axis reverses); `repeat=True` keeps one value armed (the
+  single-value trigger comparator). `WindowJob` compares 2-D/3-D points with a +-maxerr
+  window per axis (ZMotion modes 25/26/35/36), in table order;
+- actions on a hit: `Toggle`, `Pulse`, `SetLevel`, or a pulse timer (pso.PulseTimer); each
+  drives an `OutputLine` (exact edges) and every hit goes to the `EventLog`.
+
+Feedback model (MPOS): the Hardware boundary reports the encoder only at cycle ends, so
+between them the feedback is modelled as move_ratio * command(t) + e(t), with the following
+error e(t) linear between its values at the cycle ends. For a stepper that keeps step this
+is exactly the encoder; for a servo the error is the part interpolated, and it changes far
+more slowly than the position.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import MotionError, check_finite, check_positive
+from .compare_io import EventLog, OutputLine
+from .compare_math import (
+    Track,
+    VectorCycle,
+    affine_track,
+    crossings_after,
+    first_crossing,
+    first_inside,
+    history_track,
+)
+
+if TYPE_CHECKING:
+    from .controller import Controller
+
+Array = NDArray[np.float64]
+SOURCE_KINDS = ("dpos", "mpos")
+
+
+# ---------------------------------------------------------------------------- sources
+@dataclass(frozen=True)
+class AxisSource:
+    """One axis's command (dpos) or feedback (mpos) position."""
+
+    axis: int
+    kind: str = "dpos"
+
+
+@dataclass(frozen=True)
+class VectorSource:
+    """Accumulated path length of `axes` (command positions); `scale` = pulses per unit."""
+
+    axes: tuple[int, ...]
+    scale: tuple[float, ...] | None = None
+
+    @property
+    def weights(self) -> Array:
+        if self.scale is None:
+            return np.ones(len(self.axes))
+        return 1.0 / np.asarray(self.scale, dtype=np.float64)
+
+
+Source = AxisSource | VectorSource
+
+
+class LevelSeq:
+    """start, start + step, ... (`count` values, or endless with count None)."""
+
+    def __init__(self, start: float, step: float, count: int | None = None) -> None:
+        self.start = check_finite("start", start)
+        self.step = check_finite("step", step)
+        if self.step == 0.0:
+            raise MotionError("step must be != 0")
+        if count is not None and (not isinstance(count, int) or count < 1):
+            raise MotionError(f"count must be an int >= 1 or None, got {count!r}")
+        self.count = count
+
+    def __len__(self) -> int:
+        return self.count if self.count is not None else 2**62
+
+    def __getitem__(self, k: int) -> float:
+        return self.start + k * self.step
+
+
+# ---------------------------------------------------------------------------- actions
+class Action(Protocol):
+    output: int
+
+    def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
+        """Act at time t for the job's `hit`-th firing (0-based); return the output state."""
+
+
+@dataclass
+class Toggle:
+    """The first firing drives `first`, each later one inverts (ZMotion modes 1, 3, 25, 35)."""
+
+    output: int
+    first: bool = True
+
+    def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
+        level = self.first if hit % 2 == 0 else not self.first
+        eng.output(self.output).set(t, level)
+        return level
+
+
+@dataclass
+class SetLevel:
+    """Drive a fixed level at each firing."""
+
+    output: int
+    level: bool = True
+
+    def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
+        eng.output(self.output).set(t, self.level)
+        return self.level
+
+
+@dataclass
+class Pulse:
+    """A pulse of `width` seconds at `active` level (HSL CMP pulse, fixed-time pulses)."""
+
+    output: int
+    width: float
+    active: bool = True
+
+    def __post_init__(self) -> None:
+        self.width = check_positive("width", self.width)
+
+    def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
+        line = eng.output(self.output)
+        line.set(t, self.active)
+        line.set(t + self.width, not self.active)
+        return self.active
+
+
+# ---------------------------------------------------------------------------- jobs
+class CompareJob:
+    """Common bookkeeping: id, source, action, next point index, hit count, armed time."""
+
+    def __init__(self, action: Action, name: str = "") -> None:
+        if not hasattr(action, "apply") or not hasattr(action, "output"):
+            raise MotionError(f"action must have .output and .apply(), got {action!r}")
+        self.action = action
+        self.name = name
+        self.id = -1
+        self.index = 0
+        self.hits = 0
+        self.t_armed = -math.inf
+        self.active = True
+
+    @property
+    def size(self) -> int:
+        raise NotImplementedError
+
+    @property
+    def remaining(self) -> int:
+        """Points not yet fired (buffer entries still in use)."""
+        return max(self.size - self.index, 0) if self.active else 0
+
+    @property
+    def done(self) -> bool:
+        return self.index >= self.size
+
+    def scan(self, eng: CompareEngine, ta: float, t1: float) -> list[tuple[float, int, float]]:
+        raise NotImplementedError
+
+    def arm(self, eng: CompareEngine) -> None:
+        """Called when added (validation against the engine, start state)."""
+
+
+class LevelJob(CompareJob):
+    """Compare a source against `levels` in order; direction +1 up, -1 down, 0 either.
+
+    `after_final` (HSL 4.12): the value loaded after the last point; it fires too if the
+    motion reaches it. `repeat=True`: a single value, armed again after every firing.
+    """
+
+    def __init__(self, source: Source, levels: ArrayLike | LevelSeq, action: Action, *,
+                 direction: int = 0, repeat: bool = False, after_final: float | None = None,
+                 monotonic: bool = False, name: str = "") -> None:
+        super().__init__(action, name)
+        if not isinstance(source, AxisSource | VectorSource):
+            raise MotionError(f"source must be an AxisSource or VectorSource, got {source!r}")
+        if direction not in (-1, 0, 1):
+            raise MotionError(f"direction must be -1, 0 or +1, got {direction!r}")
+        if isinstance(levels, LevelSeq):
+            self.levels: Array | LevelSeq = levels
+        else:
+            arr = np.asarray(levels, dtype=np.float64).reshape(-1)
+            if arr.size == 0:
+                raise MotionError("levels must not be empty")
+            if not np.all(np.isfinite(arr)):
+                raise MotionError("levels must all be finite")
+            if monotonic and arr.size > 1:
+                d = np.diff(arr)
+                want = direction if direction else (1 if isinstance(source, VectorSource) else 0)
+                if want > 0 and not np.all(d > 0):
+                    raise MotionError("levels must be strictly increasing for this mode")
+                if want < 0 and not np.all(d < 0):
+                    raise MotionError("levels must be strictly decreasing for this mode")
+            self.levels = arr
+        if repeat and len(self.levels) != 1:
+            raise MotionError("repeat needs exactly one level")
+        self.after_final = None if after_final is None else check_finite("after_final",
+                                                                         after_final)
+        self.source = source
+        self.direction = direction
+        self.repeat = repeat
+        self.skipped = 0
+
+    @property
+    def size(self) -> int:
+        if self.repeat:
+            return 1 if self.active else 0
+        return len(self.levels) + (self.after_final is not None)
+
+    @property
+    def remaining(self) -> int:
+        if self.repeat:
+            return 1 if self.active else 0
+        return super().remaining
+
+    @property
+    def done(self) -> bool:
+        return False if self.repeat else self.index >= self.size
+
+    def level(self, k: int) -> float:
+        n = len(self.levels)
+        return float(self.levels[k]) if k < n else float(self.after_final)  # type: ignore[arg-type]
+
+    @property
+    def value(self) -> float | None:
+        """The compare value loaded now (HSL check_compare_data), None when exhausted."""
+        if self.repeat:
+            return self.level(0)
+        return self.level(self.index) if self.index < self.size else None
+
+    def arm(self, eng: CompareEngine) -> None:
+        if isinstance(self.source, VectorSource):
+            # the vector distance only grows: points already behind it can never fire
+            s = eng.vector_moved(self.source)
+            while self.index < self.size and self.level(self.index) <= s:
+                self.index += 1
+                self.skipped += 1
+
+    def scan(self, eng: CompareEngine, ta: float, t1: float) -> list[tuple[float, int, float]]:
+        ta = max(ta, self.t_armed)
+        if ta >= t1:
+            return []
+        src = self.source
+        if self.repeat:
+            lvl = self.level(0)
+            if isinstance(src, VectorSource):
+                tf = eng.vector_cycle(src).time_of(lvl, ta)
+                times = [tf] if tf is not None else []
+            else:
+                times = crossings_after(eng.track(src), lvl, ta, t1, self.direction).tolist()
+            return [(float(t), 0, lvl) for t in times]
+        hits = []
+        t = ta
+        while self.index < self.size:
+            lvl = self.level(self.index)
+            if isinstance(src, VectorSource):
+                tf = eng.vector_cycle(src).time_of(lvl, t)
+            else:
+                tf = first_crossing(eng.track(src), lvl, t, t1, self.direction)
+            if tf is None:
+                break
+            hits.append((tf, self.index, lvl))
+            self.index += 1
+            t = tf
+        return hits
+
+
+class WindowJob(CompareJob):
+    """2-D/3-D points (n x k) compared with a +-maxerr window per axis, in table order."""
+
+    def __init__(self, axes: Sequence[int], points: ArrayLike, maxerr: float, action: Action,
+                 *, kind: str = "dpos", name: str = "") -> None:
+        super().__init__(action, name)
+        self.axes = tuple(axes)
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[1] != len(self.axes) or pts.shape[0] == 0:
+            raise MotionError(f"points must be a non-empty (n, {len(self.axes)}) table, "
+                              f"got shape {pts.shape}")
+        if not np.all(np.isfinite(pts)):
+            raise MotionError("points must all be finite")
+        self.maxerr = check_positive("maxerr", maxerr)
+        if kind not in SOURCE_KINDS:
+            raise MotionError(f"kind must be one of {SOURCE_KINDS}, got {kind!r}")
+        self.points = pts
+        self.kind = kind
+
+    @property
+    def size(self) -> int:
+        return self.points.shape[0]
+
+    @property
+    def value(self) -> Array | None:
+        return self.points[self.index] if self.index < self.size else None
+
+    def scan(self, eng: CompareEngine, ta: float, t1: float) -> list[tuple[float, int, float]]:
+        ta = max(ta, self.t_armed)
+        if ta > t1:
+            return []
+        tracks = [eng.track(AxisSource(a, self.kind)) for a in self.axes]
+        hits = []
+        t = ta
+        while self.index < self.size:
+            tf = first_inside(tracks, self.points[self.index], self.maxerr, t, t1)
+            if tf is None:
+                break
+            hits.append((tf, self.index, float(self.index)))
+            self.index += 1
+            t = tf
+        return hits
+
+
+# ---------------------------------------------------------------------------- engine
+class CompareEngine:
+    """Runs compare jobs on a Controller every cycle (see module docstring).
+
+    buffer_size: total points all jobs may hold; outputs: output numbers able to compare
+    (default every general output of the machine).
+    """
+
+    def __init__(self, controller: Controller, *, buffer_size: int = 100_000,
+                 outputs: Sequence[int] | None = None) -> None:
+        if not isinstance(buffer_size, int) or buffer_size < 1:
+            raise MotionError(f"buffer_size must be an int >= 1, got {buffer_size!r}")
+        self.ctl = controller
+        self.buffer_size = buffer_size
+        n_do = controller.config.digital_outputs
+        caps = range(n_do) if outputs is None else outputs
+        for o in caps:
+            if not isinstance(o, int) or not 0 <= o < n_do:
+                raise MotionError(f"outputs must be output numbers in [0, {n_do - 1}], "
+                                  f"got {o!r}")
+        self.capable = frozenset(caps)
+        self.log = EventLog(len(controller.axes))
+        self._jobs: dict[int, CompareJob] = {}
+        self._next_id = 0
+        self._lines: dict[int, OutputLine] = {}
+        self._vectors: dict[VectorSource, float] = {}
+        self._mpos_err: dict[int, float] = {}
+        self._t_last = controller.time
+        self._tracks: dict[AxisSource, Track] = {}
+        self._vcycles: dict[VectorSource, VectorCycle] = {}
+        self._mpos_e1: dict[int, float] = {}
+        self._win = (self._t_last, self._t_last)
+        controller.add_cycle_hook(self._on_cycle)
+
+    def detach(self) -> None:
+        """Stop running (the jobs stay as they are)."""
+        self.ctl.remove_cycle_hook(self._on_cycle)
+
+    # ------------------------------------------------------------------ outputs
+    def check_output(self, number: int) -> int:
+        if isinstance(number, bool) or not isinstance(number, int) or number not in self.capable:
+            raise MotionError(f"output must be a compare-capable output "
+                              f"{sorted(self.capable)}, got {number!r}")
+        return number
+
+    def output(self, number: int) -> OutputLine:
+        """The exact waveform of output `do<number>` (created at its current level)."""
+        line = self._lines.get(number)
+        if line is None:
+            self.check_output(number)
+            line = OutputLine(number, False)
+            line.attach(self.ctl.hardware)
+            self._lines[number] = line
+        return line
+
+    # ------------------------------------------------------------------ jobs
+    @property
+    def jobs(self) -> dict[int, CompareJob]:
+        return dict(self._jobs)
+
+    def buffer_free(self) -> int:
+        """Points the buffer can still take (ZMotion ?HW_PSWITCH2)."""
+        return self.buffer_size - sum(min(j.remaining, self.buffer_size)
+                                      for j in self._jobs.values())
+
+    def add(self, job: CompareJob) -> int:
+        """Validate and arm `job` from now; returns its id. Nothing changes on refusal."""
+        if not isinstance(job, CompareJob):
+            raise MotionError(f"job must be a CompareJob, got {type(job).__name__}")
+        if job.id >= 0:
+            raise MotionError("job was already added")
+        self.check_output(job.action.output)
+        n_axes = len(self.ctl.axes)
+        axes = (job.axes if isinstance(job, WindowJob) else
+                job.source.axes if isinstance(job.source, VectorSource)  # type: ignore[attr-defined]
+                else (job.source.axis,))  # type: ignore[attr-defined]
+        for a in axes:
+            if isinstance(a, bool) or not isinstance(a, int) or not 0 <= a < n_axes:
+                raise MotionError(f"axis must be in [0, {n_axes - 1}], got {a!r}")
+        if isinstance(job, LevelJob):
+            src = job.source
+            if isinstance(src, AxisSource) and src.kind not in SOURCE_KINDS:
+                raise MotionError(f"kind must be one of {SOURCE_KINDS}, got {src.kind!r}")
+            if isinstance(src, VectorSource) and (
+                    len(src.axes) == 0 or len(set(src.axes)) != len(src.axes)
+                    or (src.scale is not None and (len(src.scale) != len(src.axes)
+                                                   or not all(math.isfinite(s) and s > 0
+                                                              for s in src.scale)))):
+                raise MotionError("vector source needs distinct axes and a positive scale "
+                                  "per axis")
+        need = min(job.remaining, self.buffer_size + 1)
+        if need > self.buffer_free():
+            raise MotionError(f"table too long: {job.remaining} points, buffer has "
+                              f"{self.buffer_free()} free of {self.buffer_size}")
+        if isinstance(job, LevelJob) and isinstance(job.source, VectorSource):
+            self.track_vector(job.source)
+        kinds = [job.kind] if isinstance(job, WindowJob) else [getattr(job.source, "kind", "")]
+        if "mpos" in kinds:
+            for a in axes:
+                self._start_mpos(a)
+        job.id = self._next_id
+        self._next_id += 1
+        job.t_armed = self.ctl.time
+        job.arm(self)
+        self._jobs[job.id] = job
+        return job.id
+
+    def remove(self, job_id: int) -> None:
+        """Stop a job and drop its unfired points (HW_PSWITCH2(2) for one job)."""
+        job = self._jobs.pop(job_id, None)
+        if job is not None:
+            job.active = False
+
+    def clear(self) -> None:
+        for k in list(self._jobs):
+            self.remove(k)
+
+    def job(self, job_id: int) -> CompareJob:
+        try:
+            return self._jobs[job_id]
+        except KeyError:
+            raise MotionError(f"no active compare job {job_id!r}") from None
+
+    # ------------------------------------------------------------------ vector distance
+    def track_vector(self, source: VectorSource) -> None:
+        """Start accumulating `source`'s path length (from 0) if not already."""
+        self._vectors.setdefault(source, 0.0)
+
+    def vector_moved(self, source: VectorSource) -> float:
+        """Path length accumulated so far (ZMotion VECTOR_MOVED)."""
+        self.track_vector(source)
+        return self._vectors[source]
+
+    def set_vector_moved(self, source: VectorSource, value: float = 0.0) -> None:
+        """VECTOR_MOVED = value (clear it before a job, as the seed says)."""
+        self._vectors[source] = check_finite("value", value)
+
+    # ------------------------------------------------------------------ per-cycle data
+    def _cmd_offset(self, axis: int) -> float:
+        return -self.ctl.axes[axis].counters.pulses_from_command(0.0)
+
+    def _mpos_error(self, axis: int) -> float:
+        """Following error in feedback counts at the current time."""
+        ctr = self.ctl.axes[axis].counters
+        h = self.ctl.history.position_at(axis, self.ctl.time)
+        return ctr.feedback_unwrapped() - ctr.move_ratio * (h + self._cmd_offset(axis))
+
+    def _start_mpos(self, axis: int) -> None:
+        if axis not in self._mpos_err:
+            self._mpos_err[axis] = self._mpos_error(axis)
+
+    def track(self, src: AxisSource) -> Track:
+        """The source's track over this cycle (cached per cycle)."""
+        tr = self._tracks.get(src)
+        if tr is None:
+            ta, t1 = self._win
+            h = history_track(self.ctl.history, src.axis, ta, t1)
+            off = self._cmd_offset(src.axis)
+            if src.kind == "dpos":
+                tr = affine_track(h, 1.0, off)
+            else:
+                r = self.ctl.axes[src.axis].counters.move_ratio
+                e0 = self._mpos_err[src.axis]
+                e1 = self._mpos_e1[src.axis]
+                tr = affine_track(h, r, r * off, e0, (e1 - e0) / (t1 - ta), ta)
+            self._tracks[src] = tr
+        return tr
+
+    def vector_cycle(self, src: VectorSource) -> VectorCycle:
+        vc = self._vcycles.get(src)
+        if vc is None:
+            ta, t1 = self._win
+            tracks = [history_track(self.ctl.history, a, ta, t1) for a in src.axes]
+            vc = VectorCycle(tracks, src.weights, ta, t1, self._vectors[src])
+            self._vcycles[src] = vc
+        return vc
+
+    # ------------------------------------------------------------------ the cycle
+    def _on_cycle(self, ctl: Controller, t1: float) -> None:
+        ta = self._t_last
+        self._t_last = t1
+        if t1 <= ta:
+            return
+        self._win = (ta, t1)
+        self._tracks = {}
+        self._vcycles = {}
+        self._mpos_e1 = {a: self._mpos_error(a) for a in self._mpos_err}
+        rows: list[tuple[float, int, int, float, int, int]] = []
+        for job in list(self._jobs.values()):
+            if not job.active:
+                continue
+            for tf, idx, val in job.scan(self, ta, t1):
+                state = job.action.apply(self, tf, job.hits)
+                job.hits += 1
+                rows.append((tf, job.id, idx, val, job.action.output, int(state)))
+            if job.done:
+                self._jobs.pop(job.id, None)
+                job.active = False
+        for src in self._vectors:
+            self._vectors[src] = self.vector_cycle(src).end
+        self._mpos_err.update(self._mpos_e1)
+        if rows:
+            rows.sort(key=lambda r: r[0])
+            times = np.array([r[0] for r in rows])
+            pos = np.column_stack([
+                ctl.history.sample(a, times).p + self._cmd_offset(a)
+                for a in range(len(ctl.axes))])
+            self.log.add(rows, pos)
+        hw = ctl.hardware
+        for line in self._lines.values():
+            line.flush(hw, ta, t1)
