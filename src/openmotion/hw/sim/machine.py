@@ -29,6 +29,7 @@ from .scenario import Scenario
 from .switches import IndexSwitch, Switch
 
 if TYPE_CHECKING:
+    from .dcservo import DCServoPlant
     from .servo import ServoPlant
 
 #: Safety bound on toggles of one switch within one piece (an EZ window per revolution).
@@ -49,11 +50,15 @@ class _Axis:
         self.gen = PulseGenerator()
         if drv.type == "servo":
             from .servo import ServoPlant
-            self.plant: StepperPlant | ServoPlant = ServoPlant(drv)
+            self.plant: StepperPlant | ServoPlant | DCServoPlant = ServoPlant(drv)
+        elif drv.type == "dc_servo":
+            from .dcservo import DCServoPlant
+            self.plant = DCServoPlant(cfg)
         else:
             self.plant = StepperPlant(drv.type == "ideal_stepper", drv.pullout_speed,
                                       drv.pullout_accel)
         self.is_servo = drv.type == "servo"
+        self.is_dc = drv.type == "dc_servo"  # motor driven by command_effort, not pulses
         check_nonnegative(f"axes[{index}].drive.backlash", drv.backlash)
         screw = cfg.pulses_per_rev * cfg.gear_ratio
         self.trans = Transmission(drv.backlash, PitchTable(drv.pitch_error, screw))
@@ -85,6 +90,8 @@ class _Axis:
             return sw.active
         if sig == "alm":
             return self.alarm
+        if sig == "rdy" and self.is_dc:
+            return self.outputs["svon"] and not self.alarm
         if sig == "rdy":
             return self.plant.ready(self.outputs["svon"], self.alarm) if self.is_servo \
                 else not self.alarm
@@ -228,6 +235,8 @@ class SimMachine:
         if ax.is_servo:
             ax.plant.set_outputs(self._t, ax.gen, ax.outputs["svon"], ax.alarm,
                                  erc=(signal == "erc" and level))
+        if ax.is_dc:
+            ax.plant.svon = ax.outputs["svon"]
         for s, lv in before.items():
             if ax.level(s) != lv:
                 self._pending.append((self._t, axis, s, not lv, ax.decoder.count))
@@ -236,6 +245,15 @@ class SimMachine:
         if signal == "emg":
             return self._emg_active != self._emg_nc
         return self._di[self._board_index(signal, "di", len(self._di))]
+
+    def command_effort(self, axis: int, t0: float, value: float) -> None:
+        """Motor effort (PWM duty in [-1, 1], clamped) of a dc_servo axis, held from t0 (>=
+        the current time) until the next call (hw.interface.EffortHardware)."""
+        ax = self._axis(axis)
+        if not ax.is_dc:
+            raise MotionError(f"axis {axis} has no effort output (drive type "
+                              f"{ax.cfg.drive.type!r}, needs 'dc_servo')")
+        ax.plant.set_effort(self._t, t0, value)
 
     # -- extras for tests and tools ---------------------------------------------------------
     def read_output(self, axis: int | None, signal: str) -> bool:
