@@ -58,7 +58,7 @@ class Axis:
         self._state = S.DISABLED
         self._fault: str | None = None
         self._powered = False
-        self._servo = config.drive.type == "servo"
+        self._servo = config.drive.type in ("servo", "dc_servo")  # axes with SVON
         self._motion: ActiveMotion | None = None
         self._pos = 0.0       # commanded position, raw pulse frame, at controller time
         self._vel = 0.0
