@@ -41,6 +41,7 @@ IO_BITS = (("rdy", 0), ("alm", 1), ("pel", 2), ("mel", 3), ("org", 4), ("ez", 9)
 
 EdgeHook = Callable[["Controller", InputEdge], None]
 CycleHook = Callable[["Controller", float], None]
+SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
 
@@ -84,6 +85,8 @@ class Controller:
         self.history = MotionHistory(len(self.axes), history_window_s, t_start=self._time)
         self._edge_hooks: list[EdgeHook] = [_estop_hook, _alarm_hook]
         self._cycle_hooks: list[CycleHook] = []
+        self._sample_hooks: list[tuple[SampleHook, int]] = []
+        self._samples = 1  # sub-steps per cycle: lcm of the sample hooks' rates
         self._fault_hooks: list[FaultHook] = []
         self._motion_checks: list[MotionCheck] = []
         self._estop = False
@@ -95,6 +98,9 @@ class Controller:
         self._pacer = RealtimePacer(self.step, self.period)
         self._rb_cycle = [-1] * len(self.axes)
         self._estop = self._emg_level_active(hardware.read_input("emg"))
+        from .servoloop import attach_servo_loops  # closed loops of axes with a loop config
+
+        self.servo_loops = attach_servo_loops(self)
 
     # ------------------------------------------------------------------ lookup
     def axis(self, key: int | str) -> Axis:
@@ -163,6 +169,24 @@ class Controller:
             if hook in self._cycle_hooks:
                 self._cycle_hooks.remove(hook)
 
+    def add_sample_hook(self, hook: SampleHook, per_cycle: int = 1) -> None:
+        """Call `hook(controller, t)` `per_cycle` times per cycle, at t = t0 + k*T/per_cycle
+        (k = 0..per_cycle-1), after the cycle's commands are sent and the hardware has been
+        advanced to t (sampled loops: read feedback, write an output held from t)."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        if isinstance(per_cycle, bool) or not isinstance(per_cycle, int) or \
+                not 1 <= per_cycle <= 1000:
+            raise MotionError(f"per_cycle must be an int in [1, 1000], got {per_cycle!r}")
+        with self._lock:
+            self._sample_hooks.append((hook, per_cycle))
+            self._samples = math.lcm(*(n for _, n in self._sample_hooks))
+
+    def remove_sample_hook(self, hook: SampleHook) -> None:
+        with self._lock:
+            self._sample_hooks = [(h, n) for h, n in self._sample_hooks if h != hook]
+            self._samples = math.lcm(1, *(n for _, n in self._sample_hooks))
+
     def add_fault_hook(self, hook: FaultHook) -> None:
         """Call `hook(axis, reason)` whenever an axis goes to ErrorStop (`fault_stop`):
         limits, alarms, E-stop, safety reactions. A group engine subscribes here."""
@@ -225,7 +249,7 @@ class Controller:
                 cmd = ax._command(t0, t1)
                 if cmd is not None:
                     hw.command(ax.index, cmd)
-            edges = hw.advance(t1)
+            edges = hw.advance(t1) if not self._sample_hooks else self._sampled(t0, t1)
             self._n = n
             self._time = t1
             if edges:
@@ -239,6 +263,21 @@ class Controller:
                 h(self, t1)
             if self.recorder is not None:
                 self._record(t1)
+
+    def _sampled(self, t0: float, t1: float) -> list[InputEdge]:
+        """Advance the hardware over [t0, t1] in sub-steps, running the sample hooks."""
+        hw = self.hardware
+        ns = self._samples
+        edges: list[InputEdge] = []
+        for k in range(ns):
+            tk = t0 + (t1 - t0) * k / ns
+            if k:
+                edges.extend(hw.advance(tk))
+            for hook, per in tuple(self._sample_hooks):
+                if k % (ns // per) == 0:
+                    hook(self, tk)
+        edges.extend(hw.advance(t1))
+        return edges
 
     def _sync(self, axis: int) -> None:
         """Read an axis back from the hardware if not done since the last cycle.
