@@ -27,10 +27,10 @@ a = (MaxVel - StrVel)/Tacc (or with `jerk` as S-curves); no StrVel jump.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from ..errors import MotionError, check_finite, check_nonnegative, check_positive
+from ..errors import MotionError
 from ..hw.interface import InputEdge
 from ..profile.pcl import MoveSpec
 from ..profile.ramps import ramp_accel, ramp_jerk
@@ -38,11 +38,9 @@ from ..profile.segments import Profile, ProfileBuilder
 from . import planning
 from .homing_modes import (
     EZ_COUNT_BASE,
-    EZ_COUNT_MAX,
-    HSL_MODES,
-    MCCL_TYPES,
+    HomeConfig,
+    HomeStatus,
     Phase,
-    mccl_phases,
     uses,
 )
 from .states import AxisState
@@ -50,110 +48,15 @@ from .states import AxisState
 if TYPE_CHECKING:
     from .axis import Axis
     from .controller import Controller
+    from .safety import Safety
 
 S = AxisState
-EL_STOPS = ("decel", "immediate")
-FINALS = ("mark", "stay")
 
 
-@dataclass(frozen=True)
-class HomeConfig:
-    """Home settings of one axis (HSL set_home_config + home_move speeds, MCCL HOME_CONFIG).
+def _installed_safety(ctl: Controller) -> Safety | None:
+    from . import safety
 
-    mode: 0..12 (HSL home_mode) or "mccl_normal" / "mccl_home_only" / "mccl_index_only".
-    direction: +1/-1 home direction (HSL: the sign of MaxVel; MCCL: wPhase0Dir).
-    phase1_same_direction: MCCL wPhase1Dir == wPhase0Dir. str_vel, max_vel (pps), tacc (s),
-    jerk (pps^3, None = T-curve). ez_count 0..15. org_offset: back-off after leaving ORG
-    (HSL ORG_ESC_Offset). home_offset: final position relative to the mechanical home (MCCL
-    dfOffset; where the counters read 0). final: "mark" = move to home_offset and clear the
-    counters there; "stay" = stop where the mode stops, counters set so the home reads 0.
-    el_stop: reaction to an end limit used by the mode. auto_search: reverse on an end limit
-    (HSL home_search). max_overrun: deceleration budget after any trigger (pulses).
-    """
-
-    mode: int | str = 0
-    direction: int = -1
-    str_vel: float = 500.0
-    max_vel: float = 5000.0
-    tacc: float = 0.1
-    jerk: float | None = None
-    ez_count: int = 0
-    org_offset: float = 0.0
-    home_offset: float = 0.0
-    final: str = "mark"
-    el_stop: str = "decel"
-    auto_search: bool = False
-    phase1_same_direction: bool = False
-    search_range: float = 2.0**27
-    max_overrun: float | None = None
-    settle_s: float = 0.0
-    timeout_s: float = 600.0
-
-    def __post_init__(self) -> None:
-        m = self.mode
-        if not (isinstance(m, int) and not isinstance(m, bool) and m in HSL_MODES) and \
-                m not in tuple(f"mccl_{k}" for k in MCCL_TYPES):
-            raise MotionError(f"mode must be 0..12 or mccl_normal/mccl_home_only/"
-                              f"mccl_index_only, got {m!r}")
-        if self.direction not in (1, -1) or isinstance(self.direction, bool):
-            raise MotionError(f"direction must be +1 or -1, got {self.direction!r}")
-        sv = check_nonnegative("str_vel", self.str_vel)
-        mv = check_positive("max_vel", self.max_vel)
-        if sv > mv:
-            raise MotionError(f"str_vel must be <= max_vel ({mv!r}), got {sv!r}")
-        if sv == 0.0:
-            raise MotionError("str_vel must be > 0 (the slow search speed)")
-        check_positive("tacc", self.tacc)
-        if self.jerk is not None:
-            check_positive("jerk", self.jerk)
-        e = self.ez_count
-        if isinstance(e, bool) or not isinstance(e, int) or not 0 <= e <= EZ_COUNT_MAX:
-            raise MotionError(f"ez_count must be an int in [0, {EZ_COUNT_MAX}], got {e!r}")
-        check_nonnegative("org_offset", self.org_offset)
-        if check_finite("home_offset", self.home_offset) != round(self.home_offset):
-            raise MotionError(f"home_offset must be a whole number of pulses, got "
-                              f"{self.home_offset!r}")
-        if self.final not in FINALS:
-            raise MotionError(f"final must be one of {FINALS}, got {self.final!r}")
-        if self.el_stop not in EL_STOPS:
-            raise MotionError(f"el_stop must be one of {EL_STOPS}, got {self.el_stop!r}")
-        check_positive("search_range", self.search_range)
-        if self.max_overrun is not None:
-            check_positive("max_overrun", self.max_overrun)
-        check_nonnegative("settle_s", self.settle_s)
-        check_positive("timeout_s", self.timeout_s)
-
-    @property
-    def accel(self) -> float:
-        """Ramp acceleration (pps^2): (MaxVel - StrVel) / Tacc, or MaxVel/Tacc if equal."""
-        dv = self.max_vel - self.str_vel
-        return (dv if dv > 0.0 else self.max_vel) / self.tacc
-
-    def phases(self) -> tuple[Phase, ...]:
-        if isinstance(self.mode, int):
-            return HSL_MODES[self.mode]
-        return mccl_phases(self.mode[5:], self.phase1_same_direction)
-
-    def speed(self, name: str) -> float:
-        return {"max": self.max_vel, "str": self.str_vel, "creep": self.max_vel / 10.0}[name]
-
-
-@dataclass
-class HomeStatus:
-    """Where a homing run is. `code` is MCC_GetGoHomeStatus-like: -1 running, 1 done,
-    0 not started / failed."""
-
-    state: str = "idle"          # idle, running, done, error, aborted
-    phase: str = ""
-    mark: float | None = None    # mechanical home, command-counter frame before the reset
-    mark_time: float | None = None
-    mark_encoder: int | None = None
-    reason: str | None = None
-    history: list[str] = field(default_factory=list)
-
-    @property
-    def code(self) -> int:
-        return -1 if self.state == "running" else 1 if self.state == "done" else 0
+    return safety._INSTALLED.get(ctl)
 
 
 def _has_index(axis: Axis) -> bool:
@@ -164,7 +67,8 @@ def _has_index(axis: Axis) -> bool:
 class Homing:
     """The home sequence of one axis. `start()`, then run the controller; `status`."""
 
-    def __init__(self, ctl: Controller, axis: int | str, config: HomeConfig) -> None:
+    def __init__(self, ctl: Controller, axis: int | str, config: HomeConfig, *,
+                 safety: Safety | None = None, escape_only: bool = False) -> None:
         if not isinstance(config, HomeConfig):
             raise MotionError(f"config must be a HomeConfig, got {type(config).__name__}")
         self.ctl = ctl
@@ -177,6 +81,11 @@ class Homing:
                               f"{self.axis.name} has encoder_mode "
                               f"{self.axis.config.encoder_mode!r} (no index)")
         self._table = table
+        self._escape_only = escape_only
+        # the Safety attached to this controller, if any: its limit / soft-limit reactions
+        # are suspended while homing handles them itself
+        self.safety = safety if safety is not None else _installed_safety(ctl)
+        self._suspended: tuple[str, ...] = ()
         self._plan: list[Phase] = []
         self._k = 0
         self._stage = "idle"
@@ -186,6 +95,7 @@ class Homing:
         self._t_begin = 0.0
         self._recovered = False
         self._after_move: str = ""
+        self._edge_p = 0.0
 
     # ------------------------------------------------------------------ public
     @property
@@ -222,6 +132,12 @@ class Homing:
         if self.running:
             raise MotionError(f"axis {ax.name}: homing already running")
         ax.begin_homing()
+        if self.safety is not None:
+            el = self._el_name(1)
+            uses_el = uses(self._table, "el") or c.auto_search
+            self._suspended = (el, "soft") if uses_el else ("soft",)
+            for sig in self._suspended:
+                self.safety.suspend(ax.index, sig)
         self.status = HomeStatus(state="running")
         self._t_begin = self.ctl.time
         self._plan = list(self._table)
@@ -230,6 +146,14 @@ class Homing:
         self.ctl.add_edge_hook(self._on_edge)
         self.ctl.add_cycle_hook(self._on_cycle)
         first = self._plan[0]
+        if self._escape_only:  # HSL escape_home: leave the switch, back off, no counters
+            self._plan = []
+            if self._active(self._sig(first)):
+                self._escape_then_table(first)
+            else:
+                self._finish("done", None)
+                ax.end_homing()
+            return
         ahead = self._el_name(first.direction)
         if first.signal != "el" and self._active(ahead):
             if not c.auto_search:
@@ -337,7 +261,7 @@ class Homing:
     def _escape_then_table(self, first: Phase) -> None:
         """Leave the active switch against the search, back off, then run the table."""
         esc = Phase(f"escape {first.signal.upper()}", first.signal, "off", -1, "str", "stop")
-        self._plan = [esc, *self._table]
+        self._plan = [esc] if self._escape_only else [esc, *self._table]
         self._after_move = ""
         self._begin_phase()
 
@@ -347,6 +271,8 @@ class Homing:
         table = list(self._table)
         rev = [Phase("reverse to ORG", "org", "on", -1, "max", "pass"),
                Phase("pass ORG", "org", "off", -1, "max", "stop")]
+        # then the table again, its first search slowly (figure 4-29 "search again")
+        table[0] = replace(table[0], speed="str")
         self._plan = [*rev, *table]
         self._k = 0
         self._stage = "search"
@@ -367,7 +293,10 @@ class Homing:
             self._stage = "move"
             self._log("back off by org_offset")
             d = self._abs(ph.direction)
-            self._move_to(round(self.axis.position + d * self.config.org_offset))
+            # the offset counts from the release edge, not from where the stop ended
+            target = round(self._edge_p + d * self.config.org_offset)
+            if (target - self.axis.position) * d > 0.0:
+                self._move_to(target)
             if self.axis.motion is not None:
                 return
         self._after_move = ""
@@ -379,6 +308,10 @@ class Homing:
 
     def _final(self) -> None:
         st = self.status
+        if self._escape_only:
+            self.axis.end_homing()
+            self._finish("done", None)
+            return
         if st.mark is None:
             self._fail("homing: sequence ended without a home mark")
             return
@@ -415,11 +348,17 @@ class Homing:
         cnt.reset_error()
         ax.end_homing()
         self._finish("done", None)
+        if self.safety is not None and self.safety.settings(ax.index).erc_width > 0.0:
+            self.safety.pulse_erc(ax.index)  # ERC one-shot on home completion (HSL 4.7)
 
     def _finish(self, state: str, reason: str | None) -> None:
         self.status.state = state
         self.status.reason = reason
         self._stage = state
+        if self.safety is not None:
+            for sig in self._suspended:
+                self.safety.resume(self.axis.index, sig)
+            self._suspended = ()
         self.ctl.remove_edge_hook(self._on_edge)
         self.ctl.remove_cycle_hook(self._on_cycle)
 
@@ -430,9 +369,10 @@ class Homing:
     # ------------------------------------------------------------------ hooks
     def _trigger(self, ph: Phase, e: InputEdge) -> None:
         ax = self.axis
+        off = ax.position - ax._pos
+        self._edge_p = self.ctl.history.state_at(ax.index, e.time).p + off
         if ph.mark:
-            off = ax.position - ax._pos
-            self.status.mark = self.ctl.history.state_at(ax.index, e.time).p + off
+            self.status.mark = self._edge_p
             self.status.mark_time = e.time
             self.status.mark_encoder = e.encoders[ax.index] if e.encoders else None
         then = ph.then
@@ -522,3 +462,26 @@ class Homing:
             self._next()
         elif stage == "final":
             self._complete()
+
+
+# -- HSL-style entry points -------------------------------------------------------------
+def home_move(ctl: Controller, axis: int | str, config: HomeConfig) -> Homing:
+    """Start homing `axis` with `config` (HSL_M_home_move); returns the running Homing."""
+    h = Homing(ctl, axis, config)
+    h.start()
+    return h
+
+
+def home_search(ctl: Controller, axis: int | str, config: HomeConfig) -> Homing:
+    """Auto home search (HSL_M_home_search, figure 4-29): as home_move, and an end limit met
+    while searching reverses the axis past ORG, backs off by org_offset and searches again
+    slowly."""
+    return home_move(ctl, axis, replace(config, auto_search=True))
+
+
+def escape_home(ctl: Controller, axis: int | str, config: HomeConfig) -> Homing:
+    """Leave ORG (HSL_M_escape_home): if ORG is active, move against the home direction at
+    StrVel until it releases, then by org_offset. Counters are not touched."""
+    h = Homing(ctl, axis, replace(config, mode=0), escape_only=True)
+    h.start()
+    return h

@@ -21,7 +21,9 @@ live here, in one table, so that they are easy to correct.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from ..errors import MotionError, check_finite, check_nonnegative, check_positive
 
 #: ez_count n waits for n + EZ_COUNT_BASE index edges ([low]: PCL6045B counts 1..16 with
 #: a 0..15 register; seed-facts 1.1).
@@ -125,3 +127,107 @@ def mccl_phases(kind: str, same_direction: bool) -> tuple[Phase, ...]:
 def uses(phases: tuple[Phase, ...], signal: str) -> bool:
     """Whether any phase waits for `signal`."""
     return any(ph.signal == signal for ph in phases)
+
+
+EL_STOPS = ("decel", "immediate")
+FINALS = ("mark", "stay")
+
+
+@dataclass(frozen=True)
+class HomeConfig:
+    """Home settings of one axis (HSL set_home_config + home_move speeds, MCCL HOME_CONFIG).
+
+    mode: 0..12 (HSL home_mode) or "mccl_normal" / "mccl_home_only" / "mccl_index_only".
+    direction: +1/-1 home direction (HSL: the sign of MaxVel; MCCL: wPhase0Dir).
+    phase1_same_direction: MCCL wPhase1Dir == wPhase0Dir. str_vel, max_vel (pps), tacc (s),
+    jerk (pps^3, None = T-curve). ez_count 0..15. org_offset: back-off after leaving ORG
+    (HSL ORG_ESC_Offset). home_offset: final position relative to the mechanical home (MCCL
+    dfOffset; where the counters read 0). final: "mark" = move to home_offset and clear the
+    counters there; "stay" = stop where the mode stops, counters set so the home reads 0.
+    el_stop: reaction to an end limit used by the mode. auto_search: reverse on an end limit
+    (HSL home_search). max_overrun: deceleration budget after any trigger (pulses).
+    """
+
+    mode: int | str = 0
+    direction: int = -1
+    str_vel: float = 500.0
+    max_vel: float = 5000.0
+    tacc: float = 0.1
+    jerk: float | None = None
+    ez_count: int = 0
+    org_offset: float = 0.0
+    home_offset: float = 0.0
+    final: str = "mark"
+    el_stop: str = "decel"
+    auto_search: bool = False
+    phase1_same_direction: bool = False
+    search_range: float = 2.0**27
+    max_overrun: float | None = None
+    settle_s: float = 0.0
+    timeout_s: float = 600.0
+
+    def __post_init__(self) -> None:
+        m = self.mode
+        if not (isinstance(m, int) and not isinstance(m, bool) and m in HSL_MODES) and \
+                m not in tuple(f"mccl_{k}" for k in MCCL_TYPES):
+            raise MotionError(f"mode must be 0..12 or mccl_normal/mccl_home_only/"
+                              f"mccl_index_only, got {m!r}")
+        if self.direction not in (1, -1) or isinstance(self.direction, bool):
+            raise MotionError(f"direction must be +1 or -1, got {self.direction!r}")
+        sv = check_nonnegative("str_vel", self.str_vel)
+        mv = check_positive("max_vel", self.max_vel)
+        if sv > mv:
+            raise MotionError(f"str_vel must be <= max_vel ({mv!r}), got {sv!r}")
+        if sv == 0.0:
+            raise MotionError("str_vel must be > 0 (the slow search speed)")
+        check_positive("tacc", self.tacc)
+        if self.jerk is not None:
+            check_positive("jerk", self.jerk)
+        e = self.ez_count
+        if isinstance(e, bool) or not isinstance(e, int) or not 0 <= e <= EZ_COUNT_MAX:
+            raise MotionError(f"ez_count must be an int in [0, {EZ_COUNT_MAX}], got {e!r}")
+        check_nonnegative("org_offset", self.org_offset)
+        if check_finite("home_offset", self.home_offset) != round(self.home_offset):
+            raise MotionError(f"home_offset must be a whole number of pulses, got "
+                              f"{self.home_offset!r}")
+        if self.final not in FINALS:
+            raise MotionError(f"final must be one of {FINALS}, got {self.final!r}")
+        if self.el_stop not in EL_STOPS:
+            raise MotionError(f"el_stop must be one of {EL_STOPS}, got {self.el_stop!r}")
+        check_positive("search_range", self.search_range)
+        if self.max_overrun is not None:
+            check_positive("max_overrun", self.max_overrun)
+        check_nonnegative("settle_s", self.settle_s)
+        check_positive("timeout_s", self.timeout_s)
+
+    @property
+    def accel(self) -> float:
+        """Ramp acceleration (pps^2): (MaxVel - StrVel) / Tacc, or MaxVel/Tacc if equal."""
+        dv = self.max_vel - self.str_vel
+        return (dv if dv > 0.0 else self.max_vel) / self.tacc
+
+    def phases(self) -> tuple[Phase, ...]:
+        if isinstance(self.mode, int):
+            return HSL_MODES[self.mode]
+        return mccl_phases(self.mode[5:], self.phase1_same_direction)
+
+    def speed(self, name: str) -> float:
+        return {"max": self.max_vel, "str": self.str_vel, "creep": self.max_vel / 10.0}[name]
+
+
+@dataclass
+class HomeStatus:
+    """Where a homing run is. `code` is MCC_GetGoHomeStatus-like: -1 running, 1 done,
+    0 not started / failed."""
+
+    state: str = "idle"          # idle, running, done, error, aborted
+    phase: str = ""
+    mark: float | None = None    # mechanical home, command-counter frame before the reset
+    mark_time: float | None = None
+    mark_encoder: int | None = None
+    reason: str | None = None
+    history: list[str] = field(default_factory=list)
+
+    @property
+    def code(self) -> int:
+        return -1 if self.state == "running" else 1 if self.state == "done" else 0

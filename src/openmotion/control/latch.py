@@ -32,7 +32,10 @@ if TYPE_CHECKING:
     from .controller import Controller
 
 EDGES = ("on", "off", "both")
-_EPS = 1e-6  # pulses: an edge fired by a pulse lands on the integer within float noise
+# pulses: an edge fired by a pulse lands on an integer of the emitted command; the history
+# (the planned profile) may differ from it by the Hermite blend of a cycle that straddles a
+# segment boundary (motion.py), far below half a pulse
+_EPS = 0.05
 
 
 @dataclass(frozen=True)
