@@ -10,9 +10,20 @@ import pytest
 
 from openmotion.control import Controller
 from openmotion.control.axis import AxisState
-from openmotion.control.group import (ERR_ARC, ERR_ARGUMENT, ERR_AXIS_BUSY, ERR_AXIS_STATE,
-                                      ERR_GROUP, ERR_LIMIT, ERR_QUEUE_FULL, ERR_SPEED,
-                                      ERR_STATE, Group, GroupError, GroupState)
+from openmotion.control.group import (
+    ERR_ARC,
+    ERR_ARGUMENT,
+    ERR_AXIS_BUSY,
+    ERR_AXIS_STATE,
+    ERR_GROUP,
+    ERR_LIMIT,
+    ERR_QUEUE_FULL,
+    ERR_SPEED,
+    ERR_STATE,
+    Group,
+    GroupError,
+    GroupState,
+)
 from openmotion.errors import MotionError
 
 FEED = 20_000.0

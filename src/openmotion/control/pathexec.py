@@ -146,7 +146,9 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float]) -> Profi
             continue
         a = dv2[k] / (2.0 * ds[k])
         vm = v[k] + v[k + 1]
-        if vm <= 0.0:
+        if vm <= 0.0 or 2.0 * ds[k] / vm > 1e6:
+            if ds[k] <= 1e-9 * max(1.0, s_end):  # a sliver left by rounding: step over it
+                continue
             raise InfeasibleError("path speed curve stalls at rest before its end")
         dt = 2.0 * ds[k] / vm  # exact for constant acceleration, also when a = 0
         b.set_velocity(float(v[k]))
@@ -183,6 +185,11 @@ class Chain:
         k = self.locate(s0)
         el = self.elements[k]
         local = s0 - float(self.cum[k])
+        slack = 1e-9 * max(1.0, self.length)
+        if el.length - local <= slack and k + 1 < len(self.elements):
+            k, el, local = k + 1, self.elements[k + 1], 0.0  # at the end of an element
+        if local <= slack:
+            local = 0.0
         first: PathElement = el if local <= 0.0 else Trimmed(el, local)
         return [first, *self.elements[k + 1:]], s0
 
@@ -294,27 +301,40 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     sd = smp.v
     s[-1] = sp.end.p
     dim = chain.elements[0].dim
+    if len(t) < 2:  # nothing left to move: hold the start
+        p0 = np.array(chain.elements[-1].end if sp.end.p >= chain.length else starts,
+                      dtype=float)
+        return [Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), 0.0,
+                        State(float(x), 0.0, 0.0), State(float(x), 0.0, 0.0), (),
+                        np.zeros(0)) for x in p0]
+    n_el = len(chain.elements)
+    cum = chain.cum
+    # positions per knot (continuous: consecutive elements join bit for bit)
     pos = np.empty((len(t), dim))
-    vel = np.empty((len(t), dim))
-    k = np.clip(np.searchsorted(chain.cum, s, side="right") - 1, 0, len(chain.elements) - 1)
-    # a knot exactly on an element boundary belongs to the element it ends (left side)
+    k = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, n_el - 1)
     for i in np.unique(k):
         m = k == i
         el = chain.elements[i]
-        local = np.clip(s[m] - chain.cum[i], 0.0, el.length)
-        pos[m] = el.point(local)
-        vel[m] = el.tangent(local) * sd[m][:, None]
+        pos[m] = el.point(np.clip(s[m] - cum[i], 0.0, el.length))
     pos[0] = starts
-    vel[0] = sp.start.v * _tangent_at(chain, float(s[0]))
-    last = chain.locate(float(s[-1]) - 1e-12 * max(1.0, chain.length))
-    pos[-1] = chain.elements[last].point(
-        min(max(float(s[-1]) - float(chain.cum[last]), 0.0), chain.elements[last].length))
     if s[-1] >= chain.length:
         pos[-1] = chain.elements[-1].end
-    vel[-1] = 0.0
+    # velocities per interval, from the element the interval lies on: at a corner taken at
+    # speed (junction deviation) the velocity jumps between two intervals, not inside one
+    s_mid = sp.sample(0.5 * (t[:-1] + t[1:])).p
+    km = np.clip(np.searchsorted(cum, s_mid, side="right") - 1, 0, n_el - 1)
+    v0 = np.empty((len(t) - 1, dim))
+    v1 = np.empty((len(t) - 1, dim))
+    for i in np.unique(km):
+        m = km == i
+        el = chain.elements[i]
+        l0 = np.clip(s[:-1][m] - cum[i], 0.0, el.length)
+        l1 = np.clip(s[1:][m] - cum[i], 0.0, el.length)
+        v0[m] = el.tangent(l0) * sd[:-1][m][:, None]
+        v1[m] = el.tangent(l1) * sd[1:][m][:, None]
+    v1[-1] = 0.0 if sp.end.v == 0.0 else v1[-1]
     h = np.diff(t)[:, None]
     dp = np.diff(pos, axis=0)
-    v0, v1 = vel[:-1], vel[1:]
     a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
     jj = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
     out = []
@@ -324,15 +344,9 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
         out.append(Profile(
             t0=t[:-1].copy(), p0=pos[:-1, i].copy(), v0=v0[:, i].copy(), a0=a0[:, i].copy(),
             j=jj[:, i].copy(), duration=float(dur),
-            start=State(float(pos[0, i]), float(vel[0, i]), 0.0),
+            start=State(float(pos[0, i]), float(v0[0, i]), 0.0),
             end=State(float(pos[-1, i]), 0.0, 0.0), labels=labels, dt=dts.copy()))
     return out
-
-
-def _tangent_at(chain: Chain, s: float) -> np.ndarray:
-    k = chain.locate(s)
-    el = chain.elements[k]
-    return np.asarray(el.tangent(min(max(s - float(chain.cum[k]), 0.0), el.length)))
 
 
 def travel_time(curve: SpeedCurve) -> float:

@@ -1,0 +1,159 @@
+"""Blended group paths on recorded runs: tolerance, speed gain, per-axis limits, ends; and
+the path-execution math (speed curves, axis profiles) as properties."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from openmotion.control import Controller
+from openmotion.control import pathexec as px
+from openmotion.control.group import Group, GroupState
+from openmotion.path import Arc, Line, plan_speeds
+
+VMAX = 50_000.0
+AMAX = 500_000.0
+
+
+def make(tol: float | None) -> tuple[Controller, Group]:
+    ctl = Controller()
+    ctl.enable_all()
+    for k in range(len(ctl.axes)):
+        ctl.hardware.scenario.remove_switch(k, "mel")
+    g = Group(ctl, ["x", "y"], feed=40_000.0, acc_time=0.1)
+    g.set_max_pulse_speed([VMAX, VMAX])
+    g.set_max_pulse_acc([AMAX, AMAX])
+    if tol is not None:
+        g.enable_blend(tol)
+    return ctl, g
+
+
+def run(points: np.ndarray, tol: float | None):
+    ctl, g = make(tol)
+    t0 = ctl.time
+    g.line(points[0])  # from the origin to the first vertex
+    for p in points[1:]:
+        g.line(p)
+    ctl.step()
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
+                         and not any(a.is_moving for a in g.axes), 60)
+    t = np.linspace(t0, ctl.time, 40001)
+    s = [ctl.history.sample(a.index, t) for a in g.axes]
+    return ctl.time - t0, g.position, s
+
+
+def dist_to_polyline(xy: np.ndarray, verts: np.ndarray) -> np.ndarray:
+    """Distance of every row of xy to the polyline through verts."""
+    best = np.full(len(xy), np.inf)
+    for a, b in zip(verts[:-1], verts[1:], strict=True):
+        ab = b - a
+        u = np.clip(((xy - a) @ ab) / (ab @ ab), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(xy - (a + u[:, None] * ab), axis=1))
+    return best
+
+
+def polygon(n: int, r: float) -> np.ndarray:
+    ang = np.linspace(0.0, 2 * np.pi, n + 1)
+    return np.stack([r + r * np.cos(ang) + 1000, r * np.sin(ang) + r + 1000], axis=1)
+
+
+def zigzag(n: int, dx: float, dy: float) -> np.ndarray:
+    x = 1000 + dx * np.arange(n)
+    y = 1000 + dy * (np.arange(n) % 2)
+    return np.stack([x, y], axis=1)
+
+
+def _check(points: np.ndarray, tol: float) -> tuple[float, float, np.ndarray]:
+    t_exact, end_e, _ = run(points, None)
+    t_blend, end_b, (sx, sy) = run(points, tol)
+    assert end_b.tolist() == points[-1].tolist() == end_e.tolist()  # ends exact
+    verts = np.vstack([[0.0, 0.0], points])
+    dev = dist_to_polyline(np.stack([sx.p, sy.p], axis=1), verts)
+    assert dev.max() <= tol * (1 + 1e-6)
+    for s in (sx, sy):
+        assert np.abs(s.v).max() <= VMAX * (1 + 1e-9)
+        assert np.abs(s.a).max() <= AMAX * (1 + 1e-5)  # Hermite error on small blend arcs
+    assert t_blend < t_exact
+    return t_exact, t_blend, np.hypot(sx.v, sy.v)
+
+
+def test_polygon_blends_within_tolerance_and_beats_exact_stop():
+    pts = polygon(100, 50_000.0)  # chord deviation of the 100-gon: r(1-cos(pi/100)) = 24.7
+    t_exact, t_blend, speed = _check(pts, 25.0)
+    assert t_blend < 0.6 * t_exact
+    # after the lead-in corner the whole polygon runs at the full feed (look-ahead)
+    n = speed.size
+    assert np.all(speed[int(0.35 * n):int(0.95 * n)] >= 40_000.0 * (1 - 1e-6))
+
+
+def test_zigzag_blends_within_tolerance():
+    _check(zigzag(40, 2000.0, 3000.0), 50.0)
+
+
+# ------------------------------------------------------------------ pathexec properties
+v2s = st.lists(st.floats(0.0, 1e4), min_size=2, max_size=8)
+
+
+@settings(max_examples=60, deadline=None)
+@given(v2s, v2s)
+def test_curve_min_max_are_pointwise(a, b):
+    ca = px.SpeedCurve(np.linspace(0.0, 10.0, len(a)), np.array(a))
+    cb = px.SpeedCurve(np.linspace(0.0, 10.0, len(b)), np.array(b))
+    grid = np.linspace(0.0, 10.0, 501)
+    lo, hi = px.curve_min(ca, cb), px.curve_max(ca, cb)
+    ya, yb = np.interp(grid, ca.s, ca.v2), np.interp(grid, cb.s, cb.v2)
+    assert np.allclose(np.interp(grid, lo.s, lo.v2), np.minimum(ya, yb), atol=1e-6)
+    assert np.allclose(np.interp(grid, hi.s, hi.v2), np.maximum(ya, yb), atol=1e-6)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.tuples(st.floats(-5e3, 5e3), st.floats(-5e3, 5e3)), min_size=1,
+                max_size=6), st.floats(0.2, 0.8), st.sampled_from([0.0, 2000.0]))
+def test_axis_profiles_follow_the_path_and_end_exactly(pts, hold_frac, scv):
+    verts = [np.zeros(2)]
+    for p in pts:
+        q = verts[-1] + np.array(p)
+        if np.linalg.norm(q - verts[-1]) > 1.0:
+            verts.append(q)
+    if len(verts) < 2:
+        return
+    els = [Line(a, b) for a, b in zip(verts[:-1], verts[1:], strict=True)]
+    c = verts[-1] + np.array([500.0, 0.0])
+    els.append(Arc(verts[-1], c, verts[-1] + np.array([1000.0, 0.0])))
+    chain = px.Chain(els, range(len(els)))
+    lim = px.Limits(20_000.0, 200_000.0, np.array([15_000.0, 15_000.0]),
+                    np.array([150_000.0, 150_000.0]), scv)
+    curve = px.plan_curve(chain, 0.0, 0.0, lim)
+    sp = px.s_profile(curve, chain.length, chain.cum[1:-1].tolist())
+    profs = px.axis_profiles(chain, sp, 0.001, [0.0, 0.0])
+    for i, p in enumerate(profs):
+        assert p.end.p == els[-1].end[i]
+    t = np.linspace(0.0, sp.duration, 4001)
+    xy = np.stack([p.sample(t).p for p in profs], axis=1)
+    s = sp.sample(t).p
+    k = np.clip(np.searchsorted(chain.cum, s, side="right") - 1, 0, len(els) - 1)
+    ref = np.empty_like(xy)
+    for i in np.unique(k):
+        ref[k == i] = els[i].point(np.clip(s[k == i] - chain.cum[i], 0.0, els[i].length))
+    assert np.max(np.abs(xy - ref)) < 1e-3
+    for p in profs:
+        smp = p.sample(t)
+        assert np.abs(smp.v).max() <= 15_000.0 * (1 + 1e-6)
+        assert np.abs(smp.a).max() <= 150_000.0 * (1 + 1e-4)
+    # hold part-way: decelerates on the path, never faster than the plan, stops at rest
+    st_ = sp.state_at(hold_frac * sp.duration)
+    a_min = min(x.accel for x in plan_speeds(els, lim.feed, lim.accel,
+                                             axis_vmax=lim.axis_vmax,
+                                             axis_amax=lim.axis_amax) if x.length > 0)
+    held = px.hold_curve(curve, st_.p, st_.v, a_min)
+    s_stop = px.stop_point(held)
+    assert st_.p <= s_stop <= chain.length
+    grid = np.linspace(st_.p, s_stop, 200)
+    assert np.all(np.interp(grid, held.s, held.v2) <= np.interp(grid, curve.s, curve.v2) + 1e-6)
+    # continue from there: the rest of the path ends on the same point
+    rest = px.plan_curve(chain, s_stop, 0.0, lim)
+    sp2 = px.s_profile(rest, chain.length, chain.cum[1:-1].tolist())
+    start = chain.point(s_stop)
+    profs2 = px.axis_profiles(chain, sp2, 0.001, start)
+    assert [p.end.p for p in profs2] == [p.end.p for p in profs]
