@@ -346,3 +346,18 @@ def test_limit_switch_stops_all_axes_of_the_group():
     assert e.value.code in (ERR_GROUP, ERR_AXIS_STATE)
     g.clear_error()
     assert g.error_code == 0 and g.state is GroupState.IDLE
+
+
+def test_limit_with_safety_attached_stops_the_group_through_the_fault_hook():
+    safety_mod = pytest.importorskip("openmotion.control.safety")
+    ctl, g = make()
+    safety_mod.Safety(ctl)
+    ctl.hardware.scenario.place_switch(0, "pel", 6000.0, 1000.0)
+    g.line([20_000, 10_000])
+    ctl.step()
+    ctl.run_until(lambda: g.state is GroupState.ERROR, 5)
+    assert g.error_code == ERR_LIMIT
+    assert g.axes[0].state is AxisState.ERROR_STOP
+    assert not g.axes[1].is_moving
+    p = g.position
+    assert abs(p[0] - 2 * p[1]) < 1e-6  # both axes stopped at the same path point

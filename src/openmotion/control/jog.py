@@ -67,7 +67,7 @@ def jog_space(ctl: Controller, axis: int | str, distance: float, ratio: float, *
         raise MotionError("distance must be non-zero")
     ax = _axis(ctl, axis)
     v = _ratio_speed(ax, ratio)
-    ax.move_relative(d, max_vel=v, tacc=tacc, units=True)
+    ax.move_relative(float(ax.units.to_pulses(d)), max_vel=v, tacc=tacc)
 
 
 def jog_conti(ctl: Controller, axis: int | str, direction: int, ratio: float, *,
