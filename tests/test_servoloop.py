@@ -243,3 +243,31 @@ def test_example_machine_file_loads_and_moves():
     assert ctl.wait_motion_done(timeout=2.0)
     ctl.advance(0.1)
     assert abs(ax.counters.feedback - 2000) <= 2
+
+
+def test_inject_step_moves_the_motor_not_the_command_counter():
+    ctl, x, lp = controller()
+    with pytest.raises(MotionError, match="the loop is open"):
+        lp.inject_step(100)
+    x.enable()
+    ctl.step()
+    for bad, msg in ((math.nan, "counts must be finite"), (2e6, r"counts must be within")):
+        with pytest.raises(MotionError, match=msg):
+            lp.inject_step(bad)
+    assert lp.bias == 0.0
+    lp.inject_step(200)
+    ctl.advance(0.1)
+    assert x.position == 0.0
+    assert abs(x.counters.feedback - 200) <= 1
+
+
+def test_servo_tuning_example_writes_a_plot(tmp_path):
+    import runpy
+    from pathlib import Path
+
+    mod = runpy.run_path(str(Path(__file__).parent.parent / "examples" / "servo_tuning.py"))
+    out = tmp_path / "tuning.png"
+    mod["main"](str(out))
+    assert out.stat().st_size > 10_000
+    t, x = mod["step_response"](0xD8, 0x00, 0x10, duration=0.05)
+    assert abs(x[-1] - mod["STEP"]) <= 1

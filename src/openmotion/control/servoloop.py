@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..config import LoopConfig
-from ..errors import MotionError
+from ..errors import MotionError, check_finite
 from ..hw.interface import EffortHardware
 from .servo import PIDFF, Compensator, FollowingErrorMonitor, LeadFilter
 from .states import AxisState
@@ -43,6 +43,8 @@ FOLLOWING_ERROR = "following error"
 #: The chip's motor command saturates at 8 bits; the PWM has 100 parts.
 LEAD_MC_LIMIT = 127.0
 LEAD_FULL_SCALE = 100.0
+#: Largest step `inject_step` accepts (counts).
+MAX_STEP = 1e6
 
 
 def make_compensator(loop: LoopConfig, sample_period: float) -> tuple[Compensator, float]:
@@ -97,6 +99,18 @@ class ServoLoop:
         self._ctl.remove_sample_hook(self._sample)
         self._hw.command_effort(self.axis.index, self._hw.time, 0.0)
         self.closed = False
+
+    def inject_step(self, counts: float) -> None:
+        """Tuning aid: add a step of `counts` to the loop's set-point (its bias), as a servo
+        tuning tool's step test does. The axis's command counter does not change; inject
+        the opposite step to undo it. The loop must be closed (axis enabled, no trip)."""
+        c = check_finite("counts", counts)
+        if abs(c) > MAX_STEP:
+            raise MotionError(f"counts must be within +-{MAX_STEP:g}, got {counts!r}")
+        if not self.closed:
+            raise MotionError(f"axis {self.axis.name}: the loop is open (axis disabled, not "
+                              "yet sampled or tripped); a step needs a closed loop")
+        self.bias += c
 
     # ------------------------------------------------------------------ tracing
     def start_trace(self) -> None:
