@@ -361,3 +361,36 @@ def test_limit_with_safety_attached_stops_the_group_through_the_fault_hook():
     assert not g.axes[1].is_moving
     p = g.position
     assert abs(p[0] - 2 * p[1]) < 1e-6  # both axes stopped at the same path point
+
+
+def test_hold_during_delay_keeps_the_rest_of_the_delay():
+    ctl, g = make()
+    g.delay(0.3)
+    g.line([1000, 1000])
+    ctl.advance(0.1)
+    g.hold()
+    assert g.state is GroupState.HELD
+    ctl.advance(0.5)
+    assert g.position.tolist() == [0.0, 0.0]
+    g.cont()
+    t_cont = ctl.time
+    ctl.run_until(lambda: g.current_index == 1, 2)
+    assert ctl.time - t_cont == pytest.approx(0.2, abs=3 * ctl.period)
+    finish(ctl, g)
+    assert g.position.tolist() == [1000.0, 1000.0]
+
+
+def test_slow_policy_plans_down_to_axis_limits():
+    ctl, g = make()
+    g.set_max_pulse_speed([8000, 50_000])
+    g.set_max_pulse_acc([100_000, 1e6])
+    with pytest.raises(GroupError):
+        g.line([10_000, 10_000])
+    g.set_axis_limit_policy("slow")
+    t0 = ctl.time
+    g.line([10_000, 10_000])
+    t1 = finish(ctl, g)
+    _, (sx, sy) = sample(ctl, g, t0, t1)
+    assert np.abs(sx.v).max() <= 8000 * (1 + 1e-9)
+    assert np.abs(sx.a).max() <= 100_000 * (1 + 1e-9)
+    assert g.position.tolist() == [10_000.0, 10_000.0]

@@ -113,6 +113,7 @@ class Group(GroupEngine):
             self.set_acc_time(acc_time)
         self._vmax = np.array([a._max_speed for a in ax], dtype=float)
         self._amax = np.full(len(ax), math.inf)
+        self._refuse = True
         self._ptp_ratio = 10.0
         self._ptp_shape = "T"
         for a in ax:
@@ -218,6 +219,14 @@ class Group(GroupEngine):
     def set_max_pulse_speed(self, pps: Sequence[float]) -> None:
         """MCC_SetMaxPulseSpeed per logical axis (pps); default the axes' maximum speed."""
         self._vmax = self._axis_values("pps", pps)
+
+    def set_axis_limit_policy(self, policy: str) -> None:
+        """"refuse" (default, MCCL): a path command whose feed or acceleration would take an
+        axis past its maximum pulse speed/acceleration is refused (ERR_SPEED / ERR_ACCEL);
+        "slow": it is accepted and the look-ahead slows the path down to the axis limits."""
+        if policy not in ("refuse", "slow"):
+            raise MotionError(f"policy must be 'refuse' or 'slow', got {policy!r}")
+        self._refuse = policy == "refuse"
 
     def set_max_pulse_acc(self, pps2: Sequence[float]) -> None:
         """MCC_SetMaxPulseAcc per logical axis (pps^2, inf = unlimited, the default)."""
@@ -338,6 +347,11 @@ class Group(GroupEngine):
         if self._state is not GroupState.MOVING or self._run is None:
             raise GroupError(ERR_STATE, f"hold needs a moving group (state {self._state.value})")
         r = self._run
+        if r.kind == "delay":  # keep the rest of the delay for continue()
+            self._held = _Run("delay", r.cmds, r.t0, t_until=max(0.0, r.t_until - self._ctl.time))
+            self._run = None
+            self._state = GroupState.HELD
+            return
         if r.kind == "path":
             self._replan(r, hold=True)
         elif r.kind == "ptp" and not self._dry:
@@ -461,6 +475,9 @@ class Group(GroupEngine):
 
     def _push_path(self, el: PathElement, end: np.ndarray) -> int:
         feed = self._feed
+        if not self._refuse:  # the planner slows the path down to the axis limits
+            return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
+                                   accel=feed / self._acc_time), end)
         tan = el.max_abs_tangent
         need = feed * tan
         bad = np.nonzero(need > self._vmax * (1 + 1e-12))[0]

@@ -174,6 +174,12 @@ class GroupEngine:
                 self._state = GroupState.IDLE
 
     def _start_next(self, t: float) -> None:
+        try:
+            self._start_queued(t)
+        except MotionError as err:  # an axis refused (safety check, state): stop the group
+            self._fault(getattr(err, "code", ERR_AXIS_STATE), f"command refused at start: {err}")
+
+    def _start_queued(self, t: float) -> None:
         cmd = self._queue.popleft()
         if cmd.kind == "delay":
             self._run = _Run("delay", [cmd], t, t_until=t + cmd.seconds)
