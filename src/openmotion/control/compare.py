@@ -173,6 +173,11 @@ class CompareJob:
         return max(self.size - self.index, 0) if self.active else 0
 
     @property
+    def buffer_use(self) -> int:
+        """Buffer entries held: the points left (an endless generator holds one)."""
+        return self.remaining
+
+    @property
     def done(self) -> bool:
         return self.index >= self.size
 
@@ -234,6 +239,12 @@ class LevelJob(CompareJob):
         if self.repeat:
             return 1 if self.active else 0
         return super().remaining
+
+    @property
+    def buffer_use(self) -> int:
+        if isinstance(self.levels, LevelSeq) and self.levels.count is None:
+            return 1 if self.active else 0
+        return self.remaining
 
     @property
     def done(self) -> bool:
@@ -393,8 +404,7 @@ class CompareEngine:
 
     def buffer_free(self) -> int:
         """Points the buffer can still take (ZMotion ?HW_PSWITCH2)."""
-        return self.buffer_size - sum(min(j.remaining, self.buffer_size)
-                                      for j in self._jobs.values())
+        return self.buffer_size - sum(j.buffer_use for j in self._jobs.values())
 
     def add(self, job: CompareJob) -> int:
         """Validate and arm `job` from now; returns its id. Nothing changes on refusal."""
@@ -421,9 +431,8 @@ class CompareEngine:
                                                               for s in src.scale)))):
                 raise MotionError("vector source needs distinct axes and a positive scale "
                                   "per axis")
-        need = min(job.remaining, self.buffer_size + 1)
-        if need > self.buffer_free():
-            raise MotionError(f"table too long: {job.remaining} points, buffer has "
+        if job.buffer_use > self.buffer_free():
+            raise MotionError(f"table too long: {job.buffer_use} points, buffer has "
                               f"{self.buffer_free()} free of {self.buffer_size}")
         if isinstance(job, LevelJob) and isinstance(job.source, VectorSource):
             self.track_vector(job.source)

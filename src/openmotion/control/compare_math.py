@@ -28,6 +28,7 @@ Array = NDArray[np.float64]
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _QUAD_RTOL = 1e-13
 _QUAD_DEPTH = 10
+_SNAP_RTOL = 1e-10  # distances this close count as reached
 _EPS = float(np.finfo(np.float64).eps)
 
 
@@ -198,7 +199,10 @@ class VectorCycle:
     def time_of(self, d: float, after: float) -> float | None:
         """First time > `after` with s(t) >= d (s is non-decreasing), or None."""
         if d > self.S[-1]:
-            return None
+            # a point exactly at the end of a move: the quadrature sum may land an ulp short
+            if d - self.S[-1] > _SNAP_RTOL * max(abs(d), 1.0):
+                return None
+            d = float(self.S[-1])
         i = int(np.searchsorted(self.S, d, side="left"))  # S[i-1] < d <= S[i]
         i = max(i, 1)
         u, w = float(self.B[i - 1]), float(self.B[i])

@@ -79,9 +79,9 @@ class HslTrigger:
         old = self._job.get(axis)
         jobs = self.eng.jobs
         if job is not None:
-            held = jobs[old].remaining if old in jobs else 0
-            if job.remaining > self.eng.buffer_free() + held:
-                raise MotionError(f"table too long: {job.remaining} points, buffer has "
+            held = jobs[old].buffer_use if old in jobs else 0
+            if job.buffer_use > self.eng.buffer_free() + held:
+                raise MotionError(f"table too long: {job.buffer_use} points, buffer has "
                                   f"{self.eng.buffer_free() + held} free")
             self.eng.check_output(job.action.output)
         if old is not None:

@@ -198,7 +198,7 @@ class ZPso:
         """Points not yet fired by the jobs of `axis` (default BASE axis 0)."""
         a = self._base[0] if axis is None else axis
         jobs = self.eng.jobs
-        return sum(jobs[i].remaining for i in self._jobs.get(a, []) if i in jobs)
+        return sum(jobs[i].buffer_use for i in self._jobs.get(a, []) if i in jobs)
 
     # ------------------------------------------------------------------ HW_TIMER
     def hw_timer(self, mode: int, cycle_us: float, on_us: float, reptimes: int,
