@@ -57,10 +57,12 @@ def profile_extent(profile: Profile, u0: float, u1: float) -> tuple[float, float
     pts = []
     if u1 > dur:
         end = profile.end
-        if end.v != 0.0 and math.isinf(u1):
+        if end.v == 0.0:
+            pts.append(end.p)
+        elif math.isinf(u1):
             pts.append(math.copysign(math.inf, end.v))
         else:
-            pts.append(end.p + end.v * (u1 - max(u0, dur)))
+            pts.append(end.p + end.v * (u1 - dur))
         pts.append(end.p + end.v * max(u0 - dur, 0.0))
     n = profile.n_segments
     if n and u0 < dur:
