@@ -13,6 +13,7 @@ at once and puts the group in error (MCCL 2.6.3 VI: all motion commands stop).
 
 from __future__ import annotations
 
+import math
 import weakref
 from collections import deque
 from dataclasses import dataclass, field
@@ -204,7 +205,8 @@ class GroupEngine:
             if self._blend and self._blend_tol > 0.0 and els and isinstance(els[-1], Line) \
                     and isinstance(el, Line):
                 b = blend_corner(els[-1], el, self._blend_tol)
-                if b is not None:
+                if b is not None and _blend_pays(b, min(c.accel, float(np.min(self._amax))),
+                                                        c.feed):
                     els[-1] = b.first
                     els.append(b.arc)
                     owners.append(c.index)
@@ -330,3 +332,23 @@ def _accels(chain: px.Chain, lim: px.Limits) -> list[float]:
     sp = plan_speeds(chain.elements, lim.feed, lim.accel, axis_vmax=lim.axis_vmax,
                      axis_amax=lim.axis_amax)
     return [x.accel for x in sp if x.length > 0.0]
+
+
+def _blend_pays(b: Any, accel: float, feed: float) -> bool:
+    """Whether rounding a corner is faster than stopping exactly at it.
+
+    The blend arc (radius R = 1/kappa, sweep phi = L/R) starts d = R*tan(phi/2) before the
+    corner and is crossed at most at v_c = sqrt(a_n*R), a_n = sqrt(3)/2*A (the look-ahead's
+    split of A on arcs). Near the corner the exact stop runs at sqrt(2*A*x) at distance x
+    from it; the blended path at sqrt(v_c**2 + 2*A*(x - d)) on the lines. Unless
+    v_c**2 >= 2*A*d (both capped by the feed) the blended path is slower at every point
+    of the lines next to the corner, so a sharp corner with a tiny blend arc stops instead.
+    """
+    length = float(b.arc.length)
+    kappa = float(b.arc.max_curvature)
+    if kappa <= 0.0 or length <= 0.0:
+        return True
+    radius = 1.0 / kappa
+    d = radius * math.tan(0.5 * length / radius)
+    v_c2 = min(feed * feed, math.sqrt(0.75) * accel * radius)
+    return v_c2 >= min(feed * feed, 2.0 * accel * d)

@@ -292,10 +292,11 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     dur = sp.duration
     n = int(math.floor(dur / period + 1e-9))
     grid = np.arange(n + 1) * period
-    t = np.union1d(grid[grid < dur], np.concatenate([sp.t0, [dur]]))
-    t = t[np.concatenate([[True], np.diff(t) > 1e-12])]
-    if t[-1] != dur:
-        t[-1] = dur
+    brk = np.union1d(sp.t0, [dur])
+    # grid knots closer than 1e-6 period to a break of s(t) are dropped: a tiny interval
+    # would make the Hermite coefficients (divided by h**2, h**3) lose all precision
+    near = _near(grid, brk, 1e-6 * period)
+    t = np.union1d(grid[(grid < dur) & ~near], brk)
     smp = sp.sample(t)
     s = np.clip(smp.p, sp.start.p, sp.end.p)
     sd = smp.v
@@ -312,8 +313,7 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     # positions per knot (continuous: consecutive elements join bit for bit)
     pos = np.empty((len(t), dim))
     k = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, n_el - 1)
-    for i in np.unique(k):
-        m = k == i
+    for i, m in _runs(k):
         el = chain.elements[i]
         pos[m] = el.point(np.clip(s[m] - cum[i], 0.0, el.length))
     pos[0] = starts
@@ -325,8 +325,7 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     km = np.clip(np.searchsorted(cum, s_mid, side="right") - 1, 0, n_el - 1)
     v0 = np.empty((len(t) - 1, dim))
     v1 = np.empty((len(t) - 1, dim))
-    for i in np.unique(km):
-        m = km == i
+    for i, m in _runs(km):
         el = chain.elements[i]
         l0 = np.clip(s[:-1][m] - cum[i], 0.0, el.length)
         l1 = np.clip(s[1:][m] - cum[i], 0.0, el.length)
@@ -337,6 +336,14 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     dp = np.diff(pos, axis=0)
     a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
     jj = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
+    # on a line the axis motion is u*s(t) exactly: take a and j from s(t), not the fit
+    ss = sp.sample(t[:-1])
+    for i, m in _runs(km):
+        el = chain.elements[i]
+        if el.max_curvature == 0.0:
+            u = np.asarray(el.tangent(0.0))
+            a0[m] = ss.a[m][:, None] * u
+            jj[m] = ss.j[m][:, None] * u
     out = []
     dts = np.diff(t)
     labels = ("path",) * len(dts)
@@ -356,3 +363,18 @@ def travel_time(curve: SpeedCurve) -> float:
     ds = np.diff(curve.s)
     ok = ds > 0.0
     return float(np.sum(2.0 * ds[ok] / vm[ok]))
+
+
+def _near(grid: np.ndarray, brk: np.ndarray, tol: float) -> np.ndarray:
+    """Which grid values lie within tol of a value of the sorted array brk."""
+    k = np.clip(np.searchsorted(brk, grid), 1, len(brk) - 1)
+    return np.minimum(np.abs(grid - brk[k - 1]), np.abs(grid - brk[k])) <= tol
+
+
+def _runs(k: np.ndarray) -> list[tuple[int, slice]]:
+    """(value, slice) of each run of equal values in a sorted index array."""
+    if len(k) == 0:
+        return []
+    starts = np.concatenate([[0], np.nonzero(np.diff(k))[0] + 1])
+    ends = np.concatenate([starts[1:], [len(k)]])
+    return [(int(k[a]), slice(int(a), int(b))) for a, b in zip(starts, ends, strict=True)]
