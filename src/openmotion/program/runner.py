@@ -1,0 +1,466 @@
+"""Run a motion program on a controller: canonical commands -> queued `Group` commands.
+
+    ctl = Controller(); ctl.enable_all()
+    run = ProgramRunner(ctl, "G21 G90 G1 X10 Y5 F600 M2")   # compiles + validates now
+    run.start(); run.wait(timeout=60)                       # virtual time
+    print(run.state, run.current_line, run.events)
+
+The whole program is compiled (G-code front end) and converted to pulse-space operations
+(convert.py) in the constructor: any error raises before anything moves. Execution is a
+controller cycle hook that streams the operations into the group queue, at most `window`
+commands at a time (a huge program never sits in the queue at once; the look-ahead spans
+what is queued when a chain starts, so a long blended run may come to rest every `window`
+commands). Semantics:
+
+- G0: straight line at the rapid feed (convert.py); G1/G2/G3: group line/arc at the feed.
+- G61/G61.1 disable blending, G64 [P] enables it; the change waits for the queued motion to
+  end (the group applies blending when a chain starts).
+- G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
+  until resume(). M2/M30: end of one pass; `repeat` passes in all.
+- M64/M65: output set when the runner reaches the command (immediately, not waiting for the
+  motion queued before it). M62/M63: set in the cycle in which the next motion command
+  starts executing. M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs.
+  M6: logged, ignored. (MSG)/(DEBUG): logged.
+- pause() holds the path (decelerating along it), resume() continues, abort() stops along
+  the path and drops the rest; single_block pauses after every source line.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from enum import Enum
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import MotionError
+from ..units import AxisUnits
+from . import canon
+from .convert import ConvertOptions, Op, Scales, convert
+from .interp import compile_text
+from .options import AXIS_LETTERS, GCodeOptions
+from .source import GCodeError, read_program
+
+if TYPE_CHECKING:
+    from ..control.controller import Controller
+    from ..control.group import Group
+
+
+class RunState(Enum):
+    READY = "ready"
+    RUNNING = "running"
+    PAUSED = "paused"
+    DONE = "done"
+    ABORTED = "aborted"
+    ERROR = "error"
+
+
+@dataclass(frozen=True)
+class RunEvent:
+    """Something that happened during the run: output, pause, message, fault, ..."""
+
+    t: float
+    kind: str
+    line: int
+    text: str
+    index: int | None = None
+    level: bool | None = None
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Execution settings (see the module docstring and convert.py)."""
+
+    rapid_ratio: float = 1.0
+    feed_mode: str = "uniform"
+    chord_tol: float = 0.001        # machine units
+    acc_time: float = 0.05          # s from rest to the feed (path accel = feed / acc_time)
+    window: int = 256               # commands queued in the group at most
+    repeat: int = 1
+    single_block: bool = False
+    optional_stop: bool = False
+
+    def __post_init__(self) -> None:
+        ConvertOptions(self.rapid_ratio, self.feed_mode, self.chord_tol)
+        a = self.acc_time
+        if isinstance(a, bool) or not isinstance(a, (int, float)) or not 0.0 < a < 1e3:
+            raise MotionError(f"acc_time must be a number in (0, 1000) s, got {a!r}")
+        for name, lo in (("window", 1), ("repeat", 1)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+                raise MotionError(f"{name} must be an integer >= {lo}, got {v!r}")
+        for name in ("single_block", "optional_stop"):
+            if not isinstance(getattr(self, name), bool):
+                raise MotionError(f"{name} must be True or False")
+
+
+def machine_axes(ctl: Controller, axes: Mapping[str, int | str] | None = None) -> dict[str, int]:
+    """G-code letter -> controller axis index; default: axes named after letters (x, y, ...),
+    except that a degree axis named after a linear letter (the XYZU table's u) becomes the
+    first free rotary letter A, B or C (G-code U/V/W are linear and scaled by G20)."""
+    if axes is None:
+        out = {a.name.upper(): a.index for a in ctl.axes if a.name.upper() in AXIS_LETTERS
+               and len(a.name) == 1}
+        for letter, index in list(out.items()):
+            # a degree axis named u/v/w (G-code linear letters) becomes the next free A/B/C
+            if ctl.config.axes[index].unit == "degree" and letter not in "ABC":
+                free = [r for r in "ABC" if r not in out]
+                if free:
+                    del out[letter]
+                    out[free[0]] = index
+        if not out:
+            raise MotionError("axes: no controller axis is named after a G-code letter "
+                              f"({AXIS_LETTERS}); pass axes={{'X': 0, ...}}")
+        return out
+    if not isinstance(axes, Mapping) or not axes:
+        raise MotionError(f"axes must be a non-empty mapping letter -> axis, got {axes!r}")
+    out = {}
+    for letter, key in axes.items():
+        if not isinstance(letter, str) or letter.upper() not in AXIS_LETTERS:
+            raise MotionError(f"axes keys must be letters of {AXIS_LETTERS}, got {letter!r}")
+        out[letter.upper()] = ctl.axis(key).index
+    if len(set(out.values())) != len(out):
+        raise MotionError("axes must map letters to different controller axes")
+    return out
+
+
+@dataclass
+class _Pass:
+    ops: list[Op]
+    start: np.ndarray
+    pc: int = 0
+
+
+class ProgramRunner:
+    """A G-code program (text, a pathlib path, or canonical commands) bound to a controller.
+
+    axes: letter -> controller axis (default: axes named x, y, z, a, ...). gcode: extra
+    GCodeOptions fields (parameters, tool_lengths, outputs, ...); axes, n_axes, start and
+    machine_units are set by the runner. The program is compiled and validated here.
+    """
+
+    def __init__(self, ctl: Controller, program: str | os.PathLike[str] | Sequence[canon.Command],
+                 *, axes: Mapping[str, int | str] | None = None,
+                 options: RunOptions | None = None, gcode: Mapping[str, object] | None = None,
+                 file: str = "") -> None:
+        self.options = RunOptions() if options is None else options
+        if not isinstance(self.options, RunOptions):
+            raise MotionError(f"options must be RunOptions, got {type(options).__name__}")
+        self._ctl = ctl
+        letters = machine_axes(ctl, axes)
+        self.letters = sorted(letters, key=AXIS_LETTERS.index)
+        self.axis_indices = [letters[k] for k in self.letters]
+        units = [AxisUnits.from_axis(ctl.config.axes[i]) for i in self.axis_indices]
+        lin_units = {u.unit for u, k in zip(units, self.letters, strict=True)
+                     if k not in "ABC" and u.unit in ("mm", "inch")}
+        self.machine_units = "inch" if lin_units == {"inch"} else "mm"
+        self.scales = Scales.build(units, self.letters, self.machine_units)
+        self._gextra = dict(gcode or {})
+        for bad in ("axes", "n_axes", "start", "machine_units"):
+            if bad in self._gextra:
+                raise MotionError(f"gcode must not set {bad!r} (the runner sets it)")
+        self._gextra.setdefault("n_outputs", ctl.config.digital_outputs)
+        self.file = file
+        self._text: str | None = None
+        self._commands: list[canon.Command] | None = None
+        if isinstance(program, os.PathLike):
+            self.file = file or os.fspath(program)
+            self._text = read_program(program, self._goptions(self._positions()).max_bytes)
+        elif isinstance(program, str):
+            self._text = program
+        elif isinstance(program, Sequence):
+            self._commands = list(program)
+            bad_cmd = [c for c in self._commands if not isinstance(c, canon.Command)]
+            if bad_cmd:
+                raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
+        else:
+            raise MotionError(f"program must be G-code text, a path or commands, got "
+                              f"{type(program).__name__}")
+        self._pass = self._compile(self._positions())
+        self.state = RunState.READY
+        self.events: list[RunEvent] = []
+        self.passes_done = 0
+        self.group: Group | None = None
+        self.error: str = ""
+        self._line_of: dict[int, int] = {}
+        self._synced: list[Op] = []
+        self._armed: list[tuple[int, Op]] = []   # (command index, output op)
+        self._last_line = 0
+        self._step_line: int | None = None
+        self.t_start = self.t_end = 0.0
+
+    # ------------------------------------------------------------------ compile
+    def _positions(self) -> np.ndarray:
+        return np.array([self._ctl.axes[i].position for i in self.axis_indices], dtype=float)
+
+    def _goptions(self, start_pulses: np.ndarray) -> GCodeOptions:
+        start = tuple(float(x) for x in start_pulses / self.scales.ppu)
+        return GCodeOptions(axes={k: n for n, k in enumerate(self.letters)},
+                            n_axes=len(self.letters), machine_units=self.machine_units,
+                            start=start, **self._gextra)  # type: ignore[arg-type]
+
+    def _compile(self, start: np.ndarray) -> _Pass:
+        cmds = self._commands
+        if cmds is None:
+            assert self._text is not None
+            cmds = compile_text(self._text, self._goptions(start), self.file)
+        self.commands = cmds
+        ops = convert(cmds, self.scales, start, ConvertOptions(
+            self.options.rapid_ratio, self.options.feed_mode, self.options.chord_tol))
+        return _Pass(ops, start.copy())
+
+    @property
+    def ops(self) -> list[Op]:
+        return self._pass.ops
+
+    # ------------------------------------------------------------------ control
+    def start(self) -> None:
+        """Open the group (the program's axes) and start streaming; returns at once."""
+        from ..control.group import Group
+
+        if self.state is not RunState.READY:
+            raise MotionError(f"start needs a ready runner (state {self.state.value})")
+        pos = self._positions()
+        if not np.array_equal(pos, self._pass.start):
+            self._pass = self._compile(pos)  # the axes moved since compiling
+        self.group = Group(self._ctl, self.axis_indices, queue_size=self.options.window,
+                           acc_time=self.options.acc_time)
+        self.group.set_axis_limit_policy("slow")
+        self.group.set_sys_max_speed(float(np.max(self.scales.vmax)))
+        self.state = RunState.RUNNING
+        self.t_start = self._ctl.time
+        self._ctl.add_cycle_hook(self._on_cycle)
+
+    def pause(self) -> None:
+        """Hold: decelerate along the path and stop; resume() continues."""
+        if self.state is not RunState.RUNNING:
+            raise MotionError(f"pause needs a running program (state {self.state.value})")
+        self._hold()
+        self.state = RunState.PAUSED
+        self._event("pause", self.current_line, "paused by the operator")
+
+    def resume(self) -> None:
+        """Continue a paused program (after pause(), M0/M1 or a single-block stop)."""
+        from ..control.group import GroupState
+
+        if self.state is not RunState.PAUSED:
+            raise MotionError(f"resume needs a paused program (state {self.state.value})")
+        g = self.group
+        assert g is not None
+        if g.state is GroupState.HOLDING:
+            raise MotionError("resume: the hold is still decelerating; wait until it rests")
+        if g.state is GroupState.HELD:
+            g.cont()
+        self._step_line = None
+        self.state = RunState.RUNNING
+        self._event("resume", self.current_line, "resumed")
+
+    def abort(self) -> None:
+        """Stop along the path, drop the rest of the program, release the axes at rest."""
+        if self.state not in (RunState.RUNNING, RunState.PAUSED):
+            raise MotionError(f"abort needs a running or paused program "
+                              f"(state {self.state.value})")
+        assert self.group is not None
+        self.group.abort()
+        self._finish(RunState.ABORTED, "aborted by the operator")
+
+    def wait(self, timeout: float) -> bool:
+        """Virtual time: run the controller until the program is no longer running."""
+        return self._ctl.run_until(lambda: self.state is not RunState.RUNNING, timeout)
+
+    @property
+    def running(self) -> bool:
+        return self.state is RunState.RUNNING
+
+    @property
+    def current_line(self) -> int:
+        """Source line of the command executing now (or last handled)."""
+        g = self.group
+        if g is not None:
+            idx = g.current_index
+            if idx >= 0 and idx in self._line_of:
+                return self._line_of[idx]
+        return self._last_line
+
+    @property
+    def progress(self) -> float:
+        """Fraction of the operations handed to the group in this pass (0..1)."""
+        n = len(self._pass.ops)
+        return 1.0 if n == 0 else self._pass.pc / n
+
+    # ------------------------------------------------------------------ execution
+    def _hold(self) -> None:
+        from ..control.group import GroupState
+
+        g = self.group
+        assert g is not None
+        if g.state is GroupState.MOVING:
+            g.hold()
+
+    def _event(self, kind: str, line: int, text: str, **kw: object) -> None:
+        self.events.append(RunEvent(self._ctl.time, kind, line, text, **kw))  # type: ignore[arg-type]
+
+    def _set_output(self, op: Op, index: int, level: bool, kind: str) -> None:
+        self._ctl.hardware.write_output(None, f"do{index}", level)
+        self._event(kind, op.line, f"do{index} = {int(level)}", index=index, level=level)
+
+    def _finish(self, state: RunState, text: str) -> None:
+        self.state = state
+        self.t_end = self._ctl.time
+        self._event(state.value, self.current_line, text)
+        self._ctl.remove_cycle_hook(self._on_cycle)
+        if self.group is not None:
+            if state is not RunState.ABORTED:
+                self.group.close()
+            else:
+                self._closing = True
+                self._ctl.add_cycle_hook(self._close_when_idle)
+
+    def _close_when_idle(self, ctl: Controller, t: float) -> None:
+        from ..control.group import GroupState
+
+        g = self.group
+        if g is not None and g.state in (GroupState.IDLE, GroupState.ERROR):
+            g.close()
+            ctl.remove_cycle_hook(self._close_when_idle)
+
+    def _idle(self) -> bool:
+        from ..control.group import GroupState
+
+        g = self.group
+        assert g is not None
+        return g.state is GroupState.IDLE and g.queue_length == 0
+
+    def _on_cycle(self, ctl: Controller, t: float) -> None:
+        from ..control.group import GroupError, GroupState
+
+        g = self.group
+        assert g is not None
+        if g.state is GroupState.ERROR:
+            self.error = f"line {self.current_line}: {g.error_message}"
+            self._event("fault", self.current_line, g.error_message)
+            self._finish(RunState.ERROR, self.error)
+            return
+        self._fire_armed(g)
+        if self.state is not RunState.RUNNING:
+            return
+        try:
+            self._feed(g)
+        except (GroupError, MotionError) as err:
+            line = self._pass.ops[self._pass.pc].line if self._pass.pc < len(self._pass.ops) \
+                else self._last_line
+            g.abort()
+            self.error = f"line {line}: {err}"
+            self._event("fault", line, str(err))
+            self._finish(RunState.ERROR, self.error)
+
+    def _fire_armed(self, g: Group) -> None:
+        if not self._armed:
+            return
+        cur = g.current_index
+        while self._armed and (0 <= self._armed[0][0] <= cur
+                               or (cur < 0 and self._idle_past(self._armed[0][0]))):
+            _, op = self._armed.pop(0)
+            self._set_output(op, op.index, op.level, "sync_output")
+
+    def _idle_past(self, index: int) -> bool:
+        # the command already ran (a short move started and ended within one cycle)
+        return self.group is not None and self._idle() and index < self._pushed
+
+    def _feed(self, g: Group) -> None:  # noqa: C901 - one dispatch over the op kinds
+        p = self._pass
+        opts = self.options
+        while p.pc < len(p.ops) and g.queue_length < opts.window:
+            op = p.ops[p.pc]
+            if opts.single_block and self._step_line is not None and op.line != self._step_line:
+                if not self._idle():
+                    return
+                self.state = RunState.PAUSED
+                self._step_line = None
+                self._event("single_block", self._last_line, "block done")
+                return
+            if op.kind in ("line", "arc", "delay"):
+                idx = self._push(g, op)
+                self._line_of[idx] = op.line
+                if op.kind != "delay":
+                    for s in self._synced:
+                        self._armed.append((idx, s))
+                    self._synced.clear()
+            elif op.kind == "output":
+                if op.synced:
+                    self._synced.append(op)
+                else:
+                    self._set_output(op, op.index, op.level, "output")
+            elif op.kind == "action" and not op.barrier:
+                self._event("message", op.line, op.text)
+            else:  # barriers: blend, pause, end, spindle/coolant/tool
+                if not self._idle():
+                    return
+                if op.kind == "blend":
+                    if op.tolerance is None:
+                        g.disable_blend()
+                    else:
+                        g.enable_blend(op.tolerance)
+                elif op.kind == "action":
+                    for index, level in op.outputs:
+                        self._set_output(op, index, level, "output")
+                    self._event("action", op.line, op.text)
+                elif op.kind == "pause" and (not op.optional or opts.optional_stop):
+                    p.pc += 1
+                    self._last_line = op.line
+                    self.state = RunState.PAUSED
+                    self._event("program_pause", op.line, "M1" if op.optional else "M0")
+                    return
+                elif op.kind == "end":
+                    p.pc = len(p.ops)
+                    self._last_line = op.line
+                    break
+            p.pc += 1
+            self._last_line = op.line
+            if opts.single_block:
+                self._step_line = op.line
+        if p.pc >= len(p.ops) and self._idle() and not self._armed:
+            self._end_of_pass()
+
+    def _push(self, g: Group, op: Op) -> int:
+        self._pushed = getattr(self, "_pushed", 0) + 1
+        if op.kind == "delay":
+            return g.delay(op.seconds)
+        g.set_feed(op.feed)
+        assert op.target is not None
+        if op.kind == "line":
+            return g.line(op.target)
+        assert op.centre is not None
+        return g.arc(op.centre, op.target, plane=op.plane, direction=op.direction,
+                     turns=op.turns)
+
+    def _end_of_pass(self) -> None:
+        for op in self._synced:  # M62/M63 with no motion after them
+            self._set_output(op, op.index, op.level, "sync_output")
+        self._synced.clear()
+        self.passes_done += 1
+        if self.passes_done >= self.options.repeat:
+            self._finish(RunState.DONE, f"{self.passes_done} pass(es) done")
+            return
+        self._event("repeat", self._last_line, f"pass {self.passes_done + 1}")
+        pos = self._positions()
+        if np.array_equal(pos, self._pass.start):
+            self._pass.pc = 0
+        else:  # a program that does not return to its start: re-plan from here
+            try:
+                self._pass = self._compile(pos)
+            except (GCodeError, MotionError) as err:
+                self.error = str(err)
+                self._event("fault", 0, str(err))
+                self._finish(RunState.ERROR, self.error)
+
+
+def run_program(ctl: Controller, program: str | os.PathLike[str] | Sequence[canon.Command], *,
+                timeout: float = 3600.0, **kw: object) -> ProgramRunner:
+    """Compile, start and run a program to its end in virtual time; returns the runner."""
+    run = ProgramRunner(ctl, program, **kw)  # type: ignore[arg-type]
+    run.start()
+    run.wait(timeout)
+    return run
