@@ -5,6 +5,8 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from openmotion.compat.hctl1100_step import oscillation
 from openmotion.config import (
@@ -271,3 +273,17 @@ def test_servo_tuning_example_writes_a_plot(tmp_path):
     assert out.stat().st_size > 10_000
     t, x = mod["step_response"](0xD8, 0x00, 0x10, duration=0.05)
     assert abs(x[-1] - mod["STEP"]) <= 1
+
+
+@settings(max_examples=8, deadline=None)
+@given(dist=st.integers(-6000, 6000).filter(lambda d: abs(d) >= 10),
+       vmax=st.floats(2000.0, 60000.0), tacc=st.floats(0.02, 0.1))
+def test_tuned_loop_ends_within_two_counts_of_any_feasible_move(dist, vmax, tacc):
+    ctl, x, lp = controller()
+    x.enable()
+    x.move_relative(dist, max_vel=vmax, tacc=tacc)
+    assert ctl.wait_motion_done(timeout=5.0)
+    ctl.advance(0.15)
+    assert x.state is AxisState.STANDSTILL
+    assert abs(x.counters.feedback - dist) <= 2
+    assert lp.peak_error < 40
