@@ -543,9 +543,8 @@ class Axis:
             if self._state is S.ERROR_STOP:
                 pass  # a fault's decelerating stop ended: the axis stays in ErrorStop
             else:
-                held = m.kind != "stop"
-                self._waiting_inp = held and self._inp_enabled
-                self._gated = held and bool(self.done_gates)
+                self._waiting_inp = m.kind != "stop" and self._inp_enabled
+                self._gated = bool(self.done_gates)  # also after a stop: corrections settle
                 if not (self._waiting_inp or self._gated):
                     self._settle()
         if self._waiting_inp and self._ctl.input_active(self.index, "inp"):
