@@ -154,6 +154,9 @@ class Safety:
         self._erc_off: list[float | None] = [None] * n
         self._erc_after_stop = [False] * n
         self._edge_time: float | None = None
+        # logical EL levels, kept from the edges (no hardware read per cycle)
+        self._el = [{s: controller.input_active(i, s) for s in ("pel", "mel")}
+                    for i in range(n)]
         #: every fault stop, oldest first
         self.stops: list[StopRecord] = []
         self.soft = SoftLimits(controller, self._is_suspended)
@@ -318,6 +321,8 @@ class Safety:
         sig = e.signal
         active = e.level != (ax.config.signal_logic(sig) == "nc") if sig in (
             "pel", "mel", "sd") else False
+        if sig in ("pel", "mel"):
+            self._el[e.axis][sig] = active
         if not active:
             return
         c = self._cfg[e.axis]
@@ -383,7 +388,7 @@ class Safety:
         if v == 0.0:
             return
         for sig, sgn in (("pel", 1), ("mel", -1)):
-            if sig in c.suspended or not self.ctl.input_active(ax.index, sig):
+            if sig in c.suspended or not self._el[ax.index][sig]:
                 continue
             if v * sgn > 0.0 or not c.el_direction_sensitive:
                 self._fault(ax, LIMIT_REASONS[sig], c.el_decelerate, self.ctl.time)

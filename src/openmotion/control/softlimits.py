@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import MotionError, check_finite
+from ..profile.velocity import stop_distance
 from . import planning
 from .states import AxisState
 
@@ -103,6 +104,7 @@ class SoftLimits:
         self._lim = [SoftLimit() for _ in controller.axes]
         self._suspended = suspended
         self._safe: dict[int, tuple[int, float, float]] = {}  # axis -> (id, lo, hi) cache
+        self._memo: dict[int, tuple] = {}  # motion id -> (spec, v, a, stop distance)
 
     def set(self, axis: int | str, plimit: float, nlimit: float) -> None:
         """HSL_M_set_soft_limit(PLimit, NLimit), command-counter positions, nlimit < plimit."""
@@ -193,6 +195,28 @@ class SoftLimits:
             raise MotionError(f"axis {ax.name}: too close to the {name} soft limit {value!r} "
                               "to start this motion")
 
+    def _fast_extent(self, m: ActiveMotion, now: float, t: float,
+                     decel: bool) -> tuple[float, float] | None:
+        """`_stop_extent` for a velocity-mode plan that keeps its direction over [now, t]
+        (monotone there, so its ends bound it), with the stop distance computed alone;
+        None when that shortcut does not apply."""
+        p0, v0, _ = m.state(now)
+        p1, v1, a1 = m.state(t)
+        if v0 * v1 < 0.0 or m.spec is None:
+            return None
+        lo, hi = min(p0, p1), max(p0, p1)
+        if decel and v1 != 0.0:
+            # constant speed: the same stop every cycle (the memo holds the spec itself)
+            memo = self._memo.get(id(m))
+            if memo is None or memo[0] is not m.spec or memo[1:3] != (v1, a1):
+                if len(self._memo) > 64:
+                    self._memo.clear()
+                memo = (m.spec, v1, a1, stop_distance(m.spec, v1, a1))
+                self._memo[id(m)] = memo
+            e = p1 + math.copysign(memo[3], v1)
+            lo, hi = min(lo, e), max(hi, e)
+        return lo, hi
+
     def on_cycle(self, t: float) -> None:
         """The per-cycle prediction (see the module docstring)."""
         T = self.ctl.period
@@ -205,22 +229,29 @@ class SoftLimits:
                 continue
             i = ax.index
             here = m.state(t)[0]
-            key = id(m)
-            cached = self._safe.get(i)
-            if cached is not None and cached[0] == key and cached[1:] == lim:
-                continue
-            lo, hi = profile_extent(m.profile, t - m.t_start, math.inf)
-            side = self._over(lo, hi, lim, here)
-            if side == 0:
-                self._safe[i] = (key, *lim)
-                continue
-            reason = "+SL" if side > 0 else "-SL"
             decel = self._lim[i].decelerate and m.kind != "stop"
-            a, b = self._stop_extent(m, t, t + T, decel)
-            if not self._over(min(a, here), max(b, here), lim, here):
-                continue
+            if m.kind == "velocity":  # open-ended: checked every cycle, cheaply
+                ext = self._fast_extent(m, t, t + T, decel) or \
+                    self._stop_extent(m, t, t + T, decel)
+                side = self._over(min(ext[0], here), max(ext[1], here), lim, here)
+                if side == 0:
+                    continue
+            else:
+                key = id(m)
+                cached = self._safe.get(i)
+                if cached is not None and cached[0] == key and cached[1:] == lim:
+                    continue
+                lo, hi = profile_extent(m.profile, t - m.t_start, math.inf)
+                side = self._over(lo, hi, lim, here)
+                if side == 0:
+                    self._safe[i] = (key, *lim)
+                    continue
+                a, b = self._stop_extent(m, t, t + T, decel)
+                if not self._over(min(a, here), max(b, here), lim, here):
+                    continue
+            reason = "+SL" if side > 0 else "-SL"
             if decel:
-                a, b = self._stop_extent(m, t, t, True)
+                a, b = self._fast_extent(m, t, t, True) or self._stop_extent(m, t, t, True)
                 if not self._over(min(a, here), max(b, here), lim, here):
                     ax.fault_stop(reason, decelerate=True)
                     continue
