@@ -168,3 +168,21 @@ def test_sharp_zigzag_is_never_slower_than_exact_stop():
     assert t_blend <= t_exact + 1e-9
     for s in (sx, sy):
         assert np.abs(s.a).max() <= AMAX * (1 + 1e-9)
+
+
+def test_contour_error_of_a_recorded_arc_run():
+    ctl, g = make(None)
+    g.line([20_000, 10_000])
+    g.arc([20_000, 15_000], [20_000, 20_000], direction="CCW")
+    t0 = ctl.time
+    ctl.step()
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
+        a.is_moving for a in g.axes), 10)
+    t = np.linspace(t0, ctl.time, 5001)
+    xy = np.stack([ctl.history.sample(a.index, t).p for a in g.axes], axis=1)
+    els = [Line([0, 0], [20_000, 10_000]),
+           Arc([20_000, 10_000], [20_000, 15_000], [20_000, 20_000])]
+    err = px.contour_error(xy, els)
+    assert err.max() < 1e-3  # the planned motion: far inside the half-pulse bound
+    off = px.contour_error(xy + np.array([0.0, 3.0]), els[:1])
+    assert off.max() >= 2.0  # it does measure something
