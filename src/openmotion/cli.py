@@ -110,6 +110,12 @@ def cmd_config(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_run(args: argparse.Namespace) -> int:
+    from .program.runjob import run_job
+
+    return run_job(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="openmotion", description=__doc__)
     sub = ap.add_subparsers(dest="command", required=True)
@@ -121,12 +127,20 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--seconds", type=float, default=2.0, help="length of the real-time run")
     c = sub.add_parser("config", help="validate a machine file and print the resolved machine")
     c.add_argument("file", nargs="?", help="TOML machine file (default: the XYZU table)")
+    r = sub.add_parser("run", help="run a G-code program or point table on the simulated "
+                       "machine, print a summary and write an HTML report")
+    r.add_argument("program", help="G-code file (.ngc, .nc, ...) or point table (.toml, .csv)")
+    r.add_argument("--machine", help="TOML machine file (default: the XYZU table)")
+    r.add_argument("--realtime", action="store_true", help="pace the run to the wall clock")
+    r.add_argument("--repeat", type=int, default=1, help="run the program N times")
+    r.add_argument("--out", default="out", help="folder for the report")
     return ap
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"profile": cmd_profile, "demo": cmd_demo, "config": cmd_config}[args.command]
+    handler = {"profile": cmd_profile, "demo": cmd_demo, "config": cmd_config,
+               "run": cmd_run}[args.command]
     try:
         return handler(args)
     except (MotionError, OSError) as exc:

@@ -39,7 +39,6 @@ from . import canon
 from .options import MM_PER_INCH, ROTARY_LETTERS
 from .source import GCodeError
 
-
 #: Blend tolerance (pulses) standing for G64 without P.
 UNBOUNDED_BLEND = 1e12
 
@@ -122,7 +121,7 @@ class ConvertOptions:
 
 
 def _fail(cmd: canon.Command, msg: str) -> GCodeError:
-    return GCodeError(f"line {cmd.line}: {msg}", file=cmd.file)
+    return GCodeError(msg, line=cmd.line, file=cmd.file)
 
 
 def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,

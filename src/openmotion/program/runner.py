@@ -27,6 +27,7 @@ commands). Semantics:
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -126,6 +127,21 @@ def machine_axes(ctl: Controller, axes: Mapping[str, int | str] | None = None) -
     return out
 
 
+def travel_limits(ctl: Controller, index: int) -> tuple[float, float] | None:
+    """Travel of a controller axis in its user units between its MEL and PEL switch edges
+    (None when it has neither); an open side is infinite."""
+    cfg = ctl.config.axes[index]
+    if cfg.mel is None and cfg.pel is None:
+        return None
+    u = AxisUnits.from_axis(cfg)
+    ends = [u.to_units(float(sw.position)) for sw in (cfg.mel, cfg.pel) if sw is not None]
+    lo = min(ends) if cfg.mel is not None else -math.inf
+    hi = max(ends) if cfg.pel is not None else math.inf
+    if cfg.mel is not None and cfg.pel is not None:
+        lo, hi = min(ends), max(ends)
+    return (lo, hi)
+
+
 @dataclass
 class _Pass:
     ops: list[Op]
@@ -162,6 +178,14 @@ class ProgramRunner:
             if bad in self._gextra:
                 raise MotionError(f"gcode must not set {bad!r} (the runner sets it)")
         self._gextra.setdefault("n_outputs", ctl.config.digital_outputs)
+        if "soft_limits" not in self._gextra:  # moves past the EL switches fail to compile
+            lims = []
+            for k, i in zip(self.letters, self.axis_indices, strict=True):
+                t = travel_limits(ctl, i)
+                f = abs(self.scales.ppu[self.letters.index(k)]) / units[
+                    self.letters.index(k)].pulses_per_unit
+                lims.append(None if t is None else (t[0] / f, t[1] / f))
+            self._gextra["soft_limits"] = lims
         self.file = file
         self._text: str | None = None
         self._commands: list[canon.Command] | None = None
@@ -185,11 +209,17 @@ class ProgramRunner:
         self.group: Group | None = None
         self.error: str = ""
         self._line_of: dict[int, int] = {}
+        self.op_of: dict[int, Op] = {}
+        self.starts_of: dict[int, np.ndarray] = {}   # start point (pulses) of each move
+        self._cursor = self._pass.start
         self._synced: list[Op] = []
         self._armed: list[tuple[int, Op]] = []   # (command index, output op)
         self._last_line = 0
         self._step_line: int | None = None
         self.t_start = self.t_end = 0.0
+        self._trace_t: list[float] = []
+        self._trace_i: list[int] = []
+        self._trace_p: list[list[float]] = []
 
     # ------------------------------------------------------------------ compile
     def _positions(self) -> np.ndarray:
@@ -225,6 +255,7 @@ class ProgramRunner:
         pos = self._positions()
         if not np.array_equal(pos, self._pass.start):
             self._pass = self._compile(pos)  # the axes moved since compiling
+        self._cursor = self._pass.start
         self.group = Group(self._ctl, self.axis_indices, queue_size=self.options.window,
                            acc_time=self.options.acc_time)
         self.group.set_axis_limit_policy("slow")
@@ -290,6 +321,18 @@ class ProgramRunner:
         n = len(self._pass.ops)
         return 1.0 if n == 0 else self._pass.pc / n
 
+    def trace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per cycle of the run: times (s), command index executing (-1: none), and the
+        group axes' positions in machine units (rows = cycles)."""
+        t = np.array(self._trace_t, dtype=float)
+        idx = np.array(self._trace_i, dtype=int)
+        p = np.array(self._trace_p, dtype=float).reshape(len(t), len(self.letters))
+        return t, idx, p / self.scales.ppu
+
+    def line_of(self, index: int) -> int:
+        """Source line of a group command index (0 if unknown)."""
+        return self._line_of.get(index, 0)
+
     # ------------------------------------------------------------------ execution
     def _hold(self) -> None:
         from ..control.group import GroupState
@@ -343,6 +386,9 @@ class ProgramRunner:
             self._event("fault", self.current_line, g.error_message)
             self._finish(RunState.ERROR, self.error)
             return
+        self._trace_t.append(t)
+        self._trace_i.append(g.current_index)
+        self._trace_p.append([ax.position for ax in g.axes])
         self._fire_armed(g)
         if self.state is not RunState.RUNNING:
             return
@@ -384,6 +430,10 @@ class ProgramRunner:
             if op.kind in ("line", "arc", "delay"):
                 idx = self._push(g, op)
                 self._line_of[idx] = op.line
+                self.op_of[idx] = op
+                if op.target is not None:
+                    self.starts_of[idx] = self._cursor
+                    self._cursor = op.target
                 if op.kind != "delay":
                     for s in self._synced:
                         self._armed.append((idx, s))
@@ -446,6 +496,7 @@ class ProgramRunner:
             return
         self._event("repeat", self._last_line, f"pass {self.passes_done + 1}")
         pos = self._positions()
+        self._cursor = pos
         if np.array_equal(pos, self._pass.start):
             self._pass.pc = 0
         else:  # a program that does not return to its start: re-plan from here
