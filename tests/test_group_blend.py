@@ -186,3 +186,23 @@ def test_contour_error_of_a_recorded_arc_run():
     assert err.max() < 1e-3  # the planned motion: far inside the half-pulse bound
     off = px.contour_error(xy + np.array([0.0, 3.0]), els[:1])
     assert off.max() >= 2.0  # it does measure something
+
+
+def test_integer_pulse_counts_follow_the_arc():
+    ctl, g = make(None)
+    g.arc([5000, 0], [10_000, 0], direction="CCW")
+    rows = []
+    ctl.add_cycle_hook(lambda c, t: rows.append(
+        [c.hardware.read_axis(k).pulses_out for k in (0, 1)]
+        + [c.axes[0].position, c.axes[1].position]))
+    ctl.step()
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
+        a.is_moving for a in g.axes), 10)
+    r = np.array(rows, dtype=float)
+    # the simulated pulse generator emits a pulse when the position crosses an integer, so
+    # a count lags the planned position by less than one pulse (a rounding generator would
+    # halve this); the planned positions themselves are on the circle
+    assert np.abs(r[:, :2] - r[:, 2:]).max() < 1.0
+    arc = Arc([0, 0], [5000, 0], [10_000, 0])
+    assert px.contour_error(r[:, 2:], [arc]).max() < 1e-6
+    assert px.contour_error(r[:, :2], [arc]).max() < 1.0
