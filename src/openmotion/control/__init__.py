@@ -7,10 +7,12 @@ from .controller import Controller
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
 from .motion import ActiveMotion
 from .servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
+from .servoloop import ServoLoop
 from .states import AxisState, MotionDone
 
 __all__ = [
     "COUNTER_MAX", "COUNTER_MIN", "ActiveMotion", "Axis", "AxisState", "Controller",
     "Counters", "CycleStats", "MotionDone", "wrap28",
     "PIDFF", "Compensator", "FollowingErrorMonitor", "FollowingErrorResult", "LeadFilter",
+    "ServoLoop",
 ]
