@@ -335,14 +335,15 @@ def _accels(chain: px.Chain, lim: px.Limits) -> list[float]:
 
 
 def _blend_pays(b: Any, accel: float, feed: float) -> bool:
-    """Whether rounding a corner is faster than stopping exactly at it.
+    """Whether rounding a corner is faster than stopping exactly at it (an estimate).
 
     The blend arc (radius R = 1/kappa, sweep phi = L/R) starts d = R*tan(phi/2) before the
-    corner and is crossed at most at v_c = sqrt(a_n*R), a_n = sqrt(3)/2*A (the look-ahead's
-    split of A on arcs). Near the corner the exact stop runs at sqrt(2*A*x) at distance x
-    from it; the blended path at sqrt(v_c**2 + 2*A*(x - d)) on the lines. Unless
-    v_c**2 >= 2*A*d (both capped by the feed) the blended path is slower at every point
-    of the lines next to the corner, so a sharp corner with a tiny blend arc stops instead.
+    corner and is crossed at v_c = min(F, sqrt(a_n*R)), a_n = sqrt(3)/2*A (the look-ahead's
+    split of A on arcs). On each side, over the distance D from the corner in which the
+    exact stop accelerates to the feed (or the shorter line ends), the exact stop takes
+    time(D from rest) and the blend time(D - d from v_c); the blend pays when
+    L/v_c + 2*time(D - d, v_c) < 2*time(D, 0). A sharp corner with a small tolerance gets an
+    arc so tight that it would crawl: it stops exactly instead.
     """
     length = float(b.arc.length)
     kappa = float(b.arc.max_curvature)
@@ -350,5 +351,14 @@ def _blend_pays(b: Any, accel: float, feed: float) -> bool:
         return True
     radius = 1.0 / kappa
     d = radius * math.tan(0.5 * length / radius)
-    v_c2 = min(feed * feed, math.sqrt(0.75) * accel * radius)
-    return v_c2 >= min(feed * feed, 2.0 * accel * d)
+    v_c = min(feed, math.sqrt(math.sqrt(0.75) * accel * radius))
+    reach = min(float(b.first.length), float(b.second.length)) + d
+    span = min(d + feed * feed / (2.0 * accel), reach)
+
+    def time(dist: float, v0: float) -> float:
+        d_acc = (feed * feed - v0 * v0) / (2.0 * accel)
+        if dist <= d_acc:
+            return (math.sqrt(v0 * v0 + 2.0 * accel * dist) - v0) / accel
+        return (feed - v0) / accel + (dist - d_acc) / feed
+
+    return length / v_c + 2.0 * time(max(0.0, span - d), v_c) < 2.0 * time(span, 0.0)
