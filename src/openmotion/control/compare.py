@@ -43,6 +43,8 @@ from .compare_math import (
     first_crossing,
     first_inside,
     history_track,
+    positions,
+    track_range,
 )
 
 if TYPE_CHECKING:
@@ -279,8 +281,10 @@ class LevelJob(CompareJob):
             if isinstance(src, VectorSource):
                 tf = eng.vector_cycle(src).time_of(lvl, ta)
                 times = [tf] if tf is not None else []
-            else:
+            elif eng.reachable(src, lvl):
                 times = crossings_after(eng.track(src), lvl, ta, t1, self.direction).tolist()
+            else:
+                times = []
             return [(float(t), 0, lvl) for t in times]
         hits = []
         t = ta
@@ -288,8 +292,10 @@ class LevelJob(CompareJob):
             lvl = self.level(self.index)
             if isinstance(src, VectorSource):
                 tf = eng.vector_cycle(src).time_of(lvl, t)
-            else:
+            elif eng.reachable(src, lvl):
                 tf = first_crossing(eng.track(src), lvl, t, t1, self.direction)
+            else:
+                tf = None
             if tf is None:
                 break
             hits.append((tf, self.index, lvl))
@@ -329,17 +335,34 @@ class WindowJob(CompareJob):
         ta = max(ta, self.t_armed)
         if ta > t1:
             return []
-        tracks = [eng.track(AxisSource(a, self.kind)) for a in self.axes]
+        srcs = [AxisSource(a, self.kind) for a in self.axes]
+        tracks = [eng.track(s) for s in srcs]
+        ranges = [eng.track_range(s) for s in srcs]
         hits = []
         t = ta
         while self.index < self.size:
-            tf = first_inside(tracks, self.points[self.index], self.maxerr, t, t1)
+            tf = first_inside(tracks, self.points[self.index], self.maxerr, t, t1, ranges)
             if tf is None:
                 break
             hits.append((tf, self.index, float(self.index)))
             self.index += 1
             t = tf
         return hits
+
+
+def every_distance(source: VectorSource, interval: float, action: Action, *,
+                   start: float | None = None, end: float | None = None) -> LevelJob:
+    """Fire every `interval` of path length, from `start` (default `interval`) up to `end`
+    (default endless): the enable window [start, end] is in the source's VECTOR_MOVED."""
+    iv = check_positive("interval", interval)
+    s = iv if start is None else check_finite("start", start)
+    count = None
+    if end is not None:
+        e = check_finite("end", end)
+        if e < s:
+            raise MotionError(f"end must be >= start, got start={s!r}, end={end!r}")
+        count = int(math.floor((e - s) / iv * (1 + 1e-12))) + 1
+    return LevelJob(source, LevelSeq(s, iv, count), action, direction=1, name="distance")
 
 
 # ---------------------------------------------------------------------------- engine
@@ -371,6 +394,7 @@ class CompareEngine:
         self._mpos_err: dict[int, float] = {}
         self._t_last = controller.time
         self._tracks: dict[AxisSource, Track] = {}
+        self._ranges = {}
         self._vcycles: dict[VectorSource, VectorCycle] = {}
         self._mpos_e1: dict[int, float] = {}
         self._win = (self._t_last, self._t_last)
@@ -508,6 +532,19 @@ class CompareEngine:
             self._tracks[src] = tr
         return tr
 
+    def track_range(self, src: AxisSource) -> tuple[float, float]:
+        """(min, max) of the source over this cycle (cached per cycle)."""
+        r = self._ranges.get(src)
+        if r is None:
+            r = self._ranges[src] = track_range(self.track(src), *self._win)
+        return r
+
+    def reachable(self, src: AxisSource, level: float) -> bool:
+        """Can the source touch `level` in this cycle? (skips the exact solver if not)"""
+        lo, hi = self.track_range(src)
+        slack = 1e-9 * (abs(level) + 1.0)
+        return lo - slack <= level <= hi + slack
+
     def vector_cycle(self, src: VectorSource) -> VectorCycle:
         vc = self._vcycles.get(src)
         if vc is None:
@@ -525,6 +562,7 @@ class CompareEngine:
             return
         self._win = (ta, t1)
         self._tracks = {}
+        self._ranges: dict[AxisSource, tuple[float, float]] = {}
         self._vcycles = {}
         self._mpos_e1 = {a: self._mpos_error(a) for a in self._mpos_err}
         rows: list[tuple[float, int, int, float, int, int]] = []
@@ -544,9 +582,8 @@ class CompareEngine:
         if rows:
             rows.sort(key=lambda r: r[0])
             times = np.array([r[0] for r in rows])
-            pos = np.column_stack([
-                ctl.history.sample(a, times).p + self._cmd_offset(a)
-                for a in range(len(ctl.axes))])
+            pos = np.column_stack([positions(self.track(AxisSource(a)), times)
+                                   for a in range(len(ctl.axes))])
             self.log.add(rows, pos)
         hw = ctl.hardware
         for line in self._lines.values():

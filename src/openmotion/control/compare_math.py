@@ -30,6 +30,7 @@ _QUAD_RTOL = 1e-13
 _QUAD_DEPTH = 10
 _SNAP_RTOL = 1e-10  # distances this close count as reached
 _EPS = float(np.finfo(np.float64).eps)
+_GL_PAIRS = list(zip(_GL_X.tolist(), _GL_W.tolist(), strict=True))
 
 
 class Track(NamedTuple):
@@ -101,11 +102,18 @@ def first_crossing(tr: Track, level: float, t: float, t1: float,
 # ends are the window start or a crossing of c - e or c + e. So the first time all axes are
 # inside is one of these candidates: test them in time order with the evaluated positions.
 def first_inside(tracks: list[Track], centre: Array, maxerr: float, t: float,
-                 t1: float) -> float | None:
-    """The first time in [t, t1] every track is within +-maxerr of its centre, or None."""
+                 t1: float, ranges: list[tuple[float, float]] | None = None) -> float | None:
+    """The first time in [t, t1] every track is within +-maxerr of its centre, or None.
+    `ranges`: each track's (min, max) over the window, to skip hopeless solver calls."""
     cands = [np.array([t])]
-    for tr, c in zip(tracks, centre, strict=True):
+    for k, (tr, c) in enumerate(zip(tracks, centre, strict=True)):
+        lo_k, hi_k = ranges[k] if ranges is not None else (-math.inf, math.inf)
+        slack = 1e-9 * (abs(c) + maxerr + 1.0)
+        if c + maxerr < lo_k - slack or c - maxerr > hi_k + slack:
+            return None  # this axis never gets near its coordinate in the window
         for lvl in (c - maxerr, c + maxerr):
+            if not lo_k - slack <= lvl <= hi_k + slack:
+                continue
             times, _ = _find_crossings(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, float(lvl), t, t1)
             cands.append(times)
     cand = np.unique(np.concatenate(cands))
@@ -119,13 +127,34 @@ def first_inside(tracks: list[Track], centre: Array, maxerr: float, t: float,
     return float(cand[idx[0]]) if idx.size else None
 
 
+def track_range(tr: Track, ta: float, t1: float) -> tuple[float, float]:
+    """(min, max) of the track's position over [ta, t1]: a cheap test that a level cannot
+    be reached in this window, so the exact solver is skipped."""
+    lo, hi = math.inf, -math.inf
+    n = tr.ts.size
+    for k in range(n):
+        a_k = float(tr.ts[k])
+        b_k = float(tr.ts[k + 1]) if k + 1 < n else math.inf
+        u, w = max(a_k, ta), min(b_k, t1)
+        if w < u:
+            continue
+        p, v, a, j = float(tr.p0[k]), float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])
+        xs = [u - a_k, w - a_k] + [r for r in _vel_roots(v, a, j) if u - a_k < r < w - a_k]
+        for x in xs:
+            y = p + x * (v + x * (a / 2.0 + x * j / 6.0))
+            lo, hi = min(lo, y), max(hi, y)
+    return lo, hi
+
+
 # ---------------------------------------------------------------------------- vector distance
 # s(t) = integral of |W v(t)| dt with W = diag(weights). Each axis's velocity is a quadratic
 # per record, so we cut the cycle at every record start and every root of every axis's
-# velocity. On each piece the speed is smooth (it only has a kink where all velocities vanish
-# together, and those instants are piece ends), and for a single axis or a straight line it
-# is a polynomial of degree <= 2, which 8-point Gauss-Legendre integrates exactly. Otherwise
-# (curves) the piece is halved adaptively until two levels agree to 1e-13 relative.
+# velocity. On a piece, with x = t - u, speed^2 = Q(x) = sum_i (c0 + c1 x + c2 x^2)^2 is a
+# quartic whose coefficients we form once; the speed sqrt(Q) is smooth inside the piece (a
+# kink needs all velocities to vanish together, and those instants are piece ends). For a
+# single axis or a straight line sqrt(Q) is a polynomial of degree <= 2, which 8-point
+# Gauss-Legendre integrates exactly; otherwise (curves) the piece is halved adaptively until
+# two levels agree to 1e-13 relative. s(t) = d is solved by safeguarded Newton (s' = speed).
 def _vel_roots(v: float, a: float, j: float) -> tuple[float, ...]:
     h = 0.5 * j
     if h == 0.0:
@@ -142,59 +171,82 @@ class VectorCycle:
 
     def __init__(self, tracks: list[Track], weights: Array, ta: float, t1: float,
                  s0: float) -> None:
-        self.tracks = tracks
-        self.w = np.asarray(weights, dtype=np.float64)
+        w = np.asarray(weights, dtype=np.float64)
         bps = {ta, t1}
         for tr in tracks:
             n = tr.ts.size
             for k in range(n):
                 a_k = float(tr.ts[k])
                 b_k = float(tr.ts[k + 1]) if k + 1 < n else math.inf
-                if b_k <= ta or a_k >= t1:
-                    if ta < a_k < t1:
-                        bps.add(a_k)
-                    continue
-                if ta < a_k:
+                if ta < a_k < t1:
                     bps.add(a_k)
+                if b_k <= ta or a_k >= t1:
+                    continue
                 for r in _vel_roots(float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])):
                     tr_ = a_k + r
                     if ta < tr_ < t1 and tr_ < b_k:
                         bps.add(tr_)
-        self.B = np.array(sorted(bps))
-        pieces = [self.integral(float(u), float(w))
-                  for u, w in zip(self.B[:-1], self.B[1:], strict=True)]
-        self.S = s0 + np.concatenate([[0.0], np.cumsum(pieces)])
+        self.B = B = np.array(sorted(bps))
+        u = B[:-1]
+        mid = 0.5 * (B[:-1] + B[1:])
+        Q = np.zeros((u.size, 5))
+        for tr, wk in zip(tracks, w, strict=True):
+            k = np.maximum(np.searchsorted(tr.ts, mid, side="right") - 1, 0)
+            d0 = u - tr.ts[k]
+            j = tr.j[k]
+            c0 = wk * (tr.v0[k] + d0 * (tr.a0[k] + d0 * j / 2.0))
+            c1 = wk * (tr.a0[k] + d0 * j)
+            c2 = wk * (j / 2.0)
+            Q[:, 0] += c0 * c0
+            Q[:, 1] += 2.0 * c0 * c1
+            Q[:, 2] += c1 * c1 + 2.0 * c0 * c2
+            Q[:, 3] += 2.0 * c1 * c2
+            Q[:, 4] += c2 * c2
+        self.Q = Q
+        self._q = Q.tolist()
+        H = B[1:] - u
+        # all pieces at once with one and two GL panels; refine only those that disagree
+        x1 = (H[:, None] / 2.0) * (_GL_X[None, :] + 1.0)
+        one = (H / 2.0) * (self._sq_rows(x1) @ _GL_W)
+        xa = (H[:, None] / 4.0) * (_GL_X[None, :] + 1.0)
+        two = (H / 4.0) * ((self._sq_rows(xa) + self._sq_rows(xa + H[:, None] / 2.0)) @ _GL_W)
+        bad = np.abs(two - one) > _QUAD_RTOL * np.maximum(np.abs(two), 1e-300)
+        for i in np.flatnonzero(bad):
+            two[i] = self._adaptive(i, 0.0, float(H[i]), 0)
+        self.S = s0 + np.concatenate([[0.0], np.cumsum(two)])
+
+    def _sq_rows(self, x: Array) -> Array:
+        Q = self.Q
+        y = Q[:, 0:1] + x * (Q[:, 1:2] + x * (Q[:, 2:3] + x * (Q[:, 3:4] + x * Q[:, 4:5])))
+        return np.sqrt(np.maximum(y, 0.0))
+
+    def _gl(self, i: int, a: float, b: float) -> float:
+        # plain floats: ~10x cheaper than numpy on 8 nodes (this runs per Newton step)
+        q0, q1, q2, q3, q4 = self._q[i]
+        h = 0.5 * (b - a)
+        acc = 0.0
+        for xg, wg in _GL_PAIRS:
+            x = a + h * (xg + 1.0)
+            y = q0 + x * (q1 + x * (q2 + x * (q3 + x * q4)))
+            acc += wg * math.sqrt(y) if y > 0.0 else 0.0
+        return h * acc
+
+    def _adaptive(self, i: int, a: float, b: float, depth: int) -> float:
+        m = 0.5 * (a + b)
+        whole = self._gl(i, a, b)
+        halves = self._gl(i, a, m) + self._gl(i, m, b)
+        if abs(halves - whole) <= _QUAD_RTOL * max(abs(halves), 1e-300) or depth >= _QUAD_DEPTH:
+            return halves
+        return self._adaptive(i, a, m, depth + 1) + self._adaptive(i, m, b, depth + 1)
 
     @property
     def end(self) -> float:
         return float(self.S[-1])
 
-    def speed(self, t: Array) -> Array:
-        acc = np.zeros(np.shape(t))
-        for tr, w in zip(self.tracks, self.w, strict=True):
-            acc += (w * velocities(tr, t)) ** 2
-        return np.sqrt(acc)
-
-    def _gl(self, u: float, w: float) -> float:
-        h = 0.5 * (w - u)
-        x = u + h * (_GL_X + 1.0)
-        return float(h * np.dot(_GL_W, self.speed(x)))
-
-    def integral(self, u: float, w: float, depth: int = 0) -> float:
-        """Integral of the speed over [u, w] (inside one smooth piece)."""
-        if w <= u:
-            return 0.0
-        whole = self._gl(u, w)
-        m = 0.5 * (u + w)
-        halves = self._gl(u, m) + self._gl(m, w)
-        if abs(halves - whole) <= _QUAD_RTOL * max(abs(halves), 1e-300) or depth >= _QUAD_DEPTH:
-            return halves
-        return self.integral(u, m, depth + 1) + self.integral(m, w, depth + 1)
-
     def at(self, t: float) -> float:
         """s(t) for t in the window."""
         i = min(max(int(np.searchsorted(self.B, t, side="right")) - 1, 0), self.B.size - 2)
-        return float(self.S[i]) + self.integral(float(self.B[i]), t)
+        return float(self.S[i]) + self._gl(i, 0.0, t - float(self.B[i]))
 
     def time_of(self, d: float, after: float) -> float | None:
         """First time > `after` with s(t) >= d (s is non-decreasing), or None."""
@@ -203,29 +255,28 @@ class VectorCycle:
             if d - self.S[-1] > _SNAP_RTOL * max(abs(d), 1.0):
                 return None
             d = float(self.S[-1])
-        i = int(np.searchsorted(self.S, d, side="left"))  # S[i-1] < d <= S[i]
-        i = max(i, 1)
-        u, w = float(self.B[i - 1]), float(self.B[i])
-        su = float(self.S[i - 1])
-        lo, hi = max(u, after), w
-        if self.at(lo) >= d:  # already there (d reached at or before `after`)
-            return lo if lo > after else None
-        # safeguarded Newton on F(t) = s(t) - d, bracketed by [lo, hi]
-        t = lo + (hi - lo) * 0.5
-        for _ in range(200):
-            f = su + self.integral(u, t) - d
+        i = max(int(np.searchsorted(self.S, d, side="left")), 1) - 1  # S[i] < d <= S[i+1]
+        u = float(self.B[i])
+        lo, hi = max(after, u) - u, float(self.B[i + 1]) - u
+        su = float(self.S[i])
+        if su + self._gl(i, 0.0, lo) >= d:  # already there at `after`
+            return u + lo if u + lo > after else None
+        q0, q1, q2, q3, q4 = self._q[i]
+        x = 0.5 * (lo + hi)
+        for _ in range(100):
+            f = su + self._gl(i, 0.0, x) - d
             if f >= 0.0:
-                hi = t
+                hi = x
             else:
-                lo = t
-            tol = 4.0 * _EPS * max(abs(t), 1.0)
+                lo = x
+            tol = 4.0 * _EPS * max(abs(u + x), 1.0)
             if hi - lo <= tol:
-                return hi
-            sp = float(self.speed(np.array([t]))[0])
-            tn = t - f / sp if sp > 0.0 else math.nan
-            if not lo < tn < hi:
-                tn = 0.5 * (lo + hi)
-            if abs(tn - t) <= tol:
-                return tn
-            t = tn
-        return hi
+                return u + hi
+            sp = math.sqrt(max(q0 + x * (q1 + x * (q2 + x * (q3 + x * q4))), 0.0))
+            xn = x - f / sp if sp > 0.0 else math.nan
+            if abs(xn - x) <= tol:  # converged (also when the step rounds to nothing)
+                return u + max(xn, x) if f < 0.0 else u + x
+            if not lo < xn < hi:
+                xn = 0.5 * (lo + hi)
+            x = xn
+        return u + hi
