@@ -206,3 +206,41 @@ def test_integer_pulse_counts_follow_the_arc():
     arc = Arc([0, 0], [5000, 0], [10_000, 0])
     assert px.contour_error(r[:, 2:], [arc]).max() < 1e-6
     assert px.contour_error(r[:, :2], [arc]).max() < 1.0
+
+
+def test_commands_queued_while_running_join_the_look_ahead():
+    ctl, g = make(30.0)
+    t0 = ctl.time
+    pts = polygon(24, 20_000.0)
+    g.line(pts[0])
+    g.line(pts[1])
+    ctl.advance(0.05)
+    for p in pts[2:]:  # streamed while the first lines run: no stop at any junction
+        g.line(p)
+        ctl.advance(0.01)
+    assert g.queue_length == 0  # all joined the running chain
+    ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
+        a.is_moving for a in g.axes), 30)
+    assert g.position.tolist() == pts[-1].tolist()
+    t = np.linspace(t0, ctl.time, 20001)
+    sx, sy = (ctl.history.sample(a.index, t) for a in g.axes)
+    speed = np.hypot(sx.v, sy.v)
+    inner = (t > t0 + 0.3) & (t < ctl.time - 0.3)
+    assert speed[inner].min() > 1000.0  # never stopped on the polygon
+    verts = np.vstack([[0.0, 0.0], pts])
+    assert dist_to_polyline(np.stack([sx.p, sy.p], axis=1), verts).max() <= 30.0 * (1 + 1e-6)
+    for s in (sx, sy):
+        assert np.abs(s.a).max() <= AMAX * (1 + 1e-9)
+        assert np.abs(s.v).max() <= VMAX * (1 + 1e-9)
+
+
+def test_command_queued_while_braking_stops_exactly_at_the_corner():
+    ctl, g = make(30.0)
+    g.line([3000, 1000])
+    ctl.step()
+    ctl.run_until(lambda: g.axes[0].velocity < 2000 and g.axes[0].motion_done == 13, 5)
+    assert g.state is GroupState.MOVING
+    g.line([3000, 5000])  # too late to blend: the corner is an exact stop
+    ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
+        a.is_moving for a in g.axes), 10)
+    assert g.position.tolist() == [3000.0, 5000.0]

@@ -15,8 +15,9 @@ from __future__ import annotations
 import contextlib
 import math
 from collections import deque
-from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable, Mapping, Sequence
+from functools import wraps
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -55,6 +56,20 @@ __all__ = [
     "ERR_GROUP", "ERR_LIMIT", "ERR_QUEUE_FULL", "ERR_SPEED", "ERR_STATE", "Group", "GroupError",
     "GroupState",
 ]
+
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _locked(fn: F) -> F:
+    """Serialise a public call with the cycle loop (real-time mode runs it on a thread)."""
+
+    @wraps(fn)
+    def wrapper(self: Group, *args: Any, **kwargs: Any) -> Any:
+        with self._ctl._lock:
+            return fn(self, *args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
 
 
 class Group(GroupEngine):
@@ -171,6 +186,7 @@ class Group(GroupEngine):
     def dry_run(self) -> bool:
         return self._dry
 
+    @_locked
     def clear_error(self) -> None:
         """MCC_ClearError: leave the error state (axes in ErrorStop still need reset())."""
         self._error, self._error_msg = 0, ""
@@ -178,6 +194,7 @@ class Group(GroupEngine):
             self._state = GroupState.IDLE
             self._tail = None
 
+    @_locked
     def close(self) -> None:
         """Abort everything immediately and release the axes for other groups."""
         self._stop_axes()
@@ -259,6 +276,7 @@ class Group(GroupEngine):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
         self._ptp_ratio, self._ptp_shape = r, shape
 
+    @_locked
     def enable_dry_run(self, on: bool = True) -> None:
         """Plan and report positions without sending pulses (only while idle)."""
         if not isinstance(on, bool):
@@ -270,6 +288,7 @@ class Group(GroupEngine):
         self._tail = None
 
     # ------------------------------------------------------------------ commands
+    @_locked
     def ptp(self, target: Sequence[float], *, relative: bool = False) -> int:
         """Point-to-point: every axis to its target with its own T/S profile at the PtP
         speed ratio; the next command waits for all axes."""
@@ -284,6 +303,7 @@ class Group(GroupEngine):
                                   0.0, 0.0))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
 
+    @_locked
     def line(self, target: Sequence[float], *, relative: bool = False) -> int:
         """Linear interpolation to `target` (all logical axes) at the feed."""
         start = self._start_point()
@@ -293,6 +313,7 @@ class Group(GroupEngine):
             raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
         return self._push_path(el, p)
 
+    @_locked
     def arc(self, centre: Sequence[float], end: Sequence[float], *, plane: tuple[int, int] = (0, 1),
             direction: str = "CCW", relative: bool = False, turns: int = 0) -> int:
         """Circular arc in the plane of logical axes `plane` around `centre` (2 plane values)
@@ -308,6 +329,7 @@ class Group(GroupEngine):
             raise GroupError(code, str(err)) from None
         return self._push_path(el, np.array(el.end))
 
+    @_locked
     def circle(self, centre: Sequence[float], *, plane: tuple[int, int] = (0, 1),
                direction: str = "CCW", relative: bool = False) -> int:
         """Full circle around `centre` (MCC_CircleXY), back to the start."""
@@ -316,10 +338,12 @@ class Group(GroupEngine):
             if not relative else self.arc(np.asarray(centre, float) + start[list(plane)],
                                           start, plane=plane, direction=direction)
 
+    @_locked
     def helix(self, centre: Sequence[float], end: Sequence[float], **kw: Any) -> int:
         """An arc whose other axes move linearly to their `end` values (same as arc)."""
         return self.arc(centre, end, **kw)
 
+    @_locked
     def arc3d(self, via: Sequence[float], end: Sequence[float], *, relative: bool = False) -> int:
         """3-D arc through a reference point (MCC_ArcXYZ)."""
         start = self._start_point()
@@ -331,6 +355,7 @@ class Group(GroupEngine):
             raise GroupError(ERR_ARC, str(err)) from None
         return self._push_path(el, np.array(el.end))
 
+    @_locked
     def delay(self, seconds: float) -> int:
         """MCC_DelayMotion: wait `seconds` after the previous command ends."""
         t = check_finite("seconds", seconds)
@@ -342,6 +367,7 @@ class Group(GroupEngine):
         self._next_index = 0
 
     # ------------------------------------------------------------------ hold / continue / abort
+    @_locked
     def hold(self) -> None:
         """MCC_HoldMotion: decelerate along the path and stop; continue() resumes."""
         if self._state is not GroupState.MOVING or self._run is None:
@@ -359,6 +385,7 @@ class Group(GroupEngine):
                 a.stop()
         self._state = GroupState.HOLDING
 
+    @_locked
     def cont(self) -> None:
         """MCC_ContiMotion: resume the remaining motion of a held group."""
         if self._state is not GroupState.HELD or self._held is None:
@@ -377,6 +404,7 @@ class Group(GroupEngine):
             self._run = _Run("delay", r.cmds, t, t_until=t + r.t_until)
         self._state = GroupState.MOVING
 
+    @_locked
     def abort(self) -> None:
         """MCC_AbortMotion: stop along the path (or discard a hold) and empty the queue."""
         self._queue.clear()
@@ -395,6 +423,7 @@ class Group(GroupEngine):
         self._aborting = self._state is GroupState.HOLDING
         self._tail = None
 
+    @_locked
     def set_override(self, percent: float) -> None:
         """MCC_SetOverSpeed: feed override in % of the programmed feed (1 .. 200). A running
         path re-plans at once: it accelerates or decelerates to the new speed (figure 11)."""
@@ -411,6 +440,7 @@ class Group(GroupEngine):
                 self._override = old
                 raise
 
+    @_locked
     def set_ptp_override(self, percent: float) -> None:
         """MCC_SetPtPOverSpeed: change the speed of running point-to-point axes."""
         p = check_finite("percent", percent)
@@ -499,8 +529,9 @@ class Group(GroupEngine):
     def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
         self._check_accepting()
         cmd.index = self._next_index
+        if not self._extend_running(cmd):
+            self._queue.append(cmd)
         self._next_index += 1
-        self._queue.append(cmd)
         if end is not None:
             self._tail = end.copy()
         return cmd.index

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import MotionError
+from ..errors import InfeasibleError, MotionError
 from ..path import Line, blend_corner, plan_speeds
 from ..path.geometry import PathElement
 from ..profile.pcl import MoveSpec
@@ -232,6 +232,47 @@ class GroupEngine:
                 a.move_absolute(float(cmd.target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
                                 shape=spec.shape)
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=cmd.target)
+
+    def _extend_running(self, cmd: _Cmd) -> bool:
+        """Streaming look-ahead: join a path command queued while a chain runs (nothing
+        else waiting, same feed and acceleration) to that chain and re-plan from now. The
+        corner with the running chain is blended when the path has not yet reached the
+        blend's start; when the new plan cannot start at the current speed (the path is
+        already braking), the corner becomes an exact stop; failing that, the command
+        just waits in the queue."""
+        r = self._run
+        if (r is None or r.kind != "path" or self._state is not GroupState.MOVING
+                or self._queue or cmd.kind != "path" or r.chain is None or r.sprof is None
+                or cmd.feed != r.cmds[0].feed or cmd.accel != r.cmds[0].accel):
+            return False
+        t = self._ctl.time
+        u = t - r.t0
+        if u >= r.sprof.duration:
+            return False
+        st = r.sprof.state_at(u)
+        s0, v0 = st.p, max(0.0, st.v)
+        old, owners = list(r.chain.elements), list(r.chain.owners)
+        el = cmd.elements[0]
+        options = []
+        if self._blend and self._blend_tol > 0.0 and isinstance(old[-1], Line) \
+                and isinstance(el, Line):
+            b = blend_corner(old[-1], el, self._blend_tol)
+            if b is not None and _blend_pays(b, min(cmd.accel, float(np.min(self._amax))),
+                                             cmd.feed) \
+                    and s0 < float(r.chain.cum[-2]) + float(b.first.length):
+                options.append((old[:-1] + [b.first, b.arc, b.second],
+                                owners + [cmd.index, cmd.index]))
+        options.append((old + [el], owners + [cmd.index]))
+        lim = self._limits(cmd)
+        for els, own in options:
+            chain = px.Chain(els, own)
+            try:
+                curve = px.plan_curve(chain, s0, v0, lim)
+            except InfeasibleError:
+                continue
+            self._launch_path(chain, curve, [*r.cmds, cmd], lim, t)
+            return True
+        return False
 
     def _launch_path(self, chain: px.Chain, curve: px.SpeedCurve, cmds: list[_Cmd],
                      lim: px.Limits, t: float) -> None:
