@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig, SwitchConfig
 from openmotion.control import AxisState, Controller
 from openmotion.control.safety import IO_STATUS_BITS, Safety, io_status
 from openmotion.errors import MotionError
 from openmotion.profile.jerk import jerk_limited
+from openmotion.profile.pcl import MoveSpec
+from openmotion.profile.velocity import stop_distance
 
 S = AxisState
 PEL, MEL = 20_000.0, -20_000.0
@@ -378,3 +382,47 @@ def test_detach_removes_the_reactions() -> None:
     ax.move_relative(30_000.0, max_vel=50_000.0, tacc=0.05)
     assert ctl.wait_motion_done(["a"], 3.0) and ax.state is S.STANDSTILL
     Safety(ctl)  # may be attached again
+
+
+@settings(max_examples=15, deadline=None)
+@given(speed=st.floats(1e3, 3e5), tacc=st.floats(0.005, 0.2), shape=st.sampled_from("TS"),
+       strv=st.floats(0.0, 0.3), reach=st.floats(0.02, 0.3), decel=st.booleans())
+def test_limit_stop_residuals_over_speeds(speed, tacc, shape, strv, reach, decel) -> None:
+    """Immediate: at most one cycle of travel past the edge. Decelerating: the stop is
+    planned from the edge instant (it ends exactly one stopping distance after the edge
+    state) and the pulse output matches the plan within a pulse."""
+    ctl, safety = setup()
+    safety.set_el("a", "decel" if decel else "immediate")
+    where = 200.5 + speed * reach
+    ctl.hardware.scenario.place_switch(0, "pel", where, 1e7)
+    ax = ctl.axis("a")
+    ax.move_velocity(speed, str_vel=strv * speed, tacc=tacc, shape=shape)
+    assert ctl.run_until(lambda: ax.fault is not None, 5.0)
+    rec = safety.last_stop("a")
+    assert where <= rec.position <= where + 1.0  # a stepper reaches the switch on a pulse
+    ctl.run_until(lambda: ax.motion is None, 5.0)
+    ctl.step()
+    assert abs(ctl.hardware.command_position(0) - ax.position) < 1.0
+    if decel:
+        st0 = ctl.history.state_at(0, rec.time)
+        spec = MoveSpec(shape, strv * speed, speed, tacc, tacc, 0.0, 0.0)
+        assert ax.position == pytest.approx(st0.p + stop_distance(spec, st0.v, st0.a),
+                                            abs=1e-6)
+    else:
+        assert rec.position <= ax.position <= rec.position + speed * ctl.period + 1e-6
+
+
+def test_a_group_engine_stops_its_other_axes_through_the_fault_hook() -> None:
+    ctl, safety = setup()
+    a, s = ctl.axis("a"), ctl.axis("s")
+
+    def group_stop(ax, reason):  # what an interpolating group would do
+        if ax is a and s.motion is not None:
+            s.fault_stop(f"group: {reason}", decelerate=True)
+
+    safety.on_axis_fault(group_stop)
+    a.move_velocity(50_000.0, tacc=0.05)
+    s.move_velocity(20_000.0, tacc=0.05)
+    ctl.run_until(lambda: a.fault is not None, 3.0)
+    assert s.state is S.ERROR_STOP and s.fault == "group: +EL"
+    assert ctl.wait_motion_done(timeout=1.0)
