@@ -179,3 +179,20 @@ def test_refused_queued_command_drops_the_rest():
     ip.queue(lambda: ran.append(1))
     ctl.step()
     assert isinstance(ip.failure, MotionError) and ip.pending == 0 and ran == []
+
+
+def test_check_time_also_after_a_decelerating_stop():
+    ctl = _servo_machine(bandwidth_hz=1.0)
+    ip = InPositionControl(ctl)
+    ip.set_tolerance("x", 1)
+    ip.set_check_time("x", 0.1)
+    ip.enable(["x"])
+    ax = ctl.axis("x")
+    ax.move_velocity(40000, tacc=0.05)
+    ctl.advance(0.2)
+    ax.stop(0.05)
+    ctl.advance(0.05)
+    assert ax.motion is None and ax.motion_done == MotionDone.WAITING_INP
+    assert ax.state is AxisState.STOPPING
+    ctl.run_until(lambda: ip.error_code != NO_ERROR, 1.0)
+    assert ip.error_code == INPOS_TIMEOUT and ax.state is AxisState.ERROR_STOP

@@ -20,7 +20,7 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 from ..errors import MotionError, check_nonnegative, check_positive
-from .states import AxisState, MotionDone
+from .states import MotionDone
 
 if TYPE_CHECKING:
     from .axis import Axis
@@ -166,8 +166,8 @@ class InPositionControl:
             since = self._since[i]
             if since is None:
                 continue
-            if ax.state is not AxisState.DISCRETE_MOTION or ax.motion is not None:
-                self._since[i] = None  # no longer waiting (stopped, faulted, new move)
+            if ax.motion is not None or not ax.is_moving:
+                self._since[i] = None  # no longer held (released, faulted, new move)
             elif t - since >= self._check[i] - 1e-12:
                 self._since[i] = None
                 self._error, self._error_axis = INPOS_TIMEOUT, i
