@@ -244,3 +244,33 @@ def test_command_queued_while_braking_stops_exactly_at_the_corner():
     ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
         a.is_moving for a in g.axes), 10)
     assert g.position.tolist() == [3000.0, 5000.0]
+
+
+@settings(max_examples=10, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.02, 0.6), st.floats(5.0, 200.0)), min_size=1,
+                max_size=3), st.booleans())
+def test_overrides_and_holds_at_random_times_keep_path_limits_and_end(events, with_hold):
+    ctl, g = make(40.0)
+    t0 = ctl.time
+    pts = np.array([[20_000.0, 0], [20_000, 20_000], [0, 20_000], [1000, 1000]])
+    for p in pts:
+        g.line(p)
+    ctl.step()
+    for k, (dt, pct) in enumerate(events):
+        ctl.advance(dt)
+        if g.state is GroupState.MOVING:
+            g.set_override(pct)
+        if with_hold and k == 0 and g.state is GroupState.MOVING:
+            g.hold()
+            ctl.run_until(lambda: g.state is GroupState.HELD, 5)
+            g.cont()
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
+        a.is_moving for a in g.axes), 60)
+    assert g.position.tolist() == pts[-1].tolist()
+    t = np.linspace(t0, ctl.time, 8001)
+    sx, sy = (ctl.history.sample(a.index, t) for a in g.axes)
+    verts = np.vstack([[0.0, 0.0], pts])
+    assert dist_to_polyline(np.stack([sx.p, sy.p], axis=1), verts).max() <= 40.0 * (1 + 1e-6)
+    for s in (sx, sy):
+        assert np.abs(s.a).max() <= AMAX * (1 + 1e-9)
+        assert np.abs(s.v).max() <= VMAX * (1 + 1e-9)
