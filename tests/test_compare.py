@@ -304,3 +304,36 @@ def test_bad_input_is_refused_and_running_job_unchanged():
     c.axes[0].move_relative(10, max_vel=1000, tacc=0.01, tdec=0.01)
     run(c)
     assert eng.log.for_job(jid)["time"].size == 5
+
+
+@given(moves=st.lists(st.integers(-3000, 3000).filter(lambda d: d != 0), min_size=1,
+                      max_size=5),
+       levels=st.lists(st.integers(-4000, 4000), min_size=1, max_size=30, unique=True),
+       direction=st.sampled_from([-1, 0, 1]))
+@settings(max_examples=25, deadline=None)
+def test_back_and_forth_fires_like_the_value_block_model(moves, levels, direction):
+    # model: one value loaded at a time; it fires when a leg reaches it (in the direction
+    # asked), strictly after the position the leg was at; then the next value is loaded
+    levels = np.array(levels, dtype=float)
+    c = machine(1)
+    eng = CompareEngine(c)
+    jid = eng.add(LevelJob(AxisSource(0), levels, Toggle(0), direction=direction))
+    expect, k, pos = [], 0, 0.0
+    for d in moves:
+        end = pos + d
+        cur = pos
+        up = d > 0
+        while k < levels.size and (direction == 0 or direction == (1 if up else -1)):
+            lv = levels[k]
+            if (up and cur < lv <= end) or (not up and end <= lv < cur):
+                expect.append(lv)
+                cur = lv
+                k += 1
+            else:
+                break
+        c.axes[0].move_relative(d, max_vel=200_000, tacc=0.005, tdec=0.005)
+        run(c)
+        pos = end
+    log = eng.log.for_job(jid)
+    assert log["value"].tolist() == expect
+    np.testing.assert_allclose(log["positions"][:, 0], expect, atol=1e-9)
