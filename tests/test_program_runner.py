@@ -84,8 +84,6 @@ def test_inch_units_and_work_offset():
     assert units(run)[0] == pytest.approx(30.4, abs=1e-9)
 
 
-@pytest.mark.xfail(reason="front end: G20 feed_per_s is not converted to machine units "
-                          "(program/modal.py, reported)", strict=True)
 def test_inch_feed_is_converted():
     ctl = iso_ctl()
     run = ProgramRunner(ctl, "G20 G90 G1 X1 F60\nM2")

@@ -87,7 +87,7 @@ class Modal:
         self.arc_incremental = True
         self.plane = 170
         self.inverse_time = False
-        self.feed = 0.0  # machine units per minute (G94) or the F number (G93)
+        self.feed = 0.0  # the F number: program units per minute (G94) or inverse time (G93)
         self.motion: int | None = None  # G80: no motion mode until G0..G3
         self.coord = 1
         self.tool_z = 0.0
@@ -255,7 +255,7 @@ class Modal:
             if f.value < 0:
                 raise b.error(f"feed rate must be >= 0, got {f.value:g}", f.pos,
                               fmt("F", f.value))
-            self.feed = f.value if self.inverse_time else self.lin(f.value)
+            self.feed = f.value  # program units per minute: converted when used
         s = words.get("S")
         if s is not None:
             used.add("S")
@@ -535,7 +535,7 @@ class Modal:
         if self.feed <= 0.0:
             raise b.error("feed rate is zero or not set: give F before or with "
                           f"{gword}", gpos, gword)
-        return self.feed / 60.0, None
+        return self.lin(self.feed) / 60.0, None
 
     def _motion(self, b: Block, gs: dict[int, tuple[int, int]], axes: dict[str, Word],
                 words: dict[str, Word], used: set[str], out: list[canon.Command],
