@@ -3,8 +3,10 @@ single-axis motion execution. Public positions are pulses; see Axis for unit-awa
 
 from .axis import Axis
 from .clock import CycleStats
+from .compensation import BACKLASH_COMPENSATING, Compensation, PitchCompTable
 from .controller import Controller
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
+from .inposition import INPOS_TIMEOUT, InPositionControl
 from .motion import ActiveMotion
 from .servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
 from .servoloop import ServoLoop
@@ -14,5 +16,6 @@ __all__ = [
     "COUNTER_MAX", "COUNTER_MIN", "ActiveMotion", "Axis", "AxisState", "Controller",
     "Counters", "CycleStats", "MotionDone", "wrap28",
     "PIDFF", "Compensator", "FollowingErrorMonitor", "FollowingErrorResult", "LeadFilter",
-    "ServoLoop",
+    "ServoLoop", "BACKLASH_COMPENSATING", "Compensation", "PitchCompTable", "INPOS_TIMEOUT",
+    "InPositionControl",
 ]
