@@ -27,9 +27,14 @@ from .canon import (
 from .interp import Interpreter, compile_file, compile_text, interpret
 from .options import GCodeOptions
 from .parser import Block, Program, parse_program
+from .points import PointTable, TablePoint
+from .report import RunSummary, format_summary, summarize, write_report
+from .runner import ProgramRunner, RunEvent, RunOptions, RunState, run_program
 from .source import GCodeError, read_program
 
 __all__ = [
+    "PointTable", "ProgramRunner", "RunEvent", "RunOptions", "RunState", "RunSummary",
+    "TablePoint", "format_summary", "run_program", "summarize", "write_report",
     "ArcMove",
     "Block",
     "Command",
