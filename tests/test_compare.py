@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from openmotion.config import AxisConfig, MachineConfig
+from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import Controller
 from openmotion.control.compare import (
     AxisSource,
@@ -149,6 +149,26 @@ def test_mpos_stepper_fires_within_one_count():
     log = eng.log.for_job(jid)
     assert log["time"].size == levels.size
     assert np.max(np.abs(log["positions"][:, 0] - levels)) <= 1.0
+
+
+def test_mpos_servo_fires_later_than_dpos_in_the_right_cycle():
+    cfg = MachineConfig("t", (AxisConfig(name="x", drive=DriveConfig(type="servo")),))
+    c = Controller(cfg)
+    c.enable_all()
+    eng = CompareEngine(c)
+    levels = np.arange(500.0, 9500.0, 250.0)
+    jm = eng.add(LevelJob(AxisSource(0, "mpos"), levels, Pulse(0, 1e-6), direction=1))
+    jd = eng.add(LevelJob(AxisSource(0, "dpos"), levels, Pulse(1, 1e-6), direction=1))
+    fb = []
+    c.add_cycle_hook(lambda ctl, t: fb.append((t, ctl.axes[0].counters.feedback_unwrapped())))
+    c.axes[0].move_relative(10_000, max_vel=50_000, tacc=0.05, tdec=0.05)
+    run(c)
+    m, d = eng.log.for_job(jm), eng.log.for_job(jd)
+    assert m["time"].size == d["time"].size == levels.size
+    assert np.all(m["time"] > d["time"])  # the servo lags the command
+    fb = np.array(fb)
+    k = np.searchsorted(fb[:, 0], m["time"])  # the cycle each firing was found in
+    assert np.all(fb[k - 1, 1] < levels + 1) and np.all(fb[k, 1] >= levels - 1)
 
 
 def straight_line(c, start, end, v=20_000.0, a=2e5, j=2e7):
