@@ -426,3 +426,14 @@ def test_a_group_engine_stops_its_other_axes_through_the_fault_hook() -> None:
     ctl.run_until(lambda: a.fault is not None, 3.0)
     assert s.state is S.ERROR_STOP and s.fault == "group: +EL"
     assert ctl.wait_motion_done(timeout=1.0)
+
+
+def test_a_limit_cuts_short_another_faults_deceleration() -> None:
+    ctl, safety = setup()
+    ax = ctl.axis("a")
+    ax.move_velocity(50_000.0, tacc=0.05)
+    ctl.run_until(lambda: ax.position > PEL - 1000.0, 2.0)
+    ax.fault_stop("test fault", decelerate=True)  # 1250 pulses to stop: past the limit
+    ctl.run_until(lambda: ax.motion is None, 1.0)
+    assert ax.fault == "+EL"
+    assert ax.position <= PEL + 50_000.0 * ctl.period + 1e-6

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from openmotion.config import AxisConfig, MachineConfig
+from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import AxisState, Controller
 from openmotion.control.safety import Safety
 from openmotion.control.softlimits import profile_extent
@@ -213,3 +213,23 @@ def test_enable_before_set_is_refused() -> None:
     ctl, safety = setup()
     with pytest.raises(MotionError, match="not set"):
         safety.soft.enable(0)
+
+
+def test_a_fault_stop_decelerating_towards_a_soft_limit_never_passes_it() -> None:
+    ax_cfg = AxisConfig(name="s", lead=10.0, max_speed=1000.0, drive=DriveConfig(type="servo"))
+    ctl = Controller(MachineConfig("t", (ax_cfg,), 0, 0, 0.001))
+    safety = Safety(ctl)
+    ctl.enable_all()
+    safety.set_alm(0, "decel")
+    safety.soft.set(0, 20_000.0, -20_000.0)
+    safety.soft.enable(0, "immediate")
+    ax = ctl.axis(0)
+    w = Watch(ctl)
+    ax.move_velocity(2e5, tacc=0.05)  # stopping takes 5000 pulses
+    ctl.run_until(lambda: ax.position > 17_000.0, 1.0)
+    ctl.hardware.scenario.trip_alarm(0)
+    ctl.step()
+    assert ax.fault == "servo alarm" and ax.motion is not None  # decelerating
+    ctl.run_until(lambda: ax.motion is None, 2.0)
+    assert ax.fault == "+SL"  # the soft limit cut the alarm's deceleration short
+    assert w.hi <= 20_000.0 + 1e-9 and ax.position <= 20_000.0

@@ -331,8 +331,10 @@ class Safety:
                 self._sd_latch[e.axis] = True
             return
         m = ax.motion
-        if not c.el_enabled or sig in c.suspended or m is None or ax.state is S.ERROR_STOP:
+        if not c.el_enabled or sig in c.suspended or m is None:
             return
+        if ax.state is S.ERROR_STOP and ax.fault == LIMIT_REASONS[sig]:
+            return  # already reacting to this limit (its decelerating stop)
         d = motion_direction(ax, m, e.time)
         if c.el_direction_sensitive and d != (1 if sig == "pel" else -1):
             return

@@ -222,8 +222,8 @@ class SoftLimits:
         T = self.ctl.period
         for ax in self.ctl.axes:
             m = ax.motion
-            if m is None or ax.state is AxisState.ERROR_STOP:
-                continue
+            if m is None or ax.state is AxisState.ERROR_STOP and ax.fault in ("+SL", "-SL"):
+                continue  # (another fault's decelerating stop is watched like any motion)
             lim = self._raw(ax)
             if lim is None:
                 continue
