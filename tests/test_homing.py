@@ -7,6 +7,8 @@ exact edge the mode defines, worked out by hand below.
 """
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from openmotion.config import AxisConfig, MachineConfig, default_machine
 from openmotion.control import AxisState, Controller
@@ -87,6 +89,28 @@ def test_repeatable_from_random_starts(mode):
         assert run(ctl, h).state == "done"
         finals.add(ctl.hardware.motor_position(0))
     assert finals == {EXPECTED_MARK[mode]}
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(start=st.integers(-40000, 250000), vmax=st.floats(3000.0, 40000.0),
+       tacc=st.floats(0.02, 0.2), mode=st.sampled_from([0, 9, 11]))
+def test_same_count_from_any_start_and_speed(start, vmax, tacc, mode):
+    """Property: wherever it starts (either side of ORG, on it, on -EL) and whatever MaxVel
+    and Tacc, the axis ends on the mode's edge with the counters at 0."""
+    ctl, ax = make(start)
+    cfg = HomeConfig(mode=mode, str_vel=1500.0, max_vel=vmax, tacc=tacc, org_offset=100)
+    st_ = run(ctl, home_search(ctl, "x", cfg), timeout=300)
+    assert st_.state == "done", st_.reason
+    assert ctl.hardware.motor_position(0) == EXPECTED_MARK[mode]
+    assert ax.counters.command == 0 and ax.counters.feedback == 0
+
+
+def test_el_immediate_stop_mode_6():
+    ctl, ax = make(20000)
+    st_ = run(ctl, home_move(ctl, "x", HomeConfig(mode=6, el_stop="immediate", **FAST)))
+    assert st_.state == "done"
+    assert st_.mark == pytest.approx(-5001, abs=1e-2)
+    assert ctl.hardware.motor_position(0) == -5001 and ax.counters.command == 0
 
 
 def test_final_stay_counts_from_the_mark():

@@ -202,8 +202,12 @@ class Homing:
     def _run(self, profile: Profile) -> None:
         c = self.config
         j = c.jerk if c.jerk is not None else c.accel / self.ctl.period
-        self.axis.run_profile(profile, stop_accel=c.accel, stop_jerk=j,
-                              replace_running=self.axis.motion is not None)
+        try:
+            self.axis.run_profile(profile, stop_accel=c.accel, stop_jerk=j,
+                                  replace_running=self.axis.motion is not None)
+        except MotionError as err:  # refused (e.g. by a safety motion check): stop here
+            if self.running:
+                self._fail(f"homing: move refused in phase {self.status.phase!r}: {err}")
 
     def _ramp(self, b: ProfileBuilder, v1: float) -> None:
         c = self.config
