@@ -6,7 +6,7 @@ history of each cycle [t0, t1] into tracks in the compared frame (command counte
 feedback model) and asks three questions, each answered between cycles, not at cycle ends:
 
 - `first_crossing`: the first time after `t` the track reaches a level (a compare value),
-  solved on monotone pieces by the same solver as MotionHistory.crossings;
+  with the events of MotionHistory.crossings (compare_roots.level_events);
 - `VectorCycle`: the accumulated path length s(t) (ZMotion VECTOR_MOVED) over the cycle and
   the time it reaches a given distance;
 - `first_inside`: the first time all axes are within +-maxerr of a point (2-D/3-D tables).
@@ -20,7 +20,8 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from ..history import MotionHistory, _find_crossings
+from ..history import MotionHistory
+from .compare_roots import level_events
 
 Array = NDArray[np.float64]
 
@@ -83,18 +84,14 @@ def crossings_after(tr: Track, level: float, t: float, t1: float,
 
     An arrival exactly at t belongs to the window that ended at t, so it is not repeated.
     """
-    times, dirs = _find_crossings(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, level, t, t1)
-    keep = times > t
-    if direction:
-        keep &= dirs == direction
-    return times[keep]
+    return np.array(level_events(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, level, t, t1, direction))
 
 
 def first_crossing(tr: Track, level: float, t: float, t1: float,
                    direction: int) -> float | None:
     """The first time in (t, t1] the track reaches `level` in `direction`, or None."""
-    times = crossings_after(tr, level, t, t1, direction)
-    return float(times[0]) if times.size else None
+    times = level_events(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, level, t, t1, direction, first=True)
+    return times[0] if times else None
 
 
 # ---------------------------------------------------------------------------- window
@@ -114,8 +111,8 @@ def first_inside(tracks: list[Track], centre: Array, maxerr: float, t: float,
         for lvl in (c - maxerr, c + maxerr):
             if not lo_k - slack <= lvl <= hi_k + slack:
                 continue
-            times, _ = _find_crossings(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, float(lvl), t, t1)
-            cands.append(times)
+            cands.append(np.array(level_events(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, float(lvl),
+                                               t, t1)))
     cand = np.unique(np.concatenate(cands))
     cand = cand[(cand >= t) & (cand <= t1)]
     ok = np.ones(cand.size, dtype=bool)

@@ -1,0 +1,51 @@
+"""The compare engine's fast level-event solver gives the same events as
+MotionHistory's crossing solver (to a few ulps), on random piecewise-cubic motion."""
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from openmotion.control.compare_roots import level_events
+from openmotion.history import MotionHistory
+from openmotion.profile.segments import ProfileBuilder
+
+seg = st.tuples(st.floats(1e-4, 0.01), st.floats(-1e7, 1e7), st.floats(-1e4, 1e4),
+                st.booleans())
+
+
+@given(segs=st.lists(seg, min_size=1, max_size=6), v0=st.floats(-5e3, 5e3),
+       pick=st.floats(0, 1), mode=st.sampled_from(["value", "knot", "random"]),
+       w0=st.floats(0, 1), w1=st.floats(0, 1), direction=st.sampled_from([-1, 0, 1]))
+@settings(max_examples=300, deadline=None)
+def test_same_events_as_history(segs, v0, pick, mode, w0, w1, direction):
+    b = ProfileBuilder(0.0, v0, v_before=v0)
+    for dur, jerk, accel, dwell in segs:
+        if dwell:  # a stop on the spot: tests dwell and arrival semantics
+            b.set_velocity(0.0)
+            b.segment(dur, 0.0, accel=0.0)
+        else:
+            b.segment(dur, jerk, accel=accel)
+    prof = b.build()
+    h = MotionHistory(1)
+    h.append(0, 0.0, prof)
+    r = h.records(0)
+    T = prof.duration
+    if mode == "value":
+        level = float(prof.state_at(pick * T).p)
+    elif mode == "knot":
+        level = float(r["p0"][min(int(pick * r["p0"].size), r["p0"].size - 1)])
+    else:
+        level = float(pick * 20 - 10)
+    t, t1 = sorted((w0 * T, w1 * T))
+    ref_t, ref_d = h.crossing_events(0, level, t, t1)
+    keep = ref_t > t
+    if direction:
+        keep &= ref_d == direction
+    ref = ref_t[keep]
+    got = np.array(level_events(r["ts"], r["p0"], r["v0"], r["a0"], r["j"], level, t, t1,
+                                direction))
+    assert got.size == ref.size, (got, ref)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=8 * np.finfo(float).eps * (1 + T))
+    first = level_events(r["ts"], r["p0"], r["v0"], r["a0"], r["j"], level, t, t1, direction,
+                         first=True)
+    assert first == got[:1].tolist()
