@@ -6,7 +6,10 @@ from .clock import CycleStats
 from .compensation import BACKLASH_COMPENSATING, Compensation, PitchCompTable
 from .controller import Controller
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
+from .group import Group
+from .groupexec import GroupError, GroupState
 from .inposition import INPOS_TIMEOUT, InPositionControl
+from .jog import jog_conti, jog_pulse, jog_space, stop_jog
 from .motion import ActiveMotion
 from .servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
 from .servoloop import ServoLoop
@@ -17,5 +20,6 @@ __all__ = [
     "Counters", "CycleStats", "MotionDone", "wrap28",
     "PIDFF", "Compensator", "FollowingErrorMonitor", "FollowingErrorResult", "LeadFilter",
     "ServoLoop", "BACKLASH_COMPENSATING", "Compensation", "PitchCompTable", "INPOS_TIMEOUT",
-    "InPositionControl",
+    "InPositionControl", "Group", "GroupError", "GroupState", "jog_conti", "jog_pulse",
+    "jog_space", "stop_jog",
 ]
