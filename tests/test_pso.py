@@ -245,3 +245,15 @@ def test_bad_calls_are_refused_and_job_unchanged():
     c.axes[0].move_relative(300, max_vel=10_000, tacc=0.01, tdec=0.01)
     assert c.wait_motion_done(timeout=5)
     assert eng.log.for_job(jid)["time"].size == 3
+
+
+def test_timer_train_still_running_counts_an_overrun():
+    c, eng, z = setup(2)
+    z.table(0, 0, 0, 1, 0, 2, 0)  # three points 1 unit apart: passed within ~15 ms
+    z.hw_timer(2, 100000, 50000, 2, 0, 0)
+    jid = z.hw_pswitch2(26, 0, 1, 10, 3, 0)
+    line_to(c, (3, 0))
+    c.advance(0.3)
+    assert eng.log.for_job(jid)["time"].size == 3  # every point still fires (logged) ...
+    assert z.timer.overruns == 2                     # ... but only the first starts a train
+    np.testing.assert_allclose(eng.output(0).pulse_widths(), [0.05, 0.05], atol=1e-9)

@@ -455,6 +455,10 @@ class CompareEngine:
                                                               for s in src.scale)))):
                 raise MotionError("vector source needs distinct axes and a positive scale "
                                   "per axis")
+        with self.ctl._lock:  # the cycle may run on the real-time thread
+            return self._add(job, axes)
+
+    def _add(self, job: CompareJob, axes: Sequence[int]) -> int:
         if job.buffer_use > self.buffer_free():
             raise MotionError(f"table too long: {job.buffer_use} points, buffer has "
                               f"{self.buffer_free()} free of {self.buffer_size}")
@@ -473,9 +477,10 @@ class CompareEngine:
 
     def remove(self, job_id: int) -> None:
         """Stop a job and drop its unfired points (HW_PSWITCH2(2) for one job)."""
-        job = self._jobs.pop(job_id, None)
-        if job is not None:
-            job.active = False
+        with self.ctl._lock:
+            job = self._jobs.pop(job_id, None)
+            if job is not None:
+                job.active = False
 
     def clear(self) -> None:
         for k in list(self._jobs):
