@@ -11,6 +11,7 @@ from .groupexec import GroupError, GroupState
 from .inposition import INPOS_TIMEOUT, InPositionControl
 from .jog import jog_conti, jog_pulse, jog_space, stop_jog
 from .motion import ActiveMotion
+from .safety import IO_STATUS_BITS, Safety, StopRecord, io_status
 from .servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
 from .servoloop import ServoLoop
 from .states import AxisState, MotionDone
@@ -21,5 +22,5 @@ __all__ = [
     "PIDFF", "Compensator", "FollowingErrorMonitor", "FollowingErrorResult", "LeadFilter",
     "ServoLoop", "BACKLASH_COMPENSATING", "Compensation", "PitchCompTable", "INPOS_TIMEOUT",
     "InPositionControl", "Group", "GroupError", "GroupState", "jog_conti", "jog_pulse",
-    "jog_space", "stop_jog",
+    "jog_space", "stop_jog", "IO_STATUS_BITS", "Safety", "StopRecord", "io_status",
 ]
