@@ -193,6 +193,8 @@ class Axis:
             else:
                 self._kill_motion()
             self._fault = reason
+            #: when the fault happened: the edge's exact time if given, else now
+            self.fault_time = self._ctl.time if at is None else float(at)
             self._state = transition(self._state, S.ERROR_STOP, self.name)
             for hook in tuple(self._ctl._fault_hooks):
                 hook(self, reason)
