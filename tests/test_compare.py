@@ -357,3 +357,17 @@ def test_back_and_forth_fires_like_the_value_block_model(moves, levels, directio
     log = eng.log.for_job(jid)
     assert log["value"].tolist() == expect
     np.testing.assert_allclose(log["positions"][:, 0], expect, atol=1e-9)
+
+
+def test_output_waveform_memory_is_bounded_by_the_history_window():
+    cfg = MachineConfig("t", (AxisConfig(name="x"),))
+    c = Controller(cfg, history_window_s=0.05)
+    c.enable_all()
+    eng = CompareEngine(c)
+    eng.add(LevelJob(AxisSource(0), LevelSeq(10.0, 10.0), Pulse(0, 1e-4), direction=1))
+    c.axes[0].move_velocity(20_000, tacc=0.01)
+    c.advance(0.5)
+    line = eng.output(0)
+    assert len(eng.log) > 900
+    assert len(line.edges) < 250 and line.edges[0][0] >= c.time - 0.05 - 1e-9
+    np.testing.assert_allclose(line.pulse_widths(), 1e-4, atol=1e-12)

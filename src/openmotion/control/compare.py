@@ -299,5 +299,8 @@ class CompareEngine:
                                    for a in range(len(ctl.axes))])
             self.log.add(rows, pos)
         hw = ctl.hardware
+        keep = t1 - ctl.history.window_s  # waveforms are kept as long as the motion history
         for line in self._lines.values():
             line.flush(hw, ta, t1)
+            if line._t and line._t[0] < keep:
+                line.forget_before(keep)

@@ -80,6 +80,14 @@ class OutputLine:
         del self._t[k:]
         del self._lv[k:]
 
+    def forget_before(self, t: float) -> None:
+        """Drop edges before t (bounded memory); the level at t becomes the start level."""
+        k = bisect.bisect_left(self._t, t)
+        if k:
+            self.initial = self._lv[k - 1]
+            del self._t[:k]
+            del self._lv[:k]
+
     def pulse_widths(self, active: bool = True) -> Array:
         """Durations of the completed `active`-level intervals (for tests and reports)."""
         t = np.array(self._t)
