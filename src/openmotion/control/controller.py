@@ -101,6 +101,9 @@ class Controller:
         from .servoloop import attach_servo_loops  # closed loops of axes with a loop config
 
         self.servo_loops = attach_servo_loops(self)
+        from .events import EventLog  # faults, limits, latches, home completion, compare
+
+        self.events = EventLog(self)
 
     # ------------------------------------------------------------------ lookup
     def axis(self, key: int | str) -> Axis:

@@ -1,0 +1,77 @@
+"""The controller's event log: faults with exact times, reading, waiting, callbacks."""
+
+import pytest
+
+from openmotion.control import Controller, Safety
+from openmotion.control.events import EventLog, classify_fault
+from openmotion.errors import MotionError
+
+
+def _ctl():
+    ctl = Controller()
+    ctl.enable_all()
+    return ctl
+
+
+def test_limit_hit_is_an_event_at_the_edge_time():
+    ctl = _ctl()
+    Safety(ctl)
+    x = ctl["x"]
+    pel = ctl.config.axes[0].pel
+    seen = []
+    ctl.events.on_event(seen.append)
+    x.move_velocity(50_000, tacc=0.05)
+    ev = ctl.events.wait("limit", "x", timeout=30.0)
+    assert ev is not None and ev.detail == "+EL" and ev.axis == 0
+    assert seen and seen[-1] is ev
+    # the edge lies between two cycle ends, and the position is the planned one then
+    assert ev.time < ctl.time
+    assert ev.position == pytest.approx(ctl.history.state_at(0, ev.time).p)
+    assert ev.position == pytest.approx(pel.position, abs=1.0)
+    assert ctl.events.last("limit") is ev
+    assert ctl.events.events(axis="y") == []
+
+
+def test_estop_events_for_every_axis():
+    ctl = _ctl()
+    for ax in ctl.axes:
+        ax.move_velocity(1000, tacc=0.05)
+    ctl.advance(0.1)
+    ctl.emergency_stop()
+    kinds = {e.kind for e in ctl.events.events()}
+    assert kinds == {"estop"}
+    assert len(ctl.events.events(kind="estop")) == len(ctl.axes)
+
+
+def test_wait_times_out_and_record_validates():
+    ctl = _ctl()
+    t0 = ctl.time
+    assert ctl.events.wait("latch", timeout=0.05) is None
+    assert ctl.time == pytest.approx(t0 + 0.05)
+    ev = ctl.events.record("home_done", 1, ctl.time, 0.0, "mode 1")
+    assert ctl.events.events(kind="home_done") == [ev]
+    with pytest.raises(MotionError, match="kind"):
+        ctl.events.record("not a kind", 0, 0.0)
+    with pytest.raises(MotionError, match="axis"):
+        ctl.events.record("latch", 9, 0.0)
+    with pytest.raises(MotionError, match="time"):
+        ctl.events.record("latch", 0, float("nan"))
+    assert len(ctl.events) == 1
+    with pytest.raises(MotionError, match="capacity"):
+        EventLog(ctl, capacity=0)
+
+
+def test_capacity_bounds_memory():
+    ctl = Controller()
+    log = EventLog(ctl, capacity=3)
+    for k in range(10):
+        log.record("compare", 0, float(k))
+    assert [e.time for e in log.events()] == [7.0, 8.0, 9.0]
+
+
+def test_classify_fault():
+    assert classify_fault("+EL") == "limit"
+    assert classify_fault("-SL") == "soft_limit"
+    assert classify_fault("servo alarm") == "alarm"
+    assert classify_fault("emergency stop") == "estop"
+    assert classify_fault("step loss") == "fault"
