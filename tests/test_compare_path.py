@@ -81,3 +81,22 @@ def test_every_distance_refuses_bad_windows():
                {"interval": 1.0, "start": 5.0, "end": 1.0}):
         with pytest.raises(MotionError):
             every_distance(src, action=Pulse(0, 1e-6), **kw)
+
+
+def test_speed_following_pwm():
+    c, eng = setup()
+    src = VectorSource((0, 1), (MM, MM))
+    pwm = eng.add_speed_pwm(src, 2, full_speed=100.0)  # mm/s; the feed is 50 mm/s
+    g = Group(c, [0, 1], feed=50 * MM, acc_time=0.05)
+    g.line([30 * MM, 40 * MM])
+    run(c, g)
+    c.advance(0.005)
+    duty = np.array([d for _, d in pwm.duties])
+    assert duty.max() == pytest.approx(0.5, abs=1e-9)          # cruise at half full speed
+    assert duty[0] == 0.0 and duty[-1] == 0.0                     # at rest before and after
+    assert np.all(np.diff(duty[: int(np.argmax(duty)) + 1]) >= -1e-12)  # ramps up
+    w = eng.output(2).pulse_widths()
+    on = duty[(duty > 0) & (duty < 1)] * c.period
+    np.testing.assert_allclose(np.sort(w), np.sort(on), atol=1e-12)
+    with pytest.raises(MotionError):
+        eng.add_speed_pwm(src, 2, full_speed=0.0)

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import MotionError, check_finite
+from ..errors import MotionError, check_finite, check_positive
 from .compare_io import EventLog, OutputLine
 from .compare_jobs import (
     SOURCE_KINDS,
@@ -66,11 +66,28 @@ if TYPE_CHECKING:
 
 __all__ = [
     "SOURCE_KINDS", "Action", "AxisSource", "CompareEngine", "CompareJob", "LevelJob",
-    "LevelSeq", "Pulse", "SetLevel", "Source", "Toggle", "VectorSource", "WindowJob",
+    "LevelSeq", "Pulse", "SetLevel", "Source", "SpeedPwm", "Toggle", "VectorSource", "WindowJob",
     "every_distance",
 ]
 
 Array = NDArray[np.float64]
+
+
+class SpeedPwm:
+    """Duty-cycle output following the path speed (see CompareEngine.add_speed_pwm)."""
+
+    def __init__(self, source: VectorSource, output: int, full_speed: float) -> None:
+        self.source = source
+        self.output = output
+        self.full_speed = full_speed
+        self.duties: list[tuple[float, float]] = []  # (cycle start, duty) for plots/tests
+
+    def apply(self, line: OutputLine, t: float, period: float, speed: float) -> None:
+        duty = min(max(speed / self.full_speed, 0.0), 1.0)
+        self.duties.append((t, duty))
+        line.set(t, duty > 0.0)
+        if 0.0 < duty < 1.0:
+            line.set(t + duty * period, False)
 
 
 # ---------------------------------------------------------------------------- engine
@@ -100,6 +117,7 @@ class CompareEngine:
         self._lines: dict[int, OutputLine] = {}
         self._vectors: dict[VectorSource, float] = {}
         self._mpos_err: dict[int, float] = {}
+        self._pwms: list[SpeedPwm] = []
         self._t_last = controller.time
         self._tracks: dict[AxisSource, Track] = {}
         self._ranges = {}
@@ -214,6 +232,25 @@ class CompareEngine:
         """VECTOR_MOVED = value (clear it before a job, as the seed says)."""
         self._vectors[source] = check_finite("value", value)
 
+    # ------------------------------------------------------------------ speed-following PWM
+    def add_speed_pwm(self, source: VectorSource, output: int, full_speed: float) -> SpeedPwm:
+        """Laser-power-style output: a PWM at the cycle rate on `output` whose duty follows
+        the path speed of `source` (duty = speed / full_speed, capped at 1). The duty of a
+        cycle is the mean speed of the cycle before (the one just executed)."""
+        if not isinstance(source, VectorSource):
+            raise MotionError(f"source must be a VectorSource, got {source!r}")
+        self.check_output(output)
+        pwm = SpeedPwm(source, output, check_positive("full_speed", full_speed))
+        self.track_vector(source)
+        self.output(output)
+        self._pwms.append(pwm)
+        return pwm
+
+    def remove_speed_pwm(self, pwm: SpeedPwm) -> None:
+        if pwm in self._pwms:
+            self._pwms.remove(pwm)
+            self.output(pwm.output).set(self.ctl.time, False)
+
     # ------------------------------------------------------------------ per-cycle data
     def _cmd_offset(self, axis: int) -> float:
         return -self.ctl.axes[axis].counters.pulses_from_command(0.0)
@@ -289,6 +326,9 @@ class CompareEngine:
             if job.done:
                 self._jobs.pop(job.id, None)
                 job.active = False
+        for pwm in self._pwms:
+            speed = (self.vector_cycle(pwm.source).end - self._vectors[pwm.source]) / (t1 - ta)
+            pwm.apply(self.output(pwm.output), t1, t1 - ta, speed)
         for src in self._vectors:
             self._vectors[src] = self.vector_cycle(src).end
         self._mpos_err.update(self._mpos_e1)
