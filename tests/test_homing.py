@@ -113,6 +113,27 @@ def test_el_immediate_stop_mode_6():
     assert ctl.hardware.motor_position(0) == -5001 and ax.counters.command == 0
 
 
+def test_servo_axis_homes_the_load_onto_the_index():
+    """A servo's command leads the load by the following error at the edge; the home is
+    taken from the encoder, so the load (not the command) ends on the index."""
+    from dataclasses import replace
+
+    from openmotion.config import DriveConfig
+    base = default_machine()
+    cfg = base.with_axis(replace(base.axes[0], drive=DriveConfig(type="servo")))
+    finals = set()
+    for start in (20000, 3000):
+        ctl, ax = make(start, config=cfg)
+        h = home_move(ctl, "x", HomeConfig(mode=11, settle_s=0.05, **FAST))
+        st_ = run(ctl, h)
+        assert st_.state == "done", st_.reason
+        assert abs(st_.mark - 10000) > 5  # the command was ahead of the load at the edge
+        ctl.advance(0.2)
+        finals.add(round(ctl.hardware.load_position(0), 6))
+        assert abs(ax.counters.feedback) <= 1
+    assert len(finals) == 1 and abs(finals.pop() - 10000) <= 1.0
+
+
 def test_final_stay_counts_from_the_mark():
     ctl, ax = make(20000)
     h = home_move(ctl, "x", HomeConfig(mode=0, final="stay", **FAST))

@@ -321,13 +321,27 @@ class Homing:
             return
         c = self.config
         self._stage = "final"
+        self._t_rest = -1.0
         if c.final == "mark":
             self._log("move to home")
-            self._move_to(float(round(st.mark) + round(c.home_offset)))
-            if self.axis.motion is None:
-                self._complete()
-        else:
-            self._complete()
+            self._move_to(float(self._home_target()))
+
+    def _home_target(self) -> int:
+        """Command position that puts the load on mark + home_offset.
+
+        The switch or index sits on the load, so the home is where the *encoder* read at
+        the marking edge: target = p_now + (enc_mark - enc_now)/ratio (+ offset), taken at
+        rest. Servo drives only: it removes the following error the command had at the
+        edge. Steppers use the command mark (the motor is the pulse count, and the encoder
+        read at the very instant a pulse trips the switch is ambiguous by one count).
+        """
+        st = self.status
+        cnt = self.axis.counters
+        off = round(self.config.home_offset)
+        if st.mark_encoder is None or not self.axis.config.drive.type.endswith("servo"):
+            return round(st.mark) + off
+        enc_now = cnt.feedback_unwrapped() - cnt._fb_off
+        return round(self.axis.position + (st.mark_encoder - enc_now) / cnt.move_ratio) + off
 
     def _complete(self) -> None:
         """Clear command, feedback, error and general counters (not the target recorder)."""
@@ -341,7 +355,7 @@ class Homing:
             home = st.mark + c.home_offset
             rel = round(ax.position - home)
             enc_rel = round(rel * cnt.move_ratio)
-            if st.mark_encoder is not None:
+            if st.mark_encoder is not None and ax.config.drive.type.endswith("servo"):
                 raw_enc = cnt.feedback_unwrapped() - cnt._fb_off
                 enc_rel = raw_enc - st.mark_encoder - round(c.home_offset * cnt.move_ratio)
         cnt.reset_all()
@@ -465,7 +479,10 @@ class Homing:
         elif stage == "move":
             self._next()
         elif stage == "final":
-            self._complete()
+            if self._t_rest < 0.0:
+                self._t_rest = t
+            if t - self._t_rest + 1e-12 >= self.config.settle_s:
+                self._complete()
 
 
 # -- HSL-style entry points -------------------------------------------------------------
