@@ -371,3 +371,24 @@ def test_output_waveform_memory_is_bounded_by_the_history_window():
     assert len(eng.log) > 900
     assert len(line.edges) < 250 and line.edges[0][0] >= c.time - 0.05 - 1e-9
     np.testing.assert_allclose(line.pulse_widths(), 1e-4, atol=1e-12)
+
+
+@given(dist=st.floats(100, 50_000), v=st.floats(10_000, 500_000), a=st.floats(1e5, 1e7),
+       j=st.floats(1e6, 1e9), n=st.integers(1, 30), seed=st.integers(0, 2**31))
+@settings(max_examples=15, deadline=None)
+def test_jerk_limited_moves_fire_on_the_profile(dist, v, a, j, n, seed):
+    # S-curve (constant-jerk) motion: on a monotone move the position fixes the time, so
+    # firing exactly on the level, at a time inside the profile, is the analytic answer
+    c = machine(1)
+    prof = jerk_limited(dist, v, a, j)
+    levels = np.sort(np.random.default_rng(seed).uniform(0.5, dist, n))
+    eng = CompareEngine(c)
+    jid = eng.add(LevelJob(AxisSource(0), levels, Pulse(0, 1e-7), direction=1))
+    t_start = c.time
+    c.axes[0].run_profile(prof, stop_accel=a, stop_jerk=j)
+    run(c)
+    log = eng.log.for_job(jid)
+    assert log["time"].size == n
+    at = prof.sample(log["time"] - t_start).p
+    np.testing.assert_allclose(at, levels, rtol=0, atol=1e-7 * max(1.0, dist / 1e4))
+    np.testing.assert_allclose(log["positions"][:, 0], levels, rtol=0, atol=1e-6)
