@@ -75,3 +75,23 @@ def test_classify_fault():
     assert classify_fault("servo alarm") == "alarm"
     assert classify_fault("emergency stop") == "estop"
     assert classify_fault("step loss") == "fault"
+
+
+def test_latch_and_home_completion_are_events():
+    from openmotion.control.homing import Homing
+    from openmotion.control.homing_modes import HomeConfig
+    from openmotion.control.latch import Latch
+
+    ctl = _ctl()
+    latch = Latch(ctl)
+    ctl.hardware.scenario.place_switch(1, "ltc", 3000.0, width=50.0)
+    ctl["y"].move_relative(6000, max_vel=20_000, tacc=0.05)
+    ev = ctl.events.wait("latch", "y", timeout=5.0)
+    assert ev is not None and ev.position == pytest.approx(latch.data("y").position)
+    assert ev.position == pytest.approx(3000.0, abs=1.0)
+    ctl.wait_motion_done()
+
+    home = Homing(ctl, "x", HomeConfig(mode=0, str_vel=100, max_vel=20_000, tacc=0.05))
+    home.start()
+    done = ctl.events.wait("home_done", "x", timeout=60.0)
+    assert done is not None and home.status.state == "done"

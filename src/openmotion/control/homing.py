@@ -366,6 +366,8 @@ class Homing:
         cnt.reset_error()
         ax.end_homing()
         self._finish("done", None)
+        self.ctl.events.record("home_done", ax.index, self.ctl.time, ax.position,
+                               f"home mode {self.config.mode}")
         if self.safety is not None and self.safety.settings(ax.index).erc_width > 0.0:
             self.safety.pulse_erc(ax.index)  # ERC one-shot on home completion (HSL 4.7)
 

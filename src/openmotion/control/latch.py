@@ -117,8 +117,10 @@ class Latch:
         cfg = ctl.axes[e.axis].config
         active = e.level != (cfg.signal_logic("ltc") == "nc")
         if _edge_wanted(active, self._edge[e.axis]):
-            self._data[e.axis] = capture(ctl, e.axis, e)
+            data = capture(ctl, e.axis, e)
+            self._data[e.axis] = data
             self._fresh[e.axis] = True
+            ctl.events.record("latch", e.axis, e.time, data.position, "LTC")
 
 
 class TouchProbe:
@@ -195,5 +197,7 @@ class TouchProbe:
         if self.window is not None and not self.window[0] <= rec.position <= self.window[1]:
             return
         self.records.append(rec)
+        self.ctl.events.record("latch", self.axis,
+                               rec.time, rec.position, "touch probe")
         if self.mode == "single":
             self.abort()
