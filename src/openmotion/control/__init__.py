@@ -3,14 +3,35 @@ single-axis motion execution. Public positions are pulses; see Axis for unit-awa
 
 from .axis import Axis
 from .clock import CycleStats
+from .compare import CompareEngine
+from .compare_io import EventLog as CompareLog
+from .compare_io import plot_firings
+from .compare_jobs import (
+    AxisSource,
+    LevelJob,
+    LevelSeq,
+    Pulse,
+    SetLevel,
+    Toggle,
+    VectorSource,
+    WindowJob,
+    every_distance,
+)
 from .compensation import BACKLASH_COMPENSATING, Compensation, PitchCompTable
 from .controller import Controller
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
+from .events import EventLog, MotionEvent
 from .group import Group
 from .groupexec import GroupError, GroupState
+from .homing import Homing, escape_home, home_move, home_search
+from .homing_modes import HomeConfig, HomeStatus
+from .homing_sequence import HomeSequence
+from .hsl_trigger import HslTrigger
 from .inposition import INPOS_TIMEOUT, InPositionControl
 from .jog import jog_conti, jog_pulse, jog_space, stop_jog
+from .latch import Latch, LatchData, TouchProbe
 from .motion import ActiveMotion
+from .pso import PulseTimer, ZPso
 from .safety import IO_STATUS_BITS, Safety, StopRecord, io_status
 from .servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
 from .servoloop import ServoLoop
@@ -23,4 +44,9 @@ __all__ = [
     "ServoLoop", "BACKLASH_COMPENSATING", "Compensation", "PitchCompTable", "INPOS_TIMEOUT",
     "InPositionControl", "Group", "GroupError", "GroupState", "jog_conti", "jog_pulse",
     "jog_space", "stop_jog", "IO_STATUS_BITS", "Safety", "StopRecord", "io_status",
+    "CompareEngine", "CompareLog", "plot_firings", "AxisSource", "LevelJob", "LevelSeq",
+    "Pulse", "SetLevel", "Toggle", "VectorSource", "WindowJob", "every_distance", "EventLog",
+    "MotionEvent", "Homing", "escape_home", "home_move", "home_search", "HomeConfig",
+    "HomeStatus", "HomeSequence", "HslTrigger", "Latch", "LatchData", "TouchProbe",
+    "PulseTimer", "ZPso",
 ]
