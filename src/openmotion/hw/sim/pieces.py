@@ -24,18 +24,21 @@ from .cubic import Cubic, cubic_time_at, solve_monotone
 EPS_PULSE = 1e-9
 
 
-def count_after(u: float, count: int, direction: int) -> int:
+def count_after(u: float, count: int, direction: int, half: float = 0.0) -> int:
     """Pulse count after the command moves monotonically (in `direction`) to u.
 
     The count is the last integer reached: floor moving up, ceil moving down (rounding
     toward the previous count), so a pulse is emitted exactly when the command reaches an
     integer, in both directions, and jitter below one pulse emits nothing.
+    With `half` = 0.5 (the half-pulse rule, Klipper's step_dist/2) pulse k is emitted when
+    the command reaches k - 1/2 going up (k + 1/2 going down): the count is the command
+    rounded to the nearest integer, within half a pulse of it at every instant.
     """
     if direction > 0:
-        k = math.floor(u + EPS_PULSE)
+        k = math.floor(u + half + EPS_PULSE)
         return k if k > count else count
     if direction < 0:
-        k = math.ceil(u - EPS_PULSE)
+        k = math.ceil(u - half - EPS_PULSE)
         return k if k < count else count
     return count
 
@@ -97,11 +100,12 @@ class StepPiece(Piece):
     m = count - lost, the count starting at `c0` and moving monotonically in `direction`.
     """
 
-    __slots__ = ("cubic", "tc", "c0", "lost")
+    __slots__ = ("cubic", "tc", "c0", "lost", "half")
 
     def __init__(self, cubic: Cubic, tc: float, t0: float, t1: float, c0: int, c1: int,
-                 lost: int, direction: int) -> None:
+                 lost: int, direction: int, half: float = 0.0) -> None:
         self.cubic, self.tc, self.c0, self.lost = cubic, tc, c0, lost
+        self.half = half  # pulse threshold offset, see count_after
         self.t0, self.t1 = t0, t1
         self.m0, self.m1 = c0 - lost, c1 - lost
         self.direction = direction
@@ -110,7 +114,7 @@ class StepPiece(Piece):
         if t >= self.t1:
             return self.m1
         u = self.cubic.pos(t - self.tc)
-        return count_after(u, self.c0, self.direction) - self.lost
+        return count_after(u, self.c0, self.direction, self.half) - self.lost
 
     def time_at(self, level: float) -> tuple[float, float]:
         c = self.cubic
@@ -119,7 +123,8 @@ class StepPiece(Piece):
         k = math.ceil(level + self.lost) - (0 if self.direction > 0 else 1)
         # the exact integer; if the cubic only gets within EPS_PULSE of it, the root is not
         # bracketed and the piece end is returned (where the count was rounded up to k)
-        s = cubic_time_at(c, float(k), self.t0 - self.tc, self.t1 - self.tc)
+        u = k - self.half if self.direction > 0 else k + self.half  # k itself if half == 0
+        s = cubic_time_at(c, float(u), self.t0 - self.tc, self.t1 - self.tc)
         return min(max(self.tc + s, self.t0), self.t1), k - self.lost
 
 
