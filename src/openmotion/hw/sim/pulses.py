@@ -30,13 +30,14 @@ class Stretch(NamedTuple):
 class PulseGenerator:
     """Command cubic + emitted pulse count (signed, never wrapped)."""
 
-    __slots__ = ("cubic", "tc", "te", "count")
+    __slots__ = ("cubic", "tc", "te", "count", "half")
 
-    def __init__(self, p: float = 0.0, t: float = 0.0) -> None:
+    def __init__(self, p: float = 0.0, t: float = 0.0, half: float = 0.0) -> None:
         self.cubic = Cubic(p)
         self.tc = t
         self.te = t
-        self.count = count_after(p, 0, 1 if p > 0 else -1)
+        self.half = half  # 0: pulse at each integer; 0.5: half-pulse rule (count_after)
+        self.count = count_after(p, 0, 1 if p > 0 else -1, half)
 
     def set(self, cubic: Cubic, tc: float, te: float) -> None:
         self.cubic, self.tc, self.te = cubic, tc, te
@@ -81,7 +82,7 @@ class PulseGenerator:
                 p0, p1 = c.pos(s0), c.pos(s1)
                 d = 1 if p1 > p0 else (-1 if p1 < p0 else 0)
                 c0 = self.count
-                c1 = count_after(p1, c0, d)
+                c1 = count_after(p1, c0, d, self.half)
                 self.count = c1
                 out.append(Stretch(tc + s0, tc + s1, c, tc, d, c0, c1))
         # holds before tc / after te produce no pulses; the caller sees gaps as holds
@@ -90,7 +91,7 @@ class PulseGenerator:
     def _jump_to(self, u: float, t: float, out: list[Stretch]) -> None:
         c0 = self.count
         d = 1 if u > c0 else -1
-        c1 = count_after(u, c0, d)
+        c1 = count_after(u, c0, d, self.half)
         if c1 != c0:
             self.count = c1
             out.append(Stretch(t, t, None, t, 1 if c1 > c0 else -1, c0, c1))
