@@ -48,7 +48,7 @@ class StepperPlant:
                 continue
             if st.c1 != st.c0:
                 out.append(StepPiece(st.cubic, st.tc, st.t0, st.t1, st.c0, st.c1, self.lost,
-                                     st.direction))
+                                     st.direction, gen.half))
         return out
 
     def _over_limit(self, c, s: float) -> bool:
