@@ -283,6 +283,19 @@ class SimMachine:
         """Commanded (float) position at the current time."""
         return self._axis(axis).gen.pos(self._t)
 
+    def set_half_pulse(self, on: bool = True) -> None:
+        """Pulse rule of every axis's generator from now on. Off (the default): pulse k
+        leaves when the command reaches integer k (floor going up), so a count lags the
+        command by up to one pulse. On: pulse k leaves at k - 1/2 going up (k + 1/2 going
+        down, Klipper's step_dist/2): the count is the command rounded to nearest, within
+        half a pulse (issue 4's quantization bound). Switch edges still land on the exact
+        pulse count. Set it at standstill; counts already emitted are not changed.
+        """
+        if not isinstance(on, bool):
+            raise MotionError(f"on must be a bool, got {on!r}")
+        for ax in self._axes:
+            ax.gen.half = 0.5 if on else 0.0
+
     # -- internals ----------------------------------------------------------------------------
     def _axis(self, axis: int) -> _Axis:
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._axes):
