@@ -14,7 +14,7 @@ S = AxisState
 
 @pytest.fixture
 def ctl():
-    c = Controller()
+    c = Controller(safety=False)
     c.enable_all()
     return c
 
@@ -36,7 +36,7 @@ def run_move(c, ax, timeout=30.0):
 @settings(max_examples=25, deadline=None)
 def test_relative_move_ends_exactly_in_planned_time(distance, str_vel, max_vel, tacc, tdec,
                                                      shape):
-    c = Controller()
+    c = Controller(safety=False)
     c.enable_all()
     ax = c.axis("x")
     ax.counters.set_command(1234)
@@ -91,7 +91,7 @@ def test_absolute_move_with_move_ratio():
     m = default_machine()
     # encoder with 2.5 feedback counts per command pulse (HSL 4.6 example ratio)
     x = replace(m.axes[0], encoder_lines_per_rev=6250, move_ratio=2.5)
-    c = Controller(m.with_axis(x))
+    c = Controller(m.with_axis(x), safety=False)
     c.enable_all()
     ax = c.axis("x")
     ax.move_absolute(8000, max_vel=100_000, tacc=0.02)
@@ -242,7 +242,7 @@ def test_units_velocity_mode_on_a_reversed_axis():
     from openmotion.config import default_machine
 
     m = default_machine()
-    c = Controller(m.with_axis(replace(m.axes[0], reverse=True)))
+    c = Controller(m.with_axis(replace(m.axes[0], reverse=True)), safety=False)
     c.enable_all()
     ax = c.axis("x")
     ax.move_velocity(10.0, tacc=0.01, units=True)  # +10 mm/s = -10000 pps
@@ -292,7 +292,7 @@ def test_28bit_wrap_during_a_move(ctl):
 )
 @settings(max_examples=25, deadline=None)
 def test_stop_at_any_time_property(distance, max_vel, tacc, shape, frac, immediate):
-    c = Controller()
+    c = Controller(safety=False)
     c.enable_all()
     ax = c.axis("x")
     ax.move_relative(distance, max_vel=max_vel, tacc=tacc, shape=shape)

@@ -2,7 +2,7 @@
 
 import pytest
 
-from openmotion.control import Controller, Safety
+from openmotion.control import Controller
 from openmotion.control.events import EventLog, classify_fault
 from openmotion.errors import MotionError
 
@@ -15,7 +15,6 @@ def _ctl():
 
 def test_limit_hit_is_an_event_at_the_edge_time():
     ctl = _ctl()
-    Safety(ctl)
     x = ctl["x"]
     pel = ctl.config.axes[0].pel
     seen = []

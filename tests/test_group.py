@@ -351,7 +351,7 @@ def test_limit_switch_stops_all_axes_of_the_group():
 def test_limit_with_safety_attached_stops_the_group_through_the_fault_hook():
     safety_mod = pytest.importorskip("openmotion.control.safety")
     ctl, g = make()
-    safety_mod.Safety(ctl)
+    assert safety_mod.Safety.of(ctl) is not None  # attached by default
     ctl.hardware.scenario.place_switch(0, "pel", 6000.0, 1000.0)
     g.line([20_000, 10_000])
     ctl.step()

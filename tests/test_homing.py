@@ -39,8 +39,9 @@ EXPECTED_MARK = {
 STARTS = {"right": 20000, "on_org": 3000, "left": -2000, "on_el": -10000}
 
 
-def make(start=0, org=(2000.0, 3000.0, 50.0), config=None):
-    ctl = Controller(config)
+def make(start=0, org=(2000.0, 3000.0, 50.0), config=None, safety=False):
+    # Homing handles the limits its modes use itself; the safety layer is tested below.
+    ctl = Controller(config, safety=safety)
     ctl.enable_all()
     if org is not None:
         ctl.hardware.scenario.place_switch(0, "org", *org)
@@ -298,7 +299,7 @@ def test_ez_mode_refused_without_index_and_when_disabled():
     x = base.axes[0]
     cfg = MachineConfig(name="m", axes=(AxisConfig(**{**x.__dict__, "encoder_mode": "pulse_dir",
                                                       "encoder_lines_per_rev": 10000}),))
-    ctl = Controller(cfg)
+    ctl = Controller(cfg, safety=False)
     with pytest.raises(MotionError, match="EZ index"):
         Homing(ctl, "x", HomeConfig(mode=3))
     h = Homing(ctl, "x", HomeConfig(mode=0))
@@ -317,8 +318,8 @@ def test_motion_commands_refused_while_homing():
 
 # -- with the safety layer attached -----------------------------------------------------------
 def test_el_mode_with_safety_suspends_and_resumes_the_limit():
-    ctl, ax = make(20000)
-    safety = Safety(ctl)
+    ctl, ax = make(20000, safety=True)
+    safety = Safety.of(ctl)
     safety.set_erc(0, 0.005)
     st = run(ctl, home_move(ctl, "x", HomeConfig(mode=6, **FAST)))
     assert st.state == "done", st.reason
@@ -331,8 +332,8 @@ def test_el_mode_with_safety_suspends_and_resumes_the_limit():
 
 
 def test_orgless_limit_hit_with_safety_stops_homing():
-    ctl, ax = make(-2000)
-    Safety(ctl)
+    ctl, ax = make(-2000, safety=True)
+    assert Safety.of(ctl) is not None
     st = run(ctl, home_move(ctl, "x", HomeConfig(mode=0, **FAST)))
     assert st.state in ("error", "aborted") and "EL" in st.reason
     assert ax.state is S.ERROR_STOP

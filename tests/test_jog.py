@@ -13,7 +13,7 @@ from openmotion.errors import MotionError
 
 @pytest.fixture
 def ctl() -> Controller:
-    c = Controller()
+    c = Controller(safety=False)
     c.enable_all()
     return c
 

@@ -14,7 +14,7 @@ S = AxisState
 
 def setup(drive: DriveConfig | None = None) -> tuple[Controller, Safety]:
     ax = AxisConfig(name="a", lead=10.0, max_speed=1000.0, drive=drive or DriveConfig())
-    ctl = Controller(MachineConfig("t", (ax,), 0, 0, 0.001))
+    ctl = Controller(MachineConfig("t", (ax,), 0, 0, 0.001), safety=False)
     safety = Safety(ctl)
     ctl.enable_all()
     return ctl, safety

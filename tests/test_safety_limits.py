@@ -30,7 +30,7 @@ def machine(logic: str = "no", drive: str = "ideal_stepper") -> MachineConfig:
 
 
 def setup(logic: str = "no") -> tuple[Controller, Safety]:
-    ctl = Controller(machine(logic))
+    ctl = Controller(machine(logic), safety=False)
     safety = Safety(ctl)
     ctl.enable_all()
     return ctl, safety

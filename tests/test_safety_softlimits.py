@@ -23,7 +23,7 @@ S = AxisState
 
 def setup(period: float = 0.001) -> tuple[Controller, Safety]:
     ax = AxisConfig(name="a", lead=10.0, max_speed=1000.0)  # 1e6 pps
-    ctl = Controller(MachineConfig("t", (ax,), 0, 0, period))
+    ctl = Controller(MachineConfig("t", (ax,), 0, 0, period), safety=False)
     safety = Safety(ctl)
     ctl.enable_all()
     return ctl, safety
@@ -218,7 +218,7 @@ def test_enable_before_set_is_refused() -> None:
 
 def test_a_fault_stop_decelerating_towards_a_soft_limit_never_passes_it() -> None:
     ax_cfg = AxisConfig(name="s", lead=10.0, max_speed=1000.0, drive=DriveConfig(type="servo"))
-    ctl = Controller(MachineConfig("t", (ax_cfg,), 0, 0, 0.001))
+    ctl = Controller(MachineConfig("t", (ax_cfg,), 0, 0, 0.001), safety=False)
     safety = Safety(ctl)
     ctl.enable_all()
     safety.set_alm(0, "decel")

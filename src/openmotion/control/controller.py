@@ -52,11 +52,14 @@ class Controller:
     config: the machine (default `default_machine()`); hardware: a back end implementing
     hw.interface.Hardware (default `SimMachine(config)`); period: interpolation period in
     seconds (default config.cycle_s, 1 ms .. 1 s); history_window_s: how much motion history
-    to keep (flat memory).
+    to keep (flat memory); safety: attach the motion I/O reactions (`Safety`: end limits,
+    slow-down, alarm, ERC, soft limits, comparators) as `ctl.safety` — on by default, as on
+    a real card; `safety=False` leaves only E-stop and servo alarm handling.
     """
 
     def __init__(self, config: MachineConfig | None = None, hardware: Hardware | None = None,
-                 *, period: float | None = None, history_window_s: float = 60.0) -> None:
+                 *, period: float | None = None, history_window_s: float = 60.0,
+                 safety: bool = True) -> None:
         if config is None:
             config = default_machine()
         if not isinstance(config, MachineConfig):
@@ -104,6 +107,9 @@ class Controller:
         from .events import EventLog  # faults, limits, latches, home completion, compare
 
         self.events = EventLog(self)
+        from .safety import Safety
+
+        self.safety: Safety | None = Safety(self) if safety else None
 
     # ------------------------------------------------------------------ lookup
     def axis(self, key: int | str) -> Axis:

@@ -1,6 +1,7 @@
 """Motion I/O safety: end limits, slow-down, alarm, E-stop, ERC, INP/SVON/RDY, io_status.
 
-A `Safety` object is attached by the user, once per controller: `safety = Safety(ctl)`.
+Every `Controller` attaches one by default (`ctl.safety`; `Controller(safety=False)` to
+opt out, then `Safety(ctl)` attaches one later; `Safety.of(ctl)` finds it).
 It installs an edge hook, a cycle hook, a fault hook and a motion check on the controller
 (nothing is active before; `detach()` removes them). It owns `safety.soft` (soft limits,
 softlimits.py) and `safety.cmp` (comparators 3 and 4, comparators.py).
@@ -166,6 +167,11 @@ class Safety:
         controller.add_fault_hook(self._on_fault)
         controller.add_motion_check(self._check_motion)
         _INSTALLED[controller] = self
+
+    @staticmethod
+    def of(controller: Controller) -> Safety | None:
+        """The Safety attached to `controller`, or None."""
+        return _INSTALLED.get(controller)
 
     def detach(self) -> None:
         """Remove every hook this object installed (reactions off)."""
