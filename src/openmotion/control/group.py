@@ -7,7 +7,11 @@ command raises `GroupError` (a MotionError) carrying a negative `code` that vend
 return as their own negative value; the queue and the running motion are then unchanged.
 The run-time side (queue execution, hold/continue/override re-planning, faults) is in
 groupexec.py; the path math in pathexec.py. Positions, speeds and accelerations are command
-pulses, pps and pps^2 of the controller axes.
+pulses, pps and pps^2 of the controller axes, or with `units=True` the axes' user units
+(mm, mm/s, mm/s^2: the MCCL mechanism parameters, openmotion.units.AxisUnits): the path is
+then planned in user space, so an arc is a true arc and the feed the true tool speed even
+when the axes have different pulses per unit; each axis's pulses are AxisUnits.to_pulses
+of its coordinate. set_max_pulse_speed/acc stay in pulses (as their MCCL names say).
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ import numpy as np
 from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
 from ..path import Arc, Arc3D, Line
 from ..path.geometry import PathElement
+from ..units import AxisUnits
 from ..profile.pcl import MoveSpec
 from . import pathexec as px
 from .groupexec import (
@@ -78,11 +83,14 @@ class Group(GroupEngine):
     axes: logical name -> controller axis (name or index), or a sequence of controller axes
     (logical names are then the axis names). feed: vector speed (pps); acc_time: time to
     reach the feed (path acceleration = feed / acc_time, default 20 periods as in MCCL).
+    units: False (pulses), True (each axis's AxisUnits from the controller's config) or one
+    AxisUnits per logical axis; positions, feed and accelerations are then in user units.
     """
 
     def __init__(self, controller: Controller, axes: Mapping[str, int | str] | Sequence[int | str],
                  *, feed: float = 10_000.0, acc_time: float | None = None,
-                 queue_size: int = 1024) -> None:
+                 queue_size: int = 1024,
+                 units: bool | Sequence[AxisUnits] = False) -> None:
         if isinstance(axes, Mapping):
             names, keys = list(axes.keys()), list(axes.values())
         elif isinstance(axes, Sequence) and not isinstance(axes, (str, bytes)):
@@ -97,6 +105,7 @@ class Group(GroupEngine):
             raise MotionError("axes must be different controller axes")
         if isinstance(queue_size, bool) or not isinstance(queue_size, int) or queue_size < 1:
             raise MotionError(f"queue_size must be an integer >= 1, got {queue_size!r}")
+        k_units = _unit_scales(controller, ax, units)
         owners = OWNERS.setdefault(controller, {})
         for a in ax:
             if a.index in owners:
@@ -104,6 +113,8 @@ class Group(GroupEngine):
         self._ctl = controller
         self.names = tuple(str(n) for n in names)
         self.axes: tuple[Axis, ...] = tuple(ax)
+        self._k = k_units                       # signed pulses per logical unit, per axis
+        self._ppu = np.abs(k_units)
         self._queue: deque[_Cmd] = deque()
         self._queue_size = queue_size
         self._next_index = 0
@@ -116,13 +127,13 @@ class Group(GroupEngine):
         self._override = 1.0
         self._ptp_override = 1.0
         self._dry = False
-        self._dry_pos = np.array([a.position for a in ax])
+        self._dry_pos = np.array([a.position for a in ax])  # pulses
         self._tail: np.ndarray | None = None   # end position of the last queued command
         self._blend_tol = 0.0
         self._blend = False
         self._feed = 0.0
         self._acc_time = 20.0 * controller.period
-        self._sys_max = float(max(a._max_speed for a in ax))
+        self._sys_max = float(max(a._max_speed / k for a, k in zip(ax, self._ppu, strict=True)))
         self.set_feed(feed)
         if acc_time is not None:
             self.set_acc_time(acc_time)
@@ -168,15 +179,21 @@ class Group(GroupEngine):
 
     @property
     def position(self) -> np.ndarray:
-        """Logical positions (pulses): the axes' command positions, or in dry run the
-        planned positions the pulses would have reached."""
+        """Logical positions (pulses, or user units): the axes' command positions, or in
+        dry run the planned positions the pulses would have reached."""
         if not self._dry:
-            return np.array([a.position for a in self.axes])
+            return self._units_of(np.array([a.position for a in self.axes]))
         r = self._run
         if r is not None and r.profiles:
             u = self._ctl.time - r.t0
-            return np.array([p.state_at(min(max(u, 0.0), p.duration)).p for p in r.profiles])
-        return self._dry_pos.copy()
+            return self._units_of(np.array([p.state_at(min(max(u, 0.0), p.duration)).p
+                                            for p in r.profiles]))
+        return self._units_of(self._dry_pos)
+
+    @property
+    def units(self) -> bool:
+        """Whether logical coordinates are user units (False: command pulses)."""
+        return bool(np.any(self._k != 1.0))
 
     @property
     def override(self) -> float:
@@ -210,7 +227,8 @@ class Group(GroupEngine):
 
     # ------------------------------------------------------------------ settings
     def set_feed(self, feed: float) -> None:
-        """MCC_SetFeedSpeed: vector speed (pps) of the following path commands."""
+        """MCC_SetFeedSpeed: vector speed (pps, or user units/s) of the following path
+        commands."""
         f = check_finite("feed", feed)
         if f <= 0.0:
             raise GroupError(ERR_SPEED, f"feed must be > 0, got {feed!r}")
@@ -220,7 +238,7 @@ class Group(GroupEngine):
         self._feed = f
 
     def set_sys_max_speed(self, speed: float) -> None:
-        """MCC_SetSysMaxSpeed: the largest feed accepted (pps)."""
+        """MCC_SetSysMaxSpeed: the largest feed accepted (pps, or user units/s)."""
         v = check_finite("speed", speed)
         if v <= 0.0:
             raise MotionError(f"speed must be > 0, got {speed!r}")
@@ -509,16 +527,17 @@ class Group(GroupEngine):
             return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
                                    accel=feed / self._acc_time), end)
         tan = el.max_abs_tangent
-        need = feed * tan
-        bad = np.nonzero(need > self._vmax * (1 + 1e-12))[0]
+        vmax, amax = self._caps()
+        need = feed * tan * self._ppu
+        bad = np.nonzero(need > vmax * self._ppu * (1 + 1e-12))[0]
         if len(bad):
             k = int(bad[0])
             raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps at "
                                         f"feed {feed:g}, above its maximum pulse speed "
                                         f"{self._vmax[k]:g} pps")
         accel = feed / self._acc_time
-        needa = accel * tan
-        bad = np.nonzero(needa > self._amax * (1 + 1e-12))[0]
+        needa = accel * tan * self._ppu
+        bad = np.nonzero(needa > amax * self._ppu * (1 + 1e-12))[0]
         if len(bad):
             k = int(bad[0])
             raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} pps^2, "
@@ -535,3 +554,21 @@ class Group(GroupEngine):
         if end is not None:
             self._tail = end.copy()
         return cmd.index
+
+
+def _unit_scales(controller: Controller, axes: Sequence[Axis],
+                 units: bool | Sequence[AxisUnits]) -> np.ndarray:
+    """Signed pulses per logical unit of each axis (all 1.0 when units is False)."""
+    if units is False:
+        return np.ones(len(axes))
+    if units is True:
+        try:
+            au = [AxisUnits.from_axis(controller.config.axes[a.index]) for a in axes]
+        except (AttributeError, IndexError):
+            raise MotionError("units=True needs the controller's machine config") from None
+    elif isinstance(units, Sequence) and not isinstance(units, (str, bytes)) \
+            and len(units) == len(axes) and all(isinstance(u, AxisUnits) for u in units):
+        au = list(units)
+    else:
+        raise MotionError(f"units must be a bool or {len(axes)} AxisUnits, got {units!r}")
+    return np.array([u.sign * u.pulses_per_unit for u in au], dtype=float)

@@ -129,6 +129,26 @@ class GroupEngine:
     _sys_max: float
     _vmax: np.ndarray
     _amax: np.ndarray
+    _k: np.ndarray      # signed pulses per logical unit (1.0: the group works in pulses)
+    _ppu: np.ndarray
+
+    def _units_of(self, pulses: np.ndarray) -> np.ndarray:
+        """Pulse positions -> logical coordinates."""
+        return np.asarray(pulses, dtype=float) / self._k
+
+    def _pulses_of(self, coords: np.ndarray) -> np.ndarray:
+        """Logical coordinates -> pulse positions (AxisUnits.to_pulses per axis)."""
+        return np.asarray(coords, dtype=float) * self._k
+
+    def _caps(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per-axis speed and acceleration caps in logical units (from the pulse caps)."""
+        return self._vmax / self._ppu, self._amax / self._ppu
+
+    def _pulse_profiles(self, profiles: list[Profile]) -> list[Profile]:
+        """Axis profiles planned in logical units -> command pulses."""
+        if np.all(self._k == 1.0):
+            return profiles
+        return [px.scaled(p, float(k)) for p, k in zip(profiles, self._k, strict=True)]
 
     @property
     def position(self) -> np.ndarray:  # defined by Group
@@ -136,8 +156,8 @@ class GroupEngine:
 
     # ------------------------------------------------------------------ execution
     def _limits(self, cmd: _Cmd) -> px.Limits:
-        return px.Limits(min(cmd.feed * self._override, self._sys_max), cmd.accel,
-                         self._vmax, self._amax)
+        vmax, amax = self._caps()
+        return px.Limits(min(cmd.feed * self._override, self._sys_max), cmd.accel, vmax, amax)
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         if self._state is GroupState.ERROR:
@@ -149,7 +169,8 @@ class GroupEngine:
                 a.is_moving for a in self.axes)):
             self._run = None
             if r.kind in ("path", "ptp") and r.target is not None and self._dry:
-                self._dry_pos = r.target.copy()
+                self._dry_pos = self._pulses_of(r.target) if r.kind == "path" \
+                    else r.target.copy()
             if self._state is GroupState.HOLDING:
                 if self._aborting:
                     self._aborting = False
@@ -205,7 +226,7 @@ class GroupEngine:
             if self._blend and self._blend_tol > 0.0 and els and isinstance(els[-1], Line) \
                     and isinstance(el, Line):
                 b = blend_corner(els[-1], el, self._blend_tol)
-                if b is not None and _blend_pays(b, min(c.accel, float(np.min(self._amax))),
+                if b is not None and _blend_pays(b, min(c.accel, float(np.min(self._caps()[1]))),
                                                         c.feed):
                     els[-1] = b.first
                     els.append(b.arc)
@@ -218,7 +239,8 @@ class GroupEngine:
     def _launch_ptp(self, cmd: _Cmd, t: float) -> None:
         assert cmd.target is not None
         profiles = []
-        start = self.position
+        start = self._pulses_of(self.position)
+        target = self._pulses_of(cmd.target)
         for k, a in enumerate(self.axes):
             spec = cmd.specs[k]
             if self._ptp_override != 1.0:
@@ -227,11 +249,11 @@ class GroupEngine:
                                 spec.tacc, spec.tdec, spec.vs_acc, spec.vs_dec)
             if self._dry:
                 profiles.append(planning.position_move(spec, float(start[k]),
-                                                       float(cmd.target[k])))
-            elif cmd.target[k] != a.position:
-                a.move_absolute(float(cmd.target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
+                                                       float(target[k])))
+            elif target[k] != a.position:
+                a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
                                 shape=spec.shape)
-        self._run = _Run("ptp", [cmd], t, profiles=profiles, target=cmd.target)
+        self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
 
     def _extend_running(self, cmd: _Cmd) -> bool:
         """Streaming look-ahead: join a path command queued while a chain runs (nothing
@@ -257,7 +279,7 @@ class GroupEngine:
         if self._blend and self._blend_tol > 0.0 and isinstance(old[-1], Line) \
                 and isinstance(el, Line):
             b = blend_corner(old[-1], el, self._blend_tol)
-            if b is not None and _blend_pays(b, min(cmd.accel, float(np.min(self._amax))),
+            if b is not None and _blend_pays(b, min(cmd.accel, float(np.min(self._caps()[1]))),
                                              cmd.feed) \
                     and s0 < float(r.chain.cum[-2]) + float(b.first.length):
                 options.append((old[:-1] + [b.first, b.arc, b.second],
@@ -279,7 +301,8 @@ class GroupEngine:
         s_end = chain.length
         sprof = px.s_profile(curve, s_end, chain.cum[1:-1].tolist())
         starts = self.position
-        profiles = px.axis_profiles(chain, sprof, self._ctl.period, starts)
+        profiles = self._pulse_profiles(px.axis_profiles(chain, sprof, self._ctl.period,
+                                                         starts))
         if not self._dry:
             self._run_profiles(profiles)
         a_min = min((lim.accel,) + tuple(
@@ -319,10 +342,11 @@ class GroupEngine:
             sprof = px.s_profile(px.SpeedCurve(np.array([s0]), np.array([0.0])), s0, [])
             profiles = [Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
                                 np.zeros(0), 0.0, p_state, p_state) for p_state in
-                        [_rest(x) for x in self.position]]
+                        [_rest(x) for x in self._pulses_of(self.position)]]
         else:
             sprof = px.s_profile(curve, s_end, r.chain.cum[1:-1].tolist())
-            profiles = px.axis_profiles(r.chain, sprof, self._ctl.period, self.position)
+            profiles = self._pulse_profiles(px.axis_profiles(r.chain, sprof, self._ctl.period,
+                                                             self.position))
         if not self._dry:
             self._run_profiles(profiles)
         assert lim is not None

@@ -356,6 +356,14 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     return out
 
 
+def scaled(p: Profile, k: float) -> Profile:
+    """The profile with every position, velocity, acceleration and jerk times k (a change
+    of units; k < 0 also mirrors it)."""
+    return Profile(p.t0, p.p0 * k, p.v0 * k, p.a0 * k, p.j * k, p.duration,
+                   State(p.start.p * k, p.start.v * k, p.start.a * k),
+                   State(p.end.p * k, p.end.v * k, p.end.a * k), p.labels, p.dt)
+
+
 def travel_time(curve: SpeedCurve) -> float:
     """Duration of following `curve` from its start to its end."""
     v = np.sqrt(np.maximum(curve.v2, 0.0))
