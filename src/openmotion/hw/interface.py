@@ -100,3 +100,19 @@ class EffortHardware(Protocol):
         """Hold motor effort `value` (duty, clamped to [-1, 1]) from time t0 (>= the
         hardware time) until the next call. MotionError for an axis without an effort
         output (not a dc_servo axis) or a bad value; nothing changes then."""
+
+
+@runtime_checkable
+class TimedOutputHardware(Protocol):
+    """Optional extension: outputs switched by the hardware at an exact future time (a
+    board's output FIFO / timed compare output), so an edge lands on the physical line at
+    its computed instant instead of at a cycle boundary.
+
+    The control layer checks `isinstance(hw, TimedOutputHardware)` and otherwise falls back
+    to `Hardware.write_output` once per cycle.
+    """
+
+    def write_output_at(self, t: float, axis: int | None, signal: str, level: bool) -> None:
+        """Drive an output (as `write_output`) at time t (>= the hardware time). Writes are
+        executed in time order (equal times in call order) inside `advance`. MotionError for
+        t in the past or a bad signal/level; nothing is scheduled then."""
