@@ -4,6 +4,7 @@ One cycle (period T, from t0 to t1 = t0 + T):
 
 1. every axis with motion hands the hardware the cubic piece of its profile for [t0, t1]
    (evaluated analytically at the cycle ends, never integrated);
+   then the pre-advance hooks run (`add_pre_advance_hook`: timed outputs for [t0, t1]);
 2. `hardware.advance(t1)` moves the machine and returns the input edges, time-ordered;
 3. each edge goes through the edge-hook list (E-stop and servo alarm are the first two;
    limits, latches and compare subscribe with `add_edge_hook`);
@@ -41,6 +42,7 @@ IO_BITS = (("rdy", 0), ("alm", 1), ("pel", 2), ("mel", 3), ("org", 4), ("ez", 9)
 
 EdgeHook = Callable[["Controller", InputEdge], None]
 CycleHook = Callable[["Controller", float], None]
+PreAdvanceHook = Callable[["Controller", float, float], None]
 SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
@@ -88,6 +90,7 @@ class Controller:
         self.history = MotionHistory(len(self.axes), history_window_s, t_start=self._time)
         self._edge_hooks: list[EdgeHook] = [_estop_hook, _alarm_hook]
         self._cycle_hooks: list[CycleHook] = []
+        self._pre_hooks: list[PreAdvanceHook] = []
         self._sample_hooks: list[tuple[SampleHook, int]] = []
         self._samples = 1  # sub-steps per cycle: lcm of the sample hooks' rates
         self._fault_hooks: list[FaultHook] = []
@@ -178,6 +181,21 @@ class Controller:
             if hook in self._cycle_hooks:
                 self._cycle_hooks.remove(hook)
 
+    def add_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
+        """Call `hook(controller, t0, t1)` every cycle after every axis's command for
+        [t0, t1] is set and before `hardware.advance(t1)`: the commanded motion of the
+        coming cycle is known then (the history holds it), so a hook can schedule timed
+        outputs for it (hw.interface.TimedOutputHardware)."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._pre_hooks.append(hook)
+
+    def remove_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
+        with self._lock:
+            if hook in self._pre_hooks:
+                self._pre_hooks.remove(hook)
+
     def add_sample_hook(self, hook: SampleHook, per_cycle: int = 1) -> None:
         """Call `hook(controller, t)` `per_cycle` times per cycle, at t = t0 + k*T/per_cycle
         (k = 0..per_cycle-1), after the cycle's commands are sent and the hardware has been
@@ -258,6 +276,8 @@ class Controller:
                 cmd = ax._command(t0, t1)
                 if cmd is not None:
                     hw.command(ax.index, cmd)
+            for pre in tuple(self._pre_hooks):
+                pre(self, t0, t1)
             edges = hw.advance(t1) if not self._sample_hooks else self._sampled(t0, t1)
             self._n = n
             self._time = t1
