@@ -22,6 +22,7 @@ from openmotion.hw.interface import AXIS_INPUTS, AXIS_OUTPUTS, AxisCommand, Axis
 from .cubic import Cubic
 from .encoder import Decoder, EncoderWiring, default_wiring
 from .mechanics import PitchTable, Transmission
+from .outputs import OutputRecord, TimedOutputs
 from .pieces import JumpPiece, Piece
 from .plant import StepperPlant
 from .pulses import PulseGenerator
@@ -159,6 +160,8 @@ class SimMachine:
         self._di = [False] * config.digital_inputs
         self._do = [False] * config.digital_outputs
         self._pending: list[tuple[float, int | None, str, bool, int | None]] = []
+        self._timed = TimedOutputs()  # do<n> writes at exact times (write_output_at)
+        self.output_record = OutputRecord()  # every output edge at its exact time
         self.scenario = Scenario(self)
 
     # -- Hardware protocol --------------------------------------------------------------------
@@ -202,6 +205,8 @@ class SimMachine:
             ta = tk
         self._run(ta, t, raw)
         self._t = t
+        for tk, _, sig, lv in self._timed.pop_due(t):
+            self._set_do(tk, sig, lv)
         raw.sort(key=lambda e: e[0])
         n = len(self._axes)
         edges = []
@@ -223,13 +228,14 @@ class SimMachine:
         if not isinstance(level, bool):
             raise MotionError(f"level must be a bool, got {level!r}")
         if axis is None:
-            self._do[self._board_index(signal, "do", len(self._do))] = level
+            self._set_do(self._t, signal, level)
             return
         ax = self._axis(axis)
         if signal not in AXIS_OUTPUTS:
             raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, got {signal!r}")
         if ax.outputs[signal] == level:
             return
+        self.output_record.add(self._t, axis, signal, level)
         before = {s: ax.level(s) for s in ("rdy", "inp")}
         ax.outputs[signal] = level
         if ax.is_servo:
@@ -240,6 +246,40 @@ class SimMachine:
         for s, lv in before.items():
             if ax.level(s) != lv:
                 self._pending.append((self._t, axis, s, not lv, ax.decoder.count))
+
+    def write_output_at(self, t: float, axis: int | None, signal: str, level: bool) -> None:
+        """Drive an output at time t >= now (hw.interface.TimedOutputHardware): executed
+        inside `advance` at t exactly (an axis output cuts the run there, as a scenario
+        action does, so the drive sees it at t); `output_record` shows the edge at t."""
+        t = check_finite("t", t)
+        if t < self._t:
+            raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
+        if not isinstance(level, bool):
+            raise MotionError(f"level must be a bool, got {level!r}")
+        if axis is None:
+            self._board_index(signal, "do", len(self._do))
+        else:
+            self._axis(axis)
+            if signal not in AXIS_OUTPUTS:
+                raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, "
+                                  f"got {signal!r}")
+        if t == self._t:
+            self.write_output(axis, signal, level)
+        elif axis is None:
+            self._timed.push(t, None, signal, level)
+        else:
+            self.scenario._push(t, lambda raw: self._timed_axis_output(axis, signal, level, raw))
+
+    def _timed_axis_output(self, axis: int, signal: str, level: bool, raw: list) -> None:
+        self.write_output(axis, signal, level)
+        raw.extend(self._pending)  # RDY/INP edges it caused belong to this advance
+        self._pending.clear()
+
+    def _set_do(self, t: float, signal: str, level: bool) -> None:
+        k = self._board_index(signal, "do", len(self._do))
+        if self._do[k] != level:
+            self._do[k] = level
+            self.output_record.add(t, None, signal, level)
 
     def read_input(self, signal: str) -> bool:
         if signal == "emg":
