@@ -28,8 +28,8 @@ import numpy as np
 from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
 from ..path import Arc, Arc3D, Line
 from ..path.geometry import PathElement
-from ..units import AxisUnits
 from ..profile.pcl import MoveSpec
+from ..units import AxisUnits
 from . import pathexec as px
 from .groupexec import (
     ERR_ACCEL,
@@ -141,6 +141,7 @@ class Group(GroupEngine):
         self._amax = np.full(len(ax), math.inf)
         self._refuse = True
         self._ptp_ratio = 10.0
+        self._path_jerk = 0.0   # 0: T-curve path speed; > 0: S-curve with this path jerk
         self._ptp_shape = "T"
         for a in ax:
             owners[a.index] = self
@@ -284,6 +285,21 @@ class Group(GroupEngine):
 
     def disable_blend(self) -> None:
         self._blend = False
+
+    def set_path_shape(self, shape: str, jerk: float | None = None) -> None:
+        """Speed profile of the following path commands: "T" (constant acceleration,
+        blended chains) or "S" (jerk-limited: the jerk of the path position stays within
+        `jerk`, pps^3 or user units/s^3). S-curve path commands run one at a time with exact
+        stops between them (no blending); a feed override applies from the next command."""
+        if shape not in ("T", "S"):
+            raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
+        if shape == "T":
+            self._path_jerk = 0.0
+            return
+        j = check_finite("jerk", jerk) if jerk is not None else math.nan
+        if not j > 0.0:
+            raise MotionError(f"jerk must be a finite number > 0 for shape 'S', got {jerk!r}")
+        self._path_jerk = j
 
     def set_ptp_speed(self, ratio: float, *, shape: str = "T") -> None:
         """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10)."""
@@ -451,7 +467,8 @@ class Group(GroupEngine):
         r = self._run
         old = self._override
         self._override = p / 100.0
-        if r is not None and r.kind == "path" and self._state is GroupState.MOVING:
+        if r is not None and r.kind == "path" and self._state is GroupState.MOVING \
+                and r.raw is None:  # an S-curve path takes the override from its successor
             try:
                 self._replan(r, hold=False)
             except Exception:
@@ -525,7 +542,7 @@ class Group(GroupEngine):
         feed = self._feed
         if not self._refuse:  # the planner slows the path down to the axis limits
             return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
-                                   accel=feed / self._acc_time), end)
+                                   accel=feed / self._acc_time, jerk=self._path_jerk), end)
         tan = el.max_abs_tangent
         vmax, amax = self._caps()
         need = feed * tan * self._ppu
@@ -543,7 +560,8 @@ class Group(GroupEngine):
             raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} pps^2, "
                                         f"above its maximum pulse acceleration "
                                         f"{self._amax[k]:g} pps^2")
-        return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel), end)
+        return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
+                               jerk=self._path_jerk), end)
 
     def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
         self._check_accepting()

@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import InfeasibleError, MotionError
 from ..path import Line, blend_corner, plan_speeds
 from ..path.geometry import PathElement
+from ..path.smoothing import fir_smooth, jerk_window
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile, State
 from . import pathexec as px
@@ -79,6 +80,7 @@ class _Cmd:
     accel: float = 0.0
     specs: tuple[MoveSpec, ...] = ()
     seconds: float = 0.0
+    jerk: float = 0.0              # path jerk limit (0: T-curve)
 
 
 @dataclass
@@ -96,6 +98,8 @@ class _Run:
     a_min: float = 0.0
     t_until: float = 0.0
     target: np.ndarray | None = None
+    raw: Profile | None = None     # S-curve: the T-curve s(t) the filter smooths
+    tj: float = 0.0                # S-curve: the filter window
 
     @property
     def t_end(self) -> float:
@@ -209,7 +213,8 @@ class GroupEngine:
             self._launch_ptp(cmd, t)
         else:
             cmds = [cmd]
-            while self._queue and self._queue[0].kind == "path" \
+            while self._queue and self._queue[0].kind == "path" and not cmd.jerk \
+                    and not self._queue[0].jerk \
                     and self._queue[0].feed == cmd.feed and self._queue[0].accel == cmd.accel:
                 cmds.append(self._queue.popleft())
             chain = self._chain(cmds)
@@ -265,7 +270,8 @@ class GroupEngine:
         r = self._run
         if (r is None or r.kind != "path" or self._state is not GroupState.MOVING
                 or self._queue or cmd.kind != "path" or r.chain is None or r.sprof is None
-                or cmd.feed != r.cmds[0].feed or cmd.accel != r.cmds[0].accel):
+                or cmd.feed != r.cmds[0].feed or cmd.accel != r.cmds[0].accel
+                or cmd.jerk or r.cmds[0].jerk):
             return False
         t = self._ctl.time
         u = t - r.t0
@@ -300,6 +306,12 @@ class GroupEngine:
                      lim: px.Limits, t: float) -> None:
         s_end = chain.length
         sprof = px.s_profile(curve, s_end, chain.cum[1:-1].tolist())
+        raw, tj = None, 0.0
+        if cmds[0].jerk:  # S-curve: smooth s(t) (one element, from rest; see path/smoothing)
+            raw = sprof
+            amax = float(np.max(np.abs(raw.a0))) if raw.n_segments else lim.accel
+            tj = jerk_window(amax, cmds[0].jerk)
+            sprof = fir_smooth(raw, tj)
         starts = self.position
         profiles = self._pulse_profiles(px.axis_profiles(chain, sprof, self._ctl.period,
                                                          starts))
@@ -308,7 +320,7 @@ class GroupEngine:
         a_min = min((lim.accel,) + tuple(
             x for x in _accels(chain, lim)))
         self._run = _Run("path", cmds, t, chain, curve, sprof, profiles, lim, a_min,
-                         target=np.array(chain.elements[-1].end))
+                         target=np.array(chain.elements[-1].end), raw=raw, tj=tj)
 
     def _run_profiles(self, profiles: list[Profile]) -> None:
         for a, p in zip(self.axes, profiles, strict=True):
@@ -324,6 +336,9 @@ class GroupEngine:
         st = r.sprof.state_at(min(max(u, 0.0), r.sprof.duration))
         s0, v0 = st.p, max(0.0, st.v)
         if u >= r.sprof.duration:
+            return
+        if r.raw is not None:
+            self._hold_scurve(r, t, u)
             return
         if hold:
             curve = px.hold_curve(r.curve, s0, v0, r.a_min)
@@ -352,6 +367,29 @@ class GroupEngine:
         assert lim is not None
         self._run = _Run("path", r.cmds, t, r.chain, curve, sprof, profiles, lim, r.a_min,
                          target=r.target)
+
+    def _hold_scurve(self, r: _Run, t: float, u: float) -> None:
+        """Hold an S-curve path: the T-curve under the filter decelerates from its own state
+        now, and the filter (same window) keeps running over old + new, so acceleration stays
+        continuous and the jerk within the limit."""
+        assert r.raw is not None and r.curve is not None and r.chain is not None
+        rs = r.raw.state_at(u)
+        s0, v0 = rs.p, max(0.0, rs.v)
+        tail: Profile
+        if v0 > 0.0 and u < r.raw.duration:
+            curve = px.hold_curve(r.curve, s0, v0, r.a_min)
+            s_end = px.stop_point(curve)
+            tail = px.s_profile(curve, s_end, []) if s_end > s0 else _still(s0)
+        else:
+            curve, tail = r.curve, _still(r.raw.end.p if u >= r.raw.duration else s0)
+        raw = r.raw.splice(u, tail)
+        sprof = fir_smooth(raw, r.tj, t_out=u)
+        profiles = self._pulse_profiles(px.axis_profiles(r.chain, sprof, self._ctl.period,
+                                                         self.position))
+        if not self._dry:
+            self._run_profiles(profiles)
+        self._run = _Run("path", r.cmds, t, r.chain, curve, sprof, profiles, r.limits, r.a_min,
+                         target=r.target, raw=_rebased(raw, u), tj=r.tj)
 
     def _on_axis_fault(self, axis: Axis, reason: str) -> None:
         """Controller fault hook: a group axis went to ErrorStop."""
@@ -391,6 +429,28 @@ class GroupEngine:
 
 def _rest(p: float) -> State:
     return State(float(p), 0.0, 0.0)
+
+
+def _still(p: float) -> Profile:
+    return Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), 0.0,
+                   _rest(p), _rest(p), (), np.zeros(0))
+
+
+def _rebased(p: Profile, u: float) -> Profile:
+    """A constant-acceleration profile with time u as its new zero (the past dropped)."""
+    dts = p.dt if p.dt is not None else np.diff(np.append(p.t0, p.duration))
+    keep = p.t0 + dts > u
+    st = p.state_at(u)
+    t0 = np.maximum(p.t0[keep] - u, 0.0)
+    dt = dts[keep].copy()
+    p0, v0 = p.p0[keep].copy(), p.v0[keep].copy()
+    if len(t0):
+        dt[0] = float(p.t0[keep][0]) + float(dt[0]) - u if p.t0[keep][0] < u else dt[0]
+        if p.t0[keep][0] < u:
+            p0[0], v0[0] = st.p, st.v
+    labels = tuple(lb for lb, k in zip(p.labels, keep, strict=False) if k)
+    return Profile(t0, p0, v0, p.a0[keep].copy(), p.j[keep].copy(), max(0.0, p.duration - u),
+                   State(st.p, st.v, st.a), p.end, labels, dt)
 
 
 def _accels(chain: px.Chain, lim: px.Limits) -> list[float]:
