@@ -103,6 +103,28 @@ class EffortHardware(Protocol):
 
 
 @runtime_checkable
+class EdgeStopHardware(Protocol):
+    """Optional extension: the pulse output stops by itself at an input edge, at the edge's
+    exact time, as a PCL6045 does at EL/EMG/ALM (HSL-4XMO 3.3, 4.8) - not one cycle later.
+
+    The control layer arms it (control/safety.py) and, when an immediate stop follows an
+    edge, asks `stop_time` whether the hardware already cut the pulses there, so that its
+    command position and history end at the same instant.
+    """
+
+    def arm_stop(self, axis: int | None, signal: str, level: bool | None,
+                 direction: int = 0) -> None:
+        """When input `signal` of `axis` changes to electrical `level` while the axis moves
+        in `direction` (+1, -1; 0 = either), stop that axis's pulse output at once (the
+        command holds where it was at the edge). `axis` None with `signal` "emg": every
+        axis. `level` None disarms."""
+
+    def stop_time(self, axis: int) -> float | None:
+        """Time at which an armed stop cut the pulse output of `axis` during the last
+        `advance`, or None."""
+
+
+@runtime_checkable
 class TimedOutputHardware(Protocol):
     """Optional extension: outputs switched by the hardware at an exact future time (a
     board's output FIFO / timed compare output), so an edge lands on the physical line at
