@@ -13,6 +13,7 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 
 from __future__ import annotations
 
+import copy
 from typing import TYPE_CHECKING
 
 from openmotion.config import DRIVE_TYPES, AxisConfig, MachineConfig
@@ -78,6 +79,9 @@ class _Axis:
         self.switches["ez"] = IndexSwitch(float(cfg.pulses_per_rev), ez_width, self.y)
         self.outputs = {s: False for s in AXIS_OUTPUTS}
         self.alarm = False
+        # armed edge stops: signal -> (electrical level, direction 0/+1/-1); see arm_stop
+        self.armed: dict[str, tuple[bool, int]] = {}
+        self.stop_time: float | None = None
         # pieces of the current run, with the state at each piece's start (for peeks)
         self.record: list[tuple[Piece, float, tuple[int, int, int]]] = []
         self.run_start: tuple[float, tuple[int, int, int]] = (self.trans.z, self._dec_state())
@@ -155,6 +159,7 @@ class SimMachine:
         self._axes = [_Axis(i, a, wiring.get(i)) for i, a in enumerate(config.axes)]
         self._t = 0.0
         self._emg_active = False
+        self._emg_armed: bool | None = None  # level at which EMG cuts every axis's pulses
         # EMG is a board input; its contact type may be given in any axis's logic table
         self._emg_nc = any(a.logic.get("emg") == "nc" for a in config.axes)
         self._di = [False] * config.digital_inputs
@@ -197,6 +202,8 @@ class SimMachine:
         raw = self._pending
         self._pending = []
         ta = self._t
+        for ax in self._axes:
+            ax.stop_time = None
         for tk, action in self.scenario.pop_due(t):
             tk = max(tk, ta)
             self._run(ta, tk, raw)
@@ -295,6 +302,31 @@ class SimMachine:
                               f"{ax.cfg.drive.type!r}, needs 'dc_servo')")
         ax.plant.set_effort(self._t, t0, value)
 
+    def arm_stop(self, axis: int | None, signal: str, level: bool | None,
+                 direction: int = 0) -> None:
+        """Cut the pulse output at the exact time `signal` goes to electrical `level`
+        (hw.interface.EdgeStopHardware); `level` None disarms."""
+        if level is not None and not isinstance(level, bool):
+            raise MotionError(f"level must be a bool or None, got {level!r}")
+        if direction not in (-1, 0, 1) or isinstance(direction, bool):
+            raise MotionError(f"direction must be -1, 0 or 1, got {direction!r}")
+        if axis is None:
+            if signal != "emg":
+                raise MotionError(f"signal must be 'emg' for axis None, got {signal!r}")
+            self._emg_armed = level
+            return
+        ax = self._axis(axis)
+        if signal not in AXIS_INPUTS:
+            raise MotionError(f"signal must be one of {AXIS_INPUTS}, got {signal!r}")
+        if level is None:
+            ax.armed.pop(signal, None)
+        else:
+            ax.armed[signal] = (level, direction)
+
+    def stop_time(self, axis: int) -> float | None:
+        """When an armed stop cut the pulses of `axis` in the last advance, else None."""
+        return self._axis(axis).stop_time
+
     # -- extras for tests and tools ---------------------------------------------------------
     def read_output(self, axis: int | None, signal: str) -> bool:
         """Level last written to an output (`svon`/`erc` of an axis, or `do<n>`)."""
@@ -353,11 +385,88 @@ class SimMachine:
     def _run(self, ta: float, tb: float, raw: list) -> None:
         """Move every axis over [ta, tb], appending raw edges."""
         for ax in self._axes:
-            pieces = ax.plant.pieces(ax.gen, ta, tb)
-            if pieces:
-                self._scan(ax, pieces, raw)
-            if ax.is_servo:
-                ax.plant.status_edges(ax, ta, tb, raw)
+            armed = [s for s in ax.armed if s in ax.switches and s != "ez"]
+            if armed and not ax.is_dc and ax.gen.te > ta:
+                self._run_armed(ax, ta, tb, raw, armed)
+            else:
+                self._run_axis(ax, ta, tb, raw, ax.plant.pieces(ax.gen, ta, tb))
+
+    def _run_axis(self, ax: _Axis, ta: float, tb: float, raw: list,
+                  pieces: list[Piece]) -> None:
+        if pieces:
+            self._scan(ax, pieces, raw)
+        if ax.is_servo:
+            ax.plant.status_edges(ax, ta, tb, raw)
+
+    def _run_armed(self, ax: _Axis, ta: float, tb: float, raw: list, armed: list[str]
+                   ) -> None:
+        """`_run` for an axis with an armed switch: find the first armed edge on the
+        pieces without touching the switches; if there is one, run again up to its time
+        (plant and count restored), hold the command there, and run on to tb."""
+        saved = (ax.gen.count, copy.copy(ax.plant))
+        pieces = ax.plant.pieces(ax.gen, ta, tb)
+        hit = self._first_armed(ax, pieces, armed)
+        if hit is None:
+            self._run_axis(ax, ta, tb, raw, pieces)
+            return
+        ts, sig = hit
+        ax.gen.count, ax.plant = saved
+        n0 = len(raw)
+        self._run_axis(ax, ta, ts, raw, ax.plant.pieces(ax.gen, ta, ts))
+        if not any(e[1] == ax.index and e[2] == sig for e in raw[n0:]):
+            # rounding left the motor a hair short of the switch: the edge is at ts
+            sw = ax.switches[sig]
+            sw.active = not sw.active
+            raw.append((ts, ax.index, sig, ax.level(sig), ax.decoder.count))
+        self._cut_pulses(ax, ts)
+        self._run_axis(ax, ts, tb, raw, ax.plant.pieces(ax.gen, ts, tb))
+
+    def _first_armed(self, ax: _Axis, pieces: list[Piece], armed: list[str]
+                     ) -> tuple[float, str] | None:
+        """(time, signal) of the first armed switch edge on `pieces` (a dry scan)."""
+        trans = ax.trans
+        dry = {s: copy.copy(ax.switches[s]) for s in armed}
+        z, y = trans.z, ax.y
+        for p in pieces:
+            d = p.direction
+            if d == 0:
+                continue
+            z1 = trans.z_after(z, p.m1, d)
+            y1 = trans.y_of(z1)
+            best: tuple[float, str] | None = None
+            for s, sw in dry.items():
+                level, want = ax.armed[s]
+                yy = y
+                for _ in range(_MAX_TOGGLES):
+                    thr = sw.next_threshold(yy, d)
+                    if thr is None or (y1 < thr if d > 0 else y1 >= thr):
+                        break
+                    sw.active = not sw.active
+                    if (sw.active != ax.nc[s]) == level and want in (0, d):
+                        t = p.time_at(trans.motor_level(thr, d))[0]
+                        if best is None or t < best[0]:
+                            best = (t, s)
+                        break
+                    yy = thr
+            if best is not None:
+                return best
+            z, y = z1, y1
+        return None
+
+    def _cut_pulses(self, ax: _Axis, t: float) -> None:
+        """The pulse output of `ax` stops at time t: the command holds its value there."""
+        ax.gen.set(Cubic(ax.gen.pos(t)), t, t)
+        ax.stop_time = t
+
+    def _armed_hit(self, ax: _Axis, sig: str, level: bool) -> None:
+        """An input of `ax` changed at the current time: cut the pulses if armed."""
+        arm = ax.armed.get(sig)
+        if arm is None or arm[0] != level:
+            return
+        v = ax.gen.vel(self._t)
+        d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
+        if arm[1] in (0, d):
+            self._cut_pulses(ax, self._t)
 
     def _scan(self, ax: _Axis, pieces: list[Piece], raw: list) -> None:
         trans = ax.trans
@@ -399,6 +508,7 @@ class SimMachine:
         lv = ax.level(sig)
         if lv != before:
             raw.append((self._t, ax.index, sig, lv, ax.decoder.count))
+            self._armed_hit(ax, sig, lv)
 
     def _place(self, axis: int, signal: str, spec: tuple[float, float, float] | None,
                raw: list) -> None:
@@ -429,6 +539,9 @@ class SimMachine:
         lv = self.read_input("emg")
         if lv != before:
             raw.append((self._t, None, "emg", lv, None))
+            if self._emg_armed is not None and lv == self._emg_armed:
+                for ax in self._axes:
+                    self._cut_pulses(ax, self._t)
 
     def _set_di(self, signal: str, level: bool, raw: list) -> None:
         k = self._board_index(signal, "di", len(self._di))
