@@ -192,6 +192,7 @@ class Axis:
                 self._replace(m, planning.decel_stop(m, t, None), m.spec, None, kind="stop")
             else:
                 self._kill_motion()
+                self._cut_at_hardware_stop(m, at)
             self._fault = reason
             #: when the fault happened: the edge's exact time if given, else now
             self.fault_time = self._ctl.time if at is None else float(at)
@@ -512,6 +513,18 @@ class Axis:
         self._motion = None
         self._vel = 0.0
         self._ctl._motion_changed(self, None)
+
+    def _cut_at_hardware_stop(self, m: ActiveMotion | None, at: float | None) -> None:
+        """The hardware cut the pulses itself at the edge time `at` (EdgeStopHardware):
+        the command position and the history end there too, not at the cycle end."""
+        stop_time = getattr(self._ctl.hardware, "stop_time", None)
+        if m is None or at is None or stop_time is None:
+            return
+        ts = stop_time(self.index)
+        if ts is None or abs(ts - float(at)) > 1e-9 or ts < m.t_start:
+            return
+        self._pos = m.state(ts)[0]
+        self._ctl.history.truncate(self.index, ts)
 
     # -- cycle hooks (called by the controller, lock held) --------------------------------
     def _command(self, t0: float, t1: float) -> AxisCommand | None:
