@@ -432,7 +432,7 @@ def _estop_hook(ctl: Controller, edge: InputEdge) -> None:
         ctl._estop = active
         if active:
             for ax in ctl.axes:
-                ax.fault_stop("emergency stop")
+                ax.fault_stop("emergency stop", at=edge.time)
 
 
 def _alarm_hook(ctl: Controller, edge: InputEdge) -> None:
