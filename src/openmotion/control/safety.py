@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from ..errors import InfeasibleError, MotionError, check_nonnegative
-from ..hw.interface import InputEdge
+from ..hw.interface import EdgeStopHardware, InputEdge
 from .comparators import Comparators
 from .softlimits import SoftLimits
 from .states import AxisState
@@ -86,6 +86,7 @@ class AxisSafety:
     sd_latched: bool = False
     erc_width: float = 0.0       # s; 0 = no automatic ERC pulse
     rdy_required: bool = False
+    edge_stop: bool = False      # immediate EL/ALM stops cut the pulses in the hardware
     suspended: set[str] = field(default_factory=set)
 
 
@@ -167,6 +168,12 @@ class Safety:
         controller.add_fault_hook(self._on_fault)
         controller.add_motion_check(self._check_motion)
         _INSTALLED[controller] = self
+        hw = controller.hardware
+        self._hw_stop = isinstance(hw, EdgeStopHardware)
+        if self._hw_stop:
+            hw.arm_stop(None, "emg", not controller._emg_level_active(False))
+        for i in range(n):
+            self._arm(i)
 
     @staticmethod
     def of(controller: Controller) -> Safety | None:
@@ -181,6 +188,28 @@ class Safety:
         c.remove_fault_hook(self._on_fault)
         c.remove_motion_check(self._check_motion)
         _INSTALLED.pop(c, None)
+        if self._hw_stop:
+            c.hardware.arm_stop(None, "emg", None)
+            for i in range(len(c.axes)):
+                for sig in ("pel", "mel", "alm"):
+                    c.hardware.arm_stop(i, sig, None)
+            self._hw_stop = False
+
+    def _arm(self, i: int) -> None:
+        """Arm the hardware's own edge stops (EdgeStopHardware) as the settings say:
+        immediate EL stops (direction-sensitive: the limit ahead only) and immediate ALM
+        stops; decelerating stops and suspended limits stay with the cycle-level reaction."""
+        if not self._hw_stop:
+            return
+        hw = self.ctl.hardware
+        c = self._cfg[i]
+        cfg = self.ctl.axes[i].config
+        for sig, sgn in (("pel", 1), ("mel", -1)):
+            on = c.edge_stop and c.el_enabled and not c.el_decelerate and sig not in c.suspended
+            d = sgn if c.el_direction_sensitive else 0
+            hw.arm_stop(i, sig, (cfg.signal_logic(sig) != "nc") if on else None, d)
+        on = c.edge_stop and not self.ctl.axes[i].alarm_decelerate
+        hw.arm_stop(i, "alm", (cfg.signal_logic("alm") != "nc") if on else None, 0)
 
     # ------------------------------------------------------------------ settings
     def _idx(self, axis: int | str) -> int:
@@ -191,13 +220,14 @@ class Safety:
         c = self._cfg[self._idx(axis)]
         return AxisSafety(c.el_enabled, c.el_decelerate, c.el_direction_sensitive,
                           c.sd_enabled, c.sd_latched, c.erc_width, c.rdy_required,
-                          set(c.suspended))
+                          c.edge_stop, set(c.suspended))
 
     def set_el(self, axis: int | str, mode: str | int) -> None:
         """HSL_M_set_el: stop mode at an end limit, "immediate" (0) or "decel" (1: to StrVel
         then stop)."""
         i = self._idx(axis)
         self._cfg[i].el_decelerate = _mode(mode, "mode")
+        self._arm(i)
 
     def set_limit_check(self, axis: int | str, enabled: bool = True, *,
                         direction_sensitive: bool = True) -> None:
@@ -208,6 +238,18 @@ class Safety:
         _bool("direction_sensitive", direction_sensitive)
         self._cfg[i].el_enabled = enabled
         self._cfg[i].el_direction_sensitive = direction_sensitive
+        self._arm(i)
+
+    def set_edge_stop(self, axis: int | str, enabled: bool) -> bool:
+        """Let the hardware cut this axis's pulses at the exact EL / ALM edge time (immediate
+        modes; a PCL6045 does). Off by default: an axis of an interpolating group would stop
+        at the edge while the others stop at the cycle end (off the path by up to v*T).
+        Returns whether the hardware can (EdgeStopHardware); E-stop is always armed."""
+        _bool("enabled", enabled)
+        i = self._idx(axis)
+        self._cfg[i].edge_stop = enabled
+        self._arm(i)
+        return self._hw_stop
 
     def set_sd(self, axis: int | str, enabled: bool, *, latched: bool = False) -> None:
         """HSL_M_set_sd: slow-down on/off, level (default) or latched mode. The SD logic is
@@ -224,6 +266,7 @@ class Safety:
         """HSL_M_set_alm mode: "immediate" (0) or "decel" (1) stop on a servo alarm."""
         ax = self.ctl.axis(axis)
         ax.alarm_decelerate = _mode(mode, "mode")
+        self._arm(ax.index)
 
     def set_erc(self, axis: int | str, width: float) -> None:
         """HSL_M_set_erc: ERC one-shot width in seconds (0 = no automatic pulse)."""
@@ -253,10 +296,12 @@ class Safety:
         (homing that uses a limit); `resume` turns it back on."""
         i = self._idx(axis)
         self._cfg[i].suspended.add(_signal(signal))
+        self._arm(i)
 
     def resume(self, axis: int | str, signal: str) -> None:
         i = self._idx(axis)
         self._cfg[i].suspended.discard(_signal(signal))
+        self._arm(i)
 
     @contextlib.contextmanager
     def suspended(self, axis: int | str, *signals: str) -> Iterator[None]:
@@ -266,10 +311,12 @@ class Safety:
         i = self._idx(axis)
         before = set(self._cfg[i].suspended)
         self._cfg[i].suspended |= set(signals)
+        self._arm(i)
         try:
             yield
         finally:
             self._cfg[i].suspended = before
+            self._arm(i)
 
     def _is_suspended(self, axis: int, signal: str) -> bool:
         return signal in self._cfg[axis].suspended
