@@ -280,24 +280,6 @@ def test_event_log_export_and_plot(tmp_path):
         eng.log.save_csv(tmp_path / "log.txt")
 
 
-def test_physical_line_follows_at_cycle_granularity():
-    c = machine(1)
-    eng = CompareEngine(c)
-    eng.add(LevelJob(AxisSource(0), [100.0], Pulse(2, 5e-6)))  # shorter than a cycle
-    eng.add(LevelJob(AxisSource(0), [200.0, 300.0], Toggle(3)))
-    seen = []
-    c.add_cycle_hook(lambda ctl, t: seen.append((ctl.hardware.read_output(None, "do2"),
-                                                 ctl.hardware.read_output(None, "do3"))))
-    c.axes[0].move_relative(400, max_vel=10_000, tacc=0.01, tdec=0.01)
-    run(c)
-    do2 = [s[0] for s in seen]
-    assert sum(do2) == 1 and not do2[-1]  # the 5 us pulse is shown for exactly one cycle
-    widths = eng.output(2).pulse_widths()
-    np.testing.assert_allclose(widths, [5e-6], atol=1e-12)
-    do3 = [s[1] for s in seen]
-    assert do3[0] is False and do3[-1] is False and any(do3)
-
-
 def test_bad_input_is_refused_and_running_job_unchanged():
     c = machine(2)
     eng = CompareEngine(c, buffer_size=10, outputs=[0, 1])

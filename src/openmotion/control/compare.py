@@ -5,7 +5,15 @@ in compare_math.py / compare_roots.py; outputs and the event log in compare_io.p
 
 Attached to a Controller through a cycle hook. At the end of each cycle [t0, t1] it takes
 the motion just executed from the MotionHistory and finds, for every active job, every
-trigger in (t0, t1] at its exact time (architecture.md "Events are located exactly"):
+trigger in (t0, t1] at its exact time (architecture.md "Events are located exactly").
+
+On hardware with timed outputs (hw.interface.TimedOutputHardware, e.g. the simulator) the
+jobs on command positions (DPOS axes, vector distance) run earlier, in the controller's
+pre-advance hook: the commanded motion of (t0, t1] is in the history before the hardware
+executes it, so their output edges are handed to the hardware with `write_output_at` and
+land on the physical line at their exact times (compare_io.OutputLine.send). MPOS jobs
+need the encoder at t1 and stay after the cycle (their edges reach the line at the cycle
+end). The event log is the same either way.
 
 - sources: `AxisSource(axis, "dpos")` = command position in the command-counter frame;
   `AxisSource(axis, "mpos")` = feedback position in the feedback-counter frame (see
@@ -76,18 +84,28 @@ Array = NDArray[np.float64]
 class SpeedPwm:
     """Duty-cycle output following the path speed (see CompareEngine.add_speed_pwm)."""
 
-    def __init__(self, source: VectorSource, output: int, full_speed: float) -> None:
+    def __init__(self, source: VectorSource, output: int, full_speed: float,
+                 per_cycle: int = 1) -> None:
         self.source = source
         self.output = output
         self.full_speed = full_speed
-        self.duties: list[tuple[float, float]] = []  # (cycle start, duty) for plots/tests
+        self.per_cycle = per_cycle
+        self.duties: list[tuple[float, float]] = []  # (PWM period start, duty) for plots/tests
 
-    def apply(self, line: OutputLine, t: float, period: float, speed: float) -> None:
-        duty = min(max(speed / self.full_speed, 0.0), 1.0)
-        self.duties.append((t, duty))
-        line.set(t, duty > 0.0)
-        if 0.0 < duty < 1.0:
-            line.set(t + duty * period, False)
+    def apply(self, line: OutputLine, vc: VectorCycle, s0: float, t0: float,
+              t1: float) -> None:
+        """PWM periods of (t0, t1] (per_cycle equal ones), each with the duty of the mean
+        path speed over that period: its length increment / (period * full_speed)."""
+        n = self.per_cycle
+        tb = [t0 + (t1 - t0) * k / n for k in range(n)] + [t1]
+        s = [s0] + [vc.at(t) for t in tb[1:-1]] + [vc.end]
+        for k in range(n):
+            a, period = tb[k], tb[k + 1] - tb[k]
+            duty = min(max((s[k + 1] - s[k]) / (period * self.full_speed), 0.0), 1.0)
+            self.duties.append((a, duty))
+            line.set(a, duty > 0.0)
+            if 0.0 < duty < 1.0:
+                line.set(a + duty * period, False)
 
 
 # ---------------------------------------------------------------------------- engine
@@ -124,11 +142,21 @@ class CompareEngine:
         self._vcycles: dict[VectorSource, VectorCycle] = {}
         self._mpos_e1: dict[int, float] = {}
         self._win = (self._t_last, self._t_last)
+        from ..hw.interface import TimedOutputHardware
+
+        #: DPOS/vector jobs run before the hardware advances; edges go out at exact times
+        self.timed = isinstance(controller.hardware, TimedOutputHardware)
+        self._t_pre = self._t_last
+        self._pre_rows: list[tuple[float, int, int, float, int, int]] = []
+        self._pre_pos: list[Array] = []
         controller.add_cycle_hook(self._on_cycle)
+        if self.timed:
+            controller.add_pre_advance_hook(self._pre_advance)
 
     def detach(self) -> None:
         """Stop running (the jobs stay as they are)."""
         self.ctl.remove_cycle_hook(self._on_cycle)
+        self.ctl.remove_pre_advance_hook(self._pre_advance)
 
     # ------------------------------------------------------------------ outputs
     def check_output(self, number: int) -> int:
@@ -233,14 +261,20 @@ class CompareEngine:
         self._vectors[source] = check_finite("value", value)
 
     # ------------------------------------------------------------------ speed-following PWM
-    def add_speed_pwm(self, source: VectorSource, output: int, full_speed: float) -> SpeedPwm:
-        """Laser-power-style output: a PWM at the cycle rate on `output` whose duty follows
-        the path speed of `source` (duty = speed / full_speed, capped at 1). The duty of a
-        cycle is the mean speed of the cycle before (the one just executed)."""
+    def add_speed_pwm(self, source: VectorSource, output: int, full_speed: float, *,
+                      per_cycle: int = 1) -> SpeedPwm:
+        """Laser-power-style output: a PWM of `per_cycle` periods per control cycle on
+        `output` whose duty follows the path speed of `source` (duty = mean speed over the
+        PWM period / full_speed, capped at 1). On timed hardware the duty is that of the
+        period itself (the coming motion is known) and the edges are exact; otherwise the
+        periods of a cycle are computed after it, so they come out one cycle late."""
         if not isinstance(source, VectorSource):
             raise MotionError(f"source must be a VectorSource, got {source!r}")
         self.check_output(output)
-        pwm = SpeedPwm(source, output, check_positive("full_speed", full_speed))
+        if isinstance(per_cycle, bool) or not isinstance(per_cycle, int) or \
+                not 1 <= per_cycle <= 1000:
+            raise MotionError(f"per_cycle must be an int in [1, 1000], got {per_cycle!r}")
+        pwm = SpeedPwm(source, output, check_positive("full_speed", full_speed), per_cycle)
         self.track_vector(source)
         self.output(output)
         self._pwms.append(pwm)
@@ -305,19 +339,18 @@ class CompareEngine:
         return vc
 
     # ------------------------------------------------------------------ the cycle
-    def _on_cycle(self, ctl: Controller, t1: float) -> None:
-        ta = self._t_last
-        self._t_last = t1
-        if t1 <= ta:
-            return
+    def _begin(self, ta: float, t1: float) -> None:
         self._win = (ta, t1)
         self._tracks = {}
         self._ranges: dict[AxisSource, tuple[float, float]] = {}
         self._vcycles = {}
-        self._mpos_e1 = {a: self._mpos_error(a) for a in self._mpos_err}
+
+    def _scan(self, pre: bool | None, ta: float, t1: float
+              ) -> list[tuple[float, int, int, float, int, int]]:
+        """Run the jobs (pre True: command-position ones, False: MPOS ones, None: all)."""
         rows: list[tuple[float, int, int, float, int, int]] = []
         for job in list(self._jobs.values()):
-            if not job.active:
+            if not job.active or (pre is not None and _on_command(job) != pre):
                 continue
             for tf, idx, val in job.scan(self, ta, t1):
                 state = job.action.apply(self, tf, job.hits)
@@ -326,21 +359,82 @@ class CompareEngine:
             if job.done:
                 self._jobs.pop(job.id, None)
                 job.active = False
+        return rows
+
+    def _positions(self, rows: list[tuple[float, int, int, float, int, int]]) -> Array:
+        times = np.array([r[0] for r in rows])
+        return np.column_stack([positions(self.track(AxisSource(a)), times)
+                                for a in range(len(self.ctl.axes))])
+
+    def _vectors_end(self, ta: float, t1: float) -> None:
+        """Speed PWMs over (ta, t1], then every VECTOR_MOVED to its value at t1."""
         for pwm in self._pwms:
-            speed = (self.vector_cycle(pwm.source).end - self._vectors[pwm.source]) / (t1 - ta)
-            pwm.apply(self.output(pwm.output), t1, t1 - ta, speed)
+            s0 = self._vectors[pwm.source]
+            vc = self.vector_cycle(pwm.source)
+            if self.timed:
+                pwm.apply(self.output(pwm.output), vc, s0, ta, t1)
+            else:  # the cycle already ran: its PWM periods are played in the next one
+                d = t1 - ta
+                pwm.apply(self.output(pwm.output), _Shifted(vc, d), s0, t1, t1 + d)
         for src in self._vectors:
             self._vectors[src] = self.vector_cycle(src).end
-        self._mpos_err.update(self._mpos_e1)
+
+    def _pre_advance(self, ctl: Controller, t0: float, t1: float) -> None:
+        """Timed hardware, before it runs (t0, t1]: command-position jobs, exact edges."""
+        ta = self._t_pre
+        self._t_pre = t1
+        if t1 <= ta:
+            return
+        self._begin(ta, t1)
+        rows = self._scan(True, ta, t1)
         if rows:
-            rows.sort(key=lambda r: r[0])
-            times = np.array([r[0] for r in rows])
-            pos = np.column_stack([positions(self.track(AxisSource(a)), times)
-                                   for a in range(len(ctl.axes))])
-            self.log.add(rows, pos)
+            self._pre_rows.extend(rows)
+            self._pre_pos.extend(self._positions(rows))
+        self._vectors_end(ta, t1)
+        hw = ctl.hardware
+        for line in self._lines.values():
+            line.send(hw, ta, t1)
+
+    def _on_cycle(self, ctl: Controller, t1: float) -> None:
+        ta = self._t_last
+        self._t_last = t1
+        if t1 <= ta:
+            return
+        self._begin(ta, t1)
+        self._mpos_e1 = {a: self._mpos_error(a) for a in self._mpos_err}
+        rows = self._scan(False if self.timed else None, ta, t1)
+        if not self.timed:
+            self._vectors_end(ta, t1)
+        self._mpos_err.update(self._mpos_e1)
+        pos = list(self._positions(rows)) if rows else []
+        if self._pre_rows:
+            rows = self._pre_rows + rows
+            pos = self._pre_pos + pos
+            self._pre_rows, self._pre_pos = [], []
+        if rows:
+            order = sorted(range(len(rows)), key=lambda k: rows[k][0])
+            self.log.add([rows[k] for k in order], np.array([pos[k] for k in order]))
         hw = ctl.hardware
         keep = t1 - ctl.history.window_s  # waveforms are kept as long as the motion history
         for line in self._lines.values():
             line.flush(hw, ta, t1)
             if line._t and line._t[0] < keep:
                 line.forget_before(keep)
+
+
+def _on_command(job: CompareJob) -> bool:
+    """Does the job compare command positions only (DPOS axes or vector distance)?"""
+    if isinstance(job, WindowJob):
+        return job.kind == "dpos"
+    src = getattr(job, "source", None)
+    return isinstance(src, VectorSource) or getattr(src, "kind", "dpos") == "dpos"
+
+
+class _Shifted:
+    """A VectorCycle read `d` seconds later (the PWM of a cycle played in the next one)."""
+
+    def __init__(self, vc: VectorCycle, d: float) -> None:
+        self.vc, self.d, self.end = vc, d, vc.end
+
+    def at(self, t: float) -> float:
+        return self.vc.at(t - self.d)

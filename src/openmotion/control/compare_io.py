@@ -1,10 +1,18 @@
 """Compare outputs and the firing log.
 
 `OutputLine` keeps the exact waveform of one compare-capable general output (`do<n>`) as a
-list of timed edges (the accurate record), and drives the physical line through
-`Hardware.write_output` once per cycle with the level the waveform has at the cycle end.
-A pulse that starts and ends inside one cycle would vanish at cycle granularity, so it is
-stretched: the line shows it for one cycle. The exact widths stay in `edges`.
+list of timed edges (the accurate record) and drives the physical line:
+
+- on hardware with timed outputs (hw.interface.TimedOutputHardware) `send` runs before the
+  hardware advances over a cycle (t0, t1] and hands it every edge of the waveform in that
+  cycle with `write_output_at`: the line switches at the exact instants and pulses shorter
+  than a cycle keep their true width. Edges added afterwards for times already executed
+  ("late": MPOS jobs, found after the cycle) are written by `flush` at the cycle end, as
+  below; a stretched pulse holds until the next edge or for one cycle;
+- otherwise `flush` writes `Hardware.write_output` once per cycle with the level the
+  waveform has at the cycle end. A pulse that starts and ends inside one cycle would vanish
+  at cycle granularity, so it is stretched: the line shows it for one cycle. The exact
+  widths stay in `edges`.
 
 `EventLog` records every firing: time, job, point index, compared value, output number,
 the output state right after the firing, and every axis's command position at that time.
@@ -15,6 +23,7 @@ from __future__ import annotations
 
 import bisect
 import csv
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -38,12 +47,20 @@ class OutputLine:
         self.initial = initial
         self._t: list[float] = []
         self._lv: list[bool] = []
-        self._written = initial
+        self._written = initial  # physical level at the end of what was written
+        self.timed = False       # the hardware switches it at exact times (send)
+        self._sent_until = -math.inf
+        self._late: list[float] = []  # times of edges added at or before _sent_until
+        self._hold = False       # a late pulse is being shown stretched
 
     def attach(self, hw: Hardware) -> None:
         """Drive the physical line to the initial level."""
+        from ..hw.interface import TimedOutputHardware
+
         hw.write_output(None, self.signal, bool(self.initial))
         self._written = self.initial
+        self.timed = isinstance(hw, TimedOutputHardware)
+        self._sent_until = float(hw.time)
 
     @property
     def edges(self) -> list[tuple[float, bool]]:
@@ -61,6 +78,8 @@ class OutputLine:
         after_same = k < len(self._t) and self._lv[k] == level
         if before == level and not after_same:
             return
+        if self.timed and t <= self._sent_until:
+            self._late.append(t)
         self._t.insert(k, t)
         self._lv.insert(k, level)
         self._merge(k)
@@ -96,12 +115,41 @@ class OutputLine:
         starts = starts[starts + 1 < t.size]
         return t[starts + 1] - t[starts]
 
+    def send(self, hw: Hardware, t0: float, t1: float) -> None:
+        """Timed hardware, before it advances over (t0, t1]: schedule every edge of the
+        cycle at its exact time (hw at t0; see module docstring)."""
+        a = bisect.bisect_right(self._t, t0)
+        b = bisect.bisect_right(self._t, t1)
+        lvl0 = self.level_at(t0)
+        if lvl0 != self._written:  # a late edge, or the end of a stretched pulse
+            if self._hold:
+                t_r = self._t[a] if a < b else t1
+                hw.write_output_at(t_r, None, self.signal, bool(lvl0))  # type: ignore[attr-defined]
+            else:
+                hw.write_output(None, self.signal, bool(lvl0))
+        for k in range(a, b):
+            hw.write_output_at(self._t[k], None, self.signal,  # type: ignore[attr-defined]
+                               bool(self._lv[k]))
+        self._written = self.level_at(t1)
+        self._sent_until = t1
+        self._late.clear()
+        self._hold = False
+
     def flush(self, hw: Hardware, t0: float, t1: float) -> None:
         """Write the physical line for the cycle (t0, t1] (see module docstring)."""
+        if self.timed:
+            late = any(t0 < t <= t1 for t in self._late)
+            self._late.clear()
+            if not late:
+                return
+            changed = late
+        else:
+            changed = self._changed(t0, t1)
         lvl = self.level_at(t1)
         target = lvl
-        if lvl == self._written and self._changed(t0, t1):
+        if lvl == self._written and changed:
             target = not lvl  # a pulse shorter than the cycle: show it for one cycle
+            self._hold = True
         if target != self._written:
             hw.write_output(None, self.signal, bool(target))
             self._written = target
