@@ -192,7 +192,6 @@ class Axis:
                 self._replace(m, planning.decel_stop(m, t, None), m.spec, None, kind="stop")
             else:
                 self._kill_motion()
-                self._cut_at_hardware_stop(m, at)
             self._fault = reason
             #: when the fault happened: the edge's exact time if given, else now
             self.fault_time = self._ctl.time if at is None else float(at)
@@ -513,15 +512,17 @@ class Axis:
         self._motion = None
         self._vel = 0.0
         self._ctl._motion_changed(self, None)
+        self._cut_at_hardware_stop(m)
 
-    def _cut_at_hardware_stop(self, m: ActiveMotion | None, at: float | None) -> None:
-        """The hardware cut the pulses itself at the edge time `at` (EdgeStopHardware):
-        the command position and the history end there too, not at the cycle end."""
+    def _cut_at_hardware_stop(self, m: ActiveMotion) -> None:
+        """The hardware cut this axis's pulses itself at an edge in the last cycle
+        (EdgeStopHardware): a motion killed now ends there too - command position and
+        history - not at the cycle end, whoever kills it (fault, group, stop)."""
         stop_time = getattr(self._ctl.hardware, "stop_time", None)
-        if m is None or at is None or stop_time is None:
+        if stop_time is None:
             return
         ts = stop_time(self.index)
-        if ts is None or abs(ts - float(at)) > 1e-9 or ts < m.t_start:
+        if ts is None or ts < m.t_start or ts > self._ctl.time:
             return
         self._pos = m.state(ts)[0]
         self._ctl.history.truncate(self.index, ts)
