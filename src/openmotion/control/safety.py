@@ -38,7 +38,10 @@ Reactions (HSL-4XMO 3, 4.8; MCCL 2.8):
 
 Residual of the cycle model: the hardware has already executed the cycle in which an edge
 happened, so an immediate stop ends where that cycle ended (at most one cycle of travel past
-the edge; a real PCL6045 stops the pulses at the edge). A decelerating stop is planned from
+the edge; a real PCL6045 stops the pulses at the edge). With a back end implementing
+`EdgeStopHardware` the pulses stop at the edge itself: EMG always armed (every axis), EL and
+ALM immediate stops with `set_edge_stop(axis, True)`; the axis then ends at the cut.
+A decelerating stop is planned from
 the edge time; the next cycle's piece starts on that plan, so the pulse output corrects by
 the difference between the old and the new plan over the rest of the edge's cycle (about
 a*T^2/2, under a pulse at usual rates, plus StrVel*T when the stop ends inside that cycle).
