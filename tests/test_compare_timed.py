@@ -240,3 +240,39 @@ def test_sub_cycle_speed_pwm_integrates_to_the_path_length():
     np.testing.assert_allclose(np.sort(w), np.sort(on), atol=1e-12)
     with pytest.raises(MotionError):
         eng.add_speed_pwm(src, 2, full_speed=1.0, per_cycle=0)
+
+
+# ----------------------------------------------------------------------------- edge stops
+def edge_stop_machine():
+    from openmotion.config import DriveConfig, SwitchConfig
+    from openmotion.control.safety import Safety
+
+    ax = AxisConfig(name="x", lead=10.0, max_speed=500.0, drive=DriveConfig(type="ideal_stepper"),
+                    pel=SwitchConfig(position=20_000.0, width=5000.0),
+                    mel=SwitchConfig(position=-20_000.0, width=-5000.0))
+    c = Controller(MachineConfig("t", (ax,), 4, 4, 0.001), safety=False)
+    assert Safety(c).set_edge_stop("x", True)
+    c.enable_all()
+    return c
+
+
+@pytest.mark.parametrize("speed", [60_000.0, 173_000.0])
+def test_hardware_edge_stop_mid_cycle_undoes_the_firings_never_reached(speed):
+    from openmotion.control import AxisState
+
+    c = edge_stop_machine()
+    eng = CompareEngine(c)
+    pts = np.arange(19_000.0, 21_000.0, 13.7)
+    jid = eng.add(LevelJob(AxisSource(0), pts, Pulse(1, 5e-6)))
+    c.axes[0].move_velocity(speed, tacc=0.05)
+    assert c.run_until(lambda: c.axes[0].state is AxisState.ERROR_STOP, 10.0)
+    t_cut = c.hardware.stop_time(0)
+    assert t_cut is not None
+    c.advance(0.01)
+    a = eng.log.arrays()
+    n = int(np.sum(pts <= 20_000.0))
+    assert a["time"].size == n and np.all(a["time"] <= t_cut)     # nothing past the cut
+    assert np.all(a["positions"][:, 0] <= 20_000.0 + 1e-6)
+    assert eng.job(jid).index == n and eng.job(jid).remaining == pts.size - n  # still armed
+    assert all(t <= t_cut + 5e-6 for t, _ in eng.output(1).edges)
+    assert c.hardware.read_output(None, "do1") == eng.output(1).level_at(c.time)

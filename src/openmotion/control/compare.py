@@ -149,6 +149,7 @@ class CompareEngine:
         self._t_pre = self._t_last
         self._pre_rows: list[tuple[float, int, int, float, int, int]] = []
         self._pre_pos: list[Array] = []
+        self._plan: list[Array] | None = None  # positions planned for the cycle (rollback)
         controller.add_cycle_hook(self._on_cycle)
         if self.timed:
             controller.add_pre_advance_hook(self._pre_advance)
@@ -379,6 +380,56 @@ class CompareEngine:
         for src in self._vectors:
             self._vectors[src] = self.vector_cycle(src).end
 
+    # A stop the hardware makes by itself at an input edge (hw.interface.EdgeStopHardware)
+    # or a re-plan from an edge time changes (t0, t1] after the pre-advance scan. The
+    # positions planned for the cycle are kept; if the history disagrees after the cycle,
+    # the scan's effects (job state, waveforms, vector lengths, PWM duties, log rows) are
+    # undone and the scan is run again on the motion as executed. Edges already handed to
+    # the hardware cannot be taken back: the line is corrected at the cycle end.
+    def _snapshot(self, ta: float, t1: float) -> None:
+        if not (self._jobs or self._pwms or self._vectors):
+            self._plan = None
+            return
+        n = len(self.ctl.axes)
+        self._plan_t = np.linspace(ta, t1, 9)[1:]
+        self._plan = [positions(self.track(AxisSource(a)), self._plan_t) for a in range(n)]
+        timers = {id(j.action): j.action for j in self._jobs.values()
+                  if hasattr(j.action, "busy_until")}
+        self._snap = (
+            dict(self._jobs),
+            {k: (j.index, j.hits, j.active) for k, j in self._jobs.items()},
+            {k: (x.busy_until, x.overruns, x.ignored) for k, x in timers.items()}, timers,
+            {n_: ln.snapshot(ta) for n_, ln in self._lines.items()},
+            dict(self._vectors), [len(p.duties) for p in self._pwms])
+
+    def _moved_off_plan(self) -> bool:
+        ta, t1 = self._win
+        if self._plan is None:
+            return False
+        hist = self.ctl.history
+        for a, planned in enumerate(self._plan):
+            now = positions(history_track(hist, a, ta, t1), self._plan_t)
+            if not np.allclose(now, planned, rtol=0.0, atol=1e-9 * (1.0 + np.abs(planned).max())):
+                return True
+        return False
+
+    def _rollback(self, ta: float) -> None:
+        jobs, state, tstate, timers, lines, vectors, duties = self._snap
+        for k, (idx, hits, active) in state.items():
+            j = jobs[k]
+            if k in self._jobs or j.done:  # not removed by the user meanwhile
+                j.index, j.hits, j.active = idx, hits, active
+                if active:
+                    self._jobs[k] = j
+        for k, (busy, over, ign) in tstate.items():
+            timers[k].busy_until, timers[k].overruns, timers[k].ignored = busy, over, ign
+        for n_, snap in lines.items():
+            self._lines[n_].restore(ta, snap)
+        self._vectors.update(vectors)
+        for p, n_ in zip(self._pwms, duties, strict=False):
+            del p.duties[n_:]
+        self._pre_rows, self._pre_pos = [], []
+
     def _pre_advance(self, ctl: Controller, t0: float, t1: float) -> None:
         """Timed hardware, before it runs (t0, t1]: command-position jobs, exact edges."""
         ta = self._t_pre
@@ -386,6 +437,7 @@ class CompareEngine:
         if t1 <= ta:
             return
         self._begin(ta, t1)
+        self._snapshot(ta, t1)
         rows = self._scan(True, ta, t1)
         if rows:
             self._pre_rows.extend(rows)
@@ -400,9 +452,16 @@ class CompareEngine:
         self._t_last = t1
         if t1 <= ta:
             return
+        replan = self.timed and self._moved_off_plan()
         self._begin(ta, t1)
+        if replan:  # redo the command-position jobs on the motion as executed
+            self._rollback(ta)
+            rows = self._scan(True, ta, t1)
+            self._vectors_end(ta, t1)
+        else:
+            rows = []
         self._mpos_e1 = {a: self._mpos_error(a) for a in self._mpos_err}
-        rows = self._scan(False if self.timed else None, ta, t1)
+        rows += self._scan(False if self.timed else None, ta, t1)
         if not self.timed:
             self._vectors_end(ta, t1)
         self._mpos_err.update(self._mpos_e1)

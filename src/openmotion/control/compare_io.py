@@ -51,6 +51,7 @@ class OutputLine:
         self.timed = False       # the hardware switches it at exact times (send)
         self._sent_until = -math.inf
         self._late: list[float] = []  # times of edges added at or before _sent_until
+        self._sent: list[tuple[float, bool]] = []  # the edges of the last send
         self._hold = False       # a late pulse is being shown stretched
 
     def attach(self, hw: Hardware) -> None:
@@ -93,6 +94,18 @@ class OutputLine:
                     del self._t[i]
                     del self._lv[i]
 
+    def snapshot(self, t: float) -> tuple[bool, list[float], list[bool]]:
+        """The waveform from time t on (to undo a cycle's edits with `restore`)."""
+        k = bisect.bisect_left(self._t, t)
+        return self.initial, self._t[k:], self._lv[k:]
+
+    def restore(self, t: float, snap: tuple[bool, list[float], list[bool]]) -> None:
+        k = bisect.bisect_left(self._t, t)
+        self.initial = snap[0]
+        self._t[k:] = snap[1]
+        self._lv[k:] = snap[2]
+        self._late.append(t)  # what was sent from t on may be wrong: check at flush
+
     def cancel_after(self, t: float) -> None:
         """Forget scheduled edges later than t (a stopped timer)."""
         k = bisect.bisect_right(self._t, t)
@@ -130,6 +143,7 @@ class OutputLine:
         for k in range(a, b):
             hw.write_output_at(self._t[k], None, self.signal,  # type: ignore[attr-defined]
                                bool(self._lv[k]))
+        self._sent = list(zip(self._t[a:b], self._lv[a:b], strict=True))
         self._written = self.level_at(t1)
         self._sent_until = t1
         self._late.clear()
@@ -138,11 +152,14 @@ class OutputLine:
     def flush(self, hw: Hardware, t0: float, t1: float) -> None:
         """Write the physical line for the cycle (t0, t1] (see module docstring)."""
         if self.timed:
-            late = any(t0 < t <= t1 for t in self._late)
+            late = any(t0 <= t <= t1 for t in self._late)
             self._late.clear()
             if not late:
                 return
-            changed = late
+            a = bisect.bisect_right(self._t, t0)
+            b = bisect.bisect_right(self._t, t1)
+            sent = set(self._sent)
+            changed = any(e not in sent for e in zip(self._t[a:b], self._lv[a:b], strict=True))
         else:
             changed = self._changed(t0, t1)
         lvl = self.level_at(t1)
