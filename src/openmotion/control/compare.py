@@ -149,7 +149,7 @@ class CompareEngine:
         self._t_pre = self._t_last
         self._pre_rows: list[tuple[float, int, int, float, int, int]] = []
         self._pre_pos: list[Array] = []
-        self._plan: list[Array] | None = None  # positions planned for the cycle (rollback)
+        self._plan: list[tuple[float, ...]] | None = None  # records planned (rollback)
         controller.add_cycle_hook(self._on_cycle)
         if self.timed:
             controller.add_pre_advance_hook(self._pre_advance)
@@ -382,7 +382,7 @@ class CompareEngine:
 
     # A stop the hardware makes by itself at an input edge (hw.interface.EdgeStopHardware)
     # or a re-plan from an edge time changes (t0, t1] after the pre-advance scan. The
-    # positions planned for the cycle are kept; if the history disagrees after the cycle,
+    # history record in force at the end of the cycle is kept; if it changed after the cycle,
     # the scan's effects (job state, waveforms, vector lengths, PWM duties, log rows) are
     # undone and the scan is run again on the motion as executed. Edges already handed to
     # the hardware cannot be taken back: the line is corrected at the cycle end.
@@ -390,9 +390,15 @@ class CompareEngine:
         if not (self._jobs or self._pwms or self._vectors):
             self._plan = None
             return
-        n = len(self.ctl.axes)
-        self._plan_t = np.linspace(ta, t1, 9)[1:]
-        self._plan = [positions(self.track(AxisSource(a)), self._plan_t) for a in range(n)]
+        axes: set[int] = set()
+        for j in self._jobs.values():
+            src = getattr(j, "source", None)
+            axes.update(j.axes if isinstance(j, WindowJob) else
+                        src.axes if isinstance(src, VectorSource) else (src.axis,))
+        for v in self._vectors:
+            axes.update(v.axes)
+        self._plan_axes = sorted(axes)
+        self._plan = [self._last_record(a, t1) for a in self._plan_axes]
         timers = {id(j.action): j.action for j in self._jobs.values()
                   if hasattr(j.action, "busy_until")}
         self._snap = (
@@ -402,16 +408,22 @@ class CompareEngine:
             {n_: ln.snapshot(ta) for n_, ln in self._lines.items()},
             dict(self._vectors), [len(p.duties) for p in self._pwms])
 
+    def _last_record(self, axis: int, t1: float) -> tuple[float, ...]:
+        """The history record in force just before t1 (a re-plan or cut inside the cycle
+        starts a new one there; a motion starting exactly at t1 does not count)."""
+        tr = self.ctl.history._axis(axis)  # the store's rows (see compare_math.history_track)
+        k = tr.index_at(math.nextafter(t1, -math.inf))
+        if k < tr.lo:
+            return ()
+        return (float(tr.ts[k]), float(tr.p0[k]), float(tr.v0[k]), float(tr.a0[k]),
+                float(tr.j[k]))
+
     def _moved_off_plan(self) -> bool:
-        ta, t1 = self._win
         if self._plan is None:
             return False
-        hist = self.ctl.history
-        for a, planned in enumerate(self._plan):
-            now = positions(history_track(hist, a, ta, t1), self._plan_t)
-            if not np.allclose(now, planned, rtol=0.0, atol=1e-9 * (1.0 + np.abs(planned).max())):
-                return True
-        return False
+        t1 = self._win[1]
+        return any(self._last_record(a, t1) != rec
+                   for a, rec in zip(self._plan_axes, self._plan, strict=True))
 
     def _rollback(self, ta: float) -> None:
         jobs, state, tstate, timers, lines, vectors, duties = self._snap
