@@ -202,3 +202,56 @@ def test_window_streams_a_long_program():
     assert run.state is RunState.DONE and max(ql) <= 64
     end = units(run)
     assert end[0] == pytest.approx(10 * math.cos(399 / 20), abs=1e-4)
+
+
+def _g1_speeds(run: ProgramRunner, first_line: int, last_line: int) -> np.ndarray:
+    """Path speed (machine units/s) per cycle while commands of lines first..last run."""
+    t, idx, p = run.trace()
+    v = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(t)
+    lines = np.array([run.line_of(int(i)) for i in idx])
+    inside = np.nonzero((lines >= first_line) & (lines <= last_line))[0]
+    k0, k1 = int(inside[0]), int(inside[-1])
+    # cycles strictly between the first move's start and the last move's end
+    return v[k0 + 1:k1 - 1]
+
+
+def test_cam_example_streams_without_resting():
+    """The 4,000-segment CAM file runs as one blended chain: the path speed never drops to
+    zero between the first and the last G1 (it used to re-plan per pushed command)."""
+    from pathlib import Path
+
+    from openmotion.program.runjob import work_origin
+
+    ctl = Controller()
+    ctl.enable_all()
+    path = Path(__file__).parents[1] / "examples" / "programs" / "cam_rose.ngc"
+    run = ProgramRunner(ctl, path, gcode={"parameters": work_origin(ctl)})
+    run.start()
+    assert run.wait(60) and run.state is RunState.DONE
+    lines = path.read_text().splitlines()
+    first = lines.index("G1 F2400") + 2          # first segment (1-based line numbers)
+    last = len(lines) - 2                        # last segment, before "G0 X0 Y0", "M2"
+    v = _g1_speeds(run, first, last)
+    assert len(v) > 1000 and float(v.min()) > 0.0
+    fast = np.nonzero(v > 10.0)[0]   # mm/s; the feed is 40 mm/s (F2400)
+    cruise = v[fast[0]:fast[-1] + 1]  # from the end of the start ramp to the final braking
+    assert len(cruise) > 0.9 * len(v) and float(cruise.min()) > 1.0
+
+
+def test_small_window_stays_linear_and_ends_exactly():
+    """A window far smaller than the program: each window is one chain (the runner does not
+    push command by command into a running chain); the end point is exact."""
+    ctl = iso_ctl()
+    text = "G21 G90 G64 P0.01 F3000\n" + "\n".join(
+        f"G1 X{10 * math.cos(k / 50):.4f} Y{10 * math.sin(k / 50):.4f}" for k in range(300)) \
+        + "\nM2\n"
+    run = ProgramRunner(ctl, text, options=RunOptions(window=100))
+    starts = []
+    run.start()
+    ctl.add_cycle_hook(lambda c, t: starts.append(run.group.queue_length
+                                                  if run.group is not None else 0))
+    assert run.wait(120) and run.state is RunState.DONE
+    assert max(starts) <= 100
+    end = units(run)
+    assert end[0] == pytest.approx(round(10 * math.cos(299 / 50), 4), abs=1e-9)
+    assert end[1] == pytest.approx(round(10 * math.sin(299 / 50), 4), abs=1e-9)

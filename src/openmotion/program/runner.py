@@ -8,9 +8,12 @@
 The whole program is compiled (G-code front end) and converted to pulse-space operations
 (convert.py) in the constructor: any error raises before anything moves. Execution is a
 controller cycle hook that streams the operations into the group queue, at most `window`
-commands at a time (a huge program never sits in the queue at once; the look-ahead spans
-what is queued when a chain starts, so a long blended run may come to rest every `window`
-commands). Semantics:
+commands at a time (default 8192, so a huge program never sits in the queue at once). The
+look-ahead spans what is queued when a chain starts: a program of up to `window` blended
+moves (the 4,000-segment CAM example) runs as one chain without resting; a longer one
+rests briefly every `window` moves. The runner never pushes into an empty queue while a
+chain runs, because the group would re-plan the whole running chain per pushed command
+(O(n^2): the CAM file took minutes; it now takes about 5 s). Semantics:
 
 - G0: straight line at the rapid feed (convert.py); G1/G2/G3: group line/arc at the feed.
 - G61/G61.1 disable blending, G64 [P] enables it; the change waits for the queued motion to
@@ -78,7 +81,7 @@ class RunOptions:
     feed_mode: str = "uniform"
     chord_tol: float = 0.001        # machine units
     acc_time: float = 0.05          # s from rest to the feed (path accel = feed / acc_time)
-    window: int = 256               # commands queued in the group at most
+    window: int = 8192              # commands queued in the group at most
     repeat: int = 1
     single_block: bool = False
     optional_stop: bool = False
@@ -428,6 +431,8 @@ class ProgramRunner:
                 self._event("single_block", self._last_line, "block done")
                 return
             if op.kind in ("line", "arc", "delay"):
+                if self._would_extend(g):
+                    return
                 idx = self._push(g, op)
                 self._line_of[idx] = op.line
                 self.op_of[idx] = op
@@ -473,6 +478,16 @@ class ProgramRunner:
                 self._step_line = op.line
         if p.pc >= len(p.ops) and self._idle() and not self._armed:
             self._end_of_pass()
+
+    @staticmethod
+    def _would_extend(g: Group) -> bool:
+        # A path command pushed into an empty queue while a chain runs joins that chain and
+        # re-plans all of it (groupexec._extend_running): one push per command would cost
+        # O(n^2) over a long program. The runner waits instead; the next window is queued
+        # as soon as the running chain ends (a rest at window boundaries, see the docstring).
+        from ..control.group import GroupState
+
+        return g.state is not GroupState.IDLE and g.queue_length == 0
 
     def _push(self, g: Group, op: Op) -> int:
         self._pushed = getattr(self, "_pushed", 0) + 1
