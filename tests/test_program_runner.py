@@ -255,3 +255,35 @@ def test_small_window_stays_linear_and_ends_exactly():
     end = units(run)
     assert end[0] == pytest.approx(round(10 * math.cos(299 / 50), 4), abs=1e-9)
     assert end[1] == pytest.approx(round(10 * math.sin(299 / 50), 4), abs=1e-9)
+
+
+@pytest.mark.parametrize(("blend", "early_mm"), [("G61", 1e-9), ("G64 P0.01", 0.01)])
+def test_m62_fires_at_the_exact_position_the_next_move_starts(blend, early_mm):
+    """M62/M63 go through the compare engine: the output switches at the exact time the
+    path passes the corner where the next move starts (inside a cycle), not per cycle."""
+    ctl = iso_ctl()
+    prog = (f"G21 G90 {blend} G1 X3 F1130\nM62 P3\nG1 X7\nM63 P3\nG1 X11\n"
+            "M62 P4\nG1 X11 Y2\nM2")
+    run = run_program(ctl, prog, timeout=60)
+    assert run.state is RunState.DONE
+    ev = {(e.index, e.level): e.t for e in run.events if e.kind == "sync_output"}
+    assert set(ev) == {(3, True), (3, False), (4, True)}
+    period = ctl.period
+    for level_mm, key in ((3.0, (3, True)), (7.0, (3, False))):
+        t_cross = ctl.history.crossings(0, level_mm * 1000.0, 0.0, ctl.time, 1)
+        assert len(t_cross) == 1
+        # collinear corners pass at speed; with G64 P the window is the tolerance wide
+        x = ctl.history.state_at(0, ev[key])
+        assert x.v > 1000.0 and ev[key] <= float(t_cross[0]) + 1e-12
+        assert x.p >= level_mm * 1000.0 - early_mm * 1000.0 - 1e-6
+    # the collinear corners are not on the cycle grid: per-cycle firing could not hit them
+    assert any(abs(ev[k] / period - round(ev[k] / period)) > 1e-3 for k in ev)
+    # the corner before the Y move: G61 stops exactly there and the output fires on
+    # arrival (within 1e-6 pulse); G64 P starts the Y move at the blend's start (the
+    # blend arc belongs to it), a little before the corner
+    t4 = ev[(4, True)]
+    t11 = float(ctl.history.crossings(0, 11000.0, 0.0, ctl.time, 1)[-1])
+    slack = 1e-6 + 5000.0 * early_mm
+    assert t4 <= t11 + 1e-12
+    assert ctl.history.state_at(0, t4).p >= 11000.0 - slack
+    assert abs(ctl.history.state_at(1, t4).p) <= slack

@@ -21,9 +21,14 @@ chain runs, because the group would re-plan the whole running chain per pushed c
 - G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
   until resume(). M2/M30: end of one pass; `repeat` passes in all.
 - M64/M65: output set when the runner reaches the command (immediately, not waiting for the
-  motion queued before it). M62/M63: set in the cycle in which the next motion command
-  starts executing. M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs.
-  M6: logged, ignored. (MSG)/(DEBUG): logged.
+  motion queued before it). M62/M63: set at the exact position where the next motion
+  command starts: while the move before it runs, a compare-engine window job (control/
+  compare.py, WindowJob on the command positions, +-1e-6 pulse, or +-the blend tolerance
+  with G64 P) is armed on that corner; the engine switches the output at the exact crossing
+  time (timed hardware). A move that starts from rest starts at a cycle boundary, where the
+  output is set in that cycle (also exact); a corner missed by the window (or G64 without
+  P) falls back to the cycle in which the move starts. M3/M4/M5, M7/M8/M9: wait for the
+  motion to end, then set their outputs. M6: logged, ignored. (MSG)/(DEBUG): logged.
 - pause() holds the path (decelerating along it), resume() continues, abort() stops along
   the path and drops the rest; single_block pauses after every source line.
 """
@@ -48,6 +53,7 @@ from .options import AXIS_LETTERS, GCodeOptions
 from .source import GCodeError, read_program
 
 if TYPE_CHECKING:
+    from ..control.compare import CompareEngine
     from ..control.controller import Controller
     from ..control.group import Group
 
@@ -146,6 +152,18 @@ def travel_limits(ctl: Controller, index: int) -> tuple[float, float] | None:
 
 
 @dataclass
+class _Armed:
+    """An M62/M63 bound to the move `index` that starts at `corner` (pulses) after `prev`."""
+
+    index: int
+    op: Op
+    corner: np.ndarray
+    prev: int | None
+    tol: float | None
+    job: object = None
+
+
+@dataclass
 class _Pass:
     ops: list[Op]
     start: np.ndarray
@@ -163,7 +181,13 @@ class ProgramRunner:
     def __init__(self, ctl: Controller, program: str | os.PathLike[str] | Sequence[canon.Command],
                  *, axes: Mapping[str, int | str] | None = None,
                  options: RunOptions | None = None, gcode: Mapping[str, object] | None = None,
-                 file: str = "") -> None:
+                 file: str = "", compare: CompareEngine | None = None) -> None:
+        from ..control.compare import CompareEngine
+
+        if compare is not None and (not isinstance(compare, CompareEngine)
+                                    or compare.ctl is not ctl):
+            raise MotionError("compare must be a CompareEngine of the same controller")
+        self._compare = compare
         self.options = RunOptions() if options is None else options
         if not isinstance(self.options, RunOptions):
             raise MotionError(f"options must be RunOptions, got {type(options).__name__}")
@@ -216,7 +240,10 @@ class ProgramRunner:
         self.starts_of: dict[int, np.ndarray] = {}   # start point (pulses) of each move
         self._cursor = self._pass.start
         self._synced: list[Op] = []
-        self._armed: list[tuple[int, Op]] = []   # (command index, output op)
+        self._armed: list[_Armed] = []   # M62/M63 waiting for their move to start
+        self._prev_motion: int | None = None   # index of the last pushed line/arc
+        self._window_tol: float | None = 1e-6  # pulses; None: blending without a bound
+        self._levels: dict[int, bool] = {}
         self._last_line = 0
         self._step_line: int | None = None
         self.t_start = self.t_end = 0.0
@@ -350,6 +377,7 @@ class ProgramRunner:
 
     def _set_output(self, op: Op, index: int, level: bool, kind: str) -> None:
         self._ctl.hardware.write_output(None, f"do{index}", level)
+        self._levels[index] = level
         self._event(kind, op.line, f"do{index} = {int(level)}", index=index, level=level)
 
     def _finish(self, state: RunState, text: str) -> None:
@@ -406,13 +434,54 @@ class ProgramRunner:
             self._finish(RunState.ERROR, self.error)
 
     def _fire_armed(self, g: Group) -> None:
-        if not self._armed:
-            return
         cur = g.current_index
-        while self._armed and (0 <= self._armed[0][0] <= cur
-                               or (cur < 0 and self._idle_past(self._armed[0][0]))):
-            _, op = self._armed.pop(0)
-            self._set_output(op, op.index, op.level, "sync_output")
+        for a in list(self._armed):
+            started = 0 <= a.index <= cur or (cur < 0 and self._idle_past(a.index))
+            job = a.job
+            if job is not None and job.hits > 0:  # type: ignore[attr-defined]
+                self._record_fired(a)
+                continue
+            if started:  # from rest (cycle boundary) or the window was missed
+                if job is not None:
+                    self._engine().remove(job.id)  # type: ignore[attr-defined]
+                self._armed.remove(a)
+                self._set_output(a.op, a.op.index, a.op.level, "sync_output")
+                continue
+            if job is None and a.prev is not None and a.tol is not None and cur >= a.prev:
+                self._arm_window(a)
+
+    def _engine(self) -> CompareEngine:
+        from ..control.compare import CompareEngine
+
+        if self._compare is None:
+            self._compare = CompareEngine(self._ctl)
+        return self._compare
+
+    def _arm_window(self, a: _Armed) -> None:
+        from ..control.compare import SetLevel, WindowJob
+
+        eng = self._engine()
+        n = a.op.index
+        line = eng.output(n)
+        known = self._levels.get(n, False)
+        if line.level_at(self._ctl.time) != known:  # an M64/M65 written around the engine
+            line.set(self._ctl.time, known)
+        assert a.tol is not None
+        job = WindowJob(self.axis_indices, a.corner[None, :], a.tol,
+                        SetLevel(n, a.op.level),
+                        name=f"M6{2 if a.op.level else 3} line {a.op.line}")
+        eng.add(job)
+        a.job = job
+
+    def _record_fired(self, a: _Armed) -> None:
+        n, level = a.op.index, a.op.level
+        edges = [t for t, lv in self._engine().output(n).edges if lv == level]
+        t = edges[-1] if edges else self._ctl.time
+        self._engine().remove(a.job.id)  # type: ignore[attr-defined]
+        self._armed.remove(a)
+        self._levels[n] = level
+        self.events.append(RunEvent(t, "sync_output", a.op.line, f"do{n} = {int(level)}",
+                                    index=n, level=level))
 
     def _idle_past(self, index: int) -> bool:
         # the command already ran (a short move started and ended within one cycle)
@@ -441,8 +510,10 @@ class ProgramRunner:
                     self._cursor = op.target
                 if op.kind != "delay":
                     for s in self._synced:
-                        self._armed.append((idx, s))
+                        self._armed.append(_Armed(idx, s, self.starts_of[idx],
+                                                  self._prev_motion, self._window_tol))
                     self._synced.clear()
+                    self._prev_motion = idx
             elif op.kind == "output":
                 if op.synced:
                     self._synced.append(op)
@@ -456,8 +527,12 @@ class ProgramRunner:
                 if op.kind == "blend":
                     if op.tolerance is None:
                         g.disable_blend()
+                        self._window_tol = 1e-6
                     else:
                         g.enable_blend(op.tolerance)
+                        # G64 without P (UNBOUNDED_BLEND) has no window: per-cycle fallback
+                        self._window_tol = (float(op.tolerance) + 1e-6
+                                            if op.tolerance < 1e9 else None)
                 elif op.kind == "action":
                     for index, level in op.outputs:
                         self._set_output(op, index, level, "output")
