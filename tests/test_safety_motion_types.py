@@ -74,8 +74,6 @@ def test_group_path_inside_the_soft_limit_runs(blend: bool) -> None:
     assert (pulses(ctl, 0), pulses(ctl, 1)) == (20000, 0)
 
 
-@pytest.mark.xfail(strict=True, reason="groupexec extends a running path axis by axis: "
-                   "x takes the new profile before y's is refused (reported)")
 def test_group_extension_over_a_soft_limit_keeps_the_axes_together() -> None:
     ctl, g = group(False)
     ctl.safety.soft.set("y", 10_000, -100_000)

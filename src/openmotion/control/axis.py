@@ -359,6 +359,28 @@ class Axis:
         (`replace_running=True`), at its current velocity. A decelerating `stop()` uses
         `stop_accel` (pps^2) and `stop_jerk` (pps^3). The profile's end state is held.
         """
+        motion, start_p = self._prepare_profile(profile, stop_accel, stop_jerk,
+                                                replace_running)
+        if self._motion is not None or self._state is S.HOMING:
+            # homing moves keep the axis in Homing; a replaced motion keeps its state
+            self._motion = motion
+            self._ctl._motion_changed(self, motion)
+        else:  # already vetted: start without checking twice
+            self._state = transition(self._state, S.DISCRETE_MOTION, self.name)
+            self._motion = motion
+            self._ctl._motion_changed(self, motion)
+        self.counters.add_target(motion.profile.end.p - start_p)
+
+    @_locked
+    def check_profile(self, profile: Profile, *, stop_accel: float, stop_jerk: float,
+                      replace_running: bool = False) -> None:
+        """Raise exactly as `run_profile` would, changing nothing (a group checks every
+        axis's new motion before it starts any of them)."""
+        self._prepare_profile(profile, stop_accel, stop_jerk, replace_running)
+
+    def _prepare_profile(self, profile: Profile, stop_accel: float, stop_jerk: float,
+                         replace_running: bool) -> tuple[ActiveMotion, float]:
+        """Validate a profile for `run_profile` and vet it; no side effects."""
         if not isinstance(profile, Profile):
             raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
         if profile.end.v != 0.0:
@@ -381,16 +403,10 @@ class Axis:
         if abs(st.v - self._vel) > 1e-6 * max(1.0, abs(self._vel)):
             raise MotionError(f"profile must start at the axis velocity {self._vel!r}, "
                               f"starts at {st.v!r}")
-        kind = "profile"
-        motion = ActiveMotion(shifted, self._ctl.time, kind, None, shifted.end.p,
+        motion = ActiveMotion(shifted, self._ctl.time, "profile", None, shifted.end.p,
                               limits=(math.inf, sa, sj))
-        if m is not None or homing:  # homing moves keep the axis in Homing
-            self._ctl._vet_motion(self, motion)
-            self._motion = motion
-            self._ctl._motion_changed(self, motion)
-        else:
-            self._start(motion, S.DISCRETE_MOTION)
-        self.counters.add_target(shifted.end.p - st.p)
+        self._ctl._vet_motion(self, motion)
+        return motion, st.p
 
     @_locked
     def begin_homing(self) -> None:

@@ -323,10 +323,23 @@ class GroupEngine:
                          target=np.array(chain.elements[-1].end), raw=raw, tj=tj)
 
     def _run_profiles(self, profiles: list[Profile]) -> None:
+        """Start every axis's profile, or none: each is checked (soft limits, states)
+        before any starts, so a refusal never leaves the group off its path."""
+        args = []
         for a, p in zip(self.axes, profiles, strict=True):
             acc = max(1.0, float(np.max(np.abs(p.a0)))) if p.n_segments else 1.0
-            a.run_profile(p, stop_accel=acc, stop_jerk=acc * 1000.0,
-                          replace_running=a.motion is not None)
+            args.append((a, p, {"stop_accel": acc, "stop_jerk": acc * 1000.0,
+                                "replace_running": a.motion is not None}))
+        for a, p, kw in args:
+            try:
+                a.check_profile(p, **kw)
+            except GroupError:
+                raise
+            except MotionError as exc:
+                raise GroupError(ERR_LIMIT if "SL" in str(exc) or "limit" in str(exc)
+                                 else ERR_AXIS_STATE, f"axis {a.name}: {exc}") from exc
+        for a, p, kw in args:
+            a.run_profile(p, **kw)
 
     def _replan(self, r: _Run, *, hold: bool) -> None:
         """Re-plan the running chain from now: a hold (to rest) or a new override."""
