@@ -55,7 +55,7 @@ def test_point_table_bad_input(tmp_path):
         t.save(tmp_path / "x.txt")
 
 
-@pytest.mark.parametrize("name", ["laser_contour.ngc", "dispense.ngc"])
+@pytest.mark.parametrize("name", ["laser_contour.ngc", "dispense.ngc", "camera_scan.ngc"])
 def test_examples_validate_on_the_default_machine(name):
     ctl = Controller()
     run = ProgramRunner(ctl, EX / name, gcode={"parameters": work_origin(ctl)})
@@ -87,3 +87,23 @@ def test_openmotion_run_writes_summary_and_report(tmp_path, capsys):
     bad.write_text("G1 X1 F600 Q\n")
     assert main(["run", str(bad), "--out", str(tmp_path / "out")]) == 2
     assert "line 1" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["laser_contour.ngc", "dispense.ngc", "camera_scan.ngc",
+                                  "pick_place.toml", "cam_rose.ngc"])
+def test_every_example_runs_via_openmotion_run(name, tmp_path, capsys):
+    assert main(["run", str(EX / name), "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "done" in out
+    assert (tmp_path / f"{Path(name).stem}.html").stat().st_size > 1000
+
+
+def test_camera_scan_script_takes_every_picture_on_the_part(capsys):
+    spec = importlib.util.spec_from_file_location("camera_scan", EX / "camera_scan.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    res = mod.main()
+    assert res["state"] == "done"
+    assert res["pictures"] == res["parts"] == 20
+    assert res["max_error_mm"] < 1e-6     # the window is +-1e-6 pulse around each part
+    assert res["row_gates"] == 8          # M62/M63 P2 around each of the 4 rows
