@@ -3,9 +3,9 @@
 camera_scan.ngc drives the serpentine rows (and gates the camera with M62/M63 P2 per
 row); this script loads the trigger table into the compare engine before the program
 runs: one 2-D window point per part (+-1e-6 pulse; HSL-4XMO trigger table / ZMotion
-HW_PSWITCH2 style, in table order), each firing a 2 ms pulse on do3 at the exact time the X/Y command
-position passes the part. Prints the number of pictures and the worst position error at
-the trigger times. Run: python examples/programs/camera_scan.py
+HW_PSWITCH2 style, in table order), each firing a 2 ms pulse on do3 at the exact time
+the X/Y command position passes the part. Prints the number of pictures and the worst
+position error at the trigger times. Run: python examples/programs/camera_scan.py
 (`openmotion run examples/programs/camera_scan.ngc` runs the motion and the row gate.)
 """
 
