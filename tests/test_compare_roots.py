@@ -2,7 +2,7 @@
 MotionHistory's crossing solver (to a few ulps), on random piecewise-cubic motion."""
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from openmotion.control.compare_roots import level_events
@@ -37,6 +37,10 @@ def test_same_events_as_history(segs, v0, pick, mode, w0, w1, direction):
     else:
         level = float(pick * 20 - 10)
     t, t1 = sorted((w0 * T, w1 * T))
+    # Motion spanning less than a micro-pulse around the level is below any counter's
+    # resolution; there the two solvers' "on the level" ulp rules may legitimately differ.
+    span = prof.sample(np.linspace(0.0, T, 257)).p
+    assume(np.ptp(span) > 1e-6)
     ref_t, ref_d = h.crossing_events(0, level, t, t1)
     keep = ref_t > t
     if direction:
