@@ -26,6 +26,8 @@ def test_demo_command_writes_plots(tmp_path, capsys):
     assert "Standstill" in out
     assert (tmp_path / "demo_trace.png").stat().st_size > 1000
     assert (tmp_path / "demo_trace.html").exists()
+    assert "faults         0" in out and "state          done" in out   # the G-code job
+    assert "<svg" in (tmp_path / "demo_laser.html").read_text()
 
 
 def test_realtime_demo_prints_statistics(capsys):

@@ -4,7 +4,8 @@ Every kind of single-axis move runs on the built-in simulator in virtual time: a
 an S-curve, a time-optimal jerk-limited move, velocity mode with a change of speed on the
 fly and a decelerating stop, an absolute move whose target is changed on the fly so that it
 goes back, and an immediate stop. It prints what happened and writes the velocity curve and
-a profile plot.
+a profile plot; then it runs a G-code laser contour as `openmotion run` does and writes its
+HTML report.
 """
 
 from __future__ import annotations
@@ -96,6 +97,42 @@ def run_steps(ctl: Controller) -> list[Step]:
     return steps
 
 
+#: The G-code job the demo runs after the single-axis moves: a laser contour with arcs and
+#: a hole, the laser on output 0 switched in sync with motion (M62/M63).
+DEMO_PROGRAM = """(openmotion demo: laser contour with arcs and a hole)
+G21 G90 G17 G94
+G64 P0.01
+G0 X-30 Y-20
+M62 P0
+G1 X20 F1800
+G3 X30 Y-10 R10
+G1 Y20
+G1 X-10
+G2 X-30 Y0 I0 J-20
+G1 Y-20
+M63 P0
+G0 X0 Y0
+M62 P0
+G3 X0 Y0 I5 J0 (5 mm hole)
+M63 P0
+G0 X-30 Y-20
+M2
+"""
+
+
+def run_gcode_job(out: Path) -> int:
+    """Run DEMO_PROGRAM like `openmotion run` does and write its HTML report."""
+    import argparse
+
+    from .program.runjob import run_job
+
+    program = out / "demo_laser.ngc"
+    program.write_text(DEMO_PROGRAM)
+    print("\nG-code job (as `openmotion run` runs it):")
+    return run_job(argparse.Namespace(program=str(program), machine=None, repeat=1,
+                                      realtime=False, out=str(out)))
+
+
 def run_demo(out: Path) -> int:
     """Run the demo, print a summary and write plots into `out`. Returns an exit code."""
     out.mkdir(parents=True, exist_ok=True)
@@ -125,7 +162,7 @@ def run_demo(out: Path) -> int:
     print()
     for p in written:
         print(f"wrote {p}")
-    return 0
+    return run_gcode_job(out)
 
 
 def run_realtime_demo(seconds: float = 2.0) -> int:
