@@ -17,7 +17,7 @@ from openmotion.program.runner import ProgramRunner, RunOptions, RunState, run_p
 
 
 def iso_ctl(n: int = 3) -> Controller:
-    """Equal scales (1000 pulses/mm), no switches: arcs run as group arcs in pulses."""
+    """Equal scales (1000 pulses/mm), no switches."""
     axes = tuple(AxisConfig(name=c, lead=10.0, max_speed=200.0) for c in "xyz"[:n])
     ctl = Controller(MachineConfig(name="iso", axes=axes, digital_outputs=8))
     ctl.enable_all()
@@ -65,15 +65,80 @@ def test_arc_in_each_plane_lies_on_circle(plane, code, axes):
     assert np.nanmax(err) < 1e-3
 
 
-def test_anisotropic_machine_sends_chords_within_tolerance():
+def xyzu_ctl() -> Controller:
     ctl = Controller()  # XYZU table: x 1000, y 2000 pulses/mm
     ctl.enable_all()
-    run = run_program(ctl, "G21 G90 G64 P0.001\nG1 X20 Y10 F1200\nG2 X30 Y10 I5 J0\nM2", timeout=60,
-                      options=RunOptions(chord_tol=0.002))
+    return ctl
+
+
+def test_anisotropic_machine_runs_true_arcs():
+    """Mixed pulse scales: the group works in mm, so the arc is one true group arc."""
+    ctl = xyzu_ctl()
+    run = run_program(ctl, "G21 G90 G64 P0.001\nG1 X20 Y10 F1200\nG2 X30 Y10 I5 J0\nM2",
+                      timeout=60)
     assert run.state is RunState.DONE
     assert np.allclose(units(run)[:2], [30.0, 10.0], atol=1e-9)
+    assert [o.kind for o in run.ops if o.kind in ("line", "arc")] == ["line", "arc"]
+    t, idx, p = run.trace()
+    sel = np.isin(idx, [k for k, o in run.op_of.items() if o.kind == "arc"])
+    assert np.max(np.abs(np.hypot(p[sel, 0] - 25.0, p[sel, 1] - 10.0) - 5.0)) < 1e-6
+    assert summarize(run).max_contour_error < 0.001 + 1e-6
+
+
+def _cruise_speeds(run: ProgramRunner, kind: str) -> np.ndarray:
+    """Vector speed (machine units/s) per cycle inside moves of `kind`, accel/decel ends
+    dropped (cycles whose speed is below 99.9 % of the top speed)."""
+    t, idx, p = run.trace()
+    sel = np.isin(idx, [k for k, o in run.op_of.items() if o.kind == kind and not o.rapid])
+    v = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1) / np.diff(t)
+    v = v[sel[1:] & sel[:-1]]
+    return v[v > 0.999 * v.max()]
+
+
+@pytest.mark.parametrize("prog,kind", [
+    ("G21 G90 G1 X40 Y40 F1200\nM2", "line"),                      # 45 degrees in XY
+    ("G21 G90 G1 X20 F6000\nG1 X30 F1200\nG3 X10 Y0 I-10 J0\nM2", "arc"),   # half circle
+])
+def test_vector_speed_equals_f_on_the_xyzu_table(prog, kind):
+    """x has 1000, y 2000 pulses/mm: the tool still moves at exactly F (20 mm/s) along the
+    45-degree line and around the arc (the old pulse-space feed gave F/2 along y)."""
+    ctl = xyzu_ctl()
+    run = run_program(ctl, prog, timeout=60)
+    assert run.state is RunState.DONE
+    v = _cruise_speeds(run, kind)
+    assert len(v) > 10
+    assert v.max() <= 20.0 * (1 + 1e-6)
+    assert v.min() >= 20.0 * (1 - 1e-3)  # chord of a cycle on the arc: slightly shorter
+    if kind == "arc":
+        t, idx, p = run.trace()
+        sel = np.isin(idx, [k for k, o in run.op_of.items() if o.kind == "arc"])
+        assert np.max(np.abs(np.hypot(p[sel, 0] - 20.0, p[sel, 1]) - 10.0)) < 1e-6
+
+
+@pytest.mark.parametrize("mode,linear_speed", [("uniform", 10.0 * 10 / math.hypot(10, 30)),
+                                               ("exact", 10.0)])
+def test_feed_mode_on_a_linear_plus_rotary_move(mode, linear_speed):
+    """G1 X10 A30 F600: "uniform" runs the mm+deg vector at F, "exact" the X part at F."""
+    ctl = xyzu_ctl()
+    run = run_program(ctl, "G21 G90 G1 X10 A30 F600\nM2", timeout=60,
+                      options=RunOptions(feed_mode=mode))
+    assert run.state is RunState.DONE
+    assert units(run)[run.letters.index("A")] == pytest.approx(30.0, abs=1e-9)
+    t, idx, p = run.trace()
+    vx = np.diff(p[:, 0]) / np.diff(t)
+    assert vx.max() == pytest.approx(linear_speed, rel=1e-6)
+
+
+def test_spiral_arc_end_is_sent_as_chords_within_tolerance():
+    """An end point off the circle (LinuxCNC tolerates it) cannot be a group arc: chords."""
+    ctl = iso_ctl()
+    run = run_program(ctl, "G21 G90 G1 X10 F1200\nG3 X-10.0005 Y0 I-10 J0\nM2", timeout=60,
+                      options=RunOptions(chord_tol=0.002))
+    assert run.state is RunState.DONE
+    assert units(run)[0] == pytest.approx(-10.0005, abs=1e-9)
     assert sum(o.kind == "line" for o in run.ops) > 10
-    assert summarize(run).max_contour_error < 0.003 + 1e-6
+    assert not any(o.kind == "arc" for o in run.ops)
+    assert summarize(run).max_contour_error < 0.002 + 1e-3
 
 
 def test_inch_units_and_work_offset():
@@ -87,7 +152,7 @@ def test_inch_units_and_work_offset():
 def test_inch_feed_is_converted():
     ctl = iso_ctl()
     run = ProgramRunner(ctl, "G20 G90 G1 X1 F60\nM2")
-    assert run.ops[0].feed == pytest.approx(25.4 * 1000.0)
+    assert run.ops[0].feed == pytest.approx(25.4)  # F60 inch/min = 25.4 mm/s
 
 
 def test_synced_output_fires_with_next_motion_and_immediate_at_once():

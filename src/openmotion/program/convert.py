@@ -1,28 +1,29 @@
-"""Canonical commands (machine units) -> pulse-space operations for a `Group`.
+"""Canonical commands (machine units) -> operations for a `Group` in machine units.
 
 The runner executes `Op`s; this module builds them and thereby validates the whole program
-against the machine (axis scales, speeds, arc geometry in pulses) before anything moves.
+against the machine (axis scales, speeds, arc geometry) before anything moves.
 
-Units: a canonical linear position (machine_units, mm or inch) becomes user units of the
-axis (mm, inch: converted with 25.4; `pulse` axes take the value as pulses) and then command
-pulses with `AxisUnits.to_pulses`; rotary A/B/C positions are degrees.
+Units: a canonical linear position (machine_units, mm or inch) is a coordinate of the
+runner's group, which is opened with `units=` (one AxisUnits per axis: signed pulses per
+machine unit, from the axis's own unit: mm, inch with 25.4, `pulse` axes 1); rotary A/B/C
+positions are degrees. The group plans the path in these units, so the feed is the true
+vector speed and an arc is a true arc even when the axes have different pulses per unit
+(the XYZU table: x 1000, y 2000 pulses/mm). Each move op carries its end point twice:
+`end` (machine units, what the group is given) and `target` (command pulses, what the
+compare engine's windows and the report use).
 
-Feeds (F is units/min in G-code, feed_per_s here): a Group's feed is the vector speed in
-PULSE space. `feed_mode="uniform"` (default) uses one factor per program, the smallest
-|pulses per unit| of the group's linear axes (rotary axes for rotary-only moves): on a
-machine whose linear axes share a scale this is exactly F; otherwise the tool speed is at
-most F (equal to F along the finest-scaled axis) and consecutive moves keep the same pulse
-feed, so the look-ahead chains them. `feed_mode="exact"` converts every move with its own
-factor P/L (pulse length / programmed length): exact F everywhere, but moves in different
-directions get different pulse feeds and the group stops between them.
+Feeds (F is units/min in G-code, feed_per_s here; the group's feed is units/s):
+`feed_mode="uniform"` (default) gives the group F as its vector speed: exact F on every
+linear (or rotary-only) move and arc; a move combining linear and rotary axes then has its
+tool speed below F (the degrees count in the vector). `feed_mode="exact"` scales such a
+mixed move so that its linear part runs at exactly F (as LinuxCNC).
 
-G0 is a straight line (never a dog-leg ptp: predictable clearance) at the highest pulse
-feed with which no moving axis exceeds `rapid_ratio` x its maximum speed.
+G0 is a straight line (never a dog-leg ptp: predictable clearance) at the highest feed
+with which no moving axis exceeds `rapid_ratio` x its maximum speed.
 
-Arcs whose plane axes have equal |pulses per unit| are Group arcs in pulse space (the
-direction flips when exactly one plane axis is reversed). Otherwise the circle is an ellipse
-in pulses and the arc is sent as chords within `chord_tol` (machine units), all with one
-feed so they form one chain.
+Arcs are group arcs in machine units. An arc whose end is off the circle by more than the
+group's Arc accepts (a LinuxCNC-tolerated spiral) is sent as chords within `chord_tol`
+(machine units), all at one feed so they form one chain.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ from . import canon
 from .options import MM_PER_INCH, ROTARY_LETTERS
 from .source import GCodeError
 
-#: Blend tolerance (pulses) standing for G64 without P.
+#: Blend tolerance (machine units) standing for G64 without P.
 UNBOUNDED_BLEND = 1e12
 
 
@@ -47,11 +48,12 @@ UNBOUNDED_BLEND = 1e12
 class Op:
     """One runner operation. kind: line, arc, delay, blend, pause, end, output, action.
 
-    line/arc: `target` (pulses, all group axes), `feed` (pps), `rapid`; arc also `centre`
-    (2 plane values, pulses), `plane`, `direction`, `turns`. delay: `seconds`. blend:
-    `tolerance` (pulses) or None = exact stop. output: `index`, `level`, `synced`.
-    action: `text` (spindle/coolant/tool/message), `outputs` ((index, level), ...),
-    `barrier` (wait until the motion before it has ended).
+    line/arc: `end` (machine units, all group axes), `target` (the same point in command
+    pulses), `feed` (machine units/s), `rapid`; arc also `centre` (2 plane values, machine
+    units), `plane`, `direction`, `turns`. delay: `seconds`. blend: `tolerance` (machine
+    units) or None = exact stop. output: `index`, `level`, `synced`. action: `text`
+    (spindle/coolant/tool/message), `outputs` ((index, level), ...), `barrier` (wait until
+    the motion before it has ended).
     """
 
     kind: str
@@ -73,6 +75,7 @@ class Op:
     text: str = ""
     outputs: tuple[tuple[int, bool], ...] = ()
     barrier: bool = False
+    end: np.ndarray | None = None
     source: canon.Command | None = field(default=None, repr=False, compare=False)
 
 
@@ -98,8 +101,20 @@ class Scales:
             rot.append(letter in ROTARY_LETTERS)
         return cls(np.array(ppu), np.array(vmax), np.array(rot, dtype=bool))
 
-    def to_pulses(self, p: tuple[float, ...]) -> np.ndarray:
+    def to_pulses(self, p: tuple[float, ...] | np.ndarray) -> np.ndarray:
         return np.asarray(p, dtype=float) * self.ppu
+
+    @property
+    def vmax_units(self) -> np.ndarray:
+        """Maximum speed per axis in machine units (deg for rotary axes) per second."""
+        return self.vmax / np.abs(self.ppu)
+
+    def axis_units(self, letters: list[str]) -> list[AxisUnits]:
+        """The group's `units=`: one AxisUnits per axis, signed pulses per machine unit."""
+        return [AxisUnits(k, "degree" if r else "machine", float(abs(q)),
+                          1 if q > 0 else -1, float(v))
+                for k, q, r, v in zip(letters, self.ppu, self.rotary, self.vmax_units,
+                                      strict=True)]
 
 
 @dataclass(frozen=True)
@@ -128,58 +143,52 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             opts: ConvertOptions) -> list[Op]:
     """Validate and convert a canonical program that starts at `start` (pulses)."""
     lin = ~scales.rotary
-    k_lin = float(np.min(np.abs(scales.ppu[lin]))) if lin.any() else 1.0
-    k_rot = float(np.min(np.abs(scales.ppu[scales.rotary]))) if scales.rotary.any() else 1.0
-    sys_max = float(np.max(scales.vmax))
+    vmax = scales.vmax_units
+    sys_max = float(np.max(vmax))
     ops: list[Op] = []
-    pos = np.asarray(start, dtype=float).copy()
-    ppu = np.abs(scales.ppu)
+    pos = np.asarray(start, dtype=float) / scales.ppu  # machine units
 
-    def feed_pps(cmd: canon.Command, delta_units: np.ndarray, length_units: float,
-                 pulse_len: float) -> float:
+    def feed_of(cmd: canon.Command, delta: np.ndarray, length: float) -> float:
+        """Group feed (units/s) for a move of `length` (vector of all axes) by `delta`."""
         if cmd.duration is not None:  # G93 inverse time: the whole move in `duration`
-            f = pulse_len / cmd.duration
-        elif opts.feed_mode == "exact" and length_units > 0.0:
-            f = cmd.feed_per_s * pulse_len / length_units
+            f = length / cmd.duration
         else:
-            moving = np.abs(delta_units) > 0.0
-            f = cmd.feed_per_s * (k_lin if (moving & lin).any() else k_rot)
+            f = cmd.feed_per_s
+            moving = np.abs(delta) > 0.0
+            if opts.feed_mode == "exact" and (moving & lin).any() and \
+                    (moving & ~lin).any():
+                # F applies to the linear part (RS-274): scale by total / linear length
+                f *= length / float(np.linalg.norm(delta[lin]))
         if not f > 0.0 or not math.isfinite(f):
-            raise _fail(cmd, f"feed {cmd.feed_per_s:g} units/s gives no usable pulse speed")
+            raise _fail(cmd, f"feed {cmd.feed_per_s:g} units/s gives no usable speed")
         return min(f, sys_max)  # F above the machine maxima is clamped (as LinuxCNC)
 
     for cmd in cmds:
         if isinstance(cmd, canon.Rapid | canon.Feed):
-            target = scales.to_pulses(cmd.end)
-            d = target - pos
-            plen = float(np.linalg.norm(d))
-            if plen == 0.0:
+            end = np.asarray(cmd.end, dtype=float)
+            d = end - pos
+            length = float(np.linalg.norm(d))
+            if length == 0.0:
                 continue  # zero-length move: nothing to do
             if isinstance(cmd, canon.Rapid):
                 moving = np.abs(d) > 0.0
-                f = float(np.min(opts.rapid_ratio * scales.vmax[moving] * plen
+                f = float(np.min(opts.rapid_ratio * vmax[moving] * length
                                  / np.abs(d[moving])))
-                ops.append(Op("line", cmd.line, cmd.file, target, min(f, sys_max), True,
-                              source=cmd))
+                ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end),
+                              min(f, sys_max), True, end=end, source=cmd))
             else:
-                du = d / scales.ppu
-                lu = float(np.linalg.norm(du[lin])) if (np.abs(du[lin]) > 0).any() \
-                    else float(np.linalg.norm(du))
-                ops.append(Op("line", cmd.line, cmd.file, target,
-                              feed_pps(cmd, du, lu, plen), source=cmd))
-            pos = target
+                ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end),
+                              feed_of(cmd, d, length), end=end, source=cmd))
+            pos = end
         elif isinstance(cmd, canon.ArcMove):
-            pos = _arc(cmd, scales, pos, opts, ops, feed_pps, ppu)
+            pos = _arc(cmd, scales, pos, opts, ops, feed_of)
         elif isinstance(cmd, canon.Dwell):
             ops.append(Op("delay", cmd.line, cmd.file, seconds=cmd.seconds, source=cmd))
         elif isinstance(cmd, canon.SetBlend):
             tol = None
             if cmd.mode == "blend":
-                # the tolerance in the finest axis's pulses: a deviation of tol pulses is
-                # at most tol / min|ppu| machine units on every axis
                 # G64 without P (best speed): no bound but the blend's own length limits
-                tol = UNBOUNDED_BLEND if cmd.tolerance is None \
-                    else cmd.tolerance * float(np.min(ppu))
+                tol = UNBOUNDED_BLEND if cmd.tolerance is None else float(cmd.tolerance)
             ops.append(Op("blend", cmd.line, cmd.file, tolerance=tol, source=cmd))
         elif isinstance(cmd, canon.Pause):
             ops.append(Op("pause", cmd.line, cmd.file, optional=cmd.optional, source=cmd))
@@ -210,29 +219,21 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
 
 
 def _arc(cmd: canon.ArcMove, scales: Scales, pos: np.ndarray, opts: ConvertOptions,
-         ops: list[Op], feed_pps, ppu: np.ndarray) -> np.ndarray:
+         ops: list[Op], feed_of) -> np.ndarray:
     i, j = cmd.plane
-    target = scales.to_pulses(cmd.end)
-    centre_p = scales.to_pulses(cmd.centre)
-    r_p = cmd.radius * ppu[i]
-    lin2 = float(np.sum(((target - pos) ** 2)[[k for k in range(len(pos)) if k not in (i, j)]]))
-    direction = cmd.direction
-    same = math.isclose(ppu[i], ppu[j], rel_tol=1e-12)
-    if same:
-        if np.sign(scales.ppu[i]) != np.sign(scales.ppu[j]):
-            direction = Direction.CW if direction == Direction.CCW else Direction.CCW
-        try:
-            Arc(pos, (centre_p[i], centre_p[j]), target, plane=(i, j), direction=direction,
-                turns=cmd.turns)
-        except MotionError:
-            same = False  # a LinuxCNC-tolerated spiral end: send it as chords
-    if same:
-        plen = math.hypot(r_p * cmd.sweep, math.sqrt(lin2))
-        du = (target - pos) / scales.ppu
-        f = feed_pps(cmd, du, cmd.length, plen)
-        ops.append(Op("arc", cmd.line, cmd.file, target, f, centre=(centre_p[i], centre_p[j]),
-                      plane=(i, j), direction=direction, turns=cmd.turns, source=cmd))
-        return target
+    end = np.asarray(cmd.end, dtype=float)
+    centre = (float(cmd.centre[i]), float(cmd.centre[j]))
+    try:
+        Arc(pos, centre, end, plane=(i, j), direction=cmd.direction, turns=cmd.turns)
+        exact = True
+    except MotionError:
+        exact = False  # a LinuxCNC-tolerated spiral end: send it as chords
+    if exact:
+        f = feed_of(cmd, end - pos, cmd.length)
+        ops.append(Op("arc", cmd.line, cmd.file, scales.to_pulses(end), f, centre=centre,
+                      plane=(i, j), direction=cmd.direction, turns=cmd.turns, end=end,
+                      source=cmd))
+        return end
     # chords: n segments of the arc within chord_tol (sagitta r(1-cos(theta/2)) <= tol)
     r = max(cmd.radius, cmd.end_radius)
     half = math.acos(max(-1.0, 1.0 - opts.chord_tol / r)) if opts.chord_tol < r else math.pi
@@ -242,18 +243,13 @@ def _arc(cmd: canon.ArcMove, scales: Scales, pos: np.ndarray, opts: ConvertOptio
                          "raise chord_tol")
     path = cmd.to_path()
     pts = path.point(np.linspace(0.0, path.length, n + 1))
-    pts[-1] = np.asarray(cmd.end, dtype=float)
-    pp = pts * scales.ppu
-    pp[0] = pos
-    seg = np.linalg.norm(np.diff(pp, axis=0), axis=1)
-    du_all = np.diff(pts, axis=0)
-    # one feed for all chords (the smallest, so no chord exceeds F): one look-ahead chain
-    f = min(feed_pps(cmd, du_all[k], float(np.linalg.norm(du_all[k])) * cmd.length
-                     / max(path.length, 1e-300), float(seg[k])) if seg[k] > 0 else math.inf
-            for k in range(n))
-    if cmd.duration is not None:
-        f = float(np.sum(seg)) / cmd.duration
+    pts[0] = pos
+    pts[-1] = end
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    # one feed for all chords (F; G93: the whole arc in `duration`): one look-ahead chain
+    f = feed_of(cmd, end - pos, float(np.sum(seg)))
     for k in range(1, n + 1):
         if seg[k - 1] > 0.0:
-            ops.append(Op("line", cmd.line, cmd.file, pp[k].copy(), f, source=cmd))
-    return pp[-1]
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(pts[k]), f,
+                          end=pts[k].copy(), source=cmd))
+    return end

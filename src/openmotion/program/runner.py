@@ -5,8 +5,10 @@
     run.start(); run.wait(timeout=60)                       # virtual time
     print(run.state, run.current_line, run.events)
 
-The whole program is compiled (G-code front end) and converted to pulse-space operations
-(convert.py) in the constructor: any error raises before anything moves. Execution is a
+The whole program is compiled (G-code front end) and converted to operations in machine
+units (convert.py) in the constructor: any error raises before anything moves. The group is
+opened with `units=` (signed pulses per machine unit of each axis), so F is the true tool
+speed and G2/G3 are true arcs also on axes with different pulses per mm. Execution is a
 controller cycle hook that streams the operations into the group queue, at most `window`
 commands at a time (default 8192, so a huge program never sits in the queue at once). The
 look-ahead spans what is queued when a chain starts: a program of up to `window` blended
@@ -15,7 +17,8 @@ rests briefly every `window` moves. The runner never pushes into an empty queue 
 chain runs, because the group would re-plan the whole running chain per pushed command
 (O(n^2): the CAM file took minutes; it now takes about 5 s). Semantics:
 
-- G0: straight line at the rapid feed (convert.py); G1/G2/G3: group line/arc at the feed.
+- G0: straight line at the rapid feed (convert.py); G1/G2/G3: group line/arc at the feed
+  (machine units/s).
 - G61/G61.1 disable blending, G64 [P] enables it; the change waits for the queued motion to
   end (the group applies blending when a chain starts).
 - G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
@@ -286,10 +289,13 @@ class ProgramRunner:
         if not np.array_equal(pos, self._pass.start):
             self._pass = self._compile(pos)  # the axes moved since compiling
         self._cursor = self._pass.start
+        # the group works in machine units (true feed and arcs on mixed pulse scales)
         self.group = Group(self._ctl, self.axis_indices, queue_size=self.options.window,
-                           acc_time=self.options.acc_time)
+                           acc_time=self.options.acc_time,
+                           feed=float(np.min(self.scales.vmax_units)),
+                           units=self.scales.axis_units(self.letters))
         self.group.set_axis_limit_policy("slow")
-        self.group.set_sys_max_speed(float(np.max(self.scales.vmax)))
+        self.group.set_sys_max_speed(float(np.max(self.scales.vmax_units)))
         self.state = RunState.RUNNING
         self.t_start = self._ctl.time
         self._ctl.add_cycle_hook(self._on_cycle)
@@ -530,8 +536,11 @@ class ProgramRunner:
                         self._window_tol = 1e-6
                     else:
                         g.enable_blend(op.tolerance)
-                        # G64 without P (UNBOUNDED_BLEND) has no window: per-cycle fallback
-                        self._window_tol = (float(op.tolerance) + 1e-6
+                        # G64 without P (UNBOUNDED_BLEND) has no window: per-cycle fallback.
+                        # A corner rounded within tol (machine units) is within
+                        # tol * |pulses/unit| pulses on each axis: the window uses the largest.
+                        k = float(np.max(np.abs(self.scales.ppu)))
+                        self._window_tol = (float(op.tolerance) * k + 1e-6
                                             if op.tolerance < 1e9 else None)
                 elif op.kind == "action":
                     for index, level in op.outputs:
@@ -569,11 +578,11 @@ class ProgramRunner:
         if op.kind == "delay":
             return g.delay(op.seconds)
         g.set_feed(op.feed)
-        assert op.target is not None
+        assert op.end is not None
         if op.kind == "line":
-            return g.line(op.target)
+            return g.line(op.end)
         assert op.centre is not None
-        return g.arc(op.centre, op.target, plane=op.plane, direction=op.direction,
+        return g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
                      turns=op.turns)
 
     def _end_of_pass(self) -> None:
