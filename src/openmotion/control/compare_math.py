@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..history import MotionHistory
-from .compare_roots import level_events
+from .compare_roots import level_events, velocity_roots
 
 Array = NDArray[np.float64]
 
@@ -136,7 +136,7 @@ def track_range(tr: Track, ta: float, t1: float) -> tuple[float, float]:
         if w < u:
             continue
         p, v, a, j = float(tr.p0[k]), float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])
-        xs = [u - a_k, w - a_k] + [r for r in _vel_roots(v, a, j) if u - a_k < r < w - a_k]
+        xs = [u - a_k, w - a_k] + [r for r in velocity_roots(v, a, j) if u - a_k < r < w - a_k]
         for x in xs:
             y = p + x * (v + x * (a / 2.0 + x * j / 6.0))
             lo, hi = min(lo, y), max(hi, y)
@@ -152,17 +152,6 @@ def track_range(tr: Track, ta: float, t1: float) -> tuple[float, float]:
 # single axis or a straight line sqrt(Q) is a polynomial of degree <= 2, which 8-point
 # Gauss-Legendre integrates exactly; otherwise (curves) the piece is halved adaptively until
 # two levels agree to 1e-13 relative. s(t) = d is solved by safeguarded Newton (s' = speed).
-def _vel_roots(v: float, a: float, j: float) -> tuple[float, ...]:
-    h = 0.5 * j
-    if h == 0.0:
-        return (-v / a,) if a != 0.0 else ()
-    disc = a * a - 4.0 * h * v
-    if disc < 0.0:
-        return ()
-    q = -0.5 * (a + math.copysign(math.sqrt(disc), a))
-    return (q / h, v / q) if q != 0.0 else (0.0,)
-
-
 class VectorCycle:
     """Path length over one window [ta, t1] of several axes' tracks, starting at s0."""
 
@@ -179,7 +168,7 @@ class VectorCycle:
                     bps.add(a_k)
                 if b_k <= ta or a_k >= t1:
                     continue
-                for r in _vel_roots(float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])):
+                for r in velocity_roots(float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])):
                     tr_ = a_k + r
                     if ta < tr_ < t1 and tr_ < b_k:
                         bps.add(tr_)

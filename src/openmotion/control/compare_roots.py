@@ -17,7 +17,7 @@ from collections.abc import Sequence
 _EPS = 2.220446049250313e-16
 
 
-def _roots(v: float, a: float, j: float) -> tuple[float, ...]:
+def velocity_roots(v: float, a: float, j: float) -> tuple[float, ...]:
     """Roots of the velocity v + a*x + j*x**2/2."""
     h = 0.5 * j
     if h == 0.0:
@@ -87,7 +87,7 @@ def level_events(ts: Sequence[float], p0: Sequence[float], v0: Sequence[float],
         xa, xb = max(t - tk, 0.0), min(end, t1) - tk
         p, v, a, j = float(p0[k]), float(v0[k]), float(a0[k]), float(j0[k])
         c = p - level
-        cuts = [xa, *sorted(r for r in _roots(v, a, j) if xa < r < xb), xb]
+        cuts = [xa, *sorted(r for r in velocity_roots(v, a, j) if xa < r < xb), xb]
         for u, w in zip(cuts[:-1], cuts[1:], strict=True):
             if not w > u:
                 continue
