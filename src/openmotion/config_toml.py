@@ -1,0 +1,224 @@
+"""Machine files: TOML text <-> MachineConfig, with unknown-key (typo) detection.
+
+Layout: top-level name / cycle_s / digital_inputs / digital_outputs, then one [axes.<name>]
+table per axis in controller order, with nested [axes.<name>.logic], [axes.<name>.drive]
+(and [axes.<name>.drive.motor]), [axes.<name>.loop] and [axes.<name>.pel|mel|org|sd].
+Every key is checked: an unknown key is an error naming it. Switch position / width /
+hysteresis are written in the axis's USER units in the file (a person measures switches in
+mm or degrees) and converted to command pulses on load, back on save; `reverse` flips the
+sign of position and width. Every name here is also importable from openmotion.config.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import replace
+from typing import Any
+
+from openmotion.config import (
+    SWITCHES,
+    AxisConfig,
+    DCMotorConfig,
+    DriveConfig,
+    LoopConfig,
+    MachineConfig,
+    SwitchConfig,
+    _real,
+)
+from openmotion.errors import MotionError
+
+__all__ = ["dumps_machine", "load_machine", "loads_machine", "machine_from_dict",
+           "machine_to_dict", "save_machine"]
+
+_TOP_KEYS = ("name", "cycle_s", "digital_inputs", "digital_outputs", "axes")
+_AXIS_TABLES = ("logic", "drive", "loop") + SWITCHES
+_AXIS_KEYS = tuple(f for f in AxisConfig.__dataclass_fields__ if f != "name")
+_AXIS_SCALARS = tuple(k for k in _AXIS_KEYS if k not in _AXIS_TABLES)
+_DRIVE_KEYS = tuple(DriveConfig.__dataclass_fields__)
+_SWITCH_KEYS = tuple(SwitchConfig.__dataclass_fields__)
+_MOTOR_KEYS = tuple(DCMotorConfig.__dataclass_fields__)
+_LOOP_KEYS = tuple(LoopConfig.__dataclass_fields__)
+
+_HEADER = """\
+# openmotion machine file. Lengths and speeds are in each axis's user unit (`unit`);
+# switch position/width/hysteresis too (converted to command pulses on load).
+"""
+
+
+def _check_keys(path: str, table: dict[str, Any], allowed: tuple[str, ...]) -> None:
+    import difflib
+
+    for key in table:
+        if key not in allowed:
+            where = f"{path}.{key}" if path else key
+            close = difflib.get_close_matches(key, allowed, n=1)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            note = " (the axis name is its table key)" if key == "name" and path else ""
+            raise MotionError(f"{where}: unknown key{note}; {hint}valid keys: "
+                              f"{', '.join(allowed)}")
+
+
+def _table(path: str, value: Any) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise MotionError(f"{path} must be a table, got {value!r}")
+    return value
+
+
+def _rebased(err: MotionError, local: str, path: str) -> MotionError:
+    """Re-prefix a message from a standalone validate("drive"/"switch") with the file path."""
+    msg = str(err)
+    return MotionError(path + msg[len(local):] if msg.startswith(local + ".") else msg)
+
+
+def _exact_units(p: float, scale: float) -> float:
+    """The user-unit value to write for pulses p: one with u * scale == p exactly when such
+    a float exists (tidier files); otherwise p / scale, and the 1e-6 pulse grid of
+    SwitchConfig absorbs the last-bit error on load."""
+    u = p / scale
+    for direction in (math.inf, -math.inf):
+        c = u
+        for _ in range(4):
+            if c * scale == p:
+                return c + 0.0  # +0.0 turns -0.0 into 0.0 for a tidy file
+            c = math.nextafter(c, direction)
+    return u + 0.0
+
+
+def _axis_from_toml(name: str, data: dict[str, Any]) -> AxisConfig:
+    path = f"axes.{name}"
+    _table(path, data)
+    _check_keys(path, data, _AXIS_KEYS)
+    kw = {k: data[k] for k in _AXIS_SCALARS if k in data}
+    if "logic" in data:
+        kw["logic"] = _table(f"{path}.logic", data["logic"])
+    if "drive" in data:
+        drive = _table(f"{path}.drive", data["drive"])
+        _check_keys(f"{path}.drive", drive, _DRIVE_KEYS)
+        drive = dict(drive)
+        if "motor" in drive:
+            motor = _table(f"{path}.drive.motor", drive["motor"])
+            _check_keys(f"{path}.drive.motor", motor, _MOTOR_KEYS)
+            try:
+                drive["motor"] = DCMotorConfig(**motor)
+            except MotionError as e:
+                raise _rebased(e, "motor", f"{path}.drive.motor") from None
+        try:
+            kw["drive"] = DriveConfig(**drive)
+        except MotionError as e:
+            raise _rebased(e, "drive", f"{path}.drive") from None
+    if "loop" in data:
+        loop = _table(f"{path}.loop", data["loop"])
+        _check_keys(f"{path}.loop", loop, _LOOP_KEYS)
+        try:
+            kw["loop"] = LoopConfig(**loop)
+        except MotionError as e:
+            raise _rebased(e, "loop", f"{path}.loop") from None
+    if not name.isidentifier():
+        raise MotionError(f"axes name must be an identifier (letters, digits, _), got {name!r}")
+    base = AxisConfig(name=name, **kw)   # validates the mechanism before we use its scale
+    scale = base.pulses_per_unit
+    sign = -1.0 if base.reverse else 1.0
+    switches = {}
+    for sw in SWITCHES:
+        if sw not in data:
+            continue
+        sp = f"{path}.{sw}"
+        t = _table(sp, data[sw])
+        _check_keys(sp, t, _SWITCH_KEYS)
+        if "position" not in t:
+            raise MotionError(f"{sp}.position is required")
+        vals = {k: _real(f"{sp}.{k}", v) for k, v in t.items()}
+        conv = {"position": vals["position"] * sign * scale}
+        if "width" in vals:
+            conv["width"] = vals["width"] * sign * scale
+        if "hysteresis" in vals:
+            conv["hysteresis"] = vals["hysteresis"] * scale
+        try:
+            switches[sw] = SwitchConfig(**conv)
+        except MotionError as e:
+            raise _rebased(e, "switch", sp) from None
+    if not switches:
+        return base
+    return replace(base, **switches)
+
+
+def machine_from_dict(data: dict[str, Any]) -> MachineConfig:
+    """Build a MachineConfig from the parsed TOML layout (see the module docstring)."""
+    _table("machine file", data)
+    _check_keys("", data, _TOP_KEYS)
+    axes_t = _table("axes", data.get("axes", {}))
+    axes = tuple(_axis_from_toml(str(n), a) for n, a in axes_t.items())
+    kw = {k: data[k] for k in _TOP_KEYS[:-1] if k in data}
+    return MachineConfig(axes=axes, **kw)
+
+
+def machine_to_dict(cfg: MachineConfig) -> dict[str, Any]:
+    """The TOML layout of `cfg` (switches in user units); inverse of machine_from_dict."""
+    if not isinstance(cfg, MachineConfig):
+        raise MotionError(f"cfg must be a MachineConfig, got {cfg!r}")
+    axes: dict[str, Any] = {}
+    for ax in cfg.axes:
+        t: dict[str, Any] = {k: getattr(ax, k) for k in _AXIS_SCALARS}
+        if ax.logic:
+            t["logic"] = dict(ax.logic)
+        d = {k: getattr(ax.drive, k) for k in _DRIVE_KEYS}
+        d["pitch_error"] = list(ax.drive.pitch_error)
+        if ax.drive.type == "dc_servo" or ax.drive.motor != DCMotorConfig():
+            d["motor"] = {k: getattr(ax.drive.motor, k) for k in _MOTOR_KEYS}
+        else:
+            del d["motor"]
+        t["drive"] = d
+        if ax.loop is not None:
+            t["loop"] = {k: getattr(ax.loop, k) for k in _LOOP_KEYS}
+        signed = ax.pulses_per_unit * (-1.0 if ax.reverse else 1.0)
+        for sw in SWITCHES:
+            s = getattr(ax, sw)
+            if s is not None:
+                t[sw] = {"position": _exact_units(s.position, signed),
+                         "width": _exact_units(s.width, signed),
+                         "hysteresis": _exact_units(s.hysteresis, ax.pulses_per_unit)}
+        axes[ax.name] = t
+    return {"name": cfg.name, "cycle_s": cfg.cycle_s, "digital_inputs": cfg.digital_inputs,
+            "digital_outputs": cfg.digital_outputs, "axes": axes}
+
+
+def loads_machine(text: str) -> MachineConfig:
+    """Parse and validate a machine description from TOML text."""
+    import tomllib
+
+    if not isinstance(text, str):
+        raise MotionError(f"text must be a str, got {type(text).__name__}")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise MotionError(f"machine file is not valid TOML: {e}") from None
+    return machine_from_dict(data)
+
+
+def load_machine(path: str | os.PathLike[str]) -> MachineConfig:
+    """Read, parse and validate a machine file (OSError if it cannot be read)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise MotionError(f"path must be a str or path, got {path!r}")
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    try:
+        return loads_machine(text)
+    except MotionError as e:
+        raise MotionError(f"{os.fspath(path)}: {e}") from None
+
+
+def dumps_machine(cfg: MachineConfig) -> str:
+    """TOML text for `cfg`; loads_machine(dumps_machine(cfg)) == cfg."""
+    import tomli_w
+
+    return _HEADER + tomli_w.dumps(machine_to_dict(cfg))
+
+
+def save_machine(cfg: MachineConfig, path: str | os.PathLike[str]) -> None:
+    """Write `cfg` to a TOML file (the text is built first: a bad cfg writes nothing)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise MotionError(f"path must be a str or path, got {path!r}")
+    text = dumps_machine(cfg)
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
