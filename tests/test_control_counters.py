@@ -127,3 +127,25 @@ def test_state_table():
     assert set(TRANSITIONS) == set(S)
     with pytest.raises(MotionError, match="Stopping -> ContinuousMotion"):
         transition(S.STOPPING, S.CONTINUOUS_MOTION)
+
+
+@given(st.integers(-(2**30), 2**30), st.integers(-(2**30), 2**30),
+       st.integers(-(2**30), 2**30), st.integers(-(2**30), 2**30),
+       st.sampled_from(("command", "feedback", "clock", "manual")),
+       st.floats(0.25, 4.0))
+@settings(max_examples=100)
+def test_readings_at_equal_the_counters_at_those_totals(pulses, enc, p2, e2, src, ratio):
+    """readings_at(p, e, t) is what the counters would read with raw totals (p, e) at t."""
+    c = Counters(ratio)
+    c.update(pulses, enc, 2.0)
+    c.set_command(12)
+    c.set_feedback(-7)
+    c.reset_error()
+    c.set_general(3, source=src)
+    offset = c.command_offset
+    assert c.command == wrap28(pulses + offset)
+    assert c.encoder_raw() == enc
+    seen = c.readings_at(p2, e2, 3.5)
+    c.update(p2, e2, 3.5)
+    assert seen == (c.command, c.feedback, c.error, c.general)
+    assert c.command_offset == offset  # moving the totals never touches the offsets

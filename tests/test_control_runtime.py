@@ -279,3 +279,25 @@ def test_servo_waits_for_inp_after_the_profile_ends():
     assert c.time > end + c.period  # the servo lags the command
     assert ax.state is S.STANDSTILL
     assert abs(ax.counters.error) <= 2
+
+
+def test_estop_input_level_follows_the_emg_contact_logic():
+    """EMG high means E-stop on a normally open contact, low on a normally closed one."""
+    assert Controller().estop_input_level is True
+    cfg = default_machine()
+    nc = cfg.with_axis(replace(cfg.axis("x"), logic={**cfg.axis("x").logic, "emg": "nc"}))
+    c = Controller(nc)
+    assert c.estop_input_level is False
+    assert c.estop_active == (c.hardware.read_input("emg") == c.estop_input_level)
+
+
+def test_lock_is_the_cycle_lock_and_reentrant(ctl):
+    """Holding `lock` around several calls (another thread's view) never deadlocks its own
+    cycle: it is the re-entrant lock each cycle takes."""
+    with ctl.lock:
+        ctl.axes[0].move_relative(100, max_vel=10_000)
+        ctl.advance(0.05)
+        assert ctl.lock.acquire(blocking=False)  # re-entrant in the holding thread
+        ctl.lock.release()
+    ctl.advance(0.1)
+    assert ctl.axes[0].position == 100

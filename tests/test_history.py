@@ -473,3 +473,28 @@ def test_scalar_and_vector_crossings_agree(case) -> None:
     # Every event is in the window, in time order.
     assert np.all((ts >= t0) & (ts <= t1))
     assert np.all(np.diff(ts) >= 0)
+
+
+def test_rows_and_record_at_read_the_store_without_copying() -> None:
+    """rows(): the records covering [t0, t1] plus the one leading in, as read-only views;
+    record_at(): the record in force at t, None before the oldest one."""
+    h = MotionHistory(1, t_start=0.0)
+    pr = scurve(0.0, 7.0)
+    h.append(0, 1.0, pr)
+    rec = h.records(0)
+    ts, p0, v0, a0, j = h.rows(0, 1.15, 1.25)
+    k0 = int(np.searchsorted(rec["ts"], 1.15, side="right")) - 2
+    k1 = int(np.searchsorted(rec["ts"], 1.25, side="right"))
+    np.testing.assert_array_equal(ts, rec["ts"][k0:k1])
+    np.testing.assert_array_equal(j, rec["j"][k0:k1])
+    assert len(p0) == len(v0) == len(a0) == len(ts) >= 2
+    with pytest.raises(ValueError):
+        p0[0] = 1.0  # a view of the store: readers cannot write into it
+    k = int(np.searchsorted(rec["ts"], 1.2, side="right")) - 1
+    assert h.record_at(0, 1.2) == tuple(float(rec[c][k]) for c in ("ts", "p0", "v0", "a0", "j"))
+    assert h.record_at(0, -1.0) is None
+    h.append(0, 1.0, pr)  # the store stays writable for its owner
+    with pytest.raises(MotionError, match="t1 must be finite"):
+        h.rows(0, 0.0, math.nan)
+    with pytest.raises(MotionError, match="axis must be in"):
+        h.record_at(1, 0.0)

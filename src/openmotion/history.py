@@ -272,6 +272,27 @@ class MotionHistory:
         return {"ts": ts.copy(), "p0": p0.copy(), "v0": v0.copy(), "a0": a0.copy(),
                 "j": j.copy()}
 
+    def rows(self, axis: int, t0: float,
+             t1: float) -> tuple[Array, Array, Array, Array, Array]:
+        """The records covering [t0, t1] plus the one before t0's (the state leading in):
+        ts, p0, v0, a0, j as read-only views of the store, not copies, so a per-cycle
+        reader touches only a few rows. Valid until the next append / truncate / expire."""
+        tr = self._axis(axis)
+        t0 = check_finite("t0", t0)
+        t1 = check_finite("t1", t1)
+        lo = max(tr.index_at(t0) - 1, tr.lo)
+        hi = max(tr.index_at(t1), lo) + 1
+        return tuple(_read_only(c[lo:hi]) for c in (tr.ts, tr.p0, tr.v0, tr.a0, tr.j))
+
+    def record_at(self, axis: int, t: float) -> tuple[float, float, float, float, float] | None:
+        """(ts, p0, v0, a0, j) of the record in force at `t`; None before the oldest one."""
+        tr = self._axis(axis)
+        k = tr.index_at(check_finite("t", t))
+        if k < tr.lo:
+            return None
+        return (float(tr.ts[k]), float(tr.p0[k]), float(tr.v0[k]), float(tr.a0[k]),
+                float(tr.j[k]))
+
     # ------------------------------------------------------------------ events
     def crossings(self, axis: int, level: float, t0: float, t1: float,
                   direction: int = 0) -> Array:
@@ -312,6 +333,11 @@ class MotionHistory:
 # sign of its start value when it ends exactly on the level (monotone in between).
 # Values within a few ulps of the level are snapped onto it, so a tangent touch computed
 # with rounding error reads as one touch, not as two crossings or none.
+
+
+def _read_only(view: Array) -> Array:
+    view.flags.writeable = False  # the view only: the store's own arrays stay writable
+    return view
 
 
 def _poly(c: Array, v: Array, a: Array, j: Array, dt: Array) -> Array:

@@ -210,7 +210,7 @@ class CompareEngine:
                                                               for s in src.scale)))):
                 raise MotionError("vector source needs distinct axes and a positive scale "
                                   "per axis")
-        with self.ctl._lock:  # the cycle may run on the real-time thread
+        with self.ctl.lock:  # the cycle may run on the real-time thread
             return self._add(job, axes)
 
     def _add(self, job: CompareJob, axes: Sequence[int]) -> int:
@@ -232,7 +232,7 @@ class CompareEngine:
 
     def remove(self, job_id: int) -> None:
         """Stop a job and drop its unfired points (HW_PSWITCH2(2) for one job)."""
-        with self.ctl._lock:
+        with self.ctl.lock:
             job = self._jobs.pop(job_id, None)
             if job is not None:
                 job.active = False
@@ -411,12 +411,7 @@ class CompareEngine:
     def _last_record(self, axis: int, t1: float) -> tuple[float, ...]:
         """The history record in force just before t1 (a re-plan or cut inside the cycle
         starts a new one there; a motion starting exactly at t1 does not count)."""
-        tr = self.ctl.history._axis(axis)  # the store's rows (see compare_math.history_track)
-        k = tr.index_at(math.nextafter(t1, -math.inf))
-        if k < tr.lo:
-            return ()
-        return (float(tr.ts[k]), float(tr.p0[k]), float(tr.v0[k]), float(tr.a0[k]),
-                float(tr.j[k]))
+        return self.ctl.history.record_at(axis, math.nextafter(t1, -math.inf)) or ()
 
     def _moved_off_plan(self) -> bool:
         if self._plan is None:
@@ -489,8 +484,7 @@ class CompareEngine:
         keep = t1 - ctl.history.window_s  # waveforms are kept as long as the motion history
         for line in self._lines.values():
             line.flush(hw, ta, t1)
-            if line._t and line._t[0] < keep:
-                line.forget_before(keep)
+            line.forget_before(keep)
 
 
 def _on_command(job: CompareJob) -> bool:

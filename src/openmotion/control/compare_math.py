@@ -50,10 +50,7 @@ def history_track(history: MotionHistory, axis: int, t0: float, t1: float) -> Tr
     Reads the history's record arrays in place (no copy of the whole window): a per-cycle
     query touches only a few rows.
     """
-    tr = history._axis(axis)  # the store's row arrays; history has no public row slice
-    lo = max(tr.index_at(t0) - 1, tr.lo)
-    hi = max(tr.index_at(t1), lo) + 1
-    return Track(tr.ts[lo:hi], tr.p0[lo:hi], tr.v0[lo:hi], tr.a0[lo:hi], tr.j[lo:hi])
+    return Track(*history.rows(axis, t0, t1))
 
 
 def affine_track(tr: Track, scale: float, offset: float, e0: float = 0.0, slope: float = 0.0,

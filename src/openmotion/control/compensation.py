@@ -163,7 +163,8 @@ class Compensation:
         self._o = 0.0
         self._target = 0.0
         self._was_moving = False
-        with axis._ctl._lock:
+        self._lock = axis._ctl.lock  # the axis's controller (Axis has no public link)
+        with self._lock:
             axis.command_transforms.append(self)
             axis.done_gates.append(self._gate)
 
@@ -173,7 +174,7 @@ class Compensation:
         on every direction change; mode 1 on, 0 off (the seed gives no Mode values)."""
         b = _check_int("pulses", pulses, 0, _I16_MAX)
         m = _check_int("mode", mode, 0, 1)
-        with self.axis._ctl._lock:
+        with self._lock:
             self._backlash = b if m else 0
 
     def suppress_vibration(self, t1: float, t2: float) -> None:
@@ -182,7 +183,7 @@ class Compensation:
         disables. Times start on the cycle grid (the pulses are ramped like any offset)."""
         a = check_range("t1", t1, 0.0, 1.0)
         b = check_range("t2", t2, 0.0, 1.0)
-        with self.axis._ctl._lock:
+        with self._lock:
             self._vib = None if a == 0.0 and b == 0.0 else (a, b)
             if self._vib is None:
                 self._vib_phase = 0
@@ -204,19 +205,19 @@ class Compensation:
         if lo < t_lo or hi > t_hi:
             raise MotionError(f"the table covers [{t_lo}, {t_hi}] pulses, which must cover "
                               f"the stroke [{lo:g}, {hi:g}]")
-        with self.axis._ctl._lock:
+        with self._lock:
             self._table = table
         return table
 
     def clear_pitch_table(self) -> None:
         """Disable pitch compensation (MCCL dwInterval <= 0); the offset ramps out."""
-        with self.axis._ctl._lock:
+        with self._lock:
             self._table = None
 
     def remove(self) -> None:
         """Detach from the axis; only once the offset is back to 0 (disable everything and
         let it ramp out first), as dropping an offset would jump the motor."""
-        with self.axis._ctl._lock:
+        with self._lock:
             if self._o != 0.0:
                 raise MotionError(f"compensation offset is {self._o:g} pulses; disable the "
                                   "compensation and let it ramp to 0 before remove()")

@@ -144,6 +144,18 @@ class Controller:
     def estop_active(self) -> bool:
         return self._estop
 
+    @property
+    def estop_input_level(self) -> bool:
+        """The physical EMG input level that means E-stop: high for a normally open
+        contact, low when any axis configures EMG as normally closed."""
+        return not self._emg_nc
+
+    @property
+    def lock(self) -> threading.RLock:
+        """The re-entrant lock every cycle runs under: hold it to read or change several
+        pieces of controller state as one step from another thread."""
+        return self._lock
+
     # ------------------------------------------------------------------ inputs
     def input_active(self, axis: int, signal: str) -> bool:
         """Logical level of an axis input (configured NO/NC logic applied)."""

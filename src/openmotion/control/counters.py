@@ -151,13 +151,16 @@ class Counters:
 
     def _raw_general(self) -> int:
         self._fresh()
+        return self._general_source_value(self._pulses, self._encoder, self._time)
+
+    def _general_source_value(self, pulses: int, encoder: int, time: float) -> int:
         src = self._gen_src
         if src == "command":
-            return self._pulses
+            return pulses
         if src == "feedback":
-            return self._encoder
+            return encoder
         if src == "clock":
-            return round(self._time * CLOCK_HZ)
+            return round(time * CLOCK_HZ)
         return 0  # manual pulse input: no MPG on the hardware boundary yet
 
     @property
@@ -176,6 +179,29 @@ class Counters:
         if source is not None:
             self._gen_src = source
         self._gen_off = v - self._raw_general()
+
+    # -- readings at other raw totals (latches, homing marks) ----------------------------
+    @property
+    def command_offset(self) -> int:
+        """Command counter minus the raw planned pulses: adding it maps a position in the raw
+        pulse frame (motion history, profiles) into the command-counter frame."""
+        return self._cmd_off
+
+    def encoder_raw(self) -> int:
+        """The raw encoder total (unwrapped, without the feedback counter's offset)."""
+        self._fresh()
+        return self._encoder
+
+    def readings_at(self, pulses: int, encoder: int,
+                    time: float) -> tuple[int, int, int, int]:
+        """(command, feedback, error, general) as the counters read when the raw totals are
+        `pulses` (planned pulses out) and `encoder` at controller time `time`, with today's
+        offsets: a latch uses it for the totals at an input edge's exact time."""
+        command = wrap28(pulses + self._cmd_off)
+        feedback = wrap28(encoder + self._fb_off)
+        error = wrap28(round(pulses - encoder / self._ratio) + self._err_off)
+        general = wrap28(self._general_source_value(pulses, encoder, time) + self._gen_off)
+        return command, feedback, error, general
 
     # -- target recorder ------------------------------------------------------------------
     @property

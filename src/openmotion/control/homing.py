@@ -43,20 +43,14 @@ from .homing_modes import (
     Phase,
     uses,
 )
+from .safety import Safety
 from .states import AxisState
 
 if TYPE_CHECKING:
     from .axis import Axis
     from .controller import Controller
-    from .safety import Safety
 
 S = AxisState
-
-
-def _installed_safety(ctl: Controller) -> Safety | None:
-    from . import safety
-
-    return safety._INSTALLED.get(ctl)
 
 
 def _has_index(axis: Axis) -> bool:
@@ -84,7 +78,7 @@ class Homing:
         self._escape_only = escape_only
         # the Safety attached to this controller, if any: its limit / soft-limit reactions
         # are suspended while homing handles them itself
-        self.safety = safety if safety is not None else _installed_safety(ctl)
+        self.safety = safety if safety is not None else Safety.of(ctl)
         self._suspended: tuple[str, ...] = ()
         self._plan: list[Phase] = []
         self._k = 0
@@ -193,7 +187,7 @@ class Homing:
         """(p, v, a) of the axis now, command-counter frame."""
         ax = self.axis
         m = ax.motion
-        off = ax.position - ax._pos
+        off = ax.counters.command_offset
         if m is None:
             return ax.position, 0.0, 0.0
         p, v, a = m.state(self.ctl.time)
@@ -340,7 +334,7 @@ class Homing:
         off = round(self.config.home_offset)
         if st.mark_encoder is None or not self.axis.config.drive.type.endswith("servo"):
             return round(st.mark) + off
-        enc_now = cnt.feedback_unwrapped() - cnt._fb_off
+        enc_now = cnt.encoder_raw()
         return round(self.axis.position + (st.mark_encoder - enc_now) / cnt.move_ratio) + off
 
     def _complete(self) -> None:
@@ -356,7 +350,7 @@ class Homing:
             rel = round(ax.position - home)
             enc_rel = round(rel * cnt.move_ratio)
             if st.mark_encoder is not None and ax.config.drive.type.endswith("servo"):
-                raw_enc = cnt.feedback_unwrapped() - cnt._fb_off
+                raw_enc = cnt.encoder_raw()
                 enc_rel = raw_enc - st.mark_encoder - round(c.home_offset * cnt.move_ratio)
         cnt.reset_all()
         if rel:
@@ -389,7 +383,7 @@ class Homing:
     # ------------------------------------------------------------------ hooks
     def _trigger(self, ph: Phase, e: InputEdge) -> None:
         ax = self.axis
-        off = ax.position - ax._pos
+        off = ax.counters.command_offset
         self._edge_p = self.ctl.history.state_at(ax.index, e.time).p + off
         if ph.mark:
             self.status.mark = self._edge_p

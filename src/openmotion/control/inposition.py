@@ -59,7 +59,7 @@ class InPositionControl:
         tol = check_nonnegative("tolerance", tolerance)
         if units:
             tol = abs(float(ax.units.to_pulses(tol)))
-        with self._ctl._lock:
+        with self._ctl.lock:
             self._tol[ax.index] = tol
 
     def tolerance(self, axis: int | str) -> float:
@@ -70,13 +70,13 @@ class InPositionControl:
         """MCC_SetInPosCheckTime: how long a finished move may wait for in-position."""
         ax = self._ctl.axis(axis)
         t = check_positive("seconds", seconds)
-        with self._ctl._lock:
+        with self._ctl.lock:
             self._check[ax.index] = t
 
     def enable(self, axes: Sequence[int | str] | None = None) -> None:
         """MCC_EnableInPos for the given axes (default all)."""
         sel = self._select(axes)
-        with self._ctl._lock:
+        with self._ctl.lock:
             for ax in sel:
                 if not self._enabled[ax.index]:
                     self._enabled[ax.index] = True
@@ -85,7 +85,7 @@ class InPositionControl:
     def disable(self, axes: Sequence[int | str] | None = None) -> None:
         """MCC_DisableInPos for the given axes (default all); a waiting move is done now."""
         sel = self._select(axes)
-        with self._ctl._lock:
+        with self._ctl.lock:
             for ax in sel:
                 if self._enabled[ax.index]:
                     self._enabled[ax.index] = False
@@ -128,7 +128,7 @@ class InPositionControl:
 
     def clear_error(self) -> None:
         """MCC_ClearError: accept queued commands again (the axis still needs reset())."""
-        with self._ctl._lock:
+        with self._ctl.lock:
             self._error = NO_ERROR
             self._error_axis = None
 
@@ -138,7 +138,7 @@ class InPositionControl:
         queued before it). Refused while a system error is set."""
         if not callable(command):
             raise MotionError(f"command must be callable, got {command!r}")
-        with self._ctl._lock:
+        with self._ctl.lock:
             if self._error:
                 raise MotionError(f"in-position error {self._error} is set; clear_error() "
                                   "first")

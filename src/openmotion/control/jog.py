@@ -43,7 +43,7 @@ def _ratio_speed(ax: Axis, ratio: float) -> float:
     r = check_finite("ratio", ratio)
     if not 0.0 < r <= 100.0:
         raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
-    return ax._max_speed * r / 100.0
+    return ax.config.max_speed_pps * r / 100.0  # the config caps it at the pulse rate
 
 
 def jog_pulse(ctl: Controller, axis: int | str, pulses: int, *, speed: float | None = None,

@@ -26,7 +26,6 @@ from typing import TYPE_CHECKING
 
 from ..errors import MotionError, check_finite
 from ..hw.interface import AXIS_INPUTS, InputEdge
-from .counters import CLOCK_HZ, wrap28
 
 if TYPE_CHECKING:
     from .controller import Controller
@@ -64,14 +63,9 @@ def capture(ctl: Controller, axis: int, edge: InputEdge) -> LatchData:
     cnt = ax.counters
     st = ctl.history.state_at(axis, edge.time)
     pulses = _pulses_at(st.p, st.v)
-    enc = edge.encoders[axis] if edge.encoders else cnt.feedback_unwrapped() - cnt._fb_off
-    command = wrap28(pulses + cnt._cmd_off)
-    feedback = wrap28(enc + cnt._fb_off)
-    error = wrap28(round(pulses - enc / cnt.move_ratio) + cnt._err_off)
-    src = cnt.general_source
-    raw = {"command": pulses, "feedback": enc, "clock": round(edge.time * CLOCK_HZ)}.get(src, 0)
-    general = wrap28(raw + cnt._gen_off)
-    return LatchData(edge.time, command, feedback, error, general, st.p + cnt._cmd_off)
+    enc = edge.encoders[axis] if edge.encoders else cnt.encoder_raw()
+    command, feedback, error, general = cnt.readings_at(pulses, enc, edge.time)
+    return LatchData(edge.time, command, feedback, error, general, st.p + cnt.command_offset)
 
 
 def _edge_wanted(active: bool, edge: str) -> bool:

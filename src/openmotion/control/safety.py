@@ -174,7 +174,7 @@ class Safety:
         hw = controller.hardware
         self._hw_stop = isinstance(hw, EdgeStopHardware)
         if self._hw_stop:
-            hw.arm_stop(None, "emg", not controller._emg_level_active(False))
+            hw.arm_stop(None, "emg", controller.estop_input_level)
         for i in range(n):
             self._arm(i)
 
