@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import free_axes, start_line
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import Controller
 from openmotion.control.compare import (
@@ -25,15 +26,9 @@ from openmotion.control.compare import (
 from openmotion.control.compare_io import plot_firings
 from openmotion.errors import MotionError
 from openmotion.profile.jerk import jerk_limited
-from openmotion.profile.segments import Profile, ProfileBuilder, State
+from openmotion.profile.segments import ProfileBuilder
 
-
-def machine(n=3, period=None):
-    """Axes without limit switches, max 500 mm/s = 500,000 pps."""
-    cfg = MachineConfig("t", tuple(AxisConfig(name=c) for c in "xyzu"[:n]))
-    c = Controller(cfg, period=period)
-    c.enable_all()
-    return c
+machine = free_axes  # n axes x, y, z, u without switches, enabled
 
 
 def trapezoid_profile(dist, v, a):
@@ -171,17 +166,9 @@ def test_mpos_servo_fires_later_than_dpos_in_the_right_cycle():
     assert np.all(fb[k - 1, 1] < levels + 1) and np.all(fb[k, 1] >= levels - 1)
 
 
-def straight_line(c, start, end, v=20_000.0, a=2e5, j=2e7):
-    """Synchronised straight line: each axis a scaled copy of one jerk-limited profile."""
-    start, end = np.asarray(start, float), np.asarray(end, float)
-    d = end - start
-    length = float(np.linalg.norm(d))
-    ref = jerk_limited(length, v, a, j)
-    for ax, (p0, dk) in enumerate(zip(start, d, strict=True)):
-        k = dk / length
-        prof = Profile(ref.t0, p0 + k * ref.p0, k * ref.v0, k * ref.a0, k * ref.j,
-                       ref.duration, State(p0), State(p0 + dk), ref.labels, ref.dt)
-        c.axes[ax].run_profile(prof, stop_accel=a, stop_jerk=j)
+def straight_line(c, start, end, **kw):
+    """Synchronised straight line (helpers.start_line), run to the end."""
+    assert start_line(c, start, end, **kw)
     run(c)
 
 

@@ -6,17 +6,14 @@ import math
 import numpy as np
 import pytest
 
-from openmotion.config import AxisConfig, MachineConfig
-from openmotion.control import Controller
+from helpers import free_axes
 from openmotion.control.compare import CompareEngine
 from openmotion.control.hsl_trigger import HslTrigger
 from openmotion.errors import MotionError
 
 
 def setup(buffer_size=100_000, move_ratio=1.0):
-    cfg = MachineConfig("t", tuple(AxisConfig(name=c, move_ratio=move_ratio) for c in "xyz"))
-    c = Controller(cfg)
-    c.enable_all()
+    c = free_axes(3, move_ratio=move_ratio)
     eng = CompareEngine(c, buffer_size=buffer_size)
     return c, eng, HslTrigger(eng)
 

@@ -5,8 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from openmotion.config import AxisConfig, MachineConfig
-from openmotion.control import Controller
+from helpers import free_axes
 from openmotion.control.compare import CompareEngine, Pulse, VectorSource, every_distance
 from openmotion.control.group import Group
 from openmotion.errors import MotionError
@@ -15,9 +14,7 @@ MM = 1000.0  # pulses per mm of the default axis (10000 ppr, 10 mm lead)
 
 
 def setup():
-    cfg = MachineConfig("t", (AxisConfig(name="x"), AxisConfig(name="y")))
-    c = Controller(cfg)
-    c.enable_all()
+    c = free_axes(2)
     return c, CompareEngine(c)
 
 

@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import free_axes
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
 from openmotion.control.compare import (
@@ -29,11 +30,7 @@ from openmotion.hw.sim import SimMachine
 MM = 1000.0
 
 
-def machine(n=2, period=None, hardware=None):
-    cfg = MachineConfig("t", tuple(AxisConfig(name=c) for c in "xyzu"[:n]))
-    c = Controller(cfg, hardware(cfg) if hardware else None, period=period)
-    c.enable_all()
-    return c
+machine = free_axes  # n axes x, y, z, u without switches, enabled
 
 
 def phys(c, n):

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from openmotion.config import DriveConfig, default_machine
 from openmotion.control import Controller
+from openmotion.control.axis import Axis
 from openmotion.control.compensation import (
     BACKLASH_COMPENSATING,
     Compensation,
@@ -30,6 +31,17 @@ def _machine(backlash: float = 0.0, pitch: tuple[float, ...] = ()) -> Controller
     ctl = Controller(dataclasses.replace(cfg, axes=(x, *cfg.axes[1:])))
     ctl.axis("x").enable()
     return ctl
+
+
+def _with_backlash(backlash: int, pitch: tuple[float, ...] = (),
+                   **comp_kw: float) -> tuple[Controller, Axis, Compensation]:
+    """Axis x with `backlash` pulses of play on its drive and a Compensation correcting
+    exactly that much (max_accel 5e6 unless `comp_kw` says otherwise)."""
+    ctl = _machine(backlash=float(backlash), pitch=pitch)
+    ax = ctl.axis("x")
+    comp = Compensation(ax, **{"max_accel": 5e6, **comp_kw})
+    comp.backlash_comp(backlash)
+    return ctl, ax, comp
 
 
 def _record(ctl: Controller, axis: int = 0) -> list:
@@ -116,10 +128,7 @@ def test_backlash_compensation_reduces_final_error_to_one_count():
 
 
 def test_backlash_counters_and_direction():
-    ctl = _machine(backlash=50.0)
-    ax = ctl.axis("x")
-    comp = Compensation(ax, max_accel=5e6)
-    comp.backlash_comp(50)
+    ctl, ax, comp = _with_backlash(50)
     _move_to(ctl, 10000)
     assert comp.offset == 0.0 and comp.direction == 1
     _move_to(ctl, 4000)
@@ -133,10 +142,7 @@ def test_backlash_counters_and_direction():
 
 
 def test_motion_done_reports_compensating_until_offset_settles():
-    ctl = _machine(backlash=400.0)
-    ax = ctl.axis("x")
-    comp = Compensation(ax, max_accel=5e6, comp_accel=2e5)
-    comp.backlash_comp(400)
+    ctl, ax, comp = _with_backlash(400, comp_accel=2e5)
     _move_to(ctl, 5000)
     ax.move_relative(-10, max_vel=1000, tacc=0.01)
     codes = []
@@ -176,9 +182,7 @@ def test_pitch_compensation_reduces_final_error_to_one_count():
 
 
 def test_backlash_and_pitch_together():
-    ctl = _machine(backlash=25.0, pitch=SCREW_ERR)
-    comp = Compensation(ctl.axis("x"), max_accel=5e6)
-    comp.backlash_comp(25)
+    ctl, _, comp = _with_backlash(25, pitch=SCREW_ERR)
     comp.set_pitch_table(10000, 1, _table_from_screw())
     for tg in (30000, 12000, 47000, 20500, 81000, 64000):
         _move_to(ctl, tg, vmax=150000.0)
@@ -219,10 +223,7 @@ def test_output_never_exceeds_axis_limits(moves, backlash):
     more: each cycle's output stays within the limits (or, where the planned piece alone
     already exceeds them - Hermite pieces of very short moves - adds nothing to it)."""
     V, A = 100000.0, 4e6
-    ctl = _machine(backlash=float(backlash), pitch=SCREW_ERR)
-    ax = ctl.axis("x")
-    comp = Compensation(ax, max_accel=A, max_vel=V)
-    comp.backlash_comp(backlash)
+    ctl, ax, comp = _with_backlash(backlash, pitch=SCREW_ERR, max_accel=A, max_vel=V)
     comp.set_pitch_table(10000, 1, _table_from_screw())
     cmds = _record(ctl)
     planned = _record_planned(ax)
@@ -245,10 +246,7 @@ def test_output_never_exceeds_axis_limits(moves, backlash):
 
 def test_compensation_uses_the_budget_left_by_a_move():
     V, A = 100000.0, 4e6
-    ctl = _machine(backlash=2000.0)
-    ax = ctl.axis("x")
-    comp = Compensation(ax, max_accel=A, max_vel=V)
-    comp.backlash_comp(2000)
+    ctl, ax, comp = _with_backlash(2000, max_accel=A, max_vel=V)
     _move_to(ctl, 40000, vmax=0.5 * V)
     cmds = _record(ctl)
     ax.move_relative(-30000, max_vel=0.5 * V, tacc=0.05)
@@ -281,10 +279,7 @@ def test_vibration_suppression_reverse_then_forward_pulse():
 
 # ---------------------------------------------------------------------- safety and refusals
 def test_offset_frozen_in_error_stop():
-    ctl = _machine(backlash=300.0)
-    ax = ctl.axis("x")
-    comp = Compensation(ax, max_accel=5e6, comp_accel=1e5)
-    comp.backlash_comp(300)
+    ctl, ax, comp = _with_backlash(300, comp_accel=1e5)
     _move_to(ctl, 5000)
     ax.move_relative(-100, max_vel=5000, tacc=0.01)
     ctl.advance(0.05)
@@ -296,10 +291,7 @@ def test_offset_frozen_in_error_stop():
 
 
 def test_remove_only_at_zero_offset():
-    ctl = _machine(backlash=40.0)
-    ax = ctl.axis("x")
-    comp = Compensation(ax, max_accel=5e6)
-    comp.backlash_comp(40)
+    ctl, ax, comp = _with_backlash(40)
     _move_to(ctl, 5000)
     _move_to(ctl, 1000)
     with pytest.raises(MotionError, match="ramp to 0"):

@@ -111,7 +111,7 @@ def test_sequences_normalised_and_logic_copied():
 
 # -- validation: every rule refused with the field path ---------------------------------
 AXIS_BAD = [
-    ("pulses_per_rev", 0, r"axes\.x\.pulses_per_rev must be >= 1"),
+    ("pulses_per_rev", 0, r"axes\.x\.pulses_per_rev must be an integer >= 1"),
     ("pulses_per_rev", 100.0, r"axes\.x\.pulses_per_rev must be an integer"),
     ("lead", -2, r"axes\.x\.lead must be > 0, got -2"),
     ("lead", math.nan, r"axes\.x\.lead must be finite"),
@@ -125,7 +125,7 @@ AXIS_BAD = [
     ("pulse_width_us", 0.0, r"axes\.x\.pulse_width_us must be > 0"),
     ("pulse_width_us", 5000.0, r"axes\.x\.pulse_width_us must be <= 1000"),
     ("encoder_mode", "ab_x3", r"axes\.x\.encoder_mode must be one of ab_x1"),
-    ("encoder_lines_per_rev", -1, r"axes\.x\.encoder_lines_per_rev must be >= 1"),
+    ("encoder_lines_per_rev", -1, r"axes\.x\.encoder_lines_per_rev must be an integer >= 1"),
     ("invert_a", "yes", r"axes\.x\.invert_a must be true or false"),
     ("invert_b", 0, r"axes\.x\.invert_b must be true or false"),
     ("invert_z", None, r"axes\.x\.invert_z must be true or false"),
@@ -204,7 +204,7 @@ MACHINE_BAD = [
     ({"cycle_s": 0.0005}, r"cycle_s must be in \[0\.001, 1\] \(MCCL 1\.\.1000 ms\)"),
     ({"cycle_s": 2.0}, r"cycle_s must be in \[0\.001, 1\]"),
     ({"cycle_s": math.nan}, r"cycle_s must be finite"),
-    ({"digital_inputs": -1}, r"digital_inputs must be in \[0, 4096\]"),
+    ({"digital_inputs": -1}, r"digital_inputs must be an integer in \[0, 4096\]"),
     ({"digital_outputs": 1.5}, r"digital_outputs must be an integer"),
     ({"axes": "xyz"}, r"axes must be a sequence of AxisConfig"),
     ({"axes": (1,)}, r"axes\[0\] must be an AxisConfig"),

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
 from openmotion.control.axis import AxisState
 from openmotion.control.group import (
@@ -31,19 +32,11 @@ ACC_T = 0.05  # path accel 400 000 pps^2
 
 
 def make(axes=("x", "y"), **kw) -> tuple[Controller, Group]:
-    ctl = Controller()
-    ctl.enable_all()
-    for k in range(len(ctl.axes)):  # the default table's -EL sits at -5 mm: allow both signs
-        ctl.hardware.scenario.remove_switch(k, "mel")
+    ctl = table_without_mel()  # the default table's -EL sits at -5 mm: allow both signs
     return ctl, Group(ctl, list(axes), feed=kw.pop("feed", FEED), acc_time=ACC_T, **kw)
 
 
-def finish(ctl: Controller, g: Group, timeout: float = 30.0) -> float:
-    """Run until the group has nothing left; returns the end time."""
-    ctl.step()
-    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), timeout)
-    return ctl.time
+finish = finish_group  # run until idle, queue empty, axes still; the end time
 
 
 def sample(ctl: Controller, g: Group, t0: float, t1: float, n: int = 20001):

@@ -7,6 +7,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
 from openmotion.control import pathexec as px
 from openmotion.control.group import Group, GroupState
@@ -17,10 +18,7 @@ AMAX = 500_000.0
 
 
 def make(tol: float | None) -> tuple[Controller, Group]:
-    ctl = Controller()
-    ctl.enable_all()
-    for k in range(len(ctl.axes)):
-        ctl.hardware.scenario.remove_switch(k, "mel")
+    ctl = table_without_mel()
     g = Group(ctl, ["x", "y"], feed=40_000.0, acc_time=0.1)
     g.set_max_pulse_speed([VMAX, VMAX])
     g.set_max_pulse_acc([AMAX, AMAX])
@@ -35,9 +33,7 @@ def run(points: np.ndarray, tol: float | None):
     g.line(points[0])  # from the origin to the first vertex
     for p in points[1:]:
         g.line(p)
-    ctl.step()
-    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), 60)
+    finish_group(ctl, g, 60)
     t = np.linspace(t0, ctl.time, 40001)
     s = [ctl.history.sample(a.index, t) for a in g.axes]
     return ctl.time - t0, g.position, s
@@ -220,9 +216,7 @@ def test_half_pulse_counts_stay_within_half_a_pulse_on_lines_and_arcs():
     ctl.add_cycle_hook(lambda c, t: rows.append(
         [c.hardware.read_axis(k).pulses_out for k in (0, 1)]
         + [c.hardware.command_position(k) for k in (0, 1)]))
-    ctl.step()
-    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), 20)
+    finish_group(ctl, g, 20)
     r = np.array(rows, dtype=float)
     assert len(r) > 100
     dev = np.abs(r[:, :2] - r[:, 2:])

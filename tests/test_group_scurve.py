@@ -8,6 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
 from openmotion.control.group import Group, GroupState
 from openmotion.errors import MotionError
@@ -18,20 +19,13 @@ FEED, ACC_T, JERK = 20_000.0, 0.05, 2.0e7  # pps, s (accel 400 000 pps^2), pps^3
 
 
 def make() -> tuple[Controller, Group]:
-    ctl = Controller(safety=False)
-    ctl.enable_all()
-    for k in range(len(ctl.axes)):  # the table's -EL sits just below 0
-        ctl.hardware.scenario.remove_switch(k, "mel")
+    ctl = table_without_mel(safety=False)  # the table's -EL sits just below 0
     g = Group(ctl, ["x", "y"], feed=FEED, acc_time=ACC_T)
     g.set_path_shape("S", jerk=JERK)
     return ctl, g
 
 
-def finish(ctl: Controller, g: Group) -> float:
-    ctl.step()
-    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), 30.0)
-    return ctl.time
+finish = finish_group  # run until idle, queue empty, axes still; the end time
 
 
 def test_line_jerk_within_limit_and_exact_end():

@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
-from openmotion.control.group import ERR_SPEED, Group, GroupError, GroupState
+from openmotion.control.group import ERR_SPEED, Group, GroupError
 from openmotion.errors import MotionError
 from openmotion.units import AxisUnits
 
@@ -15,19 +16,12 @@ FEED = 20.0  # mm/s
 
 
 def make(**kw) -> tuple[Controller, Group]:
-    ctl = Controller(safety=False)
-    ctl.enable_all()
-    for k in range(len(ctl.axes)):
-        ctl.hardware.scenario.remove_switch(k, "mel")
+    ctl = table_without_mel(safety=False)
     units = kw.pop("units", True)
     return ctl, Group(ctl, ["x", "y"], feed=FEED, acc_time=0.05, units=units, **kw)
 
 
-def finish(ctl: Controller, g: Group) -> float:
-    ctl.step()
-    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), 30.0)
-    return ctl.time
+finish = finish_group  # run until idle, queue empty, axes still; the end time
 
 
 def sampled_mm(ctl: Controller, g: Group, t0: float, t1: float, ppu: tuple[float, float]):
@@ -71,10 +65,7 @@ def test_line_in_mm_ends_exactly_and_keeps_the_direction():
 
 
 def test_reversed_axis_units_mirror_the_pulses():
-    ctl = Controller(safety=False)
-    ctl.enable_all()
-    for k in range(len(ctl.axes)):
-        ctl.hardware.scenario.remove_switch(k, "mel")
+    ctl = table_without_mel(safety=False)
     units = [AxisUnits("x", "mm", 1000.0, -1), AxisUnits("y", "mm", 500.0, 1)]
     g = Group(ctl, ["x", "y"], feed=FEED, acc_time=0.05, units=units)
     g.line([-5.0, 4.0])

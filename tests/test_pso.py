@@ -5,21 +5,16 @@ import math
 import numpy as np
 import pytest
 
-from openmotion.config import AxisConfig, MachineConfig
-from openmotion.control import Controller
+from helpers import free_axes, start_line
 from openmotion.control.compare import CompareEngine
 from openmotion.control.pso import ZPso
 from openmotion.errors import MotionError
-from openmotion.profile.jerk import jerk_limited
-from openmotion.profile.segments import Profile, State
 
 UNITS = 100.0  # seed: UNITS=100
 
 
 def setup(n=3, buffer_size=100_000):
-    cfg = MachineConfig("t", tuple(AxisConfig(name=c) for c in "xyz"[:n]))
-    c = Controller(cfg)
-    c.enable_all()
+    c = free_axes(n)
     eng = CompareEngine(c, buffer_size=buffer_size)
     z = ZPso(eng)
     z.base(*range(n))
@@ -28,21 +23,11 @@ def setup(n=3, buffer_size=100_000):
     return c, eng, z
 
 
-def line_to(c, end_units, v=20_000.0, a=2e5, j=2e7):
+def line_to(c, end_units, **kw):
     """Synchronised straight line to `end_units` (units -> pulses) on axes 0..k-1."""
-    start = np.array([c.axes[i].position for i in range(len(end_units))])
-    end = np.asarray(end_units, float) * UNITS
-    d = end - start
-    length = float(np.linalg.norm(d))
-    if length == 0:
-        return
-    ref = jerk_limited(length, v, a, j)
-    for ax, (p0, dk) in enumerate(zip(start, d, strict=True)):
-        k = dk / length
-        prof = Profile(ref.t0, p0 + k * ref.p0, k * ref.v0, k * ref.a0, k * ref.j,
-                       ref.duration, State(p0), State(p0 + dk), ref.labels, ref.dt)
-        c.axes[ax].run_profile(prof, stop_accel=a, stop_jerk=j)
-    assert c.wait_motion_done(timeout=30)
+    start = [c.axes[i].position for i in range(len(end_units))]
+    if start_line(c, start, np.asarray(end_units, float) * UNITS, **kw):
+        assert c.wait_motion_done(timeout=30)
 
 
 SEED_2D = (0, 0, 50, 50, 100, 100, 50, 150, 0, 200, -50, 150, -100, 100, -50, 50)

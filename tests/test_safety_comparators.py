@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from helpers import with_own_safety
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import AxisState, Controller
 from openmotion.control.safety import Safety
@@ -14,10 +15,7 @@ S = AxisState
 
 def setup(drive: DriveConfig | None = None) -> tuple[Controller, Safety]:
     ax = AxisConfig(name="a", lead=10.0, max_speed=1000.0, drive=drive or DriveConfig())
-    ctl = Controller(MachineConfig("t", (ax,), 0, 0, 0.001), safety=False)
-    safety = Safety(ctl)
-    ctl.enable_all()
-    return ctl, safety
+    return with_own_safety(MachineConfig("t", (ax,), 0, 0, 0.001))
 
 
 @pytest.mark.parametrize("lost, tol, detected", [(50, 10, True), (50, 60, False),

@@ -6,6 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import with_own_safety
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig, SwitchConfig
 from openmotion.control import AxisState, Controller
 from openmotion.control.safety import IO_STATUS_BITS, Safety, io_status
@@ -30,10 +31,7 @@ def machine(logic: str = "no", drive: str = "ideal_stepper") -> MachineConfig:
 
 
 def setup(logic: str = "no") -> tuple[Controller, Safety]:
-    ctl = Controller(machine(logic), safety=False)
-    safety = Safety(ctl)
-    ctl.enable_all()
-    return ctl, safety
+    return with_own_safety(machine(logic))
 
 
 def start(ax, kind: str, sign: int = 1) -> None:

@@ -9,6 +9,7 @@ import contextlib
 import numpy as np
 import pytest
 
+from helpers import table_without_mel
 from openmotion.control import AxisState, Controller
 from openmotion.control.group import Group, GroupState
 from openmotion.control.homing import Homing
@@ -19,10 +20,7 @@ FEED = 20_000.0
 
 
 def group(blend: bool) -> tuple[Controller, Group]:
-    ctl = Controller()
-    ctl.enable_all()
-    for k in range(len(ctl.axes)):  # the default table's -EL sits just below 0
-        ctl.hardware.scenario.remove_switch(k, "mel")
+    ctl = table_without_mel()  # the default table's -EL sits just below 0
     g = Group(ctl, ["x", "y"], feed=FEED, acc_time=0.05)
     if blend:
         g.enable_blend(50.0)

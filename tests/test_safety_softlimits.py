@@ -10,6 +10,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from helpers import with_own_safety
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import AxisState, Controller
 from openmotion.control.safety import Safety
@@ -23,10 +24,7 @@ S = AxisState
 
 def setup(period: float = 0.001) -> tuple[Controller, Safety]:
     ax = AxisConfig(name="a", lead=10.0, max_speed=1000.0)  # 1e6 pps
-    ctl = Controller(MachineConfig("t", (ax,), 0, 0, period), safety=False)
-    safety = Safety(ctl)
-    ctl.enable_all()
-    return ctl, safety
+    return with_own_safety(MachineConfig("t", (ax,), 0, 0, period))
 
 
 class Watch:
@@ -218,9 +216,7 @@ def test_enable_before_set_is_refused() -> None:
 
 def test_a_fault_stop_decelerating_towards_a_soft_limit_never_passes_it() -> None:
     ax_cfg = AxisConfig(name="s", lead=10.0, max_speed=1000.0, drive=DriveConfig(type="servo"))
-    ctl = Controller(MachineConfig("t", (ax_cfg,), 0, 0, 0.001), safety=False)
-    safety = Safety(ctl)
-    ctl.enable_all()
+    ctl, safety = with_own_safety(MachineConfig("t", (ax_cfg,), 0, 0, 0.001))
     safety.set_alm(0, "decel")
     safety.soft.set(0, 20_000.0, -20_000.0)
     safety.soft.enable(0, "immediate")

@@ -188,13 +188,13 @@ def test_servo_loop_refusals():
 
 @pytest.mark.parametrize(("kw", "msg"), [
     ({"compensator": "pi"}, r"loop.compensator must be one of lead, pid"),
-    ({"a": 256}, r"loop.a must be in \[0, 255\]"),
-    ({"k": -1}, r"loop.k must be in \[0, 255\]"),
+    ({"a": 256}, r"loop.a must be an integer in \[0, 255\]"),
+    ({"k": -1}, r"loop.k must be an integer in \[0, 255\]"),
     ({"b": 1.5}, r"loop.b must be an integer"),
     ({"compensator": "pid"}, r"loop.kp must be > 0 for the pid compensator"),
     ({"kd": -1.0}, r"loop.kd must be >= 0"),
     ({"kvff": math.nan}, r"loop.kvff must be finite"),
-    ({"samples_per_cycle": 0}, r"loop.samples_per_cycle must be in \[1, 1000\]"),
+    ({"samples_per_cycle": 0}, r"loop.samples_per_cycle must be an integer in \[1, 1000\]"),
     ({"following_error": 0.0}, r"loop.following_error must be > 0 counts"),
     ({"following_error": math.nan}, r"loop.following_error must be > 0 counts"),
 ])

@@ -22,9 +22,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
-from openmotion.errors import MotionError, check_distance
+from openmotion.errors import (
+    MotionError,
+    check_distance,
+    check_finite,
+    check_int,
+    check_nonnegative,
+    check_positive,
+)
 from openmotion.units import MAX_PULSE_RATE, pulses_per_unit
 
 __all__ = [
@@ -66,36 +74,11 @@ SWITCH_DECIMALS = 6
 
 
 # -- field checks: each names the field path and the rule ------------------------------
-def _real(path: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise MotionError(f"{path} must be a real number, got {value!r}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise MotionError(f"{path} must be finite, got {value!r}")
-    return x
-
-
-def _positive(path: str, value: Any) -> float:
-    x = _real(path, value)
-    if x <= 0.0:
-        raise MotionError(f"{path} must be > 0, got {value!r}")
-    return x
-
-
-def _nonneg(path: str, value: Any) -> float:
-    x = _real(path, value)
-    if x < 0.0:
-        raise MotionError(f"{path} must be >= 0, got {value!r}")
-    return x
-
-
-def _int(path: str, value: Any, lo: int, hi: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise MotionError(f"{path} must be an integer, got {value!r}")
-    if value < lo or (hi is not None and value > hi):
-        rule = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
-        raise MotionError(f"{path} must be {rule}, got {value!r}")
-    return value
+# strict: a file's "1.5" or true is a typing slip, not a number
+_real = partial(check_finite, strict=True)
+_positive = partial(check_positive, strict=True)
+_nonneg = partial(check_nonnegative, strict=True)
+_int = check_int
 
 
 def _bool(path: str, value: Any) -> bool:

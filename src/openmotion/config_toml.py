@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import replace
-from typing import Any
+from typing import Any, TypeVar
 
 from openmotion.config import (
     SWITCHES,
@@ -39,6 +39,8 @@ _DRIVE_KEYS = tuple(DriveConfig.__dataclass_fields__)
 _SWITCH_KEYS = tuple(SwitchConfig.__dataclass_fields__)
 _MOTOR_KEYS = tuple(DCMotorConfig.__dataclass_fields__)
 _LOOP_KEYS = tuple(LoopConfig.__dataclass_fields__)
+
+_T = TypeVar("_T")
 
 _HEADER = """\
 # openmotion machine file. Lengths and speeds are in each axis's user unit (`unit`);
@@ -85,6 +87,18 @@ def _exact_units(p: float, scale: float) -> float:
     return u + 0.0
 
 
+def _section(path: str, value: Any, cls: type[_T], keys: tuple[str, ...], local: str,
+             extra: dict[str, Any] | None = None) -> _T:
+    """The config object `cls` of the table at `path` (unknown keys refused, `extra`
+    replacing entries); `local` is the prefix cls's own messages use, e.g. "drive"."""
+    table = _table(path, value)
+    _check_keys(path, table, keys)
+    try:
+        return cls(**{**table, **(extra or {})})
+    except MotionError as e:
+        raise _rebased(e, local, path) from None
+
+
 def _axis_from_toml(name: str, data: dict[str, Any]) -> AxisConfig:
     path = f"axes.{name}"
     _table(path, data)
@@ -93,27 +107,16 @@ def _axis_from_toml(name: str, data: dict[str, Any]) -> AxisConfig:
     if "logic" in data:
         kw["logic"] = _table(f"{path}.logic", data["logic"])
     if "drive" in data:
-        drive = _table(f"{path}.drive", data["drive"])
-        _check_keys(f"{path}.drive", drive, _DRIVE_KEYS)
-        drive = dict(drive)
+        dp = f"{path}.drive"
+        drive = _table(dp, data["drive"])
+        _check_keys(dp, drive, _DRIVE_KEYS)  # the drive's own typos before its motor's
+        extra = {}
         if "motor" in drive:
-            motor = _table(f"{path}.drive.motor", drive["motor"])
-            _check_keys(f"{path}.drive.motor", motor, _MOTOR_KEYS)
-            try:
-                drive["motor"] = DCMotorConfig(**motor)
-            except MotionError as e:
-                raise _rebased(e, "motor", f"{path}.drive.motor") from None
-        try:
-            kw["drive"] = DriveConfig(**drive)
-        except MotionError as e:
-            raise _rebased(e, "drive", f"{path}.drive") from None
+            extra["motor"] = _section(f"{dp}.motor", drive["motor"], DCMotorConfig,
+                                      _MOTOR_KEYS, "motor")
+        kw["drive"] = _section(dp, drive, DriveConfig, _DRIVE_KEYS, "drive", extra)
     if "loop" in data:
-        loop = _table(f"{path}.loop", data["loop"])
-        _check_keys(f"{path}.loop", loop, _LOOP_KEYS)
-        try:
-            kw["loop"] = LoopConfig(**loop)
-        except MotionError as e:
-            raise _rebased(e, "loop", f"{path}.loop") from None
+        kw["loop"] = _section(f"{path}.loop", data["loop"], LoopConfig, _LOOP_KEYS, "loop")
     if not name.isidentifier():
         raise MotionError(f"axes name must be an identifier (letters, digits, _), got {name!r}")
     base = AxisConfig(name=name, **kw)   # validates the mechanism before we use its scale

@@ -23,7 +23,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-from .errors import MotionError
+from .errors import MotionError, check_int
 from .profile.segments import Profile
 from .recording import Recorder
 
@@ -85,8 +85,7 @@ def plot_profile(profile: Profile, path: str | Path, title: str | None = None, *
     if not isinstance(profile, Profile):
         raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
     p = _check_path(path)
-    if not isinstance(n, int) or isinstance(n, bool) or n < 2:
-        raise MotionError(f"n must be an integer >= 2, got {n!r}")
+    check_int("n", n, 2)
     title = "Motion profile" if title is None else str(title)
     t = profile_times(profile, n)
     s = profile.sample(t)

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import MotionError
+from .errors import MotionError, check_int
 
 FLOAT_CHANNELS = ("cmd_pos", "fb_pos", "cmd_vel")
 INT_CHANNELS = ("state", "io")
@@ -38,10 +38,8 @@ class Recorder:
 
     def __init__(self, n_axes: int, capacity: int, channels: Iterable[str] = CHANNELS, *,
                  spill_path: str | Path | None = None) -> None:
-        if not isinstance(n_axes, int) or isinstance(n_axes, bool) or n_axes < 1:
-            raise MotionError(f"n_axes must be an integer >= 1, got {n_axes!r}")
-        if not isinstance(capacity, int) or isinstance(capacity, bool) or capacity < 1:
-            raise MotionError(f"capacity must be an integer >= 1, got {capacity!r}")
+        check_int("n_axes", n_axes, 1)
+        check_int("capacity", capacity, 1)
         if isinstance(channels, str):
             raise MotionError("channels must be a sequence of channel names, not a string")
         chans = tuple(channels)

@@ -24,7 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
+from ..errors import InfeasibleError, MotionError, check_finite, check_int, check_nonnegative
 from .states import AxisState
 
 if TYPE_CHECKING:
@@ -79,8 +79,7 @@ class Comparators:
     def set_error_counter_check(self, axis: int | str, tolerance: int, on: bool) -> None:
         """HSL_M_set_error_counter_check(Tolerance, On_Off)."""
         i = self.ctl.axis(axis).index
-        if isinstance(tolerance, bool) or not isinstance(tolerance, int) or tolerance < 0:
-            raise MotionError(f"tolerance must be an int >= 0, got {tolerance!r}")
+        check_int("tolerance", tolerance, 0)
         if not isinstance(on, bool):
             raise MotionError(f"on must be a bool, got {on!r}")
         self._err[i] = (tolerance, True) if on else None

@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import MotionError, check_finite, check_positive
+from ..errors import MotionError, check_finite, check_int, check_positive
 from .compare_io import EventLog, OutputLine
 from .compare_jobs import (
     SOURCE_KINDS,
@@ -272,9 +272,7 @@ class CompareEngine:
         if not isinstance(source, VectorSource):
             raise MotionError(f"source must be a VectorSource, got {source!r}")
         self.check_output(output)
-        if isinstance(per_cycle, bool) or not isinstance(per_cycle, int) or \
-                not 1 <= per_cycle <= 1000:
-            raise MotionError(f"per_cycle must be an int in [1, 1000], got {per_cycle!r}")
+        check_int("per_cycle", per_cycle, 1, 1000)
         pwm = SpeedPwm(source, output, check_positive("full_speed", full_speed), per_cycle)
         self.track_vector(source)
         self.output(output)

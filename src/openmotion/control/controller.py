@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..config import MachineConfig, default_machine
-from ..errors import MotionError, check_nonnegative
+from ..errors import MotionError, check_int, check_nonnegative
 from ..history import MotionHistory
 from ..hw.interface import Hardware, InputEdge
 from ..recording import Recorder
@@ -214,9 +214,7 @@ class Controller:
         advanced to t (sampled loops: read feedback, write an output held from t)."""
         if not callable(hook):
             raise MotionError(f"hook must be callable, got {hook!r}")
-        if isinstance(per_cycle, bool) or not isinstance(per_cycle, int) or \
-                not 1 <= per_cycle <= 1000:
-            raise MotionError(f"per_cycle must be an int in [1, 1000], got {per_cycle!r}")
+        check_int("per_cycle", per_cycle, 1, 1000)
         with self._lock:
             self._sample_hooks.append((hook, per_cycle))
             self._samples = math.lcm(*(n for _, n in self._sample_hooks))

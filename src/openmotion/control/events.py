@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..errors import MotionError, check_finite, check_nonnegative
+from ..errors import MotionError, check_finite, check_int, check_nonnegative
 
 if TYPE_CHECKING:
     from .axis import Axis
@@ -66,8 +66,7 @@ class EventLog:
     """Bounded, time-stamped log of motion events of one controller."""
 
     def __init__(self, ctl: Controller, capacity: int = 10_000) -> None:
-        if isinstance(capacity, bool) or not isinstance(capacity, int) or capacity < 1:
-            raise MotionError(f"capacity must be an integer >= 1, got {capacity!r}")
+        check_int("capacity", capacity, 1)
         self._ctl = ctl
         self._events: deque[MotionEvent] = deque(maxlen=capacity)
         self._seq = 0

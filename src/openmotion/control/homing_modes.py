@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..errors import MotionError, check_finite, check_nonnegative, check_positive
+from ..errors import MotionError, check_finite, check_int, check_nonnegative, check_positive
 
 #: ez_count n waits for n + EZ_COUNT_BASE index edges ([low]: PCL6045B counts 1..16 with
 #: a 0..15 register; seed-facts 1.1).
@@ -184,8 +184,7 @@ class HomeConfig:
         if self.jerk is not None:
             check_positive("jerk", self.jerk)
         e = self.ez_count
-        if isinstance(e, bool) or not isinstance(e, int) or not 0 <= e <= EZ_COUNT_MAX:
-            raise MotionError(f"ez_count must be an int in [0, {EZ_COUNT_MAX}], got {e!r}")
+        check_int("ez_count", e, 0, EZ_COUNT_MAX)
         check_nonnegative("org_offset", self.org_offset)
         if check_finite("home_offset", self.home_offset) != round(self.home_offset):
             raise MotionError(f"home_offset must be a whole number of pulses, got "

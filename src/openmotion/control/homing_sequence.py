@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..errors import MotionError
+from ..errors import MotionError, check_int
 from .homing import Homing
 from .homing_modes import HomeConfig
 
@@ -27,8 +27,7 @@ class HomeSequence:
             if not (isinstance(item, tuple) and len(item) == 2):
                 raise MotionError(f"plan[{key!r}] must be (HomeConfig, order), got {item!r}")
             cfg, order = item
-            if isinstance(order, bool) or not isinstance(order, int) or order < 0:
-                raise MotionError(f"order of axis {key!r} must be an int >= 0, got {order!r}")
+            check_int(f"order of axis {key!r}", order, 0)
             groups.setdefault(order, []).append(Homing(ctl, key, cfg))
         self.groups = [groups[k] for k in sorted(groups)]
         self._g = -1

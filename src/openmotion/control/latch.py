@@ -24,7 +24,7 @@ from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..errors import MotionError, check_finite
+from ..errors import MotionError, check_finite, check_int
 from ..hw.interface import AXIS_INPUTS, InputEdge
 
 if TYPE_CHECKING:
@@ -154,8 +154,7 @@ class TouchProbe:
                 raise MotionError(f"window must be (first, last) with first <= last, "
                                   f"got {window!r}")
             window = (lo, hi)
-        if isinstance(capacity, bool) or not isinstance(capacity, int) or capacity < 1:
-            raise MotionError(f"capacity must be an int >= 1, got {capacity!r}")
+        check_int("capacity", capacity, 1)
         self.edge = edge
         self.window = window
         self.mode = mode

@@ -11,7 +11,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from ..errors import MotionError, check_finite
+from ..errors import MotionError, check_finite, check_int
 from .parser import MAX_PARAMETER
 from .source import MAX_LINE_LENGTH, MAX_PROGRAM_BYTES
 
@@ -76,8 +76,7 @@ class GCodeOptions:
             up = letter.upper() if isinstance(letter, str) else letter
             if up not in tuple(AXIS_LETTERS):
                 raise MotionError(f"axes keys must be letters of {AXIS_LETTERS}, got {letter!r}")
-            if isinstance(idx, bool) or not isinstance(idx, int) or idx < 0:
-                raise MotionError(f"axes[{letter!r}] must be an integer >= 0, got {idx!r}")
+            check_int(f"axes[{letter!r}]", idx, 0)
             if idx in axes.values():
                 raise MotionError(f"axes: machine axis {idx} is mapped twice")
             axes[up] = idx
@@ -130,16 +129,12 @@ class GCodeOptions:
             if isinstance(key, bool) or not isinstance(key, int) or key < 0:
                 raise MotionError(f"tool_lengths keys must be integers >= 0, got {key!r}")
             check_finite(f"tool_lengths[{key}]", v)
-        if isinstance(self.n_outputs, bool) or not isinstance(self.n_outputs, int) \
-                or self.n_outputs < 0:
-            raise MotionError(f"n_outputs must be an integer >= 0, got {self.n_outputs!r}")
+        check_int("n_outputs", self.n_outputs, 0)
         for name in ("spindle_output", "mist_output", "flood_output"):
             _opt_index(name, getattr(self, name))
         for name, lo in (("max_call_depth", 1), ("max_blocks", 1), ("max_line_length", 16),
                          ("max_bytes", 1)):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-                raise MotionError(f"{name} must be an integer >= {lo}, got {v!r}")
+            check_int(name, getattr(self, name), lo)
         for name in ("block_delete", "keep_comments"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False, got {getattr(self, name)!r}")
