@@ -30,6 +30,7 @@ from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile, State
 from . import pathexec as px
 from . import planning
+from .group_corners import LookaheadSettings
 from .states import AxisState
 
 if TYPE_CHECKING:
@@ -110,7 +111,7 @@ class _Run:
         return self.t0 + max((p.duration for p in self.profiles), default=0.0)
 
 
-class GroupEngine:
+class GroupEngine(LookaheadSettings):
     """Queue execution and re-planning; `Group` adds the commands and settings."""
 
     _ctl: Controller
@@ -161,7 +162,8 @@ class GroupEngine:
     # ------------------------------------------------------------------ execution
     def _limits(self, cmd: _Cmd) -> px.Limits:
         vmax, amax = self._caps()
-        return px.Limits(min(cmd.feed * self._override, self._sys_max), cmd.accel, vmax, amax)
+        return px.Limits(min(cmd.feed * self._override, self._sys_max), cmd.accel, vmax, amax,
+                         **self._corner_limits())
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         if self._state is GroupState.ERROR:

@@ -226,13 +226,18 @@ class Trimmed:
 
 @dataclass(frozen=True)
 class Limits:
-    """Path limits: feed (vector speed), tangential accel, per-axis speed/accel caps."""
+    """Path limits: feed (vector speed), tangential accel, per-axis speed/accel caps, the
+    corner speed of sharp junctions (square corner velocity, 0: exact stop) with the
+    per-axis velocity step it may cause (`axis_vjump`, None: unbounded), and the minimum
+    cruise ratio of the look-ahead (path.plan_speeds)."""
 
     feed: float
     accel: float
     axis_vmax: np.ndarray
     axis_amax: np.ndarray
     square_corner_velocity: float = 0.0
+    axis_vjump: np.ndarray | None = None
+    min_cruise_ratio: float = 0.0
 
 
 def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
@@ -245,7 +250,8 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     """
     els, _ = chain.tail_elements(s0)
     kw = dict(square_corner_velocity=lim.square_corner_velocity,
-              axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax)
+              axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax, axis_vjump=lim.axis_vjump,
+              min_cruise_ratio=lim.min_cruise_ratio)
     try:
         return _pinned(curve_from_speeds(
             plan_speeds(els, lim.feed, lim.accel, start_speed=v0, **kw), s0), chain.length)

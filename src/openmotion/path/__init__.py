@@ -8,7 +8,7 @@ build its profile.
 from .arcs import ARC_TOL, Arc, Arc3D
 from .blend import BLEND_DIST_FRACTION, Blend, blend_corner, centripetal_speed, corner_speed
 from .geometry import Direction, Line, PathElement
-from .lookahead import ElementSpeeds, plan_speeds
+from .lookahead import ElementSpeeds, acceleration_reversals, plan_speeds
 
 __all__ = [
     "ARC_TOL",
@@ -20,6 +20,7 @@ __all__ = [
     "ElementSpeeds",
     "Line",
     "PathElement",
+    "acceleration_reversals",
     "blend_corner",
     "centripetal_speed",
     "corner_speed",

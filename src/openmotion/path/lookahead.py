@@ -13,9 +13,24 @@ length L is linear: v1**2 = v0**2 + 2*a*L.
    kappa*v**2 <= a_n. Axis speeds: v*max|t_i| <= vmax_i.
 2. Junction caps: the smaller of both neighbours' vmax and, when the tangent turns, the
    junction-deviation corner speed (blend.corner_speed) with the acceleration limited per
-   axis along u2 - u1 (grbl's limit_value_by_axis_maximum).
+   axis along u2 - u1 (grbl's limit_value_by_axis_maximum), and v*|u2_i - u1_i| <= vjump_i
+   (the step of axis i's velocity at the corner) when `axis_vjump` is given.
 3. Backward pass from the end speed, then forward pass from the start speed.
 4. Cruise: the highest speed reachable between entry and exit: v**2 = (vin**2+vout**2)/2 + a*L.
+5. Minimum cruise ratio r (Klipper's minimum_cruise_ratio, anchors b1), when r > 0: steps
+   3 and 4 run once more on lowered caps. A smoothed plan W (steps 3 with the pseudo
+   acceleration a_s = (1 - r)*a_k) sets them. Each element of W is rising (W climbs by the
+   full 2*a_s*L), falling (drops by it) or a peak (anything else); hills of W end at
+   valleys, junctions with no rising element before and no falling element after them.
+   On each hill the planned speed stays at or below the hill's top (the highest speed of
+   W on it; Klipper's peak_cruise_v2), rises monotonically up to the hill's peak element
+   and falls monotonically after it (Klipper only enforces the falling side). So a short
+   element between two corners of equal speed v_c cruises for the fraction r of its
+   length at v**2 = v_c**2 + a_s*L instead of accelerating and braking back to back, and
+   a hill gives at most one speed maximum: lower r, more hills, more sign changes of the
+   acceleration. W itself obeys every cap, so the result is never slower than W and obeys
+   every limit of steps 1-3 (it is step 3 on lower caps); from a start speed W cannot
+   brake from, the real braking curve stays allowed. r = 0 skips this step.
 """
 
 from __future__ import annotations
@@ -79,7 +94,8 @@ def _limit_along(limit: float, axis: Array | None, weight: Array) -> float:
     mask = weight > 0.0
     if not np.any(mask):
         return limit
-    return min(limit, float(np.min(axis[mask] / weight[mask])))
+    with np.errstate(over="ignore"):  # a denormal weight: no limit (inf)
+        return min(limit, float(np.min(axis[mask] / weight[mask])))
 
 
 def _element_limits(el: PathElement, feed: float, accel: float, vmax_ax: Array | None,
@@ -95,7 +111,7 @@ def _element_limits(el: PathElement, feed: float, accel: float, vmax_ax: Array |
 
 
 def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
-                  amax_ax: Array | None) -> float:
+                  amax_ax: Array | None, vjump_ax: Array | None) -> float:
     u1, u2 = prev.end_tangent, nxt.start_tangent
     diff = u2 - u1
     chord = float(np.linalg.norm(diff))
@@ -104,22 +120,102 @@ def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
     a_j = _limit_along(accel, amax_ax, np.abs(diff) / chord)
     # Klipper's deviation is set by the nominal accel; a lower axis-limited accel lowers
     # v**2 proportionally: scale scv by sqrt(a_j/accel).
-    return corner_speed(u1, u2, a_j, scv * math.sqrt(a_j / accel),
-                        lengths=(prev.length, nxt.length))
+    v = corner_speed(u1, u2, a_j, scv * math.sqrt(a_j / accel),
+                     lengths=(prev.length, nxt.length))
+    # axis i's velocity steps by v*|u2_i - u1_i| at the corner
+    return _limit_along(v, vjump_ax, np.abs(diff))
 
+
+
+def _passes(jcap2: list[float], acc: list[float], length: list[float],
+            start2: float) -> tuple[list[float], list[float]]:
+    """Backward pass from the junction caps (v**2), then forward pass from start2."""
+    n = len(length)
+    back = jcap2[:]
+    for k in range(n - 1, -1, -1):
+        back[k] = min(jcap2[k], back[k + 1] + 2.0 * acc[k] * length[k])
+    fwd = [0.0] * (n + 1)
+    fwd[0] = min(start2, back[0])
+    for k in range(n):
+        fwd[k + 1] = min(back[k + 1], fwd[k] + 2.0 * acc[k] * length[k])
+    return back, fwd
+
+
+def _cruise_caps(jcap2: list[float], cap2: list[float], acc: list[float],
+                 length: list[float], ratio: float,
+                 start2: float) -> tuple[list[float], list[float]]:
+    """Element and junction caps (v**2) of the minimum cruise ratio (module doc, step 5).
+
+    The smoothed plan W uses the pseudo-acceleration (1 - ratio)*a_k. Its elements are
+    rising (W climbs by the full 2*a_s*L), falling (W drops by it) or peaks (anything
+    else); a valley, where a hill ends, is a junction with no rising element before it
+    and no falling element after it. Within a hill, the junction caps become running
+    minima towards the hill's peak element and at most the hill's top (the highest
+    smoothed speed on it), rising elements are capped by their exit junction, falling
+    ones by their entry junction, the peak element by the top. The braking curve from the
+    start speed at the real acceleration is always allowed, so a feasible start stays
+    feasible.
+    """
+    n = len(length)
+    acc_s = [(1.0 - ratio) * a for a in acc]
+    _, w = _passes(jcap2, acc_s, length, start2)
+    top = [min(cap2[k], 0.5 * (w[k] + w[k + 1]) + acc_s[k] * length[k]) for k in range(n)]
+    kind = []  # +1 rising, -1 falling, 0 peak
+    for k in range(n):
+        d = 2.0 * acc_s[k] * length[k]
+        tol = 1e-12 * (max(w[k], w[k + 1]) + d)
+        kind.append(1 if w[k] + d <= w[k + 1] + tol else
+                    -1 if w[k + 1] + d <= w[k] + tol else 0)
+    new_cap = cap2[:]
+    new_j = jcap2[:]
+    lo = 0
+    while lo < n:  # one hill: elements lo .. hi-1
+        hi = lo + 1
+        while hi < n and (kind[hi - 1] == 1 or kind[hi] == -1):
+            hi += 1
+        t = max(top[lo:hi])
+        p = lo + top[lo:hi].index(t)
+        run = t
+        for j in range(p, lo, -1):  # rising side: junctions lo+1 .. p
+            run = min(run, jcap2[j])
+            new_j[j] = run
+        run = t
+        for j in range(p + 1, hi):  # falling side: junctions p+1 .. hi-1
+            run = min(run, jcap2[j])
+            new_j[j] = run
+        for k in range(lo, hi):
+            new_cap[k] = min(cap2[k], new_j[k + 1] if k < p else t if k == p else new_j[k])
+        lo = hi
+    # the braking curve from the start speed (the smoothed plan may not start that fast)
+    brake = start2
+    for k in range(n):
+        if brake <= 0.0:
+            break
+        new_cap[k] = max(new_cap[k], min(cap2[k], brake))
+        new_j[k] = max(new_j[k], min(jcap2[k], brake))
+        brake -= 2.0 * acc[k] * length[k]
+    for k in range(1, n):
+        new_j[k] = min(new_j[k], new_cap[k - 1], new_cap[k])
+    new_j[0] = min(new_j[0], new_cap[0])
+    new_j[n] = min(new_j[n], new_cap[n - 1])
+    return new_cap, new_j
 
 def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
                 square_corner_velocity: float = 0.0, start_speed: float = 0.0,
                 end_speed: float = 0.0, axis_vmax: ArrayLike | None = None,
                 axis_amax: ArrayLike | None = None,
-                arc_tangential_ratio: float = 0.5) -> tuple[ElementSpeeds, ...]:
+                axis_vjump: ArrayLike | None = None, arc_tangential_ratio: float = 0.5,
+                min_cruise_ratio: float = 0.0) -> tuple[ElementSpeeds, ...]:
     """Entry/cruise/exit speeds for each element (see the module docstring).
 
     `feed` is the path speed cap, `accel` the path acceleration limit. Corners where the
     tangent turns are crossed at most at the junction-deviation speed of
     `square_corner_velocity` (0: exact stop). The path starts at exactly `start_speed` and
     ends at a speed <= `end_speed`. `axis_vmax`/`axis_amax` (N values, inf = unlimited)
-    bound every axis's speed and acceleration. Zero-length elements keep the speed of the
+    bound every axis's speed and acceleration; `axis_vjump` (N values) bounds the step of
+    every axis's velocity at a corner crossed at speed. `min_cruise_ratio` (0 <= r < 1, 0: off) lets
+    short elements cruise for about that fraction instead of accelerating and braking
+    back to back (module doc, step 5). Zero-length elements keep the speed of the
     junction they sit on. Raises InfeasibleError if `start_speed` is too high to obey the
     limits ahead.
     """
@@ -142,9 +238,13 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
     v_end = check_nonnegative("end_speed", end_speed)
     vmax_ax = _axis_limits("axis_vmax", axis_vmax, dim)
     amax_ax = _axis_limits("axis_amax", axis_amax, dim)
+    vjump_ax = _axis_limits("axis_vjump", axis_vjump, dim)
     ratio = check_positive("arc_tangential_ratio", arc_tangential_ratio)
     if ratio >= 1.0:
         raise MotionError(f"arc_tangential_ratio must be in (0, 1), got {arc_tangential_ratio!r}")
+    mcr = check_nonnegative("min_cruise_ratio", min_cruise_ratio)
+    if mcr >= 1.0:
+        raise MotionError(f"min_cruise_ratio must be in [0, 1), got {min_cruise_ratio!r}")
 
     live = [k for k, el in enumerate(elements) if el.length > 0.0]
     n = len(live)
@@ -164,25 +264,26 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
     jcap2[0] = cap[0] ** 2
     jcap2[n] = min(v_end, cap[n - 1]) ** 2
     for k in range(1, n):
-        vj = min(cap[k - 1], cap[k], _junction_cap(els[k - 1], els[k], a, scv, amax_ax))
+        vj = min(cap[k - 1], cap[k], _junction_cap(els[k - 1], els[k], a, scv, amax_ax,
+                                                         vjump_ax))
         jcap2[k] = vj * vj
 
-    back = jcap2[:]
-    for k in range(n - 1, -1, -1):
-        back[k] = min(jcap2[k], back[k + 1] + 2.0 * acc[k] * length[k])
+    ccap = cap  # cruise caps (lowered by the minimum cruise ratio)
+    back, fwd = _passes(jcap2, acc, length, v_start * v_start)
     if v_start * v_start > back[0] * (1.0 + 1e-12):
         raise InfeasibleError(f"start_speed {v_start:g} exceeds the highest speed the path "
                               f"allows at its start, {math.sqrt(back[0]):.6g}")
-    fwd = [0.0] * (n + 1)
-    fwd[0] = min(v_start * v_start, back[0])
-    for k in range(n):
-        fwd[k + 1] = min(back[k + 1], fwd[k] + 2.0 * acc[k] * length[k])
+    if mcr > 0.0:
+        cap2, jcap2 = _cruise_caps(jcap2, [c * c for c in cap], acc, length, mcr,
+                                   v_start * v_start)
+        ccap = [math.sqrt(c) for c in cap2]
+        back, fwd = _passes(jcap2, acc, length, v_start * v_start)
 
     planned: list[ElementSpeeds] = []
     for k in range(n):
         vin, vout = math.sqrt(fwd[k]), math.sqrt(fwd[k + 1])
         peak2 = 0.5 * (fwd[k] + fwd[k + 1]) + acc[k] * length[k]
-        cruise = max(vin, vout, min(cap[k], math.sqrt(peak2)))
+        cruise = max(vin, vout, min(ccap[k], math.sqrt(peak2)))
         planned.append(ElementSpeeds(vin, cruise, vout, acc[k], cap[k], length[k]))
 
     out: list[ElementSpeeds] = []
@@ -195,3 +296,19 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
             v = planned[nxt].entry if nxt < n else planned[-1].exit
             out.append(ElementSpeeds(v, v, v, a, f, 0.0))
     return tuple(out)
+
+
+def acceleration_reversals(plan: Sequence[ElementSpeeds], rel: float = 1e-9) -> int:
+    """How often the path acceleration of `plan` changes sign (holds at constant speed do
+    not count as a sign): a saw-tooth of accelerating and braking scores high.
+
+    A phase counts when its speed changes by more than `rel` of the cruise speed."""
+    signs: list[int] = []
+    for sp in plan:
+        if sp.length == 0.0:
+            continue
+        tol = rel * sp.cruise
+        for sign, other in ((1, sp.entry), (-1, sp.exit)):
+            if sp.cruise - other > tol and (not signs or signs[-1] != sign):
+                signs.append(sign)
+    return max(0, len(signs) - 1)
