@@ -278,3 +278,19 @@ def test_group_settings_validate_and_keep_the_old_value():
         with pytest.raises(MotionError, match="velocity"):
             g.set_corner_velocity(bad)
     assert (g.corner_velocity, g.min_cruise_ratio) == (1000.0, 0.5)
+
+
+def test_example_runs_and_ends_exactly():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "group_cam_zigzag.py"
+    spec = importlib.util.spec_from_file_location("group_cam_zigzag", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    pts = mod.wavy(12)
+    stop, smooth = mod.run(pts, 0.0, 0.0), mod.run(pts, 10_000.0, 0.5)
+    for res in (stop, smooth):
+        assert res["end"] == pts[-1].tolist()
+    assert smooth["time"] < stop["time"]
+    assert smooth["step"] <= 10_000.0 * (1 + 1e-6) + mod.A * 1e-3
