@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InfeasibleError, MotionError
-from ..path import Line, blend_corner, plan_speeds
+from ..path import Blend, blend_corner, plan_speeds
 from ..path.geometry import PathElement
 from ..path.smoothing import fir_smooth, jerk_window
 from ..profile.pcl import MoveSpec
@@ -230,18 +230,26 @@ class GroupEngine(LookaheadSettings):
         owners: list[int] = []
         for c in cmds:
             el = c.elements[0]
-            if self._blend and self._blend_tol > 0.0 and els and isinstance(els[-1], Line) \
-                    and isinstance(el, Line):
-                b = blend_corner(els[-1], el, self._blend_tol)
-                if b is not None and _blend_pays(b, min(c.accel, float(np.min(self._caps()[1]))),
-                                                        c.feed):
-                    els[-1] = b.first
-                    els.append(b.arc)
-                    owners.append(c.index)
-                    el = b.second
+            b = self._corner_blend(els[-1], el, c) if els else None
+            if b is not None:
+                els[-1] = b.first
+                els.append(b.arc)
+                owners.append(c.index)
+                el = b.second
             els.append(el)
             owners.append(c.index)
         return px.Chain(els, owners)
+
+    def _corner_blend(self, prev: PathElement, el: PathElement, cmd: _Cmd) -> Blend | None:
+        """The blend of the corner prev -> el (any Line/Arc/Arc3D pair) when blending is on
+        and rounding it pays; None: an exact stop (or a tangent corner)."""
+        if not (self._blend and self._blend_tol > 0.0):
+            return None
+        b = blend_corner(prev, el, self._blend_tol)
+        if b is None or not _blend_pays(b, min(cmd.accel, float(np.min(self._caps()[1]))),
+                                        cmd.feed):
+            return None
+        return b
 
     def _launch_ptp(self, cmd: _Cmd, t: float) -> None:
         assert cmd.target is not None
@@ -284,14 +292,10 @@ class GroupEngine(LookaheadSettings):
         old, owners = list(r.chain.elements), list(r.chain.owners)
         el = cmd.elements[0]
         options = []
-        if self._blend and self._blend_tol > 0.0 and isinstance(old[-1], Line) \
-                and isinstance(el, Line):
-            b = blend_corner(old[-1], el, self._blend_tol)
-            if b is not None and _blend_pays(b, min(cmd.accel, float(np.min(self._caps()[1]))),
-                                             cmd.feed) \
-                    and s0 < float(r.chain.cum[-2]) + float(b.first.length):
-                options.append((old[:-1] + [b.first, b.arc, b.second],
-                                owners + [cmd.index, cmd.index]))
+        b = self._corner_blend(old[-1], el, cmd)
+        if b is not None and s0 < float(r.chain.cum[-2]) + float(b.first.length):
+            options.append((old[:-1] + [b.first, b.arc, b.second],
+                            owners + [cmd.index, cmd.index]))
         options.append((old + [el], owners + [cmd.index]))
         lim = self._limits(cmd)
         for els, own in options:
@@ -482,13 +486,18 @@ def _blend_pays(b: Any, accel: float, feed: float) -> bool:
     split of A on arcs). On each side, over the distance D from the corner in which the
     exact stop accelerates to the feed (or the shorter line ends), the exact stop takes
     time(D from rest) and the blend time(D - d from v_c); the blend pays when
-    L/v_c + 2*time(D - d, v_c) < 2*time(D, 0). A sharp corner with a small tolerance gets an
+    L/v_c + 2*time(D - d, v_c) < 2*time(D, 0); F is capped by the centripetal speed of
+    an arc next to the corner. A sharp corner with a small tolerance gets an
     arc so tight that it would crawl: it stops exactly instead.
     """
     length = float(b.arc.length)
     kappa = float(b.arc.max_curvature)
     if kappa <= 0.0 or length <= 0.0:
         return True
+    for el in (b.first, b.second):  # an arc next to the corner caps the speed there too
+        k_el = float(el.max_curvature)
+        if k_el > 0.0:
+            feed = min(feed, math.sqrt(math.sqrt(0.75) * accel / k_el))
     radius = 1.0 / kappa
     d = radius * math.tan(0.5 * length / radius)
     v_c = min(feed, math.sqrt(math.sqrt(0.75) * accel * radius))

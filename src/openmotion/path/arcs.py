@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import MotionError, check_nonnegative, check_positive
+from ..errors import MotionError, check_finite, check_nonnegative, check_positive
 from .geometry import (
     Array,
     Direction,
@@ -82,6 +82,25 @@ class _Frame:
         object.__setattr__(self, "lin", frozen(self.helix + (self.end - last)))
         object.__setattr__(self, "t_start", frozen(self._tangent_at(np.asarray(0.0))))
         object.__setattr__(self, "t_end", frozen(self._tangent_at(np.asarray(length))))
+
+    def sub(self, s0: float, s1: float) -> _Frame:
+        """The part [s0, s1] (0 <= s0 < s1 <= length) as a frame of its own: the same circle,
+        radius and turning sense and the same points; the helix and the end correction
+        `lin` are carried over pro rata, the kept original ends bit for bit."""
+        k = self.sweep / self.length
+        phi0 = s0 * k
+        c, sn = math.cos(phi0), math.sin(phi0)
+        e1 = c * self.e1 + sn * self.e2
+        e2 = c * self.e2 - sn * self.e1
+        e1 = e1 / np.linalg.norm(e1)
+        e2 = e2 - (e2 @ e1) * e1
+        e2 = e2 / np.linalg.norm(e2)
+        part = (s1 - s0) / self.length
+        centre = self.centre if s0 == 0.0 else self.centre + (s0 / self.length) * self.lin
+        start = self.start if s0 == 0.0 else frozen(np.array(self.point(s0)))
+        end = self.end if s1 >= self.length else frozen(np.array(self.point(s1)))
+        return _Frame(frozen(centre), frozen(e1), frozen(e2), self.radius, (s1 - s0) * k,
+                      frozen(self.helix * part), start, end)
 
     def point(self, s: ArrayLike) -> Array:
         ss = path_positions(s, self.length)
@@ -190,6 +209,34 @@ class _ArcQueries:
         """Curvature 1/R (R/(R**2+c**2) for a helix): float for scalar s, else an array."""
         return self._frame.curvature(s)
 
+    @property
+    def is_planar(self) -> bool:
+        """True for a circular arc (no helix: every axis outside the circle's plane fixed)."""
+        return not np.any(self._frame.helix)
+
+    @property
+    def end_correction(self) -> float:
+        """Length of the end correction spread along the arc (0 up to rounding when the end
+        was exactly on the circle; up to `tol`*R for an Arc whose end was off it)."""
+        f = self._frame
+        return float(np.linalg.norm(f.lin - f.helix))
+
+    def sub(self, s0: float, s1: float) -> Any:
+        """The part of the arc between path positions s0 < s1, as an arc of the same type
+        with the same circle, radius and direction; it passes through the same points, and
+        an end kept from this arc (s0 = 0, s1 = length) is that end bit for bit."""
+        a = check_finite("s0", s0)
+        b = check_finite("s1", s1)
+        if not 0.0 <= a < b <= self.length:
+            raise MotionError(f"s0 and s1 must satisfy 0 <= s0 < s1 <= length="
+                              f"{self.length:.17g}, got s0={s0!r}, s1={s1!r}")
+        if a == 0.0 and b == self.length:
+            return self
+        return self._with_frame(self._frame.sub(a, b))
+
+    def _with_frame(self, frame: _Frame) -> Any:
+        raise NotImplementedError
+
 
 def _plane_axes(plane: Any, dim: int) -> tuple[int, int]:
     try:
@@ -271,6 +318,16 @@ class Arc(_ArcQueries):
                             ("turns", int(self.turns)), ("tol", tol), ("_frame", frame)):
             object.__setattr__(self, name, value)
 
+    def _with_frame(self, frame: _Frame) -> Arc:
+        obj = object.__new__(Arc)
+        turns = max(0, math.ceil(frame.sweep / TWO_PI - 1e-12) - 1)
+        for name, value in (("start", frame.start), ("end", frame.end),
+                            ("centre", frame.centre), ("plane", self.plane),
+                            ("direction", self.direction), ("turns", turns), ("tol", self.tol),
+                            ("_frame", frame)):
+            object.__setattr__(obj, name, value)
+        return obj
+
     @classmethod
     def relative(cls, start: ArrayLike, centre_offset: ArrayLike, end_offset: ArrayLike,
                  plane: tuple[int, int] = (0, 1), direction: Direction = Direction.CCW,
@@ -344,14 +401,24 @@ class Arc3D(_ArcQueries):
         for name, value in (("start", p0), ("via", p1), ("end", p2), ("_frame", frame)):
             object.__setattr__(self, name, value)
 
+    def _with_frame(self, frame: _Frame) -> Arc3D:
+        obj = object.__new__(Arc3D)
+        mid = frozen(np.array(frame.point(0.5 * frame.length)))
+        for name, value in (("start", frame.start), ("via", mid), ("end", frame.end),
+                            ("_frame", frame)):
+            object.__setattr__(obj, name, value)
+        return obj
+
     @classmethod
     def from_frame(cls, centre: ArrayLike, e1: ArrayLike, e2: ArrayLike, radius: float,
                    sweep: float, *, start: ArrayLike | None = None,
-                   end: ArrayLike | None = None) -> Arc3D:
+                   end: ArrayLike | None = None, end_slack: float = 0.0) -> Arc3D:
         """Arc of `radius` about `centre` from centre + R*e1, turning `sweep` towards e2.
 
         e1, e2 must be orthonormal; exact `start`/`end` (off the circle points by rounding
         only: 1e-9*R + 1e-12*|centre|) may be given so neighbouring elements join bit for bit.
+        `end_slack` (>= 0) lets `end` be that much further off; the miss is spread linearly
+        along s like an Arc's end tolerance (a fillet between arcs that are slight spirals).
         """
         c = as_point("centre", centre)
         u = as_point("e1", e1, c.size)
@@ -360,6 +427,7 @@ class Arc3D(_ArcQueries):
         sw = check_positive("sweep", sweep)
         if sw > TWO_PI:
             raise MotionError(f"sweep must be <= 2*pi, got {sweep!r}")
+        extra = check_nonnegative("end_slack", end_slack)
         if abs(u @ u - 1.0) > 1e-9 or abs(v @ v - 1.0) > 1e-9 or abs(u @ v) > 1e-9:
             raise MotionError("e1 and e2 must be orthonormal")
         p0 = c + r * u
@@ -369,7 +437,7 @@ class Arc3D(_ArcQueries):
         if start is not None:
             p0 = _near("start", start, p0, slack)
         if end is not None:
-            p2 = _near("end", end, p2, slack)
+            p2 = _near("end", end, p2, slack + extra)
         obj = object.__new__(cls)
         frame = _Frame(c, u, v, r, sw, frozen(np.zeros_like(c)), frozen(p0), frozen(p2))
         for name, value in (("start", frozen(p0)), ("via", frozen(mid)), ("end", frozen(p2)),
@@ -383,5 +451,5 @@ def _near(name: str, value: ArrayLike, expected: Array, slack: float) -> Array:
     miss = float(np.linalg.norm(p - expected))
     if miss > slack:
         raise MotionError(f"arc command error: {name} is {miss:.6g} from the arc "
-                          f"(allowed {slack:.3g}: rounding only)")
+                          f"(allowed {slack:.3g})")
     return p

@@ -1,7 +1,9 @@
 """Corners: arc blends within a path tolerance, junction speed limits, arc speed limits.
 
-Blend (LinuxCNC G64 P, anchors b6). Two lines meet at the corner P with unit directions
-u1 (in) and u2 (out). With the half-angle theta of the corner's interior angle 2*theta:
+Blend (LinuxCNC G64 P, anchors b6). A corner with an arc on either side gets the circle
+tangent to both elements (fillet.py); two lines get this closed form. Two lines meet at
+the corner P with unit directions u1 (in) and u2 (out). With the half-angle theta of the
+corner's interior angle 2*theta:
 
     cos(theta) = |u1 - u2| / 2,  sin(theta) = |u1 + u2| / 2     (no acos, exact near 0/90 deg)
 
@@ -29,8 +31,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import MotionError, check_nonnegative, check_positive
-from .arcs import Arc3D
-from .geometry import Line, as_point
+from .arcs import Arc, Arc3D
+from .fillet import fillet
+from .geometry import Line, PathElement, as_point
 
 #: A blend may use at most this fraction of each line (LinuxCNC BLEND_DIST_FRACTION).
 BLEND_DIST_FRACTION = 0.5
@@ -45,16 +48,18 @@ _SQRT2_M1 = math.sqrt(2.0) - 1.0
 
 @dataclass(frozen=True, eq=False)
 class Blend:
-    """A rounded corner: `first` trimmed, the tangent `arc`, `second` trimmed."""
+    """A rounded corner: `first` trimmed, the tangent `arc`, `second` trimmed (a Line stays
+    a Line, an Arc/Arc3D becomes a shorter one on the same circle)."""
 
-    first: Line
+    first: PathElement
     arc: Arc3D
-    second: Line
-    #: Largest distance between the arc and the programmed corner (at the arc's midpoint).
+    second: PathElement
+    #: Distance between the programmed corner and the blend arc's closest point to it
+    #: (how far the rounded path passes from the corner; <= the tolerance).
     deviation: float
 
     @property
-    def elements(self) -> tuple[Line, Arc3D, Line]:
+    def elements(self) -> tuple[PathElement, Arc3D, PathElement]:
         return (self.first, self.arc, self.second)
 
 
@@ -66,15 +71,20 @@ def _unit(name: str, value: ArrayLike, dim: int | None = None) -> np.ndarray:
     return v / norm
 
 
-def blend_corner(first: Line, second: Line, tolerance: float, *,
+def blend_corner(first: PathElement, second: PathElement, tolerance: float, *,
                  fraction: float = BLEND_DIST_FRACTION) -> Blend | None:
     """Round the corner first.end == second.start with an arc at most `tolerance` from it.
 
-    Returns None when no blend is wanted: tolerance 0, a zero-length line, collinear lines
-    (nothing to round) or a reversal (the path must stop exactly at the corner).
+    first and second are Line, Arc or Arc3D elements. Two lines get the closed form above;
+    a corner with an arc gets the fillet tangent to both (path/fillet.py), each element
+    trimmed at its tangent point within `fraction` of its length from the corner.
+    Returns None when no blend is wanted: tolerance 0, a zero-length element, a tangent
+    corner (turn below TANGENT_ANGLE: nothing to round), a reversal (the path must stop
+    exactly at the corner), a helix or elements not in one plane, or no fillet that fits.
     """
-    if not isinstance(first, Line) or not isinstance(second, Line):
-        raise MotionError("first and second must be Line elements")
+    kinds = (Line, Arc, Arc3D)
+    if not isinstance(first, kinds) or not isinstance(second, kinds):
+        raise MotionError("first and second must be Line, Arc or Arc3D elements")
     if first.dim != second.dim:
         raise MotionError(f"second must have {first.dim} axes like first, got {second.dim}")
     t = check_nonnegative("tolerance", tolerance)
@@ -87,12 +97,15 @@ def blend_corner(first: Line, second: Line, tolerance: float, *,
         raise MotionError(f"second.start must equal first.end, they are {gap:.6g} apart")
     if t == 0.0 or first.length == 0.0 or second.length == 0.0:
         return None
-    u1, u2 = first.direction, second.direction
+    u1, u2 = first.end_tangent, second.start_tangent
     cos_t = float(np.linalg.norm(u1 - u2)) / 2.0
     sin_t = float(np.linalg.norm(u1 + u2)) / 2.0
     turn = 2.0 * math.atan2(cos_t, sin_t)  # angle between u1 and u2
     if turn < TANGENT_ANGLE or math.pi - turn < REVERSAL_ANGLE:
         return None
+    if not isinstance(first, Line) or not isinstance(second, Line):
+        f = fillet(first, second, t, cos_t, sin_t, frac)
+        return None if f is None else Blend(f.first, f.arc, f.second, f.deviation)
     corner = first.end
     d_tol = t * (1.0 + sin_t) / cos_t
     d = min(frac * first.length, frac * second.length, d_tol)
