@@ -18,7 +18,8 @@ and its distance along the element from the corner from N (or, for small angles,
 asin). The fillet turns sigma*(k1*d1 + turn + k2*d2) and its closest point to the corner is
 at (|P_t|**2 + 2h*P_t.N)/(|C| + r) (no cancellation for large r).
 
-The radius is the largest for which the fillet exists, its tangent points lie within
+The radius is the largest for which the fillet exists (inside an arc's circle: at most
+99.9 % of its radius), its tangent points lie within
 `fraction` of each element from the corner, and it passes within the tolerance of the
 corner (bracketing and bisection: the deviation grows with r). Arcs whose end was only on
 their circle within tolerance (an end correction spread along s, see arcs.py) are handled
@@ -42,6 +43,17 @@ PLANE_TOL = 1e-9
 #: Bisection stops when the radius bracket is this narrow (relative).
 _R_REL = 1e-12
 _MAX_STEPS = 200
+#: A fillet inside an arc's circle has at most (1 - _MIN_GAP) times its radius (beyond, the
+#: tangent point runs away along the arc and the intersection is ill-conditioned).
+_MIN_GAP = 1e-3
+#: Rounding of the model, per unit of radius, counted into the deviation as
+#: _ROUND*r*(1 + 1/sweep): a fillet that turns little meets its offset curves at a shallow
+#: angle, so its centre (and tangent points) slide by about eps*r/sweep along them.
+_ROUND = 1e-12
+#: Halvings of the radius tried when the built fillet is beyond the tolerance.
+_RETRIES = 8
+#: The fillet's distance from the elements is checked at _SAMPLES - 1 inner points.
+_SAMPLES = 16
 
 Vec = tuple[float, float]
 
@@ -129,8 +141,8 @@ def _foot(el: _Local, centre: Vec, h: float) -> tuple[Vec, Vec, float] | None:
     """(tangent point, element normal there, distance from the corner) or None."""
     n = el.n
     den = 1.0 - el.k * h
-    if den <= 0.0:
-        return None  # the fillet would not fit inside the arc's circle
+    if den < _MIN_GAP:
+        return None  # inside the arc's circle and (almost) as large: no useful fillet
     nx = (n[0] - el.k * centre[0]) / den
     ny = (n[1] - el.k * centre[1]) / den
     size = math.hypot(nx, ny)
@@ -178,21 +190,64 @@ def _solve(e1: _Local, e2: _Local, turn: float, r: float) -> _Solution | None:
         dev = abs(_dot(p1, p1) + 2.0 * h * _dot(p1, n1)) / (norm_c + r)
     else:
         dev = min(math.hypot(*p1), math.hypot(*p2))
-    bound = dev + 2.0 * d1 * e1.corr + d2 * e2.corr
+    bound = dev + 2.0 * d1 * e1.corr + d2 * e2.corr + model_error(r, sweep)
     return _Solution(r, sigma, centre, p1, p2, d1, d2, sweep, dev, bound)
+
+
+def model_error(radius: float, sweep: float) -> float:
+    """Bound of the rounding in a fillet's computed geometry (see _ROUND)."""
+    return _ROUND * radius * (1.0 + 1.0 / sweep)
 
 
 def _ok(sol: _Solution | None, e1: _Local, e2: _Local, tol: float) -> bool:
     return sol is not None and sol.bound <= tol and sol.d1 <= e1.reach and sol.d2 <= e2.reach
 
 
+def _distance(el: _Local, q: Vec) -> float:
+    """Distance from q to the element near the corner (its curve on its own side of the
+    corner; the corner itself when q projects beyond it)."""
+    n, k = el.n, el.k
+    qq = _dot(q, q)
+    # the nearest point of the line/circle lies on the side of the corner where q.t has
+    # its sign; off = ||q - c| - R| in a form without the far centre c = n/k
+    off = abs(k * qq - 2.0 * _dot(q, n)) / (math.hypot(n[0] - k * q[0], n[1] - k * q[1]) + 1.0)
+    return off if el.way * _dot(q, el.t) >= 0.0 else math.sqrt(qq)
+
+
+def _contour(sol: _Solution, e1: _Local, e2: _Local) -> float:
+    """Largest distance of the fillet from the two elements (15 points inside it)."""
+    cx, cy = sol.centre
+    ux, uy = (sol.p1[0] - cx) / sol.r, (sol.p1[1] - cy) / sol.r
+    worst = 0.0
+    for i in range(1, _SAMPLES):
+        phi = sol.sigma * sol.sweep * i / _SAMPLES
+        c, sn = math.cos(phi), math.sin(phi)
+        q = (cx + sol.r * (c * ux - sn * uy), cy + sol.r * (sn * ux + c * uy))
+        worst = max(worst, min(_distance(e1, q), _distance(e2, q)))
+    return worst + (sol.bound - sol.dev)
+
+
 def _best(e1: _Local, e2: _Local, turn: float, tol: float, r0: float) -> _Solution | None:
-    """The largest-radius fillet that is _ok (bracket from r0, then bisect)."""
-    def at(r: float) -> _Solution | None:
+    """The largest-radius fillet that is _ok (bracket from r0, then bisect); if it strays
+    more than tol from the elements (possible inside an arc), the largest that does not."""
+    def cheap(r: float) -> _Solution | None:
         s = _solve(e1, e2, turn, r)
         return s if _ok(s, e1, e2, tol) else None
 
-    lo_sol = at(r0)
+    def full(r: float) -> _Solution | None:
+        s = cheap(r)
+        return s if s is not None and _contour(s, e1, e2) <= tol else None
+
+    sol = _largest(cheap, r0, math.inf)
+    if sol is None or _contour(sol, e1, e2) <= tol:
+        return sol
+    return _largest(full, sol.r, sol.r)
+
+
+def _largest(at: Any, r0: float, r_max: float) -> _Solution | None:
+    """Largest r <= r_max with at(r) not None: bracket by doubling/halving from r0, then
+    bisect (the conditions fail from some radius on)."""
+    lo_sol = at(r0) if r0 < r_max else None
     if lo_sol is not None:
         lo, hi = r0, 2.0 * r0
         for _ in range(_MAX_STEPS):
@@ -281,12 +336,20 @@ def fillet(first: Any, second: Any, tolerance: float, turn_cos: float, turn_sin:
     # tangent-line radius for the tolerance (the line-line closed form) to start from
     r0 = tolerance * turn_sin * (1.0 + turn_sin) / (turn_cos * turn_cos)
     sol = _best(e1, e2, turn, tolerance, r0)
-    if sol is None:
-        return None
-    try:
-        return _build(first, second, a, b, sol, tolerance)
-    except MotionError:  # degenerate trim or frame (rounding at the limits): no blend
-        return None
+    for _ in range(_RETRIES):
+        if sol is None:
+            return None
+        try:
+            out = _build(first, second, a, b, sol, tolerance)
+        except MotionError:  # degenerate trim or frame (rounding at the limits)
+            out = None
+        if out is not None:
+            return out
+        # the built fillet came out beyond the tolerance (rounding in an ill-conditioned
+        # corner): a smaller one
+        sol = _solve(e1, e2, turn, 0.5 * sol.r)
+        sol = sol if _ok(sol, e1, e2, tolerance) else None
+    return None
 
 
 def _build(first: Any, second: Any, a: Array, b: Array, sol: _Solution,
@@ -324,7 +387,7 @@ def _build(first: Any, second: Any, a: Array, b: Array, sol: _Solution,
     deviation = sol.dev + shift + miss
     scale = 1e-12 * max(1.0, float(np.max(np.abs(corner))))
     if deviation > tolerance * (1.0 + 1e-9) + scale:
-        return None  # only if the model and the elements disagree: stop exactly instead
+        return None  # the model and the elements disagree beyond rounding
     arc = Arc3D.from_frame(centre, e1, t1, sol.r, sweep, start=p_start, end=p_end,
                            end_slack=miss)
     return Fillet(f_first, arc, f_second, deviation)
