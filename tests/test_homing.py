@@ -67,10 +67,12 @@ def test_every_mode_every_start_ends_on_the_mode_edge(mode, where):
     st = run(ctl, h)
     assert st.state == "done", st.reason
     mark = EXPECTED_MARK[mode]
-    # the mark is the planned command position at the edge's exact time (within the blend
-    # of a cycle straddling a segment boundary, see motion.py)
-    assert st.mark == ctl.history.state_at(0, st.mark_time).p
-    assert st.mark == pytest.approx(mark, abs=1e-2)
+    # the mark is the count of the pulse that tripped the edge: that pulse left when the
+    # planned position was half a pulse short of it (half-pulse rule), at the edge's exact
+    # time (within the blend of a cycle straddling a segment boundary, see motion.py)
+    assert st.mark == mark
+    at = ctl.history.state_at(0, st.mark_time)
+    assert st.mark - at.p == pytest.approx(0.5 if at.v > 0 else -0.5, abs=1e-2)
     # the axis rests exactly on the mark; every counter but the target recorder is cleared
     assert ctl.hardware.command_position(0) == pytest.approx(mark, abs=1e-9)
     assert ctl.hardware.motor_position(0) == mark
@@ -110,7 +112,7 @@ def test_el_immediate_stop_mode_6():
     ctl, ax = make(20000)
     st_ = run(ctl, home_move(ctl, "x", HomeConfig(mode=6, el_stop="immediate", **FAST)))
     assert st_.state == "done"
-    assert st_.mark == pytest.approx(-5001, abs=1e-2)
+    assert st_.mark == -5001  # the pulse that tripped -EL
     assert ctl.hardware.motor_position(0) == -5001 and ax.counters.command == 0
 
 
@@ -168,7 +170,7 @@ def test_ez_count_skips_index_pulses():
     h = home_move(ctl, "x", HomeConfig(mode=4, ez_count=2, **FAST))
     st = run(ctl, h)
     assert st.state == "done", st.reason
-    assert st.mark == pytest.approx(30000, abs=1e-2)  # third index above the reversal
+    assert st.mark == 30000  # third index above the reversal
 
 
 # -- MCCL phased homing ----------------------------------------------------------------------
@@ -184,7 +186,7 @@ def test_mccl_phases(kind, same, mark):
                      str_vel=2000, tacc=0.05)
     st = run(ctl, home_move(ctl, "x", cfg))
     assert st.state == "done", st.reason
-    assert st.mark == pytest.approx(mark, abs=1e-2)
+    assert st.mark == mark
     assert ctl.hardware.motor_position(0) == mark + 500
     assert ax.counters.command == 0
 

@@ -106,7 +106,9 @@ def test_touch_probe_window_and_single(ctl):
     move(ctl, "x", 10000)
     ctl.wait_motion_done(timeout=5)
     assert probe.done and len(probe.records) == 1  # single: the 26000 release is not taken
-    assert probe.recorded_position == pytest.approx(25000.0, abs=0.05)
+    # pulse 25000 closes the switch; it left when the planned position passed 24999.5
+    assert probe.records[0].command == 25000
+    assert probe.recorded_position == pytest.approx(24999.5, abs=0.05)
     assert not probe.armed
 
 

@@ -68,9 +68,10 @@ def test_limit_stops_pulses_at_the_edge(speed: float, sign: int, logic: str, kin
     # the switch is active on [MEL - 5000, MEL): going down, pulse MEL - 1 trips it
     edge = PEL if sign > 0 else MEL - 1
     out = ctl.hardware.read_axis(0).pulses_out
-    assert abs(out - edge) < 1.0                       # under one pulse past the edge
-    assert abs(ctl.hardware.command_position(0) - edge) < 1.0
-    assert abs(ax.position - out) < 1.0                 # the controller agrees
+    assert out == edge  # the pulse that tripped the switch is the last one out
+    # the command holds that count (not the plan's value at the edge, half a pulse short)
+    assert ctl.hardware.command_position(0) == edge
+    assert ax.position == out  # the controller agrees: it rests on a whole pulse
     assert ax.fault == ("+EL" if sign > 0 else "-EL")
     assert ctl.history.state_at(0, ctl.time).p == pytest.approx(ax.position, abs=1e-6)
     # the history ends at the edge time: after it the axis holds

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -64,9 +66,11 @@ def test_limit_stops_every_motion_kind_immediately(kind: str, logic: str) -> Non
     assert ax.fault == "+EL" and ax.motion is None
     rec = safety.last_stop("a")
     assert rec is not None and rec.reason == "+EL"
-    # the edge is where the switch starts, at its exact time; the stop is at most one
-    # cycle of travel further (the cycle the edge happened in was already output)
-    assert rec.position == pytest.approx(PEL, abs=1e-6)
+    # the edge is where the switch starts, at its exact time: pulse 20000 carries the
+    # stepper onto it, and that pulse leaves when the plan passes 19999.5 (half-pulse
+    # rule); the stop is at most one cycle of travel further (the cycle the edge happened
+    # in was already output)
+    assert rec.position == pytest.approx(PEL - 0.5, abs=1e-6)
     assert PEL <= ax.position <= PEL + rec.velocity * ctl.period + 1e-6
     assert ctl.time - ctl.period <= rec.time <= ctl.time
     ctl.advance(0.05)
@@ -397,7 +401,8 @@ def test_limit_stop_residuals_over_speeds(speed, tacc, shape, strv, reach, decel
     ax.move_velocity(speed, str_vel=strv * speed, tacc=tacc, shape=shape)
     assert ctl.run_until(lambda: ax.fault is not None, 5.0)
     rec = safety.last_stop("a")
-    assert where <= rec.position <= where + 1.0  # a stepper reaches the switch on a pulse
+    # a stepper reaches the switch on pulse ceil(where), which leaves half a pulse before
+    assert rec.position == pytest.approx(math.ceil(where) - 0.5, abs=1e-6)
     ctl.run_until(lambda: ax.motion is None, 5.0)
     ctl.step()
     assert abs(ctl.hardware.command_position(0) - ax.position) < 1.0

@@ -95,8 +95,8 @@ def test_ez_once_per_revolution_at_its_positions():
     assert [(e.level, e.encoders[0]) for e in edges] == [
         (False, 1), (True, 1000), (False, 1001), (True, 2000), (False, 2001),
         (True, 3000), (False, 3001)]
-    for e in edges:
-        assert abs(e.time - e.encoders[0] / v) < 1e-9
+    for e in edges:  # pulse k leaves at command k - 1/2 (half-pulse rule)
+        assert abs(e.time - (e.encoders[0] - 0.5) / v) < 1e-9
 
 
 def test_invert_z_flips_level_when_mismatched():

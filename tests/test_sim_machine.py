@@ -65,40 +65,51 @@ def test_ideal_stepper_follows_every_pulse_and_ends_on_target():
     assert m.steps_lost(0) == 0
 
 
+@pytest.mark.parametrize("half", [True, False])
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.tuples(st.floats(-3e5, 3e5), st.floats(-3e8, 3e8)), min_size=1, max_size=6))
-def test_pulse_count_is_last_integer_reached(pieces):
-    """Monotone-or-not command chains: the count equals a dense brute-force scan."""
+def test_pulse_count_follows_the_pulse_rule(half, pieces):
+    """Monotone-or-not command chains: the count equals a dense brute-force scan of the
+    rule. Half-pulse (default): pulse k at k - 1/2 up, k + 1/2 down (round to nearest).
+    Floor (opt-out): pulse k at k itself (the last integer reached)."""
     m = machine()
+    m.set_half_pulse(half)
+    h = 0.5 if half else 0.0
     t, p = 0.0, 0.0
     for v, a in pieces:
         m.command(0, AxisCommand(t, DT, p, v, a))
-        # brute force the hysteresis rule on a dense grid (test-only loop)
+        # brute force the rule on a dense grid (test-only loop)
         count = m.read_axis(0).pulses_out
         n = 2000
         for i in range(1, n + 1):
             s = DT * i / n
             u = p + v * s + a * s * s / 2
-            if u >= count + 1 - 1e-9:
-                count = math.floor(u + 1e-9)
-            elif u <= count - 1 + 1e-9:
-                count = math.ceil(u - 1e-9)
+            if u >= count + 1 - h - 1e-9:
+                count = math.floor(u + h + 1e-9)
+            elif u <= count - 1 + h + 1e-9:
+                count = math.ceil(u - h - 1e-9)
+            if half:
+                assert abs(count - u) <= 0.5 + 1e-9  # the quantization bound
         m.advance(t + DT)
         assert m.read_axis(0).pulses_out == count
         p += v * DT + a * DT * DT / 2
         t += DT
 
 
-def test_switch_edges_at_exact_analytic_times():
+@pytest.mark.parametrize("half", [True, False])
+def test_switch_edges_at_exact_analytic_times(half):
     a = 2e6
     ax = AxisConfig("x", org=SwitchConfig(1000.5, 200.0), pel=SwitchConfig(5000.0, 1e9))
     m = machine(ax)
+    m.set_half_pulse(half)
     edges = [e for e in run_const_accel(m, 0, a, 0.08) if e.signal != "ez"]
     # stepper: org turns on at count 1001, off at 1201; pel on at 5000
     want = [("org", True, 1001), ("org", False, 1201), ("pel", True, 5000)]
     assert [(e.signal, e.level) for e in edges] == [w[:2] for w in want]
     for e, (_, _, k) in zip(edges, want, strict=True):
-        assert abs(e.time - math.sqrt(2 * k / a)) < 1e-9
+        # pulse k leaves when the command p = a t^2/2 reaches k - 1/2 (k: floor rule)
+        kk = k - 0.5 if half else k
+        assert abs(e.time - math.sqrt(2 * kk / a)) < 1e-9
         assert e.encoders == (k,)
 
 
@@ -111,9 +122,11 @@ def test_edges_time_ordered_across_axes_and_carry_all_encoders():
     edges = [e for e in m.advance(DT) if e.signal == "org"]
     times = [e.time for e in edges]
     assert times == sorted(times)
-    first = edges[0]  # y reaches 100 at 250 us, x is then at 250
-    assert first.axis == 1 and abs(first.time - 2.5e-4) < 1e-9
-    assert first.encoders == (250, 100)
+    # pulse 100 of y leaves when its command reaches 99.5 (248.75 us); x's command is then
+    # at 248.75, so x has emitted 249 pulses
+    first = edges[0]
+    assert first.axis == 1 and abs(first.time - 2.4875e-4) < 1e-9
+    assert first.encoders == (249, 100)
 
 
 def test_hysteresis_delays_release_in_both_directions():
@@ -195,8 +208,8 @@ def test_injected_step_loss_at_its_time_with_switch_edge():
     rb = m.read_axis(0)
     assert rb.pulses_out == 2000 and rb.encoder == 1950 and m.steps_lost(0) == 50
     assert len(edges) == 1 and edges[0].level
-    # org at motor 1000 = count 1050
-    assert abs(edges[0].time - 1050 / 2e6) < 1e-9 and edges[0].encoders == (1000,)
+    # org at motor 1000 = count 1050, whose pulse leaves at command 1049.5
+    assert abs(edges[0].time - 1049.5 / 2e6) < 1e-9 and edges[0].encoders == (1000,)
     # a loss that drops the motor out of the switch releases it at the action time
     m.scenario.inject_step_loss(0, 1000, at=0.0015)
     edges = [e for e in m.advance(2 * DT) if e.signal == "org"]

@@ -172,17 +172,19 @@ class MotionHistory:
         tr.push(t_abs + profile.duration, end.p, end.v, 0.0, 0.0)
         self._forget(tr, t_abs - self.window_s)
 
-    def truncate(self, axis: int, t_abs: float) -> State:
-        """Cut everything after `t_abs`; the axis holds its position there at rest.
+    def truncate(self, axis: int, t_abs: float, hold: float | None = None) -> State:
+        """Cut everything after `t_abs`; the axis holds its position there at rest (or
+        `hold`: a hardware stop holds the pulse count, up to half a pulse off the plan).
 
         Returns the state the axis had at `t_abs` (before the cut), e.g. for an immediate
         stop's report.
         """
         tr = self._axis(axis)
         t_abs = check_finite("t_abs", t_abs)
+        hold_p = None if hold is None else check_finite("hold", hold)
         st = tr.state_at(t_abs)
         self._cut(tr, t_abs)
-        tr.push(t_abs, st.p, 0.0, 0.0, 0.0)
+        tr.push(t_abs, st.p if hold_p is None else hold_p, 0.0, 0.0, 0.0)
         return st
 
     @staticmethod

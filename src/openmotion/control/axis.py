@@ -540,8 +540,12 @@ class Axis:
         ts = stop_time(self.index)
         if ts is None or ts < m.t_start or ts > self._ctl.time:
             return
-        self._pos = m.state(ts)[0]
-        self._ctl.history.truncate(self.index, ts)
+        p = m.state(ts)[0]
+        # the hardware holds the count it emitted (control.pulserule: within half a pulse of
+        # p, one with the floor rule); the axis rests there, on a whole pulse
+        count = self._ctl.hardware.read_axis(self.index).pulses_out - self.counters.out_offset
+        self._pos = float(count) if abs(count - p) <= 1.0 else p
+        self._ctl.history.truncate(self.index, ts, self._pos)
 
     # -- cycle hooks (called by the controller, lock held) --------------------------------
     def _command(self, t0: float, t1: float) -> AxisCommand | None:

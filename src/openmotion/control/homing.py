@@ -43,6 +43,7 @@ from .homing_modes import (
     Phase,
     uses,
 )
+from .pulserule import half_pulse, pulse_count
 from .safety import Safety
 from .states import AxisState
 
@@ -384,7 +385,12 @@ class Homing:
     def _trigger(self, ph: Phase, e: InputEdge) -> None:
         ax = self.axis
         off = ax.counters.command_offset
-        self._edge_p = self.ctl.history.state_at(ax.index, e.time).p + off
+        st = self.ctl.history.state_at(ax.index, e.time)
+        p = st.p
+        if not ax.config.drive.type.endswith("servo"):
+            # a stepper's edge is fired by a pulse: mark that pulse's count (pulserule)
+            p = float(pulse_count(p, st.v, half_pulse(self.ctl.hardware)))
+        self._edge_p = p + off
         if ph.mark:
             self.status.mark = self._edge_p
             self.status.mark_time = e.time

@@ -12,8 +12,10 @@ the wanted edge (`count` times), then reacts (`then`):
 - "slow": decelerate to StrVel and keep going (the next phase continues this motion);
 - "pass": keep going (the next phase continues this motion).
 
-`mark` flags the edge that defines the mechanical home: its exact command position (the
-position at the edge's exact time) is where the counters read zero at completion.
+`mark` flags the edge that defines the mechanical home: its exact command position is
+where the counters read zero at completion. On a stepper that is the pulse count that
+tripped the switch (its pulse left half a pulse before the planned position got there, see
+control.pulserule); on a servo, the planned position at the edge's exact time.
 
 The [low] rows and the EZ-count convention below are assumptions, not vendor text: they
 live here, in one table, so that they are easy to correct.
@@ -222,6 +224,7 @@ class HomeStatus:
     state: str = "idle"          # idle, running, done, error, aborted
     phase: str = ""
     mark: float | None = None    # mechanical home, command-counter frame before the reset
+    #                              (stepper: the count of the pulse that hit the edge)
     mark_time: float | None = None
     mark_encoder: int | None = None
     reason: str | None = None

@@ -5,8 +5,8 @@ hardware reports the edge time and every axis's encoder count at that instant
 (`InputEdge.encoders`), and the controller's MotionHistory gives the command position at
 that time. From those the four counters are rebuilt as they read at the edge:
 
-  command  = pulses emitted at te (the last whole pulse reached by the command, as the
-             pulse generator counts them) + the command counter's offset;
+  command  = pulses emitted at te (the planned position at te counted by the hardware's
+             pulse rule, control.pulserule) + the command counter's offset;
   feedback = encoder at te + feedback offset;  error = command - feedback/ratio (+ offset);
   general  = its source at te (command pulses, encoder, CLK/2 of te; manual: its offset).
 
@@ -19,22 +19,18 @@ position window [first, last] (PLCopen WindowOnly), once ("single") or every tim
 
 from __future__ import annotations
 
-import math
 from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import MotionError, check_finite, check_int
 from ..hw.interface import AXIS_INPUTS, InputEdge
+from .pulserule import half_pulse, pulse_count
 
 if TYPE_CHECKING:
     from .controller import Controller
 
 EDGES = ("on", "off", "both")
-# pulses: an edge fired by a pulse lands on an integer of the emitted command; the history
-# (the planned profile) may differ from it by the Hermite blend of a cycle that straddles a
-# segment boundary (motion.py), far below half a pulse
-_EPS = 0.05
 
 
 @dataclass(frozen=True)
@@ -49,20 +45,12 @@ class LatchData:
     position: float   # exact (float) command position, command-counter frame
 
 
-def _pulses_at(p: float, v: float) -> int:
-    """Pulse count of a command at p moving with velocity v (floor up, ceil down)."""
-    r = round(p)
-    if abs(p - r) <= _EPS:
-        return int(r)
-    return math.floor(p) if v >= 0.0 else math.ceil(p)
-
-
 def capture(ctl: Controller, axis: int, edge: InputEdge) -> LatchData:
     """Counters of `axis` as they read at `edge.time` (see the module doc)."""
     ax = ctl.axes[axis]
     cnt = ax.counters
     st = ctl.history.state_at(axis, edge.time)
-    pulses = _pulses_at(st.p, st.v)
+    pulses = pulse_count(st.p, st.v, half_pulse(ctl.hardware))
     enc = edge.encoders[axis] if edge.encoders else cnt.encoder_raw()
     command, feedback, error, general = cnt.readings_at(pulses, enc, edge.time)
     return LatchData(edge.time, command, feedback, error, general, st.p + cnt.command_offset)

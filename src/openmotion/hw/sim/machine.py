@@ -49,7 +49,7 @@ class _Axis:
                               f"got {drv.type!r}")
         self.index = index
         self.cfg = cfg
-        self.gen = PulseGenerator()
+        self.gen = PulseGenerator(half=0.5)
         if drv.type == "servo":
             from .servo import ServoPlant
             self.plant: StepperPlant | ServoPlant | DCServoPlant = ServoPlant(drv)
@@ -355,13 +355,25 @@ class SimMachine:
         """Commanded (float) position at the current time."""
         return self._axis(axis).gen.pos(self._t)
 
+    @property
+    def half_pulse(self) -> bool:
+        """True (the default) when the generators count by the half-pulse rule (see
+        `set_half_pulse`); the control layer reads it (control.pulserule) to rebuild counts
+        at edge times the same way."""
+        return self._axes[0].gen.half == 0.5 if self._axes else True
+
     def set_half_pulse(self, on: bool = True) -> None:
-        """Pulse rule of every axis's generator from now on. Off (the default): pulse k
-        leaves when the command reaches integer k (floor going up), so a count lags the
-        command by up to one pulse. On: pulse k leaves at k - 1/2 going up (k + 1/2 going
-        down, Klipper's step_dist/2): the count is the command rounded to nearest, within
-        half a pulse (issue 4's quantization bound). Switch edges still land on the exact
-        pulse count. Set it at standstill; counts already emitted are not changed.
+        """Pulse rule of every axis's generator from now on.
+
+        On (the default): pulse k leaves when the command reaches k - 1/2 going up (k + 1/2
+        going down, Klipper's step_dist/2), so the count is the command rounded to nearest,
+        within half a pulse of the ideal path (issue 4's quantization bound); a switch
+        crossed by pulse k trips when the command is at k -/+ 1/2.
+        Off: pulse k leaves when the command reaches k itself (floor going up, ceil going
+        down), so a count lags the command by up to one pulse. Use it to model a generator
+        that truncates (a DDA that only carries whole pulses, or a card compared against
+        one), or to reproduce results recorded with the earlier default.
+        Set it at standstill; counts already emitted are not changed.
         """
         if not isinstance(on, bool):
             raise MotionError(f"on must be a bool, got {on!r}")
@@ -454,8 +466,13 @@ class SimMachine:
         return None
 
     def _cut_pulses(self, ax: _Axis, t: float) -> None:
-        """The pulse output of `ax` stops at time t: the command holds its value there."""
-        ax.gen.set(Cubic(ax.gen.pos(t)), t, t)
+        """The pulse output of `ax` stops at time t: the command holds the count emitted.
+
+        A card's command is its count; holding the float command instead would leave it up
+        to half a pulse off the count (a switch tripped by pulse k fires with the command at
+        k -/+ 1/2), and the next move would start between pulses.
+        """
+        ax.gen.set(Cubic(float(ax.gen.count)), t, t)
         ax.stop_time = t
 
     def _armed_hit(self, ax: _Axis, sig: str, level: bool) -> None:
