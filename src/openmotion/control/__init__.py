@@ -1,6 +1,7 @@
 """The controller runtime: clock and cycle loop, axes (PLCopen states, HSL counters),
 single-axis motion execution. Public positions are pulses; see Axis for unit-aware calls."""
 
+from .accuracy import PulseAccuracy, count_accuracy, pulse_accuracy
 from .axis import Axis
 from .clock import CycleStats
 from .compare import CompareEngine
@@ -48,5 +49,5 @@ __all__ = [
     "Pulse", "SetLevel", "Toggle", "VectorSource", "WindowJob", "every_distance", "EventLog",
     "MotionEvent", "Homing", "escape_home", "home_move", "home_search", "HomeConfig",
     "HomeStatus", "HomeSequence", "HslTrigger", "Latch", "LatchData", "TouchProbe",
-    "PulseTimer", "ZPso",
+    "PulseTimer", "ZPso", "PulseAccuracy", "count_accuracy", "pulse_accuracy",
 ]

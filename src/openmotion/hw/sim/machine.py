@@ -26,6 +26,7 @@ from .mechanics import PitchTable, Transmission
 from .outputs import OutputRecord, TimedOutputs
 from .pieces import JumpPiece, Piece
 from .plant import StepperPlant
+from .pulserecord import PulseRecord, check_capacity
 from .pulses import PulseGenerator
 from .scenario import Scenario
 from .switches import IndexSwitch, Switch
@@ -49,7 +50,7 @@ class _Axis:
                               f"got {drv.type!r}")
         self.index = index
         self.cfg = cfg
-        self.gen = PulseGenerator(half=0.5)
+        self.gen = PulseGenerator()
         if drv.type == "servo":
             from .servo import ServoPlant
             self.plant: StepperPlant | ServoPlant | DCServoPlant = ServoPlant(drv)
@@ -191,8 +192,8 @@ class SimMachine:
         for f in ("t0", "p0", "v0", "a0", "j"):
             check_finite(f"cmd.{f}", getattr(cmd, f))
         check_nonnegative("cmd.dt", cmd.dt)
-        ax.gen.set(Cubic(float(cmd.p0), float(cmd.v0), float(cmd.a0), float(cmd.j)),
-                   float(cmd.t0), float(cmd.t0) + float(cmd.dt))
+        self._set_command(ax, Cubic(float(cmd.p0), float(cmd.v0), float(cmd.a0),
+                                    float(cmd.j)), float(cmd.t0), float(cmd.t0) + float(cmd.dt))
 
     def advance(self, t: float) -> list[InputEdge]:
         """Move every plant to time t; return the input edges since the last call."""
@@ -380,6 +381,29 @@ class SimMachine:
         for ax in self._axes:
             ax.gen.half = 0.5 if on else 0.0
 
+    def record_pulses(self, on: bool = True, capacity: int = 1_000_000) -> None:
+        """Start recording every pulse and command of every axis from now on (a fresh
+        record), or stop (on=False, the record is dropped). `capacity` bounds each axis's
+        record (monotone stretches and commands, a few per cycle); a full record stops."""
+        if not isinstance(on, bool):
+            raise MotionError(f"on must be a bool, got {on!r}")
+        cap = check_capacity(capacity)
+        for ax in self._axes:
+            g = ax.gen
+            g.record = PulseRecord(g.count, cap, self._t, g.cubic, g.tc, g.te) if on else None
+
+    def pulse_record(self, axis: int) -> PulseRecord:
+        """What `axis` emitted since `record_pulses()`: `pulses()` gives every pulse's exact
+        time and the count after it, `command_at(times)` the commanded position.
+        MotionError if not recording or if the record filled its capacity."""
+        rec = self._axis(axis).gen.record
+        if rec is None:
+            raise MotionError("pulse_record needs record_pulses() first")
+        if not rec.complete:
+            raise MotionError(f"axis {axis}: the pulse record filled its capacity "
+                              f"{rec.capacity}; record a shorter run or raise capacity")
+        return rec
+
     # -- internals ----------------------------------------------------------------------------
     def _axis(self, axis: int) -> _Axis:
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._axes):
@@ -415,14 +439,17 @@ class SimMachine:
         """`_run` for an axis with an armed switch: find the first armed edge on the
         pieces without touching the switches; if there is one, run again up to its time
         (plant and count restored), hold the command there, and run on to tb."""
-        saved = (ax.gen.count, copy.copy(ax.plant))
+        rec = ax.gen.record
+        saved = (ax.gen.count, copy.copy(ax.plant), rec.mark() if rec is not None else 0)
         pieces = ax.plant.pieces(ax.gen, ta, tb)
         hit = self._first_armed(ax, pieces, armed)
         if hit is None:
             self._run_axis(ax, ta, tb, raw, pieces)
             return
         ts, sig = hit
-        ax.gen.count, ax.plant = saved
+        ax.gen.count, ax.plant, mark = saved
+        if rec is not None:
+            rec.rewind(mark)
         n0 = len(raw)
         self._run_axis(ax, ta, ts, raw, ax.plant.pieces(ax.gen, ta, ts))
         if not any(e[1] == ax.index and e[2] == sig for e in raw[n0:]):
@@ -472,8 +499,14 @@ class SimMachine:
         to half a pulse off the count (a switch tripped by pulse k fires with the command at
         k -/+ 1/2), and the next move would start between pulses.
         """
-        ax.gen.set(Cubic(float(ax.gen.count)), t, t)
+        self._set_command(ax, Cubic(float(ax.gen.count)), t, t, t)
         ax.stop_time = t
+
+    def _set_command(self, ax: _Axis, cubic: Cubic, tc: float, te: float,
+                     now: float | None = None) -> None:
+        ax.gen.set(cubic, tc, te)
+        if ax.gen.record is not None:
+            ax.gen.record.command(self._t if now is None else now, cubic, tc, te)
 
     def _armed_hit(self, ax: _Axis, sig: str, level: bool) -> None:
         """An input of `ax` changed at the current time: cut the pulses if armed."""

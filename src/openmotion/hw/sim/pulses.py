@@ -8,10 +8,13 @@ count at its ends, which the plants turn into motor motion.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 from .cubic import Cubic, quadratic_roots, velocity_zeros
 from .pieces import count_after
+
+if TYPE_CHECKING:
+    from .pulserecord import PulseRecord
 
 
 class Stretch(NamedTuple):
@@ -30,14 +33,15 @@ class Stretch(NamedTuple):
 class PulseGenerator:
     """Command cubic + emitted pulse count (signed, never wrapped)."""
 
-    __slots__ = ("cubic", "tc", "te", "count", "half")
+    __slots__ = ("cubic", "tc", "te", "count", "half", "record")
 
-    def __init__(self, p: float = 0.0, t: float = 0.0, half: float = 0.0) -> None:
+    def __init__(self, p: float = 0.0, t: float = 0.0, half: float = 0.5) -> None:
         self.cubic = Cubic(p)
         self.tc = t
         self.te = t
-        self.half = half  # 0: pulse at each integer; 0.5: half-pulse rule (count_after)
+        self.half = half  # 0.5: half-pulse rule (the default); 0: pulse at each integer
         self.count = count_after(p, 0, 1 if p > 0 else -1, half)
+        self.record: PulseRecord | None = None  # every stretch emitted, when recording
 
     def set(self, cubic: Cubic, tc: float, te: float) -> None:
         self.cubic, self.tc, self.te = cubic, tc, te
@@ -86,6 +90,9 @@ class PulseGenerator:
                 self.count = c1
                 out.append(Stretch(tc + s0, tc + s1, c, tc, d, c0, c1))
         # holds before tc / after te produce no pulses; the caller sees gaps as holds
+        if self.record is not None:
+            for st in out:
+                self.record.add(st, self.half)
         return out
 
     def _jump_to(self, u: float, t: float, out: list[Stretch]) -> None:
