@@ -67,6 +67,33 @@ def test_pulse_record_validation_and_capacity():
         m.pulse_record(0)
 
 
+def test_counters_follow_the_pulse_rule_after_moves_and_stops():
+    ctl = Controller()
+    ctl.enable_all()
+    x = ctl.axis("x")
+    x.move_absolute(1000, max_vel=20_000.0, tacc=0.05)
+    assert ctl.wait_motion_done(timeout=5)
+    c = x.counters
+    assert (c.command, c.feedback, c.error, x.position) == (1000, 1000, 0, 1000.0)
+    assert ctl.hardware.read_axis(0).pulses_out == 1000
+    # a decelerating stop ends between pulses: the counters show the plan rounded to
+    # nearest, which is what the generator emitted; the axis keeps the float plan
+    for d in (7_321, -4_567):
+        x.move_relative(d, max_vel=29_876.3, tacc=0.047)
+        ctl.advance(0.0737)
+        x.stop()
+        assert ctl.wait_motion_done(timeout=5)
+        p = x.position
+        assert p != round(p)  # the stop did end between pulses
+        assert c.command == round(p) == ctl.hardware.read_axis(0).pulses_out
+        assert c.feedback == c.command and abs(c.command - p) <= 0.5
+        assert ctl.hardware.command_position(0) == pytest.approx(p, abs=1e-9)
+    # the next move still ends exactly on its whole-pulse target
+    x.move_absolute(-250, max_vel=30_000.0, tacc=0.05)
+    assert ctl.wait_motion_done(timeout=5)
+    assert (c.command, c.feedback, x.position) == (-250, -250, -250.0)
+
+
 def test_count_accuracy_from_arrays_and_its_validation():
     t = np.array([0.0, 1.0, 2.0])
     cmd = np.array([[0.0, 0.0], [0.5, 0.2], [1.0, 0.4]])

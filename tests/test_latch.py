@@ -37,7 +37,8 @@ def test_ltc_captures_four_counters_at_speed(ctl):
     assert d.general == 12346
     st = ctl.history.state_at(0, d.time)
     assert abs(st.v) > 10000  # captured at speed, not at a cycle boundary
-    assert abs(d.position - (12346 + 1000)) < 1.0
+    # the planned position at the edge: pulse 12346 left at its half-pulse point
+    assert d.position == pytest.approx(12345.5 + 1000, abs=1e-6)
     assert d.position == pytest.approx(st.p + 1000)
 
 

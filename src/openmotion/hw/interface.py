@@ -4,7 +4,8 @@ The control layer never knows whether the hardware is simulated. Each cycle it:
 
 1. hands every axis the commanded motion for the coming cycle as one cubic piece
    (`AxisCommand`): a pulse generator emits pulses exactly where that polynomial crosses
-   each integer count, so the command is exact between cycles, not only at cycle ends;
+   each count's half-pulse point, so the command is exact between cycles, not only at
+   cycle ends;
 2. calls `advance(t)`, which moves the hardware to time t and returns every input edge that
    happened since the last call, each with its exact time (`InputEdge`);
 3. reads counters and input levels (`read_axis`), and writes outputs.
@@ -29,7 +30,9 @@ AXIS_OUTPUTS = ("svon", "erc")
 class AxisCommand:
     """Commanded pulse position over [t0, t0 + dt]: p0 + v0*s + a0*s**2/2 + j*s**3/6.
 
-    Positions are in command pulses (float); the pulse output is the integer part crossed.
+    Positions are in command pulses (float); the pulse output is the command rounded to
+    the nearest count (pulse k leaves at k - 1/2 going up, k + 1/2 going down; a back end
+    that counts otherwise sets `half_pulse = False`, see control/pulserule.py).
     """
 
     t0: float
