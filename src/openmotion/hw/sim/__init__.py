@@ -4,6 +4,7 @@ the hardware boundary, with a scenario API for faults and events at chosen times
 from .dcmotor import DCMotor, DCMotorParams
 from .encoder import EncoderWiring
 from .machine import SimMachine
+from .pulserecord import PulseRecord
 from .scenario import Scenario
 
-__all__ = ["DCMotor", "DCMotorParams", "EncoderWiring", "Scenario", "SimMachine"]
+__all__ = ["DCMotor", "DCMotorParams", "EncoderWiring", "PulseRecord", "Scenario", "SimMachine"]
