@@ -22,9 +22,10 @@ from .arcgeom import (
     sweep_angle,
 )
 from .parser import Block
+from .words import Word, feed_length, fmt
 
 if TYPE_CHECKING:
-    from .modal import Modal, Word
+    from .modal import Modal
 
 #: Plane -> (first, second, helix) axis letters and the centre-offset letters.
 PLANES = {170: ("X", "Y", "Z", "I", "J", "K"), 180: ("Z", "X", "Y", "K", "I", "J"),
@@ -35,8 +36,6 @@ def arc_move(m: Modal, b: Block, mode: int, gpos: int, target: list[float],
              words: dict[str, Word], used: set[str]) -> canon.ArcMove:
     """The ArcMove of a G2 (mode 20) / G3 (30) line from m.pos to `target`; marks the words
     it consumes in `used`. Raises GCodeError naming the word at fault."""
-    from .modal import feed_length, fmt  # modal imports this module
-
     gword = f"G{mode // 10}"
     la, lb, _lh, oa, ob, oh = PLANES[m.plane]
     for L in (la, lb):
@@ -47,7 +46,7 @@ def arc_move(m: Modal, b: Block, mode: int, gpos: int, target: list[float],
         w = words[oh]
         raise b.error(f"{oh} is not allowed for an arc in the {la}{lb} plane", w.pos,
                       fmt(oh, w.value))
-    feed, duration = m._feed_rate(b, words, gword, gpos)
+    feed, duration = m.feed_rate(b, words, gword, gpos)
     ax_a, ka = m.letters[la]
     ax_b, kb = m.letters[lb]
     s = m.lin
@@ -59,7 +58,7 @@ def arc_move(m: Modal, b: Block, mode: int, gpos: int, target: list[float],
     pw = words.get("P")
     if pw is not None:
         used.add("P")
-        turns = m._int_word(b, "P", pw, 1) - 1
+        turns = m.int_word(b, "P", pw, 1) - 1
     try:
         if "R" in words:
             rw = words["R"]
@@ -100,7 +99,7 @@ def arc_move(m: Modal, b: Block, mode: int, gpos: int, target: list[float],
         lo = [min(p, q) for p, q in zip(m.pos, target, strict=True)]
         hi = [max(p, q) for p, q in zip(m.pos, target, strict=True)]
         lo[ax_a], hi[ax_a], lo[ax_b], hi[ax_b] = amin, amax, bmin, bmax
-        m._check_limits(b, lo, hi, gword, gpos)
+        m.check_limits(b, lo, hi, gword, gpos)
     centre = m.pos[:]
     centre[ax_a], centre[ax_b] = ca, cb
     if duration is not None:

@@ -188,7 +188,7 @@ class Interpreter:
                 pc += 1
                 continue
             if b.comments:
-                modal._messages(b, out)
+                modal.messages(b, out)
             kw = o.keyword
             if kw == "SUB":  # reached by falling through: skip the definition
                 pc = flow.subs[o.label][1] + 1

@@ -10,7 +10,8 @@ letter L maps to machine coordinate  p * scale(L) + work(L) + g92(L) + tool(L)  
 converts the program unit (G20/G21) to the machine unit for linear axes (1 for A/B/C),
 work is the selected G54..G59.3 origin, g92 the G92 offset and tool the G43 length (Z only).
 Offsets live in LinuxCNC's parameters: G54 X..W = #5221..#5229 (+20 per system), G92 =
-#5211..#5219, G28 = #5161.., G30 = #5181..; all in machine units.
+#5211..#5219, G28 = #5161.., G30 = #5181..; all in machine units. The group-0 commands that
+rewrite them (G10, G28/G30, G92) are in coords.py; G2/G3 in arcmove.py.
 """
 
 from __future__ import annotations
@@ -20,10 +21,12 @@ import re
 
 from . import canon
 from .arcmove import arc_move
+from .coords import offset_command
 from .expr import EvalError, Node
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
+from .words import Word, feed_length, fmt
 
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
 G_GROUP = {
@@ -53,20 +56,6 @@ M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
 _DEBUG_PARAM = re.compile(r"#<([^>]*)>|#(\d+)")
-
-
-class Word:
-    """A word's evaluated value and where it was (for error messages)."""
-
-    __slots__ = ("value", "pos")
-
-    def __init__(self, value: float, pos: int) -> None:
-        self.value = value
-        self.pos = pos
-
-
-def fmt(letter: str, v: float) -> str:
-    return f"{letter}{v:g}"
 
 
 class Modal:
@@ -106,11 +95,11 @@ class Modal:
             params.set_number(5210, 1.0)
         params.set_number(5220, 1.0)
         self.off = [0.0] * 9
-        self._update_offsets()
+        self.update_offsets()
         params.position_hook = self.program_position
 
     # -- coordinates -----------------------------------------------------------------
-    def _update_offsets(self) -> None:
+    def update_offsets(self) -> None:
         base = 5221 + 20 * (self.coord - 1)
         nums = self.params.numbers
         for k in range(9):
@@ -134,19 +123,19 @@ class Modal:
         d = self.pos[info[0]] - self.off[k]
         return d if letter in ROTARY_LETTERS else d * self.ldiv / self.lscale
 
-    def _axis(self, b: Block, letter: str, w: Word) -> int:
+    def axis_index(self, b: Block, letter: str, w: Word) -> int:
         info = self.letters.get(letter)
         if info is None:
             raise b.error(f"axis letter {letter} has no machine axis (axes: "
                           f"{', '.join(sorted(self.letters))})", w.pos, fmt(letter, w.value))
         return info[0]
 
-    def _target(self, b: Block, axes: dict[str, Word], machine: bool = False,
+    def target_position(self, b: Block, axes: dict[str, Word], machine: bool = False,
                 incremental: bool | None = None) -> list[float]:
         inc = self.incremental if incremental is None else incremental
         target = self.pos[:]
         for letter, w in axes.items():
-            ax = self._axis(b, letter, w)
+            ax = self.axis_index(b, letter, w)
             v = self.conv(w.value, letter)
             if machine:
                 target[ax] = v
@@ -156,7 +145,7 @@ class Modal:
                 target[ax] = v + self.off[self.letters[letter][1]]
         return target
 
-    def _check_limits(self, b: Block, lo: list[float], hi: list[float], word: str,
+    def check_limits(self, b: Block, lo: list[float], hi: list[float], word: str,
                       pos: int) -> None:
         limits = self.opt.soft_limits
         if limits is None:
@@ -242,7 +231,7 @@ class Modal:
             self._assign(b)
         used: set[str] = set()
         if b.comments:
-            self._messages(b, out)
+            self.messages(b, out)
         # feed mode, F, S, T
         if 5 in gs:
             inv = gs[5][0] == 930
@@ -269,7 +258,7 @@ class Modal:
         t = words.get("T")
         if t is not None:
             used.add("T")
-            self.selected_tool = self._int_word(b, "T", t, 0)
+            self.selected_tool = self.int_word(b, "T", t, 0)
         if 6 in ms:
             self.tool = self.selected_tool
             out.append(canon.ToolChange(self.tool, line, file))
@@ -293,7 +282,7 @@ class Modal:
             if p is None:
                 raise b.error(f"M{code} needs P (the output number)", pos, f"M{code}")
             used.add("P")
-            idx = self._int_word(b, "P", p, 0)
+            idx = self.int_word(b, "P", p, 0)
             if idx >= self.opt.n_outputs:
                 raise b.error(f"output number must be < {self.opt.n_outputs}, got {idx}",
                               p.pos, fmt("P", p.value))
@@ -317,7 +306,7 @@ class Modal:
         if 12 in gs:
             self.coord = COORD_SYSTEMS[gs[12][0]]
             self.params.set_number(5220, float(self.coord))
-            self._update_offsets()
+            self.update_offsets()
         if 13 in gs:
             self._path_control(b, gs[13][0], words, used, out)
         if 3 in gs:
@@ -330,7 +319,7 @@ class Modal:
                 raise b.error("axis words are used by two commands on this line "
                               f"(G{g0[0] / 10:g} and G{gs[1][0] / 10:g})", gs[1][1],
                               f"G{gs[1][0] / 10:g}")
-            self._group0(b, g0, axes, words, used, out)
+            offset_command(self, b, g0, axes, words, used, out)
             used.update(axes)
         elif 1 in gs or axes or (g0 is not None and g0[0] == 530):
             if 1 in gs:
@@ -353,7 +342,7 @@ class Modal:
         return True
 
     # -- pieces ----------------------------------------------------------------------
-    def _int_word(self, b: Block, letter: str, w: Word, lo: int) -> int:
+    def int_word(self, b: Block, letter: str, w: Word, lo: int) -> int:
         n = round(w.value)
         if abs(w.value - n) > 1e-4 or n < lo:
             raise b.error(f"{letter} must be an integer >= {lo}, got {w.value:g}", w.pos,
@@ -380,9 +369,9 @@ class Modal:
             else:
                 self.params.set_named(target, value)
         # Offsets are read from parameters: a program may set #5221.. directly.
-        self._update_offsets()
+        self.update_offsets()
 
-    def _messages(self, b: Block, out: list[canon.Command]) -> None:
+    def messages(self, b: Block, out: list[canon.Command]) -> None:
         for _col, text in b.comments:
             body = text.lstrip()
             head = body[:6].upper()
@@ -415,9 +404,9 @@ class Modal:
             tool = self.tool
             if h is not None:
                 used.add("H")
-                tool = self._int_word(b, "H", h, 0)
+                tool = self.int_word(b, "H", h, 0)
             self.tool_z = float(self.opt.tool_lengths.get(tool, 0.0))
-        self._update_offsets()
+        self.update_offsets()
 
     def _path_control(self, b: Block, code: int, words: dict[str, Word], used: set[str],
                       out: list[canon.Command]) -> None:
@@ -440,90 +429,7 @@ class Modal:
             cam = self.lin(q.value)
         out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
 
-    def _group0(self, b: Block, g: tuple[int, int], axes: dict[str, Word],
-                words: dict[str, Word], used: set[str], out: list[canon.Command]) -> None:
-        code, gpos = g
-        gword = f"G{code / 10:g}"
-        nums = self.params.numbers
-        if code in (280, 300):
-            base = 5161 if code == 280 else 5181
-            if axes:
-                mid = self._target(b, axes)
-                self._check_limits(b, mid, mid, gword, gpos)
-                out.append(canon.Rapid(tuple(mid), b.line, b.file))
-                self.pos = mid
-                letters = list(axes)
-            else:
-                letters = list(self.letters)
-            end = self.pos[:]
-            for L in letters:
-                ax, k = self.letters[L]
-                end[ax] = nums[base + k]
-            self._check_limits(b, end, end, gword, gpos)
-            out.append(canon.Rapid(tuple(end), b.line, b.file))
-            self.pos = end
-        elif code in (281, 301):
-            base = 5161 if code == 281 else 5181
-            for ax, k in self.letters.values():
-                self.params.set_number(base + k, self.pos[ax])
-        elif code == 920:
-            if not axes:
-                raise b.error("G92 needs at least one axis word", gpos, gword)
-            for L, w in axes.items():
-                ax = self._axis(b, L, w)
-                k = self.letters[L][1]
-                base = self.off[k] - self.g92[k]
-                self.g92[k] = self.pos[ax] - base - self.conv(w.value, L)
-                self.params.set_number(5211 + k, self.g92[k])
-            self.params.set_number(5210, 1.0)
-            self._update_offsets()
-        elif code in (921, 922):
-            self.g92 = [0.0] * 9
-            if code == 921:
-                for k in range(9):
-                    self.params.set_number(5211 + k, 0.0)
-            self.params.set_number(5210, 0.0)
-            self._update_offsets()
-        elif code == 923:
-            self.g92 = [nums[5211 + k] for k in range(9)]
-            self.params.set_number(5210, 1.0)
-            self._update_offsets()
-        elif code == 100:
-            self._g10(b, gpos, axes, words, used)
-
-    def _g10(self, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, Word],
-             used: set[str]) -> None:
-        lw = words.get("L")
-        if lw is None:
-            raise b.error("G10 needs L (L2 or L20)", gpos, "G10")
-        used.add("L")
-        L = self._int_word(b, "L", lw, 0)
-        if L not in (2, 20):
-            raise b.error(f"G10 L{L} is not supported (only L2 and L20)", lw.pos, f"L{L}")
-        if "R" in words:
-            raise b.error("G10 R (coordinate system rotation) is not supported",
-                          words["R"].pos, "R")
-        pw = words.get("P")
-        if pw is None:
-            raise b.error("G10 needs P (coordinate system 1..9, 0 = current)", gpos, "G10")
-        used.add("P")
-        p = self._int_word(b, "P", pw, 0)
-        if p > 9:
-            raise b.error(f"G10 P must be in [0, 9], got {p}", pw.pos, fmt("P", pw.value))
-        system = p or self.coord
-        base = 5221 + 20 * (system - 1)
-        for letter, w in axes.items():
-            ax = self._axis(b, letter, w)
-            k = self.letters[letter][1]
-            v = self.conv(w.value, letter)
-            if L == 2:
-                self.params.set_number(base + k, v)
-            else:  # L20: the current position becomes v in that system
-                extra = self.g92[k] + (self.tool_z if k == 2 else 0.0)
-                self.params.set_number(base + k, self.pos[ax] - extra - v)
-        self._update_offsets()
-
-    def _feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int
+    def feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int
                    ) -> tuple[float, float | None]:
         """(feed_per_s, duration) for a feed move; errors when F is missing."""
         if self.inverse_time:
@@ -554,31 +460,16 @@ class Modal:
                 raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
             if self.incremental:
                 raise b.error("G53 cannot be used in incremental mode (G91)", gs[0][1], "G53")
-        target = self._target(b, axes, machine=machine)
+        target = self.target_position(b, axes, machine=machine)
         if mode == 0:
-            self._check_limits(b, target, target, gword, gpos)
+            self.check_limits(b, target, target, gword, gpos)
             out.append(canon.Rapid(tuple(target), b.line, b.file))
         elif mode == 10:
-            feed, duration = self._feed_rate(b, words, gword, gpos)
+            feed, duration = self.feed_rate(b, words, gword, gpos)
             if duration is not None:
                 feed = feed_length(self.pos, target, self.letters) / duration
-            self._check_limits(b, target, target, gword, gpos)
+            self.check_limits(b, target, target, gword, gpos)
             out.append(canon.Feed(tuple(target), feed, b.line, b.file, duration))
         else:
             out.append(arc_move(self, b, mode, gpos, target, words, used))
         self.pos = target
-
-
-def feed_length(start: list[float], end: list[float], letters: dict[str, tuple[int, int]],
-                 skip: tuple[int, ...] = ()) -> float:
-    """Move length as LinuxCNC measures feed: linear axes if any moves, else rotary."""
-    lin = rot = 0.0
-    for L, (ax, _k) in letters.items():
-        if ax in skip:
-            continue
-        d = (end[ax] - start[ax]) ** 2
-        if L in ROTARY_LETTERS:
-            rot += d
-        else:
-            lin += d
-    return math.sqrt(lin) if lin > 0.0 else math.sqrt(rot)

@@ -1,0 +1,104 @@
+"""Coordinate systems and offsets: G10 L2/L20, G28/G30 and their .1 forms, G92 and
+G92.1/.2/.3 (RS-274/NGC group 0, LinuxCNC semantics).
+
+They change no modal state of their own: they move through a stored position or rewrite
+the parameters that hold the offsets (G54.. origins #5221.. (+20 per system), G92
+#5211..#5219 with #5210 its on flag, G28 #5161.., G30 #5181..; machine units), then the
+modal state re-reads them (`Modal.update_offsets`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from . import canon
+from .parser import Block
+from .words import Word, fmt
+
+if TYPE_CHECKING:
+    from .modal import Modal
+
+
+def offset_command(m: Modal, b: Block, g: tuple[int, int], axes: dict[str, Word],
+                   words: dict[str, Word], used: set[str], out: list[canon.Command]) -> None:
+    """Execute the group-0 word `g` = (code, column): G10, G28/G30 (.1) or G92 (.1/.2/.3)."""
+    code, gpos = g
+    gword = f"G{code / 10:g}"
+    nums = m.params.numbers
+    if code in (280, 300):
+        base = 5161 if code == 280 else 5181
+        if axes:
+            mid = m.target_position(b, axes)
+            m.check_limits(b, mid, mid, gword, gpos)
+            out.append(canon.Rapid(tuple(mid), b.line, b.file))
+            m.pos = mid
+            letters = list(axes)
+        else:
+            letters = list(m.letters)
+        end = m.pos[:]
+        for L in letters:
+            ax, k = m.letters[L]
+            end[ax] = nums[base + k]
+        m.check_limits(b, end, end, gword, gpos)
+        out.append(canon.Rapid(tuple(end), b.line, b.file))
+        m.pos = end
+    elif code in (281, 301):
+        base = 5161 if code == 281 else 5181
+        for ax, k in m.letters.values():
+            m.params.set_number(base + k, m.pos[ax])
+    elif code == 920:
+        if not axes:
+            raise b.error("G92 needs at least one axis word", gpos, gword)
+        for L, w in axes.items():
+            ax = m.axis_index(b, L, w)
+            k = m.letters[L][1]
+            base = m.off[k] - m.g92[k]
+            m.g92[k] = m.pos[ax] - base - m.conv(w.value, L)
+            m.params.set_number(5211 + k, m.g92[k])
+        m.params.set_number(5210, 1.0)
+        m.update_offsets()
+    elif code in (921, 922):
+        m.g92 = [0.0] * 9
+        if code == 921:
+            for k in range(9):
+                m.params.set_number(5211 + k, 0.0)
+        m.params.set_number(5210, 0.0)
+        m.update_offsets()
+    elif code == 923:
+        m.g92 = [nums[5211 + k] for k in range(9)]
+        m.params.set_number(5210, 1.0)
+        m.update_offsets()
+    elif code == 100:
+        _g10(m, b, gpos, axes, words, used)
+
+def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, Word],
+     used: set[str]) -> None:
+    lw = words.get("L")
+    if lw is None:
+        raise b.error("G10 needs L (L2 or L20)", gpos, "G10")
+    used.add("L")
+    L = m.int_word(b, "L", lw, 0)
+    if L not in (2, 20):
+        raise b.error(f"G10 L{L} is not supported (only L2 and L20)", lw.pos, f"L{L}")
+    if "R" in words:
+        raise b.error("G10 R (coordinate system rotation) is not supported",
+                      words["R"].pos, "R")
+    pw = words.get("P")
+    if pw is None:
+        raise b.error("G10 needs P (coordinate system 1..9, 0 = current)", gpos, "G10")
+    used.add("P")
+    p = m.int_word(b, "P", pw, 0)
+    if p > 9:
+        raise b.error(f"G10 P must be in [0, 9], got {p}", pw.pos, fmt("P", pw.value))
+    system = p or m.coord
+    base = 5221 + 20 * (system - 1)
+    for letter, w in axes.items():
+        ax = m.axis_index(b, letter, w)
+        k = m.letters[letter][1]
+        v = m.conv(w.value, letter)
+        if L == 2:
+            m.params.set_number(base + k, v)
+        else:  # L20: the current position becomes v in that system
+            extra = m.g92[k] + (m.tool_z if k == 2 else 0.0)
+            m.params.set_number(base + k, m.pos[ax] - extra - v)
+    m.update_offsets()
