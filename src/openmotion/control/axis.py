@@ -16,7 +16,7 @@ from collections.abc import Callable
 from functools import wraps
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ..errors import InfeasibleError, MotionError, check_finite, check_positive
+from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative, check_positive
 from ..hw.interface import AxisCommand
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
@@ -351,16 +351,19 @@ class Axis:
 
     @_locked
     def run_profile(self, profile: Profile, *, stop_accel: float, stop_jerk: float,
-                    replace_running: bool = False) -> None:
+                    replace_running: bool = False, str_vel: float = 0.0) -> None:
         """Execute an externally planned Profile from now (for groups, homing, scripts).
 
         Positions are in the command-counter frame; the profile must start where the axis
-        is (within 1e-6 pulse) and, when replacing a running `run_profile` motion
-        (`replace_running=True`), at its current velocity. A decelerating `stop()` uses
-        `stop_accel` (pps^2) and `stop_jerk` (pps^3). The profile's end state is held.
+        is (within 1e-6 pulse) and at its velocity (a replaced `run_profile` motion's, with
+        `replace_running=True`). `str_vel` (pps, default 0) is the PCL6045 StrVel: like a
+        T/S move (`MoveSpec.plan`), the profile may jump from rest to a speed <= str_vel at
+        its start (only when the axis is at rest) and from a speed <= str_vel to rest at its
+        end. A decelerating `stop()` uses `stop_accel` (pps^2) and `stop_jerk` (pps^3). The
+        profile's end state is held.
         """
         motion, start_p = self._prepare_profile(profile, stop_accel, stop_jerk,
-                                                replace_running)
+                                                replace_running, str_vel)
         if self._motion is not None or self._state is S.HOMING:
             # homing moves keep the axis in Homing; a replaced motion keeps its state
             self._motion = motion
@@ -373,13 +376,14 @@ class Axis:
 
     @_locked
     def check_profile(self, profile: Profile, *, stop_accel: float, stop_jerk: float,
-                      replace_running: bool = False) -> None:
+                      replace_running: bool = False, str_vel: float = 0.0) -> None:
         """Raise exactly as `run_profile` would, changing nothing (a group checks every
         axis's new motion before it starts any of them)."""
-        self._prepare_profile(profile, stop_accel, stop_jerk, replace_running)
+        self._prepare_profile(profile, stop_accel, stop_jerk, replace_running, str_vel)
 
     def _prepare_profile(self, profile: Profile, stop_accel: float, stop_jerk: float,
-                         replace_running: bool) -> tuple[ActiveMotion, float]:
+                         replace_running: bool,
+                         str_vel: float = 0.0) -> tuple[ActiveMotion, float]:
         """Validate a profile for `run_profile` and vet it; no side effects."""
         if not isinstance(profile, Profile):
             raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
@@ -387,6 +391,12 @@ class Axis:
             raise MotionError(f"profile must end at rest (end.v == 0), got {profile.end.v!r}")
         sa = check_positive("stop_accel", stop_accel)
         sj = check_positive("stop_jerk", stop_jerk)
+        sv = check_nonnegative("str_vel", str_vel)
+        jump_tol = sv * 1e-9 + 1e-6  # pps: the float error of a planned StrVel
+        v_end = _end_speed(profile)
+        if abs(v_end) > sv + jump_tol:
+            raise MotionError(f"profile must end at rest or jump to rest from at most "
+                              f"str_vel={sv:g} pps, ends at {v_end!r}")
         m = self._motion
         homing = self._state is S.HOMING
         if replace_running and m is not None:
@@ -400,8 +410,10 @@ class Axis:
         if abs(st.p - self._pos) > 1e-6:
             raise MotionError(f"profile must start at the axis position {self.position!r}, "
                               f"starts at {profile.state_at(0.0).p!r}")
-        if abs(st.v - self._vel) > 1e-6 * max(1.0, abs(self._vel)):
-            raise MotionError(f"profile must start at the axis velocity {self._vel!r}, "
+        if abs(st.v - self._vel) > 1e-6 * max(1.0, abs(self._vel)) and not (
+                m is None and self._vel == 0.0 and abs(st.v) <= sv + jump_tol):
+            raise MotionError(f"profile must start at the axis velocity {self._vel!r} "
+                              f"(or jump from rest to at most str_vel={sv:g} pps), "
                               f"starts at {st.v!r}")
         motion = ActiveMotion(shifted, self._ctl.time, "profile", None, shifted.end.p,
                               limits=(math.inf, sa, sj))
@@ -602,3 +614,11 @@ class Axis:
         return (self._state, self._fault, self._pos, self._vel, self._speed_range,
                 self.counters.snapshot(), id(m),
                 None if m is None else (m.t_start, m.kind, m.target, m.profile.duration))
+
+
+def _end_speed(p: Profile) -> float:
+    """Velocity of a profile just before its end (its last segment's end velocity)."""
+    if not p.n_segments:
+        return 0.0
+    dt = float(p.dt[-1]) if p.dt is not None else p.duration - float(p.t0[-1])
+    return float(p.v0[-1] + dt * (p.a0[-1] + dt * p.j[-1] / 2.0))

@@ -142,6 +142,7 @@ class Group(GroupEngine):
         self._refuse = True
         self._ptp_ratio = 10.0
         self._path_jerk = 0.0   # 0: T-curve path speed; > 0: S-curve with this path jerk
+        self._str_vel = 0.0     # StrVel of the following path commands (0: from/to rest)
         self._ptp_shape = "T"
         for a in ax:
             owners[a.index] = self
@@ -195,6 +196,11 @@ class Group(GroupEngine):
     def units(self) -> bool:
         """Whether logical coordinates are user units (False: command pulses)."""
         return bool(np.any(self._k != 1.0))
+
+    @property
+    def str_vel(self) -> float:
+        """StrVel of the following path commands (pps, or user units/s)."""
+        return self._str_vel
 
     @property
     def override(self) -> float:
@@ -300,6 +306,17 @@ class Group(GroupEngine):
         if not j > 0.0:
             raise MotionError(f"jerk must be a finite number > 0 for shape 'S', got {jerk!r}")
         self._path_jerk = j
+
+    def set_str_vel(self, speed: float) -> None:
+        """Start velocity (PCL6045 StrVel, HSL-4XMO 4.6) of the following path commands, in
+        pps or user units/s (default 0, as MCCL): a chain starts at rest with a jump to this
+        vector speed, and ends at it with a jump to rest. Checked when a command is queued:
+        <= its feed and StrVel*|u_i| <= each axis's maximum speed (GroupError ERR_SPEED).
+        T-curve paths only: an S-curve path command with StrVel > 0 is refused."""
+        v = check_finite("speed", speed)
+        if v < 0.0:
+            raise GroupError(ERR_ARGUMENT, f"speed (StrVel) must be >= 0, got {speed!r}")
+        self._str_vel = v
 
     def set_ptp_speed(self, ratio: float, *, shape: str = "T") -> None:
         """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10)."""
@@ -430,7 +447,7 @@ class Group(GroupEngine):
             assert r.chain is not None and r.sprof is not None and r.limits is not None
             s0 = r.sprof.end.p
             lim = self._limits(r.cmds[0])
-            curve = px.plan_curve(r.chain, s0, 0.0, lim)
+            curve = px.plan_curve(r.chain, s0, lim.str_vel, lim, jump=True)  # StrVel again
             self._launch_path(r.chain, curve, r.cmds, lim, t)
         elif r.kind == "ptp":
             self._launch_ptp(r.cmds[0], t)
@@ -539,12 +556,14 @@ class Group(GroupEngine):
         return arr + base[[i, j]] if base is not None else arr
 
     def _push_path(self, el: PathElement, end: np.ndarray) -> int:
-        feed = self._feed
-        if not self._refuse:  # the planner slows the path down to the axis limits
-            return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
-                                   accel=feed / self._acc_time, jerk=self._path_jerk), end)
+        feed, sv = self._feed, self._str_vel
         tan = el.max_abs_tangent
         vmax, amax = self._caps()
+        self._check_str_vel(sv, feed, tan)
+        if not self._refuse:  # the planner slows the path down to the axis limits
+            return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
+                                   accel=feed / self._acc_time, jerk=self._path_jerk,
+                                   str_vel=sv), end)
         need = feed * tan * self._ppu
         bad = np.nonzero(need > vmax * self._ppu * (1 + 1e-12))[0]
         if len(bad):
@@ -561,7 +580,27 @@ class Group(GroupEngine):
                                         f"above its maximum pulse acceleration "
                                         f"{self._amax[k]:g} pps^2")
         return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
-                               jerk=self._path_jerk), end)
+                               jerk=self._path_jerk, str_vel=sv), end)
+
+    def _check_str_vel(self, sv: float, feed: float, tan: np.ndarray) -> None:
+        """StrVel of a path command: <= its feed, within every axis's maximum speed along
+        the move (a jump cannot be slowed down), T-curve only."""
+        if sv == 0.0:
+            return
+        if sv > feed * (1 + 1e-12):
+            raise GroupError(ERR_SPEED, f"StrVel {sv:g} must be <= the feed {feed:g}")
+        caps = np.minimum(self._vmax, [a._max_speed for a in self.axes])
+        need = sv * tan * self._ppu
+        bad = np.nonzero(need > caps * (1 + 1e-12))[0]
+        if len(bad):
+            k = int(bad[0])
+            raise GroupError(ERR_SPEED, f"axis {self.names[k]} would jump to {need[k]:g} pps "
+                                        f"at StrVel {sv:g}, above its maximum speed "
+                                        f"{caps[k]:g} pps")
+        if self._path_jerk:
+            raise GroupError(ERR_ARGUMENT, "StrVel > 0 needs the T path shape: S-curve paths "
+                                           "start and end at rest (set_str_vel(0) or "
+                                           "set_path_shape('T'))")
 
     def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
         self._check_accepting()

@@ -82,6 +82,7 @@ class _Cmd:
     specs: tuple[MoveSpec, ...] = ()
     seconds: float = 0.0
     jerk: float = 0.0              # path jerk limit (0: T-curve)
+    str_vel: float = 0.0           # StrVel: a path starts/ends with a jump from/to rest
 
 
 @dataclass
@@ -163,7 +164,7 @@ class GroupEngine(LookaheadSettings):
     def _limits(self, cmd: _Cmd) -> px.Limits:
         vmax, amax = self._caps()
         return px.Limits(min(cmd.feed * self._override, self._sys_max), cmd.accel, vmax, amax,
-                         **self._corner_limits())
+                         str_vel=cmd.str_vel, **self._corner_limits())
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         if self._state is GroupState.ERROR:
@@ -217,11 +218,12 @@ class GroupEngine(LookaheadSettings):
             cmds = [cmd]
             while self._queue and self._queue[0].kind == "path" and not cmd.jerk \
                     and not self._queue[0].jerk \
-                    and self._queue[0].feed == cmd.feed and self._queue[0].accel == cmd.accel:
+                    and self._queue[0].feed == cmd.feed and self._queue[0].accel == cmd.accel \
+                    and self._queue[0].str_vel == cmd.str_vel:
                 cmds.append(self._queue.popleft())
             chain = self._chain(cmds)
             lim = self._limits(cmd)
-            curve = px.plan_curve(chain, 0.0, 0.0, lim)
+            curve = px.plan_curve(chain, 0.0, lim.str_vel, lim, jump=True)
             self._launch_path(chain, curve, cmds, lim, t)
         self._state = GroupState.MOVING
 
@@ -281,7 +283,7 @@ class GroupEngine(LookaheadSettings):
         if (r is None or r.kind != "path" or self._state is not GroupState.MOVING
                 or self._queue or cmd.kind != "path" or r.chain is None or r.sprof is None
                 or cmd.feed != r.cmds[0].feed or cmd.accel != r.cmds[0].accel
-                or cmd.jerk or r.cmds[0].jerk):
+                or cmd.jerk or r.cmds[0].jerk or cmd.str_vel != r.cmds[0].str_vel):
             return False
         t = self._ctl.time
         u = t - r.t0
@@ -322,20 +324,22 @@ class GroupEngine(LookaheadSettings):
         profiles = self._pulse_profiles(px.axis_profiles(chain, sprof, self._ctl.period,
                                                          starts))
         if not self._dry:
-            self._run_profiles(profiles)
+            self._run_profiles(profiles, lim.str_vel)
         a_min = min((lim.accel,) + tuple(
             x for x in _accels(chain, lim)))
         self._run = _Run("path", cmds, t, chain, curve, sprof, profiles, lim, a_min,
                          target=np.array(chain.elements[-1].end), raw=raw, tj=tj)
 
-    def _run_profiles(self, profiles: list[Profile]) -> None:
+    def _run_profiles(self, profiles: list[Profile], str_vel: float = 0.0) -> None:
         """Start every axis's profile, or none: each is checked (soft limits, states)
-        before any starts, so a refusal never leaves the group off its path."""
+        before any starts, so a refusal never leaves the group off its path. An axis may
+        jump by at most the path's StrVel (in its pulses) at the start and the end."""
         args = []
-        for a, p in zip(self.axes, profiles, strict=True):
+        for a, p, ppu in zip(self.axes, profiles, self._ppu, strict=True):
             acc = max(1.0, float(np.max(np.abs(p.a0)))) if p.n_segments else 1.0
             args.append((a, p, {"stop_accel": acc, "stop_jerk": acc * 1000.0,
-                                "replace_running": a.motion is not None}))
+                                "replace_running": a.motion is not None,
+                                "str_vel": str_vel * float(ppu)}))
         for a, p, kw in args:
             try:
                 a.check_profile(p, **kw)
@@ -381,9 +385,9 @@ class GroupEngine(LookaheadSettings):
             sprof = px.s_profile(curve, s_end, r.chain.cum[1:-1].tolist())
             profiles = self._pulse_profiles(px.axis_profiles(r.chain, sprof, self._ctl.period,
                                                              self.position))
-        if not self._dry:
-            self._run_profiles(profiles)
         assert lim is not None
+        if not self._dry:
+            self._run_profiles(profiles, lim.str_vel)
         self._run = _Run("path", r.cmds, t, r.chain, curve, sprof, profiles, lim, r.a_min,
                          target=r.target)
 

@@ -43,10 +43,13 @@ from ..profile.segments import Profile, ProfileBuilder, State
 # -------------------------------------------------------------------------- speed curves
 @dataclass(frozen=True)
 class SpeedCurve:
-    """v**2 piecewise linear in s over knots `s` (increasing) with values `v2` (>= 0)."""
+    """v**2 piecewise linear in s over knots `s` (increasing) with values `v2` (>= 0).
+    `jump`: the path is at rest before s[0] and jumps to sqrt(v2[0]) there (a StrVel start,
+    as a PCL6045 move starts); otherwise it arrives at s[0] with that speed."""
 
     s: np.ndarray
     v2: np.ndarray
+    jump: bool = False
 
     def at(self, s: float) -> float:
         return float(np.interp(s, self.s, self.v2))
@@ -133,14 +136,16 @@ def stop_point(curve: SpeedCurve) -> float:
 # -------------------------------------------------------------------------- s(t)
 def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float]) -> Profile:
     """Constant-acceleration Profile of s following `curve` from its start to `s_end`
-    (where the curve must be 0). `breaks` (element boundaries) become segment boundaries."""
+    (where the curve is 0, or the speed a StrVel end jumps to rest from). `breaks` (element
+    boundaries) become segment boundaries. A `jump` curve gives a profile at rest before
+    t = 0 whose first segment starts at the curve's speed (`MoveSpec.plan`'s StrVel jump)."""
     knots = np.union1d(curve.s, [b for b in breaks if curve.s[0] < b < s_end])
     knots = knots[(knots >= curve.s[0]) & (knots <= s_end)]
     v2 = np.maximum(np.interp(knots, curve.s, curve.v2), 0.0)
     v = np.sqrt(v2)
     ds = np.diff(knots)
     dv2 = np.diff(v2)
-    b = ProfileBuilder(float(knots[0]), float(v[0]))
+    b = ProfileBuilder(float(knots[0]), float(v[0]), v_before=0.0 if curve.jump else None)
     for k in range(len(ds)):
         if ds[k] <= 0.0:
             continue
@@ -228,8 +233,9 @@ class Trimmed:
 class Limits:
     """Path limits: feed (vector speed), tangential accel, per-axis speed/accel caps, the
     corner speed of sharp junctions (square corner velocity, 0: exact stop) with the
-    per-axis velocity step it may cause (`axis_vjump`, None: unbounded), and the minimum
-    cruise ratio of the look-ahead (path.plan_speeds)."""
+    per-axis velocity step it may cause (`axis_vjump`, None: unbounded), the minimum
+    cruise ratio of the look-ahead (path.plan_speeds), and the StrVel (vector speed a path
+    ends at before it jumps to rest; 0: ends at rest)."""
 
     feed: float
     accel: float
@@ -238,35 +244,36 @@ class Limits:
     square_corner_velocity: float = 0.0
     axis_vjump: np.ndarray | None = None
     min_cruise_ratio: float = 0.0
+    str_vel: float = 0.0
 
 
 def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
-               old: SpeedCurve | None = None) -> SpeedCurve:
-    """Speed curve for the rest of `chain` from s0 at speed v0, ending at rest.
+               old: SpeedCurve | None = None, *, jump: bool = False) -> SpeedCurve:
+    """Speed curve for the rest of `chain` from s0 at speed v0, ending at rest or, with a
+    StrVel (`lim.str_vel`), at a speed <= StrVel from which it jumps to rest.
 
+    `jump=True`: the path is at rest and starts with a jump to v0 (StrVel), lowered to the
+    highest start speed the limits ahead allow (feed x override, axis caps, a stop ahead).
     When v0 is above what the new limits allow (a lower override), the path decelerates at
     the smallest tangential acceleration of the remaining elements until it meets the new
     plan, and never exceeds the `old` curve it was following (see the module doc).
     """
     els, _ = chain.tail_elements(s0)
-    kw = dict(square_corner_velocity=lim.square_corner_velocity,
+    kw = dict(square_corner_velocity=lim.square_corner_velocity, end_speed=lim.str_vel,
               axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax, axis_vjump=lim.axis_vjump,
               min_cruise_ratio=lim.min_cruise_ratio)
     try:
         return _pinned(curve_from_speeds(
-            plan_speeds(els, lim.feed, lim.accel, start_speed=v0, **kw), s0), chain.length)
+            plan_speeds(els, lim.feed, lim.accel, start_speed=v0, **kw), s0), chain.length,
+            jump=jump and v0 > 0.0)
     except InfeasibleError:
-        if old is None:
+        if old is None and not jump:
             raise
-    lo, hi = 0.0, v0  # highest feasible start speed, by bisection
-    for _ in range(50):
-        mid = 0.5 * (lo + hi)
-        try:
-            plan_speeds(els, lim.feed, lim.accel, start_speed=mid, **kw)
-            lo = mid
-        except InfeasibleError:
-            hi = mid
+    lo = _highest_start(els, v0, lim, kw)
     sp = plan_speeds(els, lim.feed, lim.accel, start_speed=lo, **kw)
+    if jump:
+        return _pinned(curve_from_speeds(sp, s0), chain.length, jump=lo > 0.0)
+    assert old is not None
     a_min = min(x.accel for x in sp if x.length > 0.0)
     new = curve_from_speeds(sp, s0)
     # the new plan starts at lo < v0: join it with a ramp from v0 (max), under the old curve
@@ -275,13 +282,26 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     return _pinned(curve_min(joined, old.tail(s0)), chain.length)
 
 
-def _pinned(curve: SpeedCurve, length: float) -> SpeedCurve:
+def _highest_start(els: Sequence[PathElement], v0: float, lim: Limits, kw: dict) -> float:
+    """The highest start speed <= v0 the look-ahead accepts on `els` (bisection)."""
+    lo, hi = 0.0, v0
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        try:
+            plan_speeds(els, lim.feed, lim.accel, start_speed=mid, **kw)
+            lo = mid
+        except InfeasibleError:
+            hi = mid
+    return lo
+
+
+def _pinned(curve: SpeedCurve, length: float, *, jump: bool = False) -> SpeedCurve:
     """The curve with its last knot exactly at the chain length (sums round differently)."""
     s = curve.s.copy()
     s[-1] = length
     keep = np.concatenate([np.diff(s) > 0.0, [True]])
     keep[0] = True
-    return SpeedCurve(s[keep], curve.v2[keep])
+    return SpeedCurve(s[keep], curve.v2[keep], jump)
 
 
 def hold_curve(old: SpeedCurve, s0: float, v0: float, accel: float) -> SpeedCurve:
@@ -306,6 +326,7 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     smp = sp.sample(t)
     s = np.clip(smp.p, sp.start.p, sp.end.p)
     sd = smp.v
+    sd[-1] = _end_speed(sp)  # the speed just before the end (a StrVel end jumps from it)
     s[-1] = sp.end.p
     dim = chain.elements[0].dim
     if len(t) < 2:  # nothing left to move: hold the start
@@ -337,7 +358,6 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
         l1 = np.clip(s[1:][m] - cum[i], 0.0, el.length)
         v0[m] = el.tangent(l0) * sd[:-1][m][:, None]
         v1[m] = el.tangent(l1) * sd[1:][m][:, None]
-    v1[-1] = 0.0 if sp.end.v == 0.0 else v1[-1]
     h = np.diff(t)[:, None]
     dp = np.diff(pos, axis=0)
     a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
@@ -357,9 +377,19 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
         out.append(Profile(
             t0=t[:-1].copy(), p0=pos[:-1, i].copy(), v0=v0[:, i].copy(), a0=a0[:, i].copy(),
             j=jj[:, i].copy(), duration=float(dur),
-            start=State(float(pos[0, i]), float(v0[0, i]), 0.0),
+            start=State(float(pos[0, i]), float(v0[0, i]) if sp.start.v else 0.0, 0.0),
             end=State(float(pos[-1, i]), 0.0, 0.0), labels=labels, dt=dts.copy()))
     return out
+
+
+def _end_speed(sp: Profile) -> float:
+    """Path speed just before the end of s(t): 0 for a stop at rest (within the rounding of
+    the last segment), else the speed a StrVel end jumps to rest from."""
+    if not sp.n_segments or sp.end.v != 0.0:
+        return float(sp.end.v)
+    dt = float(sp.dt[-1]) if sp.dt is not None else sp.duration - float(sp.t0[-1])
+    v = float(sp.v0[-1] + dt * (sp.a0[-1] + dt * sp.j[-1] / 2.0))
+    return v if v > 1e-9 * max(1.0, float(np.max(np.abs(sp.v0)))) else 0.0
 
 
 def scaled(p: Profile, k: float) -> Profile:
