@@ -306,3 +306,20 @@ def test_example_runs_with_and_without_str_vel():
     assert pcl["end_speed"] == pytest.approx(5.0, rel=1e-6)
     assert mccl["end"] == pcl["end"] == [10.0, 20.0]
     assert pcl["time"] < mccl["time"]  # the ramps start and end at StrVel
+
+
+def test_safety_stops_a_str_vel_path():
+    ctl, g = make()
+    ctl.safety.soft.set("y", 10_000, -100_000)
+    ctl.safety.soft.enable("y", "decel")
+    g.line([8000, 12_000])  # beyond the soft limit: refused before anything moves
+    ctl.advance(0.1)
+    assert g.state is GroupState.ERROR and "soft limit" in g.error_message
+    assert [ctl.hardware.read_axis(i).pulses_out for i in (0, 1)] == [0, 0]
+    ctl, g = make()
+    g.line([20_000, 20_000])
+    ctl.hardware.scenario.press_estop(at=0.3)
+    ctl.run_until(lambda: g.state is GroupState.ERROR, 5.0)
+    ctl.advance(0.05)
+    x, y = (ctl.hardware.read_axis(i).pulses_out for i in (0, 1))
+    assert 0 < x < 20_000 and abs(x - y) <= 1 and not any(a.is_moving for a in g.axes)
