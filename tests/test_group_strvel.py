@@ -14,7 +14,6 @@ from openmotion.control import Controller
 from openmotion.control.group import ERR_ARGUMENT, ERR_SPEED, Group, GroupError, GroupState
 from openmotion.errors import MotionError
 from openmotion.profile.pcl import trapezoid
-from openmotion.profile.segments import ProfileBuilder
 
 FEED = 20_000.0
 ACC_T = 0.05
@@ -279,20 +278,18 @@ def test_run_profile_takes_a_pcl_str_vel_move_from_rest():
     assert ax.snapshot() == moving
 
 
-def test_run_profile_end_jump_is_bounded_by_str_vel():
+def test_run_profile_ends_with_a_jump_to_rest_on_the_target():
     ctl = Controller()
     ctl.enable_all()
     ax = ctl["x"]
-    b = ProfileBuilder(0.0)  # from rest to 2000 pps, cruise, then a jump to rest
-    b.segment(0.01, accel=200_000.0)
-    b.segment(0.1, accel=0.0)
-    prof = b.build()
-    for sv in (0.0, 1999.0):
-        with pytest.raises(MotionError, match="end"):
-            ax.check_profile(prof, stop_accel=1e6, stop_jerk=1e9, str_vel=sv)
+    prof = trapezoid(8000.0, 2000.0, 20_000.0, 0.05, 0.05, start=0.0)
+    t0 = ctl.time
     ax.run_profile(prof, stop_accel=1e6, stop_jerk=1e9, str_vel=2000.0)
+    t_end = t0 + prof.duration
     assert ctl.wait_motion_done(timeout=5)
-    assert ax.position == prof.end.p and ax.velocity == 0.0
+    assert ax.position == 8000.0 and ax.velocity == 0.0
+    v = ctl.history.sample(0, [t_end - 1e-9, t_end]).v
+    assert v[0] == pytest.approx(2000.0, rel=1e-5) and v[1] == 0.0
 
 
 def test_example_runs_with_and_without_str_vel():

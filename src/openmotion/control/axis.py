@@ -358,9 +358,9 @@ class Axis:
         is (within 1e-6 pulse) and at its velocity (a replaced `run_profile` motion's, with
         `replace_running=True`). `str_vel` (pps, default 0) is the PCL6045 StrVel: like a
         T/S move (`MoveSpec.plan`), the profile may jump from rest to a speed <= str_vel at
-        its start (only when the axis is at rest) and from a speed <= str_vel to rest at its
-        end. A decelerating `stop()` uses `stop_accel` (pps^2) and `stop_jerk` (pps^3). The
-        profile's end state is held.
+        its start when the axis is at rest. Its end state (rest) is held; the last segment
+        may end at a speed (a StrVel end jumps to rest, as a T/S move's does). A
+        decelerating `stop()` uses `stop_accel` (pps^2) and `stop_jerk` (pps^3).
         """
         motion, start_p = self._prepare_profile(profile, stop_accel, stop_jerk,
                                                 replace_running, str_vel)
@@ -393,10 +393,6 @@ class Axis:
         sj = check_positive("stop_jerk", stop_jerk)
         sv = check_nonnegative("str_vel", str_vel)
         jump_tol = sv * 1e-9 + 1e-6  # pps: the float error of a planned StrVel
-        v_end = _end_speed(profile)
-        if abs(v_end) > sv + jump_tol:
-            raise MotionError(f"profile must end at rest or jump to rest from at most "
-                              f"str_vel={sv:g} pps, ends at {v_end!r}")
         m = self._motion
         homing = self._state is S.HOMING
         if replace_running and m is not None:
@@ -615,10 +611,3 @@ class Axis:
                 self.counters.snapshot(), id(m),
                 None if m is None else (m.t_start, m.kind, m.target, m.profile.duration))
 
-
-def _end_speed(p: Profile) -> float:
-    """Velocity of a profile just before its end (its last segment's end velocity)."""
-    if not p.n_segments:
-        return 0.0
-    dt = float(p.dt[-1]) if p.dt is not None else p.duration - float(p.t0[-1])
-    return float(p.v0[-1] + dt * (p.a0[-1] + dt * p.j[-1] / 2.0))
