@@ -135,3 +135,20 @@ def test_gcode_g64_p_blends_g2_g3_corners():
     v = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(t)
     moving = np.nonzero(v > 1e-9)[0]
     assert v[moving[0] + 5:moving[-1] - 5].min() > 1.0  # mm/s: no stop at any corner
+
+
+def test_example_prints_faster_blended_runs_within_tolerance():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "group_arc_blend.py"
+    spec = importlib.util.spec_from_file_location("group_arc_blend", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    exact, blended = mod.run(0.0), mod.run(50.0)
+    for r in (exact, blended):
+        assert r["end"] == [10_000.0, 0.0]
+        assert r["accel"] <= 1.0 + 1e-9
+    assert exact["deviation"] < 1e-6
+    assert 25.0 < blended["deviation"] <= 50.0 * (1 + 1e-6)
+    assert blended["time"] < exact["time"]

@@ -284,8 +284,10 @@ class Group(GroupEngine):
         return arr
 
     def enable_blend(self, tolerance: float) -> None:
-        """Blend consecutive path commands; line-line corners are rounded so that the path
-        passes within `tolerance` pulses of the programmed corner (0: exact stop)."""
+        """Blend consecutive path commands: corners between lines and arcs are rounded so
+        that the path passes within `tolerance` (pulses, or user units with `units=`) of
+        the programmed corner point (0: exact stop). Helices and elements in different
+        planes still stop exactly at their corners."""
         self._blend_tol = check_nonnegative("tolerance", tolerance)
         self._blend = True
 

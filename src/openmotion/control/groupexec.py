@@ -3,12 +3,12 @@
 Point-to-point commands start every axis with its own T/S profile and the next command
 waits for all of them. Consecutive path commands with the same feed and acceleration are
 planned as one chain by the look-ahead (`path.plan_speeds`) and executed by pathexec.py:
-with blending on, line-line corners are rounded (`path.blend_corner`) within the tolerance
-and the chain runs through them; with blending off every corner is an exact stop. Hold,
-continue, abort and the feed override re-plan the running chain from the current path
-state. A group axis going to ErrorStop (the controller's fault hooks, when present, and a
-check every cycle) or reaching the limit switch ahead of it stops every axis of the group
-at once and puts the group in error (MCCL 2.6.3 VI: all motion commands stop).
+with blending on, corners between lines and arcs are rounded (`path.blend_corner`) within
+the tolerance and the chain runs through them; with blending off every corner is an exact
+stop. Hold, continue, abort and the feed override re-plan the running chain from the
+current path state. A group axis going to ErrorStop (the controller's fault hooks, when
+present, and a check every cycle) or reaching the limit switch ahead of it stops every axis
+of the group at once and puts the group in error (MCCL 2.6.3 VI: all motion commands stop).
 """
 
 from __future__ import annotations
