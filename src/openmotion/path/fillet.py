@@ -19,11 +19,14 @@ asin). The fillet turns sigma*(k1*d1 + turn + k2*d2) and its closest point to th
 at (|P_t|**2 + 2h*P_t.N)/(|C| + r) (no cancellation for large r).
 
 The radius is the largest for which the fillet exists (inside an arc's circle: at most
-99.9 % of its radius), its tangent points lie within
-`fraction` of each element from the corner, and it passes within the tolerance of the
-corner (bracketing and bisection: the deviation grows with r). Arcs whose end was only on
-their circle within tolerance (an end correction spread along s, see arcs.py) are handled
-with that correction counted into the deviation.
+99.9 % of its radius), its tangent points lie within `fraction` of each element from the
+corner, it passes within the tolerance of the corner and stays within it of the elements
+(15 inner points, checked on the result and, if needed, in a second bisection): these fail
+from some radius on, so bracketing and bisection find it. The deviation counts what the
+arcs' end corrections (an end only on the circle within tolerance, spread along s, see
+arcs.py) and the model's rounding can add. The fillet is then built on the real elements
+(their trim points and tangents, so the joints are exact) and its deviation measured
+again; if that is beyond the tolerance, the radius is halved.
 """
 
 from __future__ import annotations
@@ -84,7 +87,7 @@ class _Solution:
     d2: float       # ... and on to the second
     sweep: float
     dev: float      # distance corner -> fillet (model, exact circles)
-    bound: float    # dev plus what end corrections of the elements can add
+    bound: float    # dev plus what end corrections and rounding can add
 
 
 def _dot(a: Vec, b: Vec) -> float:
