@@ -456,7 +456,7 @@ def multi_record_cases(draw):
 @settings(max_examples=150, deadline=None)
 @given(case=multi_record_cases())
 def test_scalar_and_vector_crossings_agree(case) -> None:
-    import openmotion.history as hist
+    import openmotion.crossings as hist  # the solver MotionHistory.crossing_events uses
 
     h, level, t0, t1 = case
     old = hist._SCALAR_RECORDS

@@ -14,19 +14,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from ..crossings import velocity_roots
+
+__all__ = ["level_events", "velocity_roots"]
+
 _EPS = 2.220446049250313e-16
-
-
-def velocity_roots(v: float, a: float, j: float) -> tuple[float, ...]:
-    """Roots of the velocity v + a*x + j*x**2/2."""
-    h = 0.5 * j
-    if h == 0.0:
-        return (-v / a,) if a != 0.0 else ()
-    disc = a * a - 4.0 * h * v
-    if disc < 0.0:
-        return ()
-    q = -0.5 * (a + math.copysign(math.sqrt(disc), a))
-    return (q / h, v / q) if q != 0.0 else (0.0,)
 
 
 def _f(c: float, v: float, a: float, j: float, x: float, level: float, p: float) -> float:
