@@ -51,8 +51,8 @@ def test_arc_path_jerk_within_limit_and_on_circle():
     t0 = ctl.time
     g.arc([0, 10_000], [0, 20_000], direction="CW")
     sp = []
-    ctl.add_cycle_hook(lambda c, t: sp.append(g._run.sprof) if g._run is not None
-                       and g._run.kind == "path" and (not sp or sp[-1] is not g._run.sprof)
+    ctl.add_cycle_hook(lambda c, t: sp.append(g._run.plan.sprof) if g._run is not None
+                       and g._run.kind == "path" and (not sp or sp[-1] is not g._run.plan.sprof)
                        else None)
     t1 = finish(ctl, g)
     assert [a.position for a in g.axes] == [0.0, 20_000.0]

@@ -11,7 +11,7 @@ import pytest
 
 from helpers import table_without_mel
 from openmotion.control import AxisState, Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.group import ERR_LIMIT, Group, GroupError, GroupState
 from openmotion.control.homing import Homing
 from openmotion.control.homing_modes import HomeConfig
 from openmotion.control.jog import jog_conti
@@ -50,13 +50,17 @@ def test_group_path_over_a_soft_limit_is_refused_before_it_starts(blend: bool,
     ctl, g = group(blend)
     ctl.safety.soft.set("y", 10_000, -100_000)
     ctl.safety.soft.enable("y", action)
-    # the arc bulges to y = 12000 although every end point is inside the limit
+    # the arc bulges to y = 12000 although every end point is inside the limit: refused
+    # when it is queued (MCCL-style negative code), the queue left as it was
     g.line([8000, 8000])
-    g.arc([12000, 8000], [16000, 8000], direction="CW")
-    g.line([20000, 0])
-    run_group(ctl, g)
-    assert g.state is GroupState.ERROR and "soft limit" in g.error_message
-    assert (pulses(ctl, 0), pulses(ctl, 1)) == (0, 0)  # nothing moved
+    with pytest.raises(GroupError, match=r"\+ soft limit 10000") as err:
+        g.arc([12000, 8000], [16000, 8000], direction="CW")
+    assert err.value.code == ERR_LIMIT
+    assert g.queue_length + (g.current_index >= 0) == 1
+    g.line([20000, 0])  # the program goes on below the limit
+    ymax = run_group(ctl, g)
+    assert g.state is GroupState.IDLE and ymax <= 10_000
+    assert (pulses(ctl, 0), pulses(ctl, 1)) == (20000, 0)
 
 
 @pytest.mark.parametrize("blend", [False, True])

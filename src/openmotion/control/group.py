@@ -27,10 +27,11 @@ import numpy as np
 
 from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
 from ..path import Arc, Arc3D, Line
+from ..path.extent import element_extent
 from ..path.geometry import PathElement
 from ..profile.pcl import MoveSpec
 from ..units import AxisUnits
-from . import pathexec as px
+from . import pathrun
 from .groupexec import (
     ERR_ACCEL,
     ERR_ARC,
@@ -174,9 +175,9 @@ class Group(GroupEngine):
         r = self._run or self._held
         if r is None:
             return -1
-        if r.kind == "path" and r.sprof is not None and r.chain is not None:
-            s = r.sprof.state_at(max(0.0, self._ctl.time - r.t0)).p
-            return r.chain.owners[r.chain.locate(s)]
+        if r.plan is not None:
+            chain = r.plan.chain
+            return chain.owners[chain.locate(r.plan.s_at(self._ctl.time))]
         return r.cmds[0].index
 
     @property
@@ -445,12 +446,10 @@ class Group(GroupEngine):
             raise GroupError(ERR_STATE, f"continue needs a held group (state {self._state.value})")
         r, self._held = self._held, None
         t = self._ctl.time
-        if r.kind == "path":
-            assert r.chain is not None and r.sprof is not None and r.limits is not None
-            s0 = r.sprof.end.p
-            lim = self._limits(r.cmds[0])
-            curve = px.plan_curve(r.chain, s0, lim.str_vel, lim, jump=True)  # StrVel again
-            self._launch_path(r.chain, curve, r.cmds, lim, t)
+        if r.plan is not None:  # from rest (with the StrVel jump again)
+            chain = r.plan.chain
+            self._launch(pathrun.start(chain, self._limits(chain, r.cmds[0].str_vel),
+                                       r.plan.tj, t, s0=r.plan.sprof.end.p), r.cmds, t)
         elif r.kind == "ptp":
             self._launch_ptp(r.cmds[0], t)
         else:
@@ -486,8 +485,7 @@ class Group(GroupEngine):
         r = self._run
         old = self._override
         self._override = p / 100.0
-        if r is not None and r.kind == "path" and self._state is GroupState.MOVING \
-                and r.raw is None:  # an S-curve path takes the override from its successor
+        if r is not None and r.plan is not None and self._state is GroupState.MOVING:
             try:
                 self._replan(r, hold=False)
             except Exception:
@@ -557,7 +555,31 @@ class Group(GroupEngine):
             raise GroupError(ERR_ARGUMENT, f"{name} must be 2 finite numbers, got {value!r}")
         return arr + base[[i, j]] if base is not None else arr
 
+    def _check_soft_limits(self, el: PathElement) -> None:
+        """Refuse (ERR_LIMIT) a path element that would take an axis past an enabled soft
+        limit (further than where it starts), before it is queued."""
+        from .safety import Safety
+
+        safety = Safety.of(self._ctl)
+        if safety is None or self._dry:
+            return
+        lo, hi = element_extent(el)
+        a_, b_ = lo * self._k, hi * self._k
+        plo, phi = np.minimum(a_, b_), np.maximum(a_, b_)
+        start = np.asarray(el.start, dtype=float) * self._k
+        for i, ax in enumerate(self.axes):
+            lim = safety.soft.get(ax.index)
+            if not lim.enabled:
+                continue
+            if phi[i] > max(lim.plimit, start[i]) + 1e-9 * max(1.0, abs(lim.plimit)):
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the + "
+                                            f"soft limit {lim.plimit!r} (reaches {phi[i]:.6g})")
+            if plo[i] < min(lim.nlimit, start[i]) - 1e-9 * max(1.0, abs(lim.nlimit)):
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the - "
+                                            f"soft limit {lim.nlimit!r} (reaches {plo[i]:.6g})")
+
     def _push_path(self, el: PathElement, end: np.ndarray) -> int:
+        self._check_soft_limits(el)
         feed, sv = self._feed, self._str_vel
         tan = el.max_abs_tangent
         vmax, amax = self._caps()
@@ -607,9 +629,10 @@ class Group(GroupEngine):
     def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
         self._check_accepting()
         cmd.index = self._next_index
-        if not self._extend_running(cmd):
-            self._queue.append(cmd)
+        self._queue.append(cmd)
         self._next_index += 1
+        if self._run is not None and self._run.plan is not None:
+            self._join_queued(self._ctl.time)  # joins now if the running chain needs it
         if end is not None:
             self._tail = end.copy()
         return cmd.index

@@ -23,13 +23,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InfeasibleError, MotionError
-from ..path import Blend, blend_corner, plan_speeds
+from ..path import blend_corner
 from ..path.geometry import PathElement
-from ..path.smoothing import fir_smooth, jerk_window
+from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
-from ..profile.segments import Profile, State
+from ..profile.segments import Profile
 from . import pathexec as px
-from . import planning
+from . import pathrun, planning
 from .group_corners import LookaheadSettings
 from .states import AxisState
 
@@ -92,24 +92,22 @@ class _Run:
     kind: str
     cmds: list[_Cmd]
     t0: float
-    chain: px.Chain | None = None
-    curve: px.SpeedCurve | None = None
-    sprof: Profile | None = None
+    plan: pathrun.PathPlan | None = None   # path: the chain and the motion along it
     profiles: list[Profile] = field(default_factory=list)
-    limits: px.Limits | None = None
-    a_min: float = 0.0
     t_until: float = 0.0
     target: np.ndarray | None = None
-    raw: Profile | None = None     # S-curve: the T-curve s(t) the filter smooths
-    tj: float = 0.0                # S-curve: the filter window
 
     @property
     def t_end(self) -> float:
         if self.kind == "delay":
             return self.t_until
-        if self.sprof is not None:
-            return self.t0 + self.sprof.duration
+        if self.plan is not None:
+            return self.plan.t_end
         return self.t0 + max((p.duration for p in self.profiles), default=0.0)
+
+
+#: Most commands joined to a running chain in one re-plan (bounds one cycle's work).
+MAX_JOIN = 2000
 
 
 class GroupEngine(LookaheadSettings):
@@ -161,10 +159,13 @@ class GroupEngine(LookaheadSettings):
         raise NotImplementedError
 
     # ------------------------------------------------------------------ execution
-    def _limits(self, cmd: _Cmd) -> px.Limits:
+    def _limits(self, chain: px.Chain, str_vel: float = 0.0) -> px.Limits:
+        """Limits of a chain: its elements' own feeds times the override, capped by the
+        system maximum; per-axis caps in logical units; the chain's StrVel."""
         vmax, amax = self._caps()
-        return px.Limits(min(cmd.feed * self._override, self._sys_max), cmd.accel, vmax, amax,
-                         str_vel=cmd.str_vel, **self._corner_limits())
+        acc = float(np.max(chain.accels)) if chain.accels is not None else 1.0
+        return px.Limits(self._sys_max, acc, vmax, amax, scale=self._override,
+                         str_vel=str_vel, **self._corner_limits())
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         if self._state is GroupState.ERROR:
@@ -179,20 +180,17 @@ class GroupEngine(LookaheadSettings):
                 self._dry_pos = self._pulses_of(r.target) if r.kind == "path" \
                     else r.target.copy()
             if self._state is GroupState.HOLDING:
+                if self._dry and r.profiles:
+                    self._dry_pos = np.array([p.end.p for p in r.profiles])
                 if self._aborting:
                     self._aborting = False
                     self._state = GroupState.IDLE
                     self._tail = None
-                    if self._dry and r.profiles:
-                        self._dry_pos = np.array([p.end.p for p in r.profiles])
                     return
                 self._held = r
-                if self._dry and r.profiles:
-                    self._dry_pos = np.array([p.end.p for p in r.profiles])
                 self._state = GroupState.HELD
                 return
-            if r.kind == "path" and r.sprof is not None and r.chain is not None \
-                    and r.sprof.end.p < r.chain.length:
+            if r.plan is not None and r.plan.stopped_short:
                 # a run that stopped short (should not happen) is kept as held
                 self._held, self._state = r, GroupState.HELD
                 return
@@ -201,6 +199,8 @@ class GroupEngine(LookaheadSettings):
                 self._start_next(t)
             else:
                 self._state = GroupState.IDLE
+        elif self._queue:
+            self._join_queued(t)
 
     def _start_next(self, t: float) -> None:
         try:
@@ -215,44 +215,133 @@ class GroupEngine(LookaheadSettings):
         elif cmd.kind == "ptp":
             self._launch_ptp(cmd, t)
         else:
-            cmds = [cmd]
-            while self._queue and self._queue[0].kind == "path" and not cmd.jerk \
-                    and not self._queue[0].jerk \
-                    and self._queue[0].feed == cmd.feed and self._queue[0].accel == cmd.accel \
-                    and self._queue[0].str_vel == cmd.str_vel:
-                cmds.append(self._queue.popleft())
+            tj = jerk_window(cmd.accel, cmd.jerk) if cmd.jerk else 0.0
+            cmds = [cmd, *self._take(tj, cmd.elements[0].length, [cmd])]
             chain = self._chain(cmds)
-            lim = self._limits(cmd)
-            curve = px.plan_curve(chain, 0.0, lim.str_vel, lim, jump=True)
-            self._launch_path(chain, curve, cmds, lim, t)
+            self._launch(pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t),
+                         cmds, t)
         self._state = GroupState.MOVING
 
+    # ------------------------------------------------------------------ streaming
+    def _joins(self, tj: float, cmd: _Cmd, str_vel: float = 0.0) -> bool:
+        """Whether `cmd` can join a chain smoothed with window tj (0: a T chain) that starts
+        and ends at `str_vel`: a path command of the same shape and StrVel whose own window
+        fits in tj (its jerk stays bounded)."""
+        if cmd.kind != "path" or cmd.str_vel != str_vel:
+            return False
+        if tj == 0.0 or not cmd.jerk:
+            return tj == 0.0 and not cmd.jerk
+        return jerk_window(cmd.accel, cmd.jerk) <= tj * (1.0 + 1e-12)
+
+    def _reach(self, cmd: _Cmd, tj: float) -> float:
+        """Path length a chain should keep ahead for `cmd`: twice what it takes to brake
+        from its feed (override included), plus a few cycles and the smoothing window, so
+        joining commands never makes the running motion brake for the chain's end."""
+        f = min(cmd.feed * self._override, self._sys_max)
+        return 2.0 * (f * f / (2.0 * cmd.accel) + f * (4.0 * self._ctl.period + tj))
+
+    def _take(self, tj: float, have: float, cmds: list[_Cmd]) -> list[_Cmd]:
+        """Pop the queued commands that join a chain with `have` length ahead until it
+        holds twice its reach (Klipper's lazy flush: the rest waits in the queue)."""
+        out: list[_Cmd] = []
+        reach = max(self._reach(c, tj) for c in cmds[-1:]) if cmds else 0.0
+        sv = cmds[0].str_vel if cmds else 0.0
+        while self._queue and len(out) < MAX_JOIN and self._joins(tj, self._queue[0], sv):
+            reach = max(reach, self._reach(self._queue[0], tj))
+            if have >= 2.0 * reach:
+                break
+            c = self._queue.popleft()
+            out.append(c)
+            have += c.elements[0].length
+        return out
+
+    def _join_queued(self, t: float) -> None:
+        """Streaming look-ahead: when the running chain has less than its reach ahead, join
+        the next queued path commands and re-plan from now. The corner with the running
+        chain is blended when the path has not yet reached the blend's start; otherwise the
+        corner keeps its exact stop (or junction speed). A join that cannot be followed
+        from the present speed leaves the commands queued (they start after the chain)."""
+        r = self._run
+        if r is None or r.plan is None or self._state is not GroupState.MOVING:
+            return
+        plan = r.plan
+        if not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
+            return
+        have = plan.remaining(t)
+        if have >= self._reach(self._queue[0], plan.tj) and have >= self._reach(
+                r.cmds[-1], plan.tj):
+            return
+        new = self._take(plan.tj, have, [r.cmds[-1]])
+        if not new:
+            return
+        s_raw = plan.chain.length - have
+        last = plan.chain.elements[-1]
+        options = []
+        first, els, owners = self._elements(new, last)
+        if first is not last and s_raw < float(plan.chain.cum[-2]) + first.length:
+            options.append(plan.chain.joined(els, owners, *self._per(owners, new),
+                                             replace_last=first))
+        _, els, owners = self._elements(new)
+        options.append(plan.chain.joined(els, owners, *self._per(owners, new)))
+        for chain in options:
+            try:
+                p2 = pathrun.replan(plan, t, chain=chain,
+                                    limits=self._limits(chain, plan.limits.str_vel))
+            except InfeasibleError:
+                continue
+            try:
+                self._launch(p2, [*r.cmds, *new], t)
+            except MotionError as err:  # refused by an axis (safety): stop the group
+                self._fault(getattr(err, "code", ERR_AXIS_STATE), f"join refused: {err}")
+            return
+        self._queue.extendleft(reversed(new))
+
+    @staticmethod
+    def _per(owners: list[int], cmds: list[_Cmd]) -> tuple[list[float], list[float]]:
+        """Feed and acceleration of each element, from the command that owns it."""
+        by = {c.index: c for c in cmds}
+        return [by[o].feed for o in owners], [by[o].accel for o in owners]
+
     def _chain(self, cmds: list[_Cmd]) -> px.Chain:
-        els: list[PathElement] = []
-        owners: list[int] = []
+        """The commands' elements end to end, corners blended where that pays."""
+        _, els, owners = self._elements(cmds)
+        return px.Chain(els, owners, *self._per(owners, cmds))
+
+    def _elements(self, cmds: list[_Cmd], prev: PathElement | None = None
+                  ) -> tuple[PathElement | None, list[PathElement], list[int]]:
+        """The commands' elements (and owners), each corner blended where that pays; with
+        `prev` (the last element before them) the first corner too: `prev` comes back
+        trimmed by that blend (or unchanged)."""
+        els: list[PathElement] = [prev] if prev is not None else []
+        owners: list[int] = [-1] if prev is not None else []
         for c in cmds:
             el = c.elements[0]
-            b = self._corner_blend(els[-1], el, c) if els else None
+            b = self._blend_pair(els[-1], el, c) if els else None
             if b is not None:
-                els[-1] = b.first
-                els.append(b.arc)
+                els[-1] = b[0]
+                els.append(b[1])
                 owners.append(c.index)
-                el = b.second
+                el = b[2]
             els.append(el)
             owners.append(c.index)
-        return px.Chain(els, owners)
+        if prev is None:
+            return None, els, owners
+        return els[0], els[1:], owners[1:]
 
-    def _corner_blend(self, prev: PathElement, el: PathElement, cmd: _Cmd) -> Blend | None:
-        """The blend of the corner prev -> el (any Line/Arc/Arc3D pair) when blending is on
-        and rounding it pays; None: an exact stop (or a tangent corner)."""
+    def _blend_pair(self, prev: PathElement, el: PathElement,
+                    cmd: _Cmd) -> tuple[PathElement, PathElement, PathElement] | None:
+        """The corner prev -> el (any Line/Arc/Arc3D pair) rounded within the tolerance
+        (trimmed prev, the blend, the trimmed el), or None: blending off, no corner, or an
+        exact stop is faster."""
         if not (self._blend and self._blend_tol > 0.0):
             return None
         b = blend_corner(prev, el, self._blend_tol)
         if b is None or not _blend_pays(b, min(cmd.accel, float(np.min(self._caps()[1]))),
                                         cmd.feed):
             return None
-        return b
+        return b.first, b.arc, b.second
 
+    # ------------------------------------------------------------------ launching
     def _launch_ptp(self, cmd: _Cmd, t: float) -> None:
         assert cmd.target is not None
         profiles = []
@@ -272,63 +361,16 @@ class GroupEngine(LookaheadSettings):
                                 shape=spec.shape)
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
 
-    def _extend_running(self, cmd: _Cmd) -> bool:
-        """Streaming look-ahead: join a path command queued while a chain runs (nothing
-        else waiting, same feed and acceleration) to that chain and re-plan from now. The
-        corner with the running chain is blended when the path has not yet reached the
-        blend's start; when the new plan cannot start at the current speed (the path is
-        already braking), the corner becomes an exact stop; failing that, the command
-        just waits in the queue."""
-        r = self._run
-        if (r is None or r.kind != "path" or self._state is not GroupState.MOVING
-                or self._queue or cmd.kind != "path" or r.chain is None or r.sprof is None
-                or cmd.feed != r.cmds[0].feed or cmd.accel != r.cmds[0].accel
-                or cmd.jerk or r.cmds[0].jerk or cmd.str_vel != r.cmds[0].str_vel):
-            return False
-        t = self._ctl.time
-        u = t - r.t0
-        if u >= r.sprof.duration:
-            return False
-        st = r.sprof.state_at(u)
-        s0, v0 = st.p, max(0.0, st.v)
-        old, owners = list(r.chain.elements), list(r.chain.owners)
-        el = cmd.elements[0]
-        options = []
-        b = self._corner_blend(old[-1], el, cmd)
-        if b is not None and s0 < float(r.chain.cum[-2]) + float(b.first.length):
-            options.append((old[:-1] + [b.first, b.arc, b.second],
-                            owners + [cmd.index, cmd.index]))
-        options.append((old + [el], owners + [cmd.index]))
-        lim = self._limits(cmd)
-        for els, own in options:
-            chain = px.Chain(els, own)
-            try:
-                curve = px.plan_curve(chain, s0, v0, lim)
-            except InfeasibleError:
-                continue
-            self._launch_path(chain, curve, [*r.cmds, cmd], lim, t)
-            return True
-        return False
-
-    def _launch_path(self, chain: px.Chain, curve: px.SpeedCurve, cmds: list[_Cmd],
-                     lim: px.Limits, t: float) -> None:
-        s_end = chain.length
-        sprof = px.s_profile(curve, s_end, chain.cum[1:-1].tolist())
-        raw, tj = None, 0.0
-        if cmds[0].jerk:  # S-curve: smooth s(t) (one element, from rest; see path/smoothing)
-            raw = sprof
-            amax = float(np.max(np.abs(raw.a0))) if raw.n_segments else lim.accel
-            tj = jerk_window(amax, cmds[0].jerk)
-            sprof = fir_smooth(raw, tj)
-        starts = self.position
-        profiles = self._pulse_profiles(px.axis_profiles(chain, sprof, self._ctl.period,
-                                                         starts))
+    def _launch(self, plan: pathrun.PathPlan, cmds: list[_Cmd], t: float) -> None:
+        """Run `plan` from now: per-axis profiles along the chain, started all or none."""
+        profiles = self._pulse_profiles(px.axis_profiles(plan.chain, plan.sprof,
+                                                         self._ctl.period, self.position))
         if not self._dry:
-            self._run_profiles(profiles, lim.str_vel)
-        a_min = min((lim.accel,) + tuple(
-            x for x in _accels(chain, lim)))
-        self._run = _Run("path", cmds, t, chain, curve, sprof, profiles, lim, a_min,
-                         target=np.array(chain.elements[-1].end), raw=raw, tj=tj)
+            self._run_profiles(profiles, plan.limits.str_vel)
+        first = plan.chain.owners[0]
+        cmds = [c for c in cmds if c.index >= first] or cmds[-1:]
+        self._run = _Run("path", cmds, t, plan, profiles,
+                         target=np.array(plan.chain.elements[-1].end))
 
     def _run_profiles(self, profiles: list[Profile], str_vel: float = 0.0) -> None:
         """Start every axis's profile, or none: each is checked (soft limits, states)
@@ -353,66 +395,12 @@ class GroupEngine(LookaheadSettings):
 
     def _replan(self, r: _Run, *, hold: bool) -> None:
         """Re-plan the running chain from now: a hold (to rest) or a new override."""
-        assert r.chain is not None and r.sprof is not None and r.curve is not None
+        assert r.plan is not None
         t = self._ctl.time
-        u = t - r.t0
-        st = r.sprof.state_at(min(max(u, 0.0), r.sprof.duration))
-        s0, v0 = st.p, max(0.0, st.v)
-        if u >= r.sprof.duration:
+        if t >= r.plan.t_end:
             return
-        if r.raw is not None:
-            self._hold_scurve(r, t, u)
-            return
-        if hold:
-            curve = px.hold_curve(r.curve, s0, v0, r.a_min)
-            lim = r.limits
-        else:
-            lim = self._limits(r.cmds[0])
-            curve = px.plan_curve(r.chain, s0, v0, lim, old=r.curve.tail(s0))
-        if v0 == 0.0 and hold:
-            curve = px.SpeedCurve(np.array([s0, s0]), np.array([0.0, 0.0]))
-        s_end = r.chain.length
-        if curve.s[-1] <= s0:
-            s_end = s0
-        elif hold:
-            s_end = px.stop_point(curve)
-        if s_end <= s0:
-            sprof = px.s_profile(px.SpeedCurve(np.array([s0]), np.array([0.0])), s0, [])
-            profiles = [Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
-                                np.zeros(0), 0.0, p_state, p_state) for p_state in
-                        [_rest(x) for x in self._pulses_of(self.position)]]
-        else:
-            sprof = px.s_profile(curve, s_end, r.chain.cum[1:-1].tolist())
-            profiles = self._pulse_profiles(px.axis_profiles(r.chain, sprof, self._ctl.period,
-                                                             self.position))
-        assert lim is not None
-        if not self._dry:
-            self._run_profiles(profiles, lim.str_vel)
-        self._run = _Run("path", r.cmds, t, r.chain, curve, sprof, profiles, lim, r.a_min,
-                         target=r.target)
-
-    def _hold_scurve(self, r: _Run, t: float, u: float) -> None:
-        """Hold an S-curve path: the T-curve under the filter decelerates from its own state
-        now, and the filter (same window) keeps running over old + new, so acceleration stays
-        continuous and the jerk within the limit."""
-        assert r.raw is not None and r.curve is not None and r.chain is not None
-        rs = r.raw.state_at(u)
-        s0, v0 = rs.p, max(0.0, rs.v)
-        tail: Profile
-        if v0 > 0.0 and u < r.raw.duration:
-            curve = px.hold_curve(r.curve, s0, v0, r.a_min)
-            s_end = px.stop_point(curve)
-            tail = px.s_profile(curve, s_end, []) if s_end > s0 else _still(s0)
-        else:
-            curve, tail = r.curve, _still(r.raw.end.p if u >= r.raw.duration else s0)
-        raw = r.raw.splice(u, tail)
-        sprof = fir_smooth(raw, r.tj, t_out=u)
-        profiles = self._pulse_profiles(px.axis_profiles(r.chain, sprof, self._ctl.period,
-                                                         self.position))
-        if not self._dry:
-            self._run_profiles(profiles)
-        self._run = _Run("path", r.cmds, t, r.chain, curve, sprof, profiles, r.limits, r.a_min,
-                         target=r.target, raw=_rebased(raw, u), tj=r.tj)
+        lim = r.plan.limits if hold else self._limits(r.plan.chain, r.plan.limits.str_vel)
+        self._launch(pathrun.replan(r.plan, t, limits=lim, hold=hold), r.cmds, t)
 
     def _on_axis_fault(self, axis: Axis, reason: str) -> None:
         """Controller fault hook: a group axis went to ErrorStop."""
@@ -448,38 +436,6 @@ class GroupEngine(LookaheadSettings):
         for a in self.axes:
             if a.state is not AxisState.ERROR_STOP:
                 a.stop_immediately()
-
-
-def _rest(p: float) -> State:
-    return State(float(p), 0.0, 0.0)
-
-
-def _still(p: float) -> Profile:
-    return Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), 0.0,
-                   _rest(p), _rest(p), (), np.zeros(0))
-
-
-def _rebased(p: Profile, u: float) -> Profile:
-    """A constant-acceleration profile with time u as its new zero (the past dropped)."""
-    dts = p.dt if p.dt is not None else np.diff(np.append(p.t0, p.duration))
-    keep = p.t0 + dts > u
-    st = p.state_at(u)
-    t0 = np.maximum(p.t0[keep] - u, 0.0)
-    dt = dts[keep].copy()
-    p0, v0 = p.p0[keep].copy(), p.v0[keep].copy()
-    if len(t0):
-        dt[0] = float(p.t0[keep][0]) + float(dt[0]) - u if p.t0[keep][0] < u else dt[0]
-        if p.t0[keep][0] < u:
-            p0[0], v0[0] = st.p, st.v
-    labels = tuple(lb for lb, k in zip(p.labels, keep, strict=False) if k)
-    return Profile(t0, p0, v0, p.a0[keep].copy(), p.j[keep].copy(), max(0.0, p.duration - u),
-                   State(st.p, st.v, st.a), p.end, labels, dt)
-
-
-def _accels(chain: px.Chain, lim: px.Limits) -> list[float]:
-    sp = plan_speeds(chain.elements, lim.feed, lim.accel, axis_vmax=lim.axis_vmax,
-                     axis_amax=lim.axis_amax)
-    return [x.accel for x in sp if x.length > 0.0]
 
 
 def _blend_pays(b: Any, accel: float, feed: float) -> bool:

@@ -31,12 +31,14 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..errors import InfeasibleError
-from ..path import ElementSpeeds, plan_speeds
+from ..path import ElementSpeeds, Line, plan_speeds
 from ..path.geometry import PathElement
+from ..path.lookahead import speed_caps
 from ..profile.segments import Profile, ProfileBuilder, State
 
 
@@ -49,6 +51,7 @@ class SpeedCurve:
 
     s: np.ndarray
     v2: np.ndarray
+    a_min: float = math.inf  # smallest tangential acceleration of the elements planned
     jump: bool = False
 
     def at(self, s: float) -> float:
@@ -134,18 +137,26 @@ def stop_point(curve: SpeedCurve) -> float:
 
 
 # -------------------------------------------------------------------------- s(t)
-def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float]) -> Profile:
+def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
+              dwell: float = 0.0, lead: float = 0.0) -> Profile:
     """Constant-acceleration Profile of s following `curve` from its start to `s_end`
-    (where the curve is 0, or the speed a StrVel end jumps to rest from). `breaks` (element
-    boundaries) become segment boundaries. A `jump` curve gives a profile at rest before
-    t = 0 whose first segment starts at the curve's speed (`MoveSpec.plan`'s StrVel jump)."""
-    knots = np.union1d(curve.s, [b for b in breaks if curve.s[0] < b < s_end])
+    (where the curve must be 0). `breaks` (element boundaries) become segment boundaries.
+    The curve ends at 0 or at the speed a StrVel end jumps to rest from. A `jump` curve
+    gives a profile at rest before t = 0 whose first segment starts at the curve's speed
+    (`MoveSpec.plan`'s StrVel jump). `dwell` > 0 rests that long wherever the curve stops
+    before its end (an exact-stop corner), `lead` > 0 rests that long before moving: a
+    moving-average smoothing of s(t) then passes such a corner at rest (path/smoothing.py)."""
+    brk = np.asarray(breaks, dtype=float)
+    knots = np.union1d(curve.s, brk[(brk > curve.s[0]) & (brk < s_end)])
     knots = knots[(knots >= curve.s[0]) & (knots <= s_end)]
     v2 = np.maximum(np.interp(knots, curve.s, curve.v2), 0.0)
     v = np.sqrt(v2)
     ds = np.diff(knots)
     dv2 = np.diff(v2)
     b = ProfileBuilder(float(knots[0]), float(v[0]), v_before=0.0 if curve.jump else None)
+    if lead > 0.0:
+        b.segment(lead, 0.0, accel=0.0, label="dwell")
+    last = len(ds) - 1
     for k in range(len(ds)):
         if ds[k] <= 0.0:
             continue
@@ -158,17 +169,26 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float]) -> Profi
         dt = 2.0 * ds[k] / vm  # exact for constant acceleration, also when a = 0
         b.set_velocity(float(v[k]))
         b.segment(dt, 0.0, accel=float(a))
+        if dwell > 0.0 and v[k + 1] == 0.0 and k < last:
+            b.set_velocity(0.0)
+            b.segment(dwell, 0.0, accel=0.0, label="dwell")
     return b.build(end_p=float(s_end))
 
 
 # -------------------------------------------------------------------------- chains
 class Chain:
-    """Elements laid end to end along a global path position s."""
+    """Elements laid end to end along a global path position s, with the feed and the path
+    acceleration each element was commanded with (None: the Limits' values)."""
 
-    def __init__(self, elements: Sequence[PathElement], owners: Sequence[int]) -> None:
+    def __init__(self, elements: Sequence[PathElement], owners: Sequence[int],
+                 feeds: Sequence[float] | None = None, accels: Sequence[float] | None = None,
+                 *, cum: np.ndarray | None = None) -> None:
         self.elements = tuple(elements)
         self.owners = tuple(owners)  # command index of each element
-        self.cum = np.concatenate([[0.0], np.cumsum([el.length for el in self.elements])])
+        self.feeds = None if feeds is None else np.asarray(feeds, dtype=float)
+        self.accels = None if accels is None else np.asarray(accels, dtype=float)
+        self.cum = cum if cum is not None else np.concatenate(
+            [[0.0], np.cumsum([el.length for el in self.elements])])
 
     @property
     def length(self) -> float:
@@ -185,8 +205,33 @@ class Chain:
             return np.array(self.elements[-1].end)
         return el.point(min(max(s - self.cum[k], 0.0), el.length))
 
-    def tail_elements(self, s0: float) -> tuple[list[PathElement], float]:
-        """Elements from s0 on (the first trimmed) and the global s of their start."""
+    def joined(self, elements: Sequence[PathElement], owners: Sequence[int],
+               feeds: Sequence[float] | None, accels: Sequence[float] | None,
+               replace_last: PathElement | None = None) -> Chain:
+        """This chain (its last element replaced by `replace_last`, e.g. trimmed by a
+        blend) followed by more elements; the s of the kept elements is unchanged."""
+        head = self.elements[:-1] + (replace_last,) if replace_last is not None \
+            else self.elements
+        cum = self.cum[:-1] if replace_last is not None else self.cum
+        start = float(cum[-1])
+        lens = [el.length for el in ([replace_last] if replace_last is not None else [])
+                + list(elements)]
+        tail = start + np.cumsum(lens)
+        return Chain(head + tuple(elements), self.owners + tuple(owners),
+                     _cat(self.feeds, feeds), _cat(self.accels, accels),
+                     cum=np.concatenate([cum, tail]))
+
+    def dropped(self, k: int) -> tuple[Chain, float]:
+        """The chain without its first k elements, s rebased to start at 0, and the offset
+        subtracted (the same subtraction applied to a profile keeps both consistent)."""
+        off = float(self.cum[k])
+        return Chain(self.elements[k:], self.owners[k:],
+                     None if self.feeds is None else self.feeds[k:],
+                     None if self.accels is None else self.accels[k:],
+                     cum=self.cum[k:] - off), off
+
+    def tail_elements(self, s0: float) -> tuple[list[PathElement], int]:
+        """Elements from s0 on (the first trimmed) and the index of the first."""
         k = self.locate(s0)
         el = self.elements[k]
         local = s0 - float(self.cum[k])
@@ -196,7 +241,15 @@ class Chain:
         if local <= slack:
             local = 0.0
         first: PathElement = el if local <= 0.0 else Trimmed(el, local)
-        return [first, *self.elements[k + 1:]], s0
+        return [first, *self.elements[k + 1:]], k
+
+
+def _cat(a: np.ndarray | None, b: Sequence[float] | None) -> np.ndarray | None:
+    if a is None and b is None:
+        return None
+    if a is None or b is None:
+        raise ValueError("feeds/accels must be given for every element or for none")
+    return np.concatenate([a, np.asarray(b, dtype=float)])
 
 
 class Trimmed:
@@ -233,9 +286,13 @@ class Trimmed:
 class Limits:
     """Path limits: feed (vector speed), tangential accel, per-axis speed/accel caps, the
     corner speed of sharp junctions (square corner velocity, 0: exact stop) with the
-    per-axis velocity step it may cause (`axis_vjump`, None: unbounded), the minimum
-    cruise ratio of the look-ahead (path.plan_speeds), and the StrVel (vector speed a path
-    ends at before it jumps to rest; 0: ends at rest)."""
+    per-axis velocity step it may cause (`axis_vjump`, None: unbounded), and the minimum
+    cruise ratio of the look-ahead (path.plan_speeds).
+
+    With a chain that carries its own feeds/accels, `feed` is the cap on every element's
+    feed (the system maximum) and each element's feed is multiplied by `scale` (the
+    override) first; `accel` is then unused. `str_vel`: the speed a path ends at before it
+    jumps to rest (0: ends at rest)."""
 
     feed: float
     accel: float
@@ -244,11 +301,21 @@ class Limits:
     square_corner_velocity: float = 0.0
     axis_vjump: np.ndarray | None = None
     min_cruise_ratio: float = 0.0
+    scale: float = 1.0
     str_vel: float = 0.0
 
 
+def _chain_limits(chain: Chain, k0: int, lim: Limits) -> tuple[Any, Any]:
+    """Feeds and accelerations of the elements from index k0 on (scalars when uniform)."""
+    if chain.feeds is None or chain.accels is None:
+        return lim.feed, lim.accel
+    return (np.minimum(chain.feeds[k0:] * lim.scale, lim.feed).tolist(),
+            chain.accels[k0:].tolist())
+
+
 def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
-               old: SpeedCurve | None = None, *, jump: bool = False) -> SpeedCurve:
+               old: SpeedCurve | None = None, *, guard: float = 0.0,
+               jump: bool = False) -> SpeedCurve:
     """Speed curve for the rest of `chain` from s0 at speed v0, ending at rest or, with a
     StrVel (`lim.str_vel`), at a speed <= StrVel from which it jumps to rest.
 
@@ -257,42 +324,105 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     When v0 is above what the new limits allow (a lower override), the path decelerates at
     the smallest tangential acceleration of the remaining elements until it meets the new
     plan, and never exceeds the `old` curve it was following (see the module doc).
+    `guard` > 0 (an S-curve's smoothing distance, see `guarded`) extends every speed cap
+    that far along the path on both sides. The curve's `a_min` is the smallest tangential
+    acceleration of the remaining elements (what a hold may use everywhere).
     """
-    els, _ = chain.tail_elements(s0)
+    els, k0 = chain.tail_elements(s0)
+    feeds, accels = _chain_limits(chain, k0, lim)
+    if guard > 0.0:
+        els, feeds, accels = guarded(els, feeds, accels, lim, guard)
     kw = dict(square_corner_velocity=lim.square_corner_velocity, end_speed=lim.str_vel,
               axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax, axis_vjump=lim.axis_vjump,
               min_cruise_ratio=lim.min_cruise_ratio)
     try:
-        return _pinned(curve_from_speeds(
-            plan_speeds(els, lim.feed, lim.accel, start_speed=v0, **kw), s0), chain.length,
-            jump=jump and v0 > 0.0)
+        sp = plan_speeds(els, feeds, accels, start_speed=v0, **kw)
+        return _with_amin(_pinned(curve_from_speeds(sp, s0), chain.length,
+                                  jump=jump and v0 > 0.0), sp)
     except InfeasibleError:
         if old is None and not jump:
             raise
-    lo = _highest_start(els, v0, lim, kw)
-    sp = plan_speeds(els, lim.feed, lim.accel, start_speed=lo, **kw)
+    lo = _highest_start(els, feeds, accels, v0, kw)
+    sp = plan_speeds(els, feeds, accels, start_speed=lo, **kw)
     if jump:
-        return _pinned(curve_from_speeds(sp, s0), chain.length, jump=lo > 0.0)
+        return _with_amin(_pinned(curve_from_speeds(sp, s0), chain.length, jump=lo > 0.0), sp)
     assert old is not None
     a_min = min(x.accel for x in sp if x.length > 0.0)
     new = curve_from_speeds(sp, s0)
     # the new plan starts at lo < v0: join it with a ramp from v0 (max), under the old curve
     down = ramp(s0, v0, a_min, chain.length)
     joined = curve_max(down, new)
-    return _pinned(curve_min(joined, old.tail(s0)), chain.length)
+    return _with_amin(_pinned(curve_min(joined, old.tail(s0)), chain.length), sp)
 
 
-def _highest_start(els: Sequence[PathElement], v0: float, lim: Limits, kw: dict) -> float:
+def _highest_start(els: Sequence[PathElement], feeds: Any, accels: Any, v0: float,
+                   kw: dict) -> float:
     """The highest start speed <= v0 the look-ahead accepts on `els` (bisection)."""
     lo, hi = 0.0, v0
     for _ in range(50):
         mid = 0.5 * (lo + hi)
         try:
-            plan_speeds(els, lim.feed, lim.accel, start_speed=mid, **kw)
+            plan_speeds(els, feeds, accels, start_speed=mid, **kw)
             lo = mid
         except InfeasibleError:
             hi = mid
     return lo
+
+
+def _with_amin(curve: SpeedCurve, sp: Sequence[ElementSpeeds]) -> SpeedCurve:
+    acc = [x.accel for x in sp if x.length > 0.0]
+    return SpeedCurve(curve.s, curve.v2, min(acc) if acc else math.inf, curve.jump)
+
+
+def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits,
+            w: float) -> tuple[list[PathElement], list[float], list[float]]:
+    """Elements whose speed caps hold `w` beyond each element's ends (and each corner's
+    junction speed `w` around it), for a path speed that is later smoothed by a moving
+    average: the smoothed position lies within v*tj <= w of every raw position in its
+    window, so the smoothed speed (an average of raw speeds) keeps every cap the raw speed
+    keeps over that reach. Lines longer than 2w are split so that only their first and last
+    w are slowed for a neighbour; shorter lines and curved elements take the smallest cap
+    within w of either end on their whole length (safe, a little slower)."""
+    n = len(els)
+    fl = [float(x) for x in feeds] if isinstance(feeds, list) else [float(feeds)] * n
+    al = [float(x) for x in accels] if isinstance(accels, list) else [float(accels)] * n
+    caps, jcaps = speed_caps(els, fl, al, square_corner_velocity=lim.square_corner_velocity,
+                             axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax,
+                             axis_vjump=lim.axis_vjump)
+    cum = np.concatenate([[0.0], np.cumsum([el.length for el in els])])
+    cap = np.asarray(caps)
+    jc = np.asarray(jcaps)  # jc[k]: at the start of element k (jc[0] = inf)
+
+    def low(x0: float, x1: float) -> float:
+        """Smallest element cap over (x0, x1) and junction cap over [x0, x1]."""
+        i0 = max(int(np.searchsorted(cum, x0, side="right")) - 1, 0)
+        i1 = min(int(np.searchsorted(cum, x1, side="left")), n)
+        c = float(np.min(cap[i0:max(i1, i0 + 1)]))
+        j0 = int(np.searchsorted(cum, x0, side="left"))
+        j1 = int(np.searchsorted(cum, x1, side="right"))
+        if j1 > j0:
+            c = min(c, float(np.min(jc[j0:min(j1, n)], initial=math.inf)))
+        return c
+
+    out: list[PathElement] = []
+    of: list[float] = []
+    oa: list[float] = []
+    for k, el in enumerate(els):
+        a, b = float(cum[k]), float(cum[k + 1])
+        if isinstance(el, Line) and el.length > 2.0 * w:
+            head = Line(el.start, el.point(w))
+            mid = Line(head.end, el.point(el.length - w))
+            tail = Line(mid.end, el.end)
+            for piece, c in ((head, low(a - w, a + 2.0 * w)), (mid, fl[k]),
+                             (tail, low(b - 2.0 * w, b + w))):
+                out.append(piece)
+                of.append(min(fl[k], c))
+                oa.append(al[k])
+        else:
+            out.append(el)
+            of.append(min(fl[k], low(a - w, b + w)))
+            oa.append(al[k])
+    return out, of, oa
 
 
 def _pinned(curve: SpeedCurve, length: float, *, jump: bool = False) -> SpeedCurve:
@@ -301,7 +431,7 @@ def _pinned(curve: SpeedCurve, length: float, *, jump: bool = False) -> SpeedCur
     s[-1] = length
     keep = np.concatenate([np.diff(s) > 0.0, [True]])
     keep[0] = True
-    return SpeedCurve(s[keep], curve.v2[keep], jump)
+    return SpeedCurve(s[keep], curve.v2[keep], curve.a_min, jump)
 
 
 def hold_curve(old: SpeedCurve, s0: float, v0: float, accel: float) -> SpeedCurve:
@@ -428,11 +558,11 @@ def contour_error(points: np.ndarray, elements: Sequence[PathElement],
                   step: float = 50.0) -> np.ndarray:
     """Distance of every recorded point (rows of `points`) to the nearest element.
 
-    Lines and planar circular arcs are measured exactly (closed form). Other elements: the
-    nearest of points every `step` of arc length, a local search (33 points over one step)
-    and three Gauss-Newton rounds find the foot point, and the distance is taken to the
-    tangent line there (the foot's residual enters as kappa*ds**2/2). Checks recorded runs
-    against the programmed path (issue 4, accuracy; control.accuracy for pulse counts).
+    Lines are measured exactly (projection). Other elements: the nearest of points every
+    `step` of arc length, then three rounds of a local search (33 points over a window
+    shrinking 16-fold per round) finds the foot point to about step/10**4 of arc length,
+    and the distance is taken to the tangent line there (error kappa*ds**2/2). Checks
+    recorded runs against the programmed path (issue 4, accuracy).
     """
     pts = np.asarray(points, dtype=float)
     best = np.full(len(pts), np.inf)
@@ -444,34 +574,9 @@ def contour_error(points: np.ndarray, elements: Sequence[PathElement],
             u = np.zeros(len(pts)) if den == 0.0 else np.clip(((pts - a) @ ab) / den, 0.0, 1.0)
             d = np.linalg.norm(pts - (a + u[:, None] * ab), axis=1)
         else:
-            d = _circle_distance(pts, el)
-            if d is None:
-                d = _curve_distance(pts, el, step)
+            d = _curve_distance(pts, el, step)
         best = np.minimum(best, d)
     return best
-
-
-def _circle_distance(pts: np.ndarray, el: PathElement) -> np.ndarray | None:
-    """Exact distance to a planar circular arc (no helix), else None: the foot point is the
-    radial projection when its angle lies on the arc, otherwise the nearer end."""
-    try:
-        c, r, sweep = np.asarray(el.circle_centre), float(el.radius), float(el.sweep)
-        e1, e2 = (np.asarray(e) for e in el.basis)
-    except AttributeError:
-        return None
-    last = c + r * (math.cos(sweep) * e1 + math.sin(sweep) * e2)
-    if np.linalg.norm(np.asarray(el.end) - last) > 1e-9 * max(1.0, r):
-        return None  # a helix, or an end corrected onto the circle: the general search
-    d = pts - c
-    u, w = d @ e1, d @ e2
-    off = d - u[:, None] * e1 - w[:, None] * e2  # out of the plane (explicit: no cancellation)
-    on = np.sqrt((np.hypot(u, w) - r) ** 2 + (off * off).sum(axis=1))
-    phi = np.mod(np.arctan2(w, u), 2.0 * math.pi)
-    if sweep >= 2.0 * math.pi - 1e-12:
-        return on
-    ends = np.minimum(np.linalg.norm(pts - np.asarray(el.start), axis=1),
-                      np.linalg.norm(pts - np.asarray(el.end), axis=1))
-    return np.where(phi <= sweep, on, ends)
 
 
 def _curve_distance(pts: np.ndarray, el: PathElement, step: float) -> np.ndarray:
@@ -483,14 +588,11 @@ def _curve_distance(pts: np.ndarray, el: PathElement, step: float) -> np.ndarray
         s_best[lo:lo + 512] = s_ref[np.argmin((diff * diff).sum(axis=2), axis=1)]
     w = float(s_ref[1] - s_ref[0])
     offs = np.linspace(-1.0, 1.0, 33)
-    cand = np.clip(s_best[:, None] + w * offs[None], 0.0, el.length)
-    diff = el.point(cand) - pts[:, None, :]
-    s_best = cand[np.arange(len(pts)), np.argmin((diff * diff).sum(axis=2), axis=1)]
-    # Gauss-Newton on (x - P(s)).T(s) = 0 from within step/16: it contracts by about
-    # kappa*distance per round, so points near the curve (the ones that matter) converge
     for _ in range(3):
-        r = pts - el.point(s_best)
-        s_best = np.clip(s_best + (r * el.tangent(s_best)).sum(axis=1), 0.0, el.length)
+        cand = np.clip(s_best[:, None] + w * offs[None], 0.0, el.length)
+        diff = el.point(cand) - pts[:, None, :]
+        s_best = cand[np.arange(len(pts)), np.argmin((diff * diff).sum(axis=2), axis=1)]
+        w /= 16.0
     # distance to the tangent line at the foot point: the arc-length residual of the search
     # then enters only to second order (kappa*ds**2/2)
     r = pts - el.point(s_best)

@@ -200,7 +200,22 @@ def _cruise_caps(jcap2: list[float], cap2: list[float], acc: list[float],
     new_j[n] = min(new_j[n], new_cap[n - 1])
     return new_cap, new_j
 
-def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
+
+def _per_element(name: str, value: float | Sequence[float], n: int) -> list[float]:
+    """One positive value per element from a scalar or a sequence of n values."""
+    if isinstance(value, (int, float, np.floating)) and not isinstance(value, bool):
+        return [check_positive(name, value)] * n
+    try:
+        vals = [float(x) for x in value]  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise MotionError(f"{name} must be a number > 0 or {n} of them, got {value!r}") from None
+    if len(vals) != n:
+        raise MotionError(f"{name} must be a number > 0 or {n} of them, got {len(vals)} values")
+    return [check_positive(f"{name}[{k}]", x) for k, x in enumerate(vals)]
+
+
+def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
+                accel: float | Sequence[float], *,
                 square_corner_velocity: float = 0.0, start_speed: float = 0.0,
                 end_speed: float = 0.0, axis_vmax: ArrayLike | None = None,
                 axis_amax: ArrayLike | None = None,
@@ -208,7 +223,8 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
                 min_cruise_ratio: float = 0.0) -> tuple[ElementSpeeds, ...]:
     """Entry/cruise/exit speeds for each element (see the module docstring).
 
-    `feed` is the path speed cap, `accel` the path acceleration limit. Corners where the
+    `feed` is the path speed cap, `accel` the path acceleration limit: one value for the
+    whole path or one per element (a program that changes F keeps blending). Corners where the
     tangent turns are crossed at most at the junction-deviation speed of
     `square_corner_velocity` (0: exact stop). The path starts at exactly `start_speed` and
     ends at a speed <= `end_speed`. `axis_vmax`/`axis_amax` (N values, inf = unlimited)
@@ -231,8 +247,8 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
         if el.dim != dim:
             raise MotionError(f"elements[{k}] must have {dim} axes like elements[0], "
                               f"got {el.dim}")
-    f = check_positive("feed", feed)
-    a = check_positive("accel", accel)
+    feeds = _per_element("feed", feed, len(elements))
+    accels = _per_element("accel", accel, len(elements))
     scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
     v_start = check_nonnegative("start_speed", start_speed)
     v_end = check_nonnegative("end_speed", end_speed)
@@ -252,9 +268,11 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
         if v_start > 0.0:
             raise InfeasibleError(f"start_speed {v_start:g} cannot be stopped on a path of "
                                   "length 0")
-        return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0) for _ in elements)
+        return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0) for f, a in zip(feeds, accels,
+                                                                                strict=True))
     els = [elements[k] for k in live]
-    lim = [_element_limits(el, f, a, vmax_ax, amax_ax, ratio) for el in els]
+    lim = [_element_limits(el, feeds[k], accels[k], vmax_ax, amax_ax, ratio)
+           for el, k in zip(els, live, strict=True)]
     acc = [x[0] for x in lim]
     cap = [x[1] for x in lim]
     length = [el.length for el in els]
@@ -264,8 +282,9 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
     jcap2[0] = cap[0] ** 2
     jcap2[n] = min(v_end, cap[n - 1]) ** 2
     for k in range(1, n):
-        vj = min(cap[k - 1], cap[k], _junction_cap(els[k - 1], els[k], a, scv, amax_ax,
-                                                         vjump_ax))
+        a_j = min(accels[live[k - 1]], accels[live[k]])
+        vj = min(cap[k - 1], cap[k], _junction_cap(els[k - 1], els[k], a_j, scv, amax_ax,
+                                                   vjump_ax))
         jcap2[k] = vj * vj
 
     ccap = cap  # cruise caps (lowered by the minimum cruise ratio)
@@ -294,7 +313,7 @@ def plan_speeds(elements: Sequence[PathElement], feed: float, accel: float, *,
             nxt += 1
         else:  # zero length: sits on the junction before live element nxt
             v = planned[nxt].entry if nxt < n else planned[-1].exit
-            out.append(ElementSpeeds(v, v, v, a, f, 0.0))
+            out.append(ElementSpeeds(v, v, v, accels[k], feeds[k], 0.0))
     return tuple(out)
 
 
@@ -312,3 +331,31 @@ def acceleration_reversals(plan: Sequence[ElementSpeeds], rel: float = 1e-9) -> 
             if sp.cruise - other > tol and (not signs or signs[-1] != sign):
                 signs.append(sign)
     return max(0, len(signs) - 1)
+
+def speed_caps(elements: Sequence[PathElement], feed: float | Sequence[float],
+               accel: float | Sequence[float], *, square_corner_velocity: float = 0.0,
+               axis_vmax: ArrayLike | None = None, axis_amax: ArrayLike | None = None,
+               axis_vjump: ArrayLike | None = None,
+               arc_tangential_ratio: float = 0.5) -> tuple[list[float], list[float]]:
+    """The speed caps `plan_speeds` uses: one per element (feed, axis speeds, centripetal
+    limit) and one per junction (`[k]` at the start of element k; `[0]` is inf): the
+    junction-deviation corner speed, 0 where the path must stop."""
+    n = len(elements)
+    dim = elements[0].dim if n else 0
+    feeds = _per_element("feed", feed, n)
+    accels = _per_element("accel", accel, n)
+    scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
+    vmax_ax = _axis_limits("axis_vmax", axis_vmax, dim)
+    amax_ax = _axis_limits("axis_amax", axis_amax, dim)
+    vjump_ax = _axis_limits("axis_vjump", axis_vjump, dim)
+    caps = [_element_limits(el, f, a, vmax_ax, amax_ax, arc_tangential_ratio)[1]
+            if el.length > 0.0 else f for el, f, a in zip(elements, feeds, accels, strict=True)]
+    jcaps = [math.inf]
+    for k in range(1, n):
+        prev, nxt = elements[k - 1], elements[k]
+        if prev.length == 0.0 or nxt.length == 0.0:
+            jcaps.append(math.inf)
+            continue
+        jcaps.append(_junction_cap(prev, nxt, min(accels[k - 1], accels[k]), scv, amax_ax,
+                                   vjump_ax))
+    return caps, jcaps

@@ -1,0 +1,175 @@
+"""A running path chain and its re-plans: start, join (streaming), override, hold.
+
+One mechanism for T and S paths. The look-ahead gives a speed curve v**2(s) (pathexec);
+that curve becomes the *raw* motion s(t), piecewise constant acceleration. A T path
+executes the raw motion itself; an S path executes the raw motion smoothed by a moving
+average of window tj (path/smoothing.py), which bounds the path jerk by |delta a|/tj. For
+the smoothed motion to keep the raw motion's speed caps, the caps are held a distance
+`guard` = tj * (highest speed) beyond every element and corner (pathexec.guarded), and the
+raw motion rests tj at every exact-stop corner so the smoothed one passes it at rest.
+
+Every change while running is the same operation: take the raw state now, plan a new raw
+tail from it over the (possibly longer) chain, splice it onto the raw motion, and smooth
+from now on. The smoothed motion up to now depends only on the raw motion up to now, so it
+continues without a jump in position, speed or acceleration. Elements the path has left
+behind are dropped at each re-plan (their s is subtracted from everything), so a chain
+that streams commands for hours stays as short as its look-ahead.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..path.smoothing import fir_smooth
+from ..profile.segments import Profile, ProfileBuilder
+from . import pathexec as px
+
+
+@dataclass(frozen=True)
+class PathPlan:
+    """What a running chain follows. Times are controller times; s is chain position."""
+
+    chain: px.Chain
+    curve: px.SpeedCurve   # the look-ahead plan the raw motion follows
+    raw: Profile           # raw s(t), its time 0 at `raw_t0`
+    raw_t0: float
+    sprof: Profile         # executed s(t), its time 0 at `t0` (raw itself when tj == 0)
+    t0: float
+    tj: float              # smoothing window (0: T path)
+    limits: px.Limits
+    a_min: float           # tangential acceleration every remaining element allows
+
+    @property
+    def t_end(self) -> float:
+        return self.t0 + self.sprof.duration
+
+    def s_at(self, t: float) -> float:
+        return self.sprof.state_at(min(max(t - self.t0, 0.0), self.sprof.duration)).p
+
+    def remaining(self, t: float) -> float:
+        """Path length the raw motion still has before the chain's end."""
+        u = t - self.raw_t0
+        return self.chain.length - self.raw.state_at(min(max(u, 0.0), self.raw.duration)).p
+
+    @property
+    def stopped_short(self) -> bool:
+        return self.sprof.end.p < self.chain.length
+
+
+def guard_of(chain: px.Chain, lim: px.Limits, tj: float) -> float:
+    """The guard distance of an S path: tj times the highest feed of the chain."""
+    if tj <= 0.0:
+        return 0.0
+    f = lim.feed if chain.feeds is None else min(lim.feed, float(np.max(chain.feeds)) * lim.scale)
+    return tj * f
+
+
+def start(chain: px.Chain, lim: px.Limits, tj: float, t: float, s0: float = 0.0) -> PathPlan:
+    """A chain from rest at path position s0 (0: its start; a held chain continues),
+    with the StrVel jump of its limits."""
+    sv = lim.str_vel  # a StrVel path starts with a jump to it (T paths only)
+    curve = px.plan_curve(chain, s0, sv, lim, guard=guard_of(chain, lim, tj), jump=sv > 0.0)
+    raw = px.s_profile(curve, chain.length, chain.cum[1:-1], dwell=tj)
+    sprof = fir_smooth(raw, tj) if tj > 0.0 else raw
+    return drop_travelled(PathPlan(chain, curve, raw, t, sprof, t, tj, lim, _amin(curve, lim)))
+
+
+def replan(plan: PathPlan, t: float, *, chain: px.Chain | None = None,
+           limits: px.Limits | None = None, hold: bool = False) -> PathPlan:
+    """Re-plan `plan` from time t: over `chain` (the same chain extended; default the
+    chain itself) with `limits` (default the plan's), or decelerating to rest (`hold`).
+    Raises InfeasibleError when the new chain cannot be followed from the present speed
+    (a join that comes too late); the caller then keeps the old plan."""
+    chain = chain or plan.chain
+    lim = limits or plan.limits
+    tj = plan.tj
+    u = t - plan.raw_t0
+    raw = _rest_until(plan.raw, u)
+    rs = raw.state_at(u)
+    s0, v0 = rs.p, max(0.0, rs.v)
+    guard = guard_of(chain, lim, tj)
+    lead = 0.0
+    if hold:
+        curve = px.hold_curve(plan.curve, s0, v0, plan.a_min)
+        s_end = px.stop_point(curve) if v0 > 0.0 else s0
+    else:
+        old = plan.curve.tail(s0) if chain is plan.chain else None
+        curve = px.plan_curve(chain, s0, v0, lim, old, guard=guard)
+        s_end = chain.length
+        if v0 == 0.0 and tj > 0.0 and chain is not plan.chain:
+            lead = tj  # joined at rest (the raw motion had ended): stop out the corner
+    if s_end > s0:
+        tail = px.s_profile(curve, s_end, chain.cum[1:-1], dwell=tj, lead=lead)
+    else:
+        tail = _still(s0, 0.0)
+    spliced = raw.splice(u, tail)
+    if tj > 0.0:
+        sprof = fir_smooth(spliced, tj, t_out=u)
+        cut = max(0.0, u - tj)  # keep a window of raw history for the next re-plan
+        new_raw, raw_t0 = (spliced, plan.raw_t0) if cut <= 0.0 else \
+            (_rebased(spliced, cut), plan.raw_t0 + cut)
+    else:
+        sprof, new_raw, raw_t0 = tail, tail, t
+    new = PathPlan(chain, curve, new_raw, raw_t0, sprof, t, tj, lim,
+                   plan.a_min if hold else _amin(curve, lim))
+    return drop_travelled(new)
+
+
+def drop_travelled(plan: PathPlan) -> PathPlan:
+    """Drop the elements the raw motion (and so the executed one) has fully left."""
+    s_keep = min(plan.raw.start.p, plan.sprof.start.p)
+    k = plan.chain.locate(s_keep)
+    if k < 1:
+        return plan
+    chain, off = plan.chain.dropped(k)
+    curve = replace(plan.curve, s=plan.curve.s - off)
+    return replace(plan, chain=chain, curve=curve, raw=plan.raw.shifted(-off),
+                   sprof=_pinned_shift(plan.sprof, off, plan.chain.length, chain.length))
+
+
+def _pinned_shift(p: Profile, off: float, old_len: float, new_len: float) -> Profile:
+    """p shifted by -off, its end exactly at the new chain length when it ended at the
+    old one (so the last knot lands on the chain's end point bit for bit)."""
+    out = p.shifted(-off)
+    if p.end.p >= old_len:
+        out = replace(out, end=out.end._replace(p=new_len))
+    return out
+
+
+def _amin(curve: px.SpeedCurve, lim: px.Limits) -> float:
+    return curve.a_min if math.isfinite(curve.a_min) else lim.accel
+
+
+def _still(p: float, d: float) -> Profile:
+    b = ProfileBuilder(p)
+    if d > 0.0:
+        b.segment(d, 0.0, accel=0.0, label="rest")
+    return b.build(end_p=p)
+
+
+def _rest_until(raw: Profile, u: float) -> Profile:
+    """The raw motion, resting at its end until at least time u."""
+    if u <= raw.duration:
+        return raw
+    return raw.splice(raw.duration, _still(raw.end.p, u - raw.duration))
+
+
+def _rebased(p: Profile, u: float) -> Profile:
+    """A constant-acceleration profile with time u as its new zero (the past dropped)."""
+    dts = p.dt if p.dt is not None else np.diff(np.append(p.t0, p.duration))
+    keep = p.t0 + dts > u
+    st = p.state_at(u)
+    t0 = np.maximum(p.t0[keep] - u, 0.0)
+    dt = dts[keep].copy()
+    p0, v0 = p.p0[keep].copy(), p.v0[keep].copy()
+    if len(t0):
+        first = float(p.t0[keep][0])
+        if first < u:
+            dt[0] = first + float(dt[0]) - u
+            p0[0], v0[0] = st.p, st.v
+    labels = tuple(lb for lb, k in zip(p.labels, keep, strict=False) if k)
+    return Profile(t0, p0, v0, p.a0[keep].copy(), p.j[keep].copy(), max(0.0, p.duration - u),
+                   st, p.end, labels, dt)
