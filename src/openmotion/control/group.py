@@ -296,10 +296,11 @@ class Group(GroupEngine):
         self._blend = False
 
     def set_path_shape(self, shape: str, jerk: float | None = None) -> None:
-        """Speed profile of the following path commands: "T" (constant acceleration,
-        blended chains) or "S" (jerk-limited: the jerk of the path position stays within
-        `jerk`, pps^3 or user units/s^3). S-curve path commands run one at a time with exact
-        stops between them (no blending); a feed override applies from the next command."""
+        """Speed profile of the following path commands: "T" (constant path acceleration)
+        or "S" (jerk-limited: the jerk of the path position stays within `jerk`, pps^3 or
+        user units/s^3). S paths blend, stream, hold and take overrides like T paths: the
+        T plan is smoothed by a moving average of window 2*accel/jerk, its speed caps held
+        that much further along the path, exact-stop corners passed at rest."""
         if shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
         if shape == "T":

@@ -1,14 +1,18 @@
 """The run-time side of a `Group`: executing its queue from a controller cycle hook.
 
 Point-to-point commands start every axis with its own T/S profile and the next command
-waits for all of them. Consecutive path commands with the same feed and acceleration are
-planned as one chain by the look-ahead (`path.plan_speeds`) and executed by pathexec.py:
-with blending on, corners between lines and arcs are rounded (`path.blend_corner`) within
-the tolerance and the chain runs through them; with blending off every corner is an exact
-stop. Hold, continue, abort and the feed override re-plan the running chain from the
-current path state. A group axis going to ErrorStop (the controller's fault hooks, when
-present, and a check every cycle) or reaching the limit switch ahead of it stops every axis
-of the group at once and puts the group in error (MCCL 2.6.3 VI: all motion commands stop).
+waits for all of them. Consecutive path commands of the same shape (T, or S with a fitting
+smoothing window) and StrVel run as one chain: each element keeps its own feed and
+acceleration, and with blending on the corners between lines and arcs are rounded
+(`path.blend_corner`) within the tolerance; other corners stop exactly (or are taken at the
+corner velocity). The look-ahead is lazy (Klipper's flush): a chain holds the queued
+commands up to twice the distance it needs to brake from its feed, and joins the next ones
+when it runs short, so a program of any length streams through a bounded plan. Joining,
+hold, continue and the feed override are all one re-plan of the running chain from the
+present state (pathrun.py). A group axis going to ErrorStop (the controller's fault hooks,
+when present, and a check every cycle) or reaching the limit switch ahead of it stops every
+axis of the group at once and puts the group in error (MCCL 2.6.3 VI: all motion commands
+stop).
 """
 
 from __future__ import annotations
