@@ -7,8 +7,10 @@ build its profile.
 
 from .arcs import ARC_TOL, Arc, Arc3D
 from .blend import BLEND_DIST_FRACTION, Blend, blend_corner, centripetal_speed, corner_speed
+from .contour import contour_error
+from .extent import element_extent
 from .geometry import Direction, Line, PathElement
-from .lookahead import ElementSpeeds, acceleration_reversals, plan_speeds
+from .lookahead import ElementSpeeds, acceleration_reversals, plan_speeds, speed_caps
 
 __all__ = [
     "ARC_TOL",
@@ -23,6 +25,9 @@ __all__ = [
     "acceleration_reversals",
     "blend_corner",
     "centripetal_speed",
+    "contour_error",
     "corner_speed",
+    "element_extent",
     "plan_speeds",
+    "speed_caps",
 ]
