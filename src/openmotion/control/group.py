@@ -5,13 +5,14 @@ group at a time. Commands (point-to-point, line, arc, circle, helix, 3-D arc, de
 validated and queued; each accepted command gets the next command index (>= 0). A refused
 command raises `GroupError` (a MotionError) carrying a negative `code` that vendor facades
 return as their own negative value; the queue and the running motion are then unchanged.
-The run-time side (queue execution, hold/continue/override re-planning, faults) is in
-groupexec.py; the path math in pathexec.py. Positions, speeds and accelerations are command
-pulses, pps and pps^2 of the controller axes, or with `units=True` the axes' user units
-(mm, mm/s, mm/s^2: the MCCL mechanism parameters, openmotion.units.AxisUnits): the path is
-then planned in user space, so an arc is a true arc and the feed the true tool speed even
-when the axes have different pulses per unit; each axis's pulses are AxisUnits.to_pulses
-of its coordinate. set_max_pulse_speed/acc stay in pulses (as their MCCL names say).
+The checks a command passes before it is queued are in group_checks.py; the run-time side
+(queue execution, hold/continue/override re-planning, faults) is in groupexec.py; the path
+math in pathexec.py. Positions, speeds and accelerations are command pulses, pps and pps^2
+of the controller axes, or with `units=True` the axes' user units (mm, mm/s, mm/s^2: the
+MCCL mechanism parameters, openmotion.units.AxisUnits): the path is then planned in user
+space, so an arc is a true arc and the feed the true tool speed even when the axes have
+different pulses per unit; each axis's pulses are AxisUnits.to_pulses of its coordinate.
+set_max_pulse_speed/acc stay in pulses (as their MCCL names say).
 """
 
 from __future__ import annotations
@@ -27,11 +28,10 @@ import numpy as np
 
 from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
 from ..path import Arc, Arc3D, Line
-from ..path.extent import element_extent
-from ..path.geometry import PathElement
 from ..profile.pcl import MoveSpec
 from ..units import AxisUnits
 from . import pathrun
+from .group_checks import GroupChecks, unit_scales
 from .groupexec import (
     ERR_ACCEL,
     ERR_ARC,
@@ -45,7 +45,6 @@ from .groupexec import (
     ERR_SPEED,
     ERR_STATE,
     OWNERS,
-    GroupEngine,
     GroupError,
     GroupState,
     _Cmd,
@@ -78,7 +77,7 @@ def _locked(fn: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
-class Group(GroupEngine):
+class Group(GroupChecks):
     """Coordinated axes of `controller` with a command queue.
 
     axes: logical name -> controller axis (name or index), or a sequence of controller axes
@@ -106,7 +105,7 @@ class Group(GroupEngine):
             raise MotionError("axes must be different controller axes")
         if isinstance(queue_size, bool) or not isinstance(queue_size, int) or queue_size < 1:
             raise MotionError(f"queue_size must be an integer >= 1, got {queue_size!r}")
-        k_units = _unit_scales(controller, ax, units)
+        k_units = unit_scales(controller, ax, units)
         owners = OWNERS.setdefault(controller, {})
         for a in ax:
             if a.index in owners:
@@ -274,15 +273,6 @@ class Group(GroupEngine):
     def set_max_pulse_acc(self, pps2: Sequence[float]) -> None:
         """MCC_SetMaxPulseAcc per logical axis (pps^2, inf = unlimited, the default)."""
         self._amax = self._axis_values("pps2", pps2)
-
-    def _axis_values(self, name: str, values: Sequence[float]) -> np.ndarray:
-        try:
-            arr = np.array(values, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise MotionError(f"{name} must be {len(self.axes)} numbers") from None
-        if arr.size != len(self.axes) or np.any(np.isnan(arr)) or np.any(arr <= 0.0):
-            raise MotionError(f"{name} must be {len(self.axes)} numbers > 0, got {values!r}")
-        return arr
 
     def enable_blend(self, tolerance: float) -> None:
         """Blend consecutive path commands: corners between lines and arcs are rounded so
@@ -509,149 +499,3 @@ class Group(GroupEngine):
                     with contextlib.suppress(InfeasibleError):
                         a.change_speed(min(a._max_speed, spec.max_vel * self._ptp_override),
                                        spec.tacc)
-
-    # ------------------------------------------------------------------ queue helpers
-    def _check_accepting(self) -> None:
-        if self._state is GroupState.ERROR:
-            raise GroupError(ERR_GROUP, f"group in error {self._error} ({self._error_msg}); "
-                                        "clear_error() first")
-        if len(self._queue) >= self._queue_size:
-            raise GroupError(ERR_QUEUE_FULL, f"queue full ({self._queue_size} commands)")
-        for a in self.axes:
-            if a.state is AxisState.ERROR_STOP:
-                raise GroupError(ERR_AXIS_STATE, f"axis {a.name} is in ErrorStop ({a.fault})")
-            if a.state is AxisState.DISABLED and not self._dry:
-                raise GroupError(ERR_AXIS_STATE, f"axis {a.name} is disabled; enable() first")
-            if self._run is None and not self._dry and a.is_moving:
-                raise GroupError(ERR_AXIS_BUSY, f"axis {a.name} is moving outside the group")
-
-    def _start_point(self) -> np.ndarray:
-        self._check_accepting()
-        if self._tail is None or (self._run is None and not self._queue
-                                  and self._held is None):
-            self._tail = self.position
-        return self._tail.copy()
-
-    def _point(self, name: str, value: Sequence[float], base: np.ndarray | None) -> np.ndarray:
-        try:
-            arr = np.array(value, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} numbers") from None
-        if arr.size != len(self.axes) or not np.all(np.isfinite(arr)):
-            raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} finite numbers, "
-                                           f"got {value!r}")
-        return arr + base if base is not None else arr
-
-    def _point2(self, name: str, value: Sequence[float], base: np.ndarray | None,
-                plane: tuple[int, int]) -> np.ndarray:
-        try:
-            arr = np.array(value, dtype=float).reshape(-1)
-            i, j = (int(k) for k in plane)
-            if not (0 <= i < len(self.axes) and 0 <= j < len(self.axes)):
-                raise IndexError
-        except (TypeError, ValueError, IndexError):
-            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 numbers and plane two axis "
-                                           f"indices, got {value!r}, {plane!r}") from None
-        if arr.size != 2 or not np.all(np.isfinite(arr)):
-            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 finite numbers, got {value!r}")
-        return arr + base[[i, j]] if base is not None else arr
-
-    def _check_soft_limits(self, el: PathElement) -> None:
-        """Refuse (ERR_LIMIT) a path element that would take an axis past an enabled soft
-        limit (further than where it starts), before it is queued."""
-        from .safety import Safety
-
-        safety = Safety.of(self._ctl)
-        if safety is None or self._dry:
-            return
-        lo, hi = element_extent(el)
-        a_, b_ = lo * self._k, hi * self._k
-        plo, phi = np.minimum(a_, b_), np.maximum(a_, b_)
-        start = np.asarray(el.start, dtype=float) * self._k
-        for i, ax in enumerate(self.axes):
-            lim = safety.soft.get(ax.index)
-            if not lim.enabled:
-                continue
-            if phi[i] > max(lim.plimit, start[i]) + 1e-9 * max(1.0, abs(lim.plimit)):
-                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the + "
-                                            f"soft limit {lim.plimit!r} (reaches {phi[i]:.6g})")
-            if plo[i] < min(lim.nlimit, start[i]) - 1e-9 * max(1.0, abs(lim.nlimit)):
-                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the - "
-                                            f"soft limit {lim.nlimit!r} (reaches {plo[i]:.6g})")
-
-    def _push_path(self, el: PathElement, end: np.ndarray) -> int:
-        self._check_soft_limits(el)
-        feed, sv = self._feed, self._str_vel
-        tan = el.max_abs_tangent
-        vmax, amax = self._caps()
-        self._check_str_vel(sv, feed, tan)
-        if not self._refuse:  # the planner slows the path down to the axis limits
-            return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
-                                   accel=feed / self._acc_time, jerk=self._path_jerk,
-                                   str_vel=sv), end)
-        need = feed * tan * self._ppu
-        bad = np.nonzero(need > vmax * self._ppu * (1 + 1e-12))[0]
-        if len(bad):
-            k = int(bad[0])
-            raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps at "
-                                        f"feed {feed:g}, above its maximum pulse speed "
-                                        f"{self._vmax[k]:g} pps")
-        accel = feed / self._acc_time
-        needa = accel * tan * self._ppu
-        bad = np.nonzero(needa > amax * self._ppu * (1 + 1e-12))[0]
-        if len(bad):
-            k = int(bad[0])
-            raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} pps^2, "
-                                        f"above its maximum pulse acceleration "
-                                        f"{self._amax[k]:g} pps^2")
-        return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
-                               jerk=self._path_jerk, str_vel=sv), end)
-
-    def _check_str_vel(self, sv: float, feed: float, tan: np.ndarray) -> None:
-        """StrVel of a path command: <= its feed, within every axis's maximum speed along
-        the move (a jump cannot be slowed down), T-curve only."""
-        if sv == 0.0:
-            return
-        if sv > feed * (1 + 1e-12):
-            raise GroupError(ERR_SPEED, f"StrVel {sv:g} must be <= the feed {feed:g}")
-        caps = np.minimum(self._vmax, [a._max_speed for a in self.axes])
-        need = sv * tan * self._ppu
-        bad = np.nonzero(need > caps * (1 + 1e-12))[0]
-        if len(bad):
-            k = int(bad[0])
-            raise GroupError(ERR_SPEED, f"axis {self.names[k]} would jump to {need[k]:g} pps "
-                                        f"at StrVel {sv:g}, above its maximum speed "
-                                        f"{caps[k]:g} pps")
-        if self._path_jerk:
-            raise GroupError(ERR_ARGUMENT, "StrVel > 0 needs the T path shape: S-curve paths "
-                                           "start and end at rest (set_str_vel(0) or "
-                                           "set_path_shape('T'))")
-
-    def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
-        self._check_accepting()
-        cmd.index = self._next_index
-        self._queue.append(cmd)
-        self._next_index += 1
-        if self._run is not None and self._run.plan is not None:
-            self._join_queued(self._ctl.time)  # joins now if the running chain needs it
-        if end is not None:
-            self._tail = end.copy()
-        return cmd.index
-
-
-def _unit_scales(controller: Controller, axes: Sequence[Axis],
-                 units: bool | Sequence[AxisUnits]) -> np.ndarray:
-    """Signed pulses per logical unit of each axis (all 1.0 when units is False)."""
-    if units is False:
-        return np.ones(len(axes))
-    if units is True:
-        try:
-            au = [AxisUnits.from_axis(controller.config.axes[a.index]) for a in axes]
-        except (AttributeError, IndexError):
-            raise MotionError("units=True needs the controller's machine config") from None
-    elif isinstance(units, Sequence) and not isinstance(units, (str, bytes)) \
-            and len(units) == len(axes) and all(isinstance(u, AxisUnits) for u in units):
-        au = list(units)
-    else:
-        raise MotionError(f"units must be a bool or {len(axes)} AxisUnits, got {units!r}")
-    return np.array([u.sign * u.pulses_per_unit for u in au], dtype=float)

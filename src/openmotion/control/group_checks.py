@@ -1,0 +1,208 @@
+"""Accepting a group command: everything checked before it is queued, and the push.
+
+A `Group` command is validated completely before anything changes: the group and its axes
+can accept it, its points have the right shape, the path stays inside the enabled soft
+limits, its StrVel and the axes' maximum pulse speed/acceleration allow its feed (policy
+"refuse"). Only then is it pushed (next command index) and the tail moved; a refusal is a
+`GroupError` with its negative code, leaving the queue, the tail and the running motion as
+they were. `unit_scales` resolves the group's `units=` argument.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import MotionError
+from ..path.extent import element_extent
+from ..path.geometry import PathElement
+from ..units import AxisUnits
+from .groupexec import (
+    ERR_ACCEL,
+    ERR_ARGUMENT,
+    ERR_AXIS_BUSY,
+    ERR_AXIS_STATE,
+    ERR_GROUP,
+    ERR_LIMIT,
+    ERR_QUEUE_FULL,
+    ERR_SPEED,
+    GroupEngine,
+    GroupError,
+    GroupState,
+    _Cmd,
+)
+from .states import AxisState
+
+if TYPE_CHECKING:
+    from .axis import Axis
+    from .controller import Controller
+
+
+class GroupChecks(GroupEngine):
+    """Base of `Group`: command validation and the queue push (on top of the engine)."""
+
+    _queue: deque[_Cmd]
+    _queue_size: int
+    _next_index: int
+    _feed: float
+    _acc_time: float
+    _str_vel: float
+    _path_jerk: float
+    _refuse: bool
+
+    def _axis_values(self, name: str, values: Sequence[float]) -> np.ndarray:
+        try:
+            arr = np.array(values, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise MotionError(f"{name} must be {len(self.axes)} numbers") from None
+        if arr.size != len(self.axes) or np.any(np.isnan(arr)) or np.any(arr <= 0.0):
+            raise MotionError(f"{name} must be {len(self.axes)} numbers > 0, got {values!r}")
+        return arr
+
+    def _check_accepting(self) -> None:
+        if self._state is GroupState.ERROR:
+            raise GroupError(ERR_GROUP, f"group in error {self._error} ({self._error_msg}); "
+                                        "clear_error() first")
+        if len(self._queue) >= self._queue_size:
+            raise GroupError(ERR_QUEUE_FULL, f"queue full ({self._queue_size} commands)")
+        for a in self.axes:
+            if a.state is AxisState.ERROR_STOP:
+                raise GroupError(ERR_AXIS_STATE, f"axis {a.name} is in ErrorStop ({a.fault})")
+            if a.state is AxisState.DISABLED and not self._dry:
+                raise GroupError(ERR_AXIS_STATE, f"axis {a.name} is disabled; enable() first")
+            if self._run is None and not self._dry and a.is_moving:
+                raise GroupError(ERR_AXIS_BUSY, f"axis {a.name} is moving outside the group")
+
+    def _start_point(self) -> np.ndarray:
+        self._check_accepting()
+        if self._tail is None or (self._run is None and not self._queue
+                                  and self._held is None):
+            self._tail = self.position
+        return self._tail.copy()
+
+    def _point(self, name: str, value: Sequence[float], base: np.ndarray | None) -> np.ndarray:
+        try:
+            arr = np.array(value, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} numbers") from None
+        if arr.size != len(self.axes) or not np.all(np.isfinite(arr)):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} finite numbers, "
+                                           f"got {value!r}")
+        return arr + base if base is not None else arr
+
+    def _point2(self, name: str, value: Sequence[float], base: np.ndarray | None,
+                plane: tuple[int, int]) -> np.ndarray:
+        try:
+            arr = np.array(value, dtype=float).reshape(-1)
+            i, j = (int(k) for k in plane)
+            if not (0 <= i < len(self.axes) and 0 <= j < len(self.axes)):
+                raise IndexError
+        except (TypeError, ValueError, IndexError):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 numbers and plane two axis "
+                                           f"indices, got {value!r}, {plane!r}") from None
+        if arr.size != 2 or not np.all(np.isfinite(arr)):
+            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 finite numbers, got {value!r}")
+        return arr + base[[i, j]] if base is not None else arr
+
+    def _check_soft_limits(self, el: PathElement) -> None:
+        """Refuse (ERR_LIMIT) a path element that would take an axis past an enabled soft
+        limit (further than where it starts), before it is queued."""
+        from .safety import Safety
+
+        safety = Safety.of(self._ctl)
+        if safety is None or self._dry:
+            return
+        lo, hi = element_extent(el)
+        a_, b_ = lo * self._k, hi * self._k
+        plo, phi = np.minimum(a_, b_), np.maximum(a_, b_)
+        start = np.asarray(el.start, dtype=float) * self._k
+        for i, ax in enumerate(self.axes):
+            lim = safety.soft.get(ax.index)
+            if not lim.enabled:
+                continue
+            if phi[i] > max(lim.plimit, start[i]) + 1e-9 * max(1.0, abs(lim.plimit)):
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the + "
+                                            f"soft limit {lim.plimit!r} (reaches {phi[i]:.6g})")
+            if plo[i] < min(lim.nlimit, start[i]) - 1e-9 * max(1.0, abs(lim.nlimit)):
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the - "
+                                            f"soft limit {lim.nlimit!r} (reaches {plo[i]:.6g})")
+
+    def _push_path(self, el: PathElement, end: np.ndarray) -> int:
+        self._check_soft_limits(el)
+        feed, sv = self._feed, self._str_vel
+        tan = el.max_abs_tangent
+        vmax, amax = self._caps()
+        self._check_str_vel(sv, feed, tan)
+        if not self._refuse:  # the planner slows the path down to the axis limits
+            return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
+                                   accel=feed / self._acc_time, jerk=self._path_jerk,
+                                   str_vel=sv), end)
+        need = feed * tan * self._ppu
+        bad = np.nonzero(need > vmax * self._ppu * (1 + 1e-12))[0]
+        if len(bad):
+            k = int(bad[0])
+            raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps at "
+                                        f"feed {feed:g}, above its maximum pulse speed "
+                                        f"{self._vmax[k]:g} pps")
+        accel = feed / self._acc_time
+        needa = accel * tan * self._ppu
+        bad = np.nonzero(needa > amax * self._ppu * (1 + 1e-12))[0]
+        if len(bad):
+            k = int(bad[0])
+            raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} pps^2, "
+                                        f"above its maximum pulse acceleration "
+                                        f"{self._amax[k]:g} pps^2")
+        return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
+                               jerk=self._path_jerk, str_vel=sv), end)
+
+    def _check_str_vel(self, sv: float, feed: float, tan: np.ndarray) -> None:
+        """StrVel of a path command: <= its feed, within every axis's maximum speed along
+        the move (a jump cannot be slowed down), T-curve only."""
+        if sv == 0.0:
+            return
+        if sv > feed * (1 + 1e-12):
+            raise GroupError(ERR_SPEED, f"StrVel {sv:g} must be <= the feed {feed:g}")
+        caps = np.minimum(self._vmax, [a._max_speed for a in self.axes])
+        need = sv * tan * self._ppu
+        bad = np.nonzero(need > caps * (1 + 1e-12))[0]
+        if len(bad):
+            k = int(bad[0])
+            raise GroupError(ERR_SPEED, f"axis {self.names[k]} would jump to {need[k]:g} pps "
+                                        f"at StrVel {sv:g}, above its maximum speed "
+                                        f"{caps[k]:g} pps")
+        if self._path_jerk:
+            raise GroupError(ERR_ARGUMENT, "StrVel > 0 needs the T path shape: S-curve paths "
+                                           "start and end at rest (set_str_vel(0) or "
+                                           "set_path_shape('T'))")
+
+    def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
+        self._check_accepting()
+        cmd.index = self._next_index
+        self._queue.append(cmd)
+        self._next_index += 1
+        if self._run is not None and self._run.plan is not None:
+            self._join_queued(self._ctl.time)  # joins now if the running chain needs it
+        if end is not None:
+            self._tail = end.copy()
+        return cmd.index
+
+
+def unit_scales(controller: Controller, axes: Sequence[Axis],
+                units: bool | Sequence[AxisUnits]) -> np.ndarray:
+    """Signed pulses per logical unit of each axis (all 1.0 when units is False)."""
+    if units is False:
+        return np.ones(len(axes))
+    if units is True:
+        try:
+            au = [AxisUnits.from_axis(controller.config.axes[a.index]) for a in axes]
+        except (AttributeError, IndexError):
+            raise MotionError("units=True needs the controller's machine config") from None
+    elif isinstance(units, Sequence) and not isinstance(units, (str, bytes)) \
+            and len(units) == len(axes) and all(isinstance(u, AxisUnits) for u in units):
+        au = list(units)
+    else:
+        raise MotionError(f"units must be a bool or {len(axes)} AxisUnits, got {units!r}")
+    return np.array([u.sign * u.pulses_per_unit for u in au], dtype=float)
