@@ -301,3 +301,27 @@ def test_lock_is_the_cycle_lock_and_reentrant(ctl):
         ctl.lock.release()
     ctl.advance(0.1)
     assert ctl.axes[0].position == 100
+
+
+def test_axis_accessors_raw_position_powered_max_speed_check_speed():
+    c = Controller()
+    x = c["x"]
+    assert not x.powered
+    c.enable_all()
+    assert x.powered
+    assert x.max_speed == min(c.config.axes[0].max_speed_pps, 6.55e6)
+    x.counters.set_command(1000)  # moves the counter frame, not the raw pulse frame
+    assert x.raw_position == 0.0 and x.position == 1000.0
+    x.move_relative(250, max_vel=5000, tacc=0.01)
+    c.wait_motion_done()
+    assert x.raw_position == 250.0 and x.position == 1250.0
+    assert x.check_speed("v", -x.max_speed) == -x.max_speed
+    ppu = x.units.pulses_per_unit
+    assert x.check_speed("v", 2.0, units=True) == pytest.approx(2.0 * ppu)
+    before = x.snapshot()
+    for bad in (x.max_speed * 1.01, float("nan"), float("inf")):
+        with pytest.raises(MotionError, match="v "):
+            x.check_speed("v", bad)
+    assert x.snapshot() == before
+    x.disable()
+    assert not x.powered

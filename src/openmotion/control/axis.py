@@ -6,7 +6,8 @@ so setting a counter never moves anything. Public arguments are in pulses, pps a
 pass `units=True` to give positions and speeds in the axis's user unit (AxisUnits).
 
 Every command validates and plans completely before it changes anything: a refused command
-(MotionError) leaves the state, counters and running motion exactly as they were.
+(MotionError) leaves the state, counters and running motion exactly as they were. Running
+the installed motion from the controller's cycle is axisexec.py (`AxisEngine`, the base).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
 from ..units import MAX_PULSE_RATE, AxisUnits
 from . import planning
+from .axisexec import AxisEngine
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters
 from .motion import ActiveMotion
 from .states import AxisState, MotionDone, transition
@@ -45,7 +47,7 @@ def _locked(fn: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
-class Axis:
+class Axis(AxisEngine):
     """An axis of a `Controller`. Get it with `controller.axis(name_or_index)`."""
 
     def __init__(self, index: int, config: AxisConfig, controller: Controller) -> None:
@@ -119,6 +121,22 @@ class Axis:
     def motion(self) -> ActiveMotion | None:
         """The motion being executed (profile anchored at `t_start`), if any."""
         return self._motion
+
+    @property
+    def raw_position(self) -> float:
+        """Commanded position in the raw pulse frame (the hardware's unwrapped pulses_out
+        frame, without the command counter's offset), at controller time."""
+        return self._pos
+
+    @property
+    def powered(self) -> bool:
+        """Whether the axis is powered (enabled; SVON on for a servo drive)."""
+        return self._powered
+
+    @property
+    def max_speed(self) -> float:
+        """Maximum safe speed (pps): the config's max_speed_pps, capped at the pulse rate."""
+        return self._max_speed
 
     @property
     def speed_range(self) -> float | None:
@@ -203,7 +221,7 @@ class Axis:
     @_locked
     def fix_speed_range(self, max_vel: float, *, units: bool = False) -> None:
         """Fix the speed range: the maximum speed `change_speed` may reach (HSL 4.11)."""
-        v = self._speed_in("max_vel", max_vel, units)
+        v = self.check_speed("max_vel", max_vel, units)
         if v <= 0.0:
             raise MotionError(f"max_vel must be > 0, got {max_vel!r}")
         self._speed_range = v
@@ -226,7 +244,10 @@ class Axis:
         self._inp_enabled = enabled
 
     # ------------------------------------------------------------------ argument helpers
-    def _speed_in(self, name: str, value: float, units: bool) -> float:
+    def check_speed(self, name: str, value: float, units: bool = False) -> float:
+        """`value` as a speed in pps (from user units/s with `units=True`), refused
+        (MotionError naming `name`) unless finite and within the axis's maximum safe speed
+        `max_speed`; the sign is kept. Changes nothing (homing checks its speeds with it)."""
         v = check_finite(name, value)
         v = float(self.units.scale_to_pulses(v)) if units else v
         if abs(v) > self._max_speed * (1.0 + 1e-9):
@@ -236,10 +257,10 @@ class Axis:
 
     def _spec(self, shape: str, str_vel: float, max_vel: float, tacc: float,
               tdec: float | None, vs_acc: float, vs_dec: float, units: bool) -> MoveSpec:
-        sv = self._speed_in("str_vel", str_vel, units)
-        mv = self._speed_in("max_vel", max_vel, units)
-        va = self._speed_in("vs_acc", vs_acc, units)
-        vd = self._speed_in("vs_dec", vs_dec, units)
+        sv = self.check_speed("str_vel", str_vel, units)
+        mv = self.check_speed("max_vel", max_vel, units)
+        va = self.check_speed("vs_acc", vs_acc, units)
+        vd = self.check_speed("vs_dec", vs_dec, units)
         td = tacc if tdec is None else tdec
         return MoveSpec(shape, sv, mv, tacc, td, va, vd)
 
@@ -274,11 +295,11 @@ class Axis:
         v = check_finite("velocity", velocity)
         if units:  # signed: a reversed axis runs the other way in pulses
             v = float(self.units.velocity_to_pps(v))
-        v = self._speed_in("velocity", v, False)
+        v = self.check_speed("velocity", v, False)
         if v == 0.0:
             raise MotionError("velocity must be non-zero (its sign gives the direction)")
-        sv = self._speed_in("str_vel", str_vel, units)
-        va = self._speed_in("vs_acc", vs_acc, units)
+        sv = self.check_speed("str_vel", str_vel, units)
+        va = self.check_speed("vs_acc", vs_acc, units)
         spec = MoveSpec(shape, sv, abs(v), tacc, tacc, va, va)
         self._check_can_start()
         profile = planning.velocity_move(spec, 1.0 if v > 0 else -1.0, self._pos)
@@ -330,7 +351,7 @@ class Axis:
         a position measured like `move_absolute`. Limits in pps, pps^2, pps^3 (or user units
         with units=True). On-the-fly changes are not offered for this kind; stops are."""
         d = check_finite("distance", distance)
-        vm = self._speed_in("v_max", v_max, units)
+        vm = self.check_speed("v_max", v_max, units)
         am = check_positive("a_max", a_max)
         jm = check_positive("j_max", j_max)
         dm = None if d_max is None else check_positive("d_max", d_max)
@@ -439,7 +460,7 @@ class Axis:
         is fixed, the move's own MaxVel. Refused (InfeasibleError, motion unchanged) when a
         positioning move has too few pulses left to reach the speed and still stop.
         """
-        v = abs(self._speed_in("new_vel", new_vel, units))
+        v = abs(self.check_speed("new_vel", new_vel, units))
         ta = check_positive("tacc", tacc)
         m = self._check_running("change_speed")
         if m.spec is None:
@@ -508,101 +529,6 @@ class Axis:
         profile = planning.position_move(spec, self._pos, float(target))
         self._start(ActiveMotion(profile, self._ctl.time, kind, spec, float(target),
                                  abs_target), S.DISCRETE_MOTION)
-
-    def _start(self, motion: ActiveMotion, state: AxisState) -> None:
-        self._ctl._vet_motion(self, motion)
-        self._state = transition(self._state, state, self.name)
-        self._motion = motion
-        self._ctl._motion_changed(self, motion)
-
-    def _replace(self, old: ActiveMotion, profile: Any, spec: MoveSpec | None,
-                 target: float | None, *, kind: str | None = None,
-                 abs_target: float | None = None) -> None:
-        m = ActiveMotion(profile, old.t_start, kind or old.kind, spec, target,
-                         abs_target if abs_target is not None else old.abs_target,
-                         old.limits, old.v_range)
-        if m.kind != "stop":
-            self._ctl._vet_motion(self, m)
-        self._motion = m
-        self._ctl._motion_changed(self, m)
-
-    def _kill_motion(self) -> None:
-        """End any motion at the current commanded position, at rest."""
-        m = self._motion
-        self._waiting_inp = False
-        self._gated = False
-        if m is None:
-            return
-        self._motion = None
-        self._vel = 0.0
-        self._ctl._motion_changed(self, None)
-        self._cut_at_hardware_stop(m)
-
-    def _cut_at_hardware_stop(self, m: ActiveMotion) -> None:
-        """The hardware cut this axis's pulses itself at an edge in the last cycle
-        (EdgeStopHardware): a motion killed now ends there too - command position and
-        history - not at the cycle end, whoever kills it (fault, group, stop)."""
-        stop_time = getattr(self._ctl.hardware, "stop_time", None)
-        if stop_time is None:
-            return
-        ts = stop_time(self.index)
-        if ts is None or ts < m.t_start or ts > self._ctl.time:
-            return
-        p = m.state(ts)[0]
-        # the hardware holds the count it emitted (control.pulserule: within half a pulse of
-        # p, one with the floor rule); the axis rests there, on a whole pulse
-        count = self._ctl.hardware.read_axis(self.index).pulses_out - self.counters.out_offset
-        self._pos = float(count) if abs(count - p) <= 1.0 else p
-        self._ctl.history.truncate(self.index, ts, self._pos)
-
-    # -- cycle hooks (called by the controller, lock held) --------------------------------
-    def _command(self, t0: float, t1: float) -> AxisCommand | None:
-        m = self._motion
-        if m is None:
-            if not self.command_transforms:
-                return None  # the pulse generator holds its last end position
-            cmd = AxisCommand(t0, t1 - t0, self._pos)
-        else:
-            p0, v0, a0, j, p1, v1 = m.piece(t0, t1)
-            self._pos = p1
-            self._vel = v1 if t1 < m.t_end or m.kind == "velocity" else 0.0
-            cmd = AxisCommand(t0, t1 - t0, p0, v0, a0, j)
-        for tr in self.command_transforms:
-            cmd = tr(self, cmd)
-        return cmd
-
-    def _gate_code(self) -> int:
-        for g in self.done_gates:
-            code = g(self)
-            if code:
-                return code
-        return MotionDone.STOPPED
-
-    def _cycle_end(self, t1: float) -> None:
-        m = self._motion
-        if m is not None and m.finished(t1):
-            self._motion = None
-            self._vel = 0.0
-            self._pos = m.profile.end.p
-            if self._state is S.ERROR_STOP:
-                pass  # a fault's decelerating stop ended: the axis stays in ErrorStop
-            else:
-                self._waiting_inp = m.kind != "stop" and self._inp_enabled
-                self._gated = bool(self.done_gates)  # also after a stop: corrections settle
-                if not (self._waiting_inp or self._gated):
-                    self._settle()
-        if self._waiting_inp and self._ctl.input_active(self.index, "inp"):
-            self._waiting_inp = False
-            if not self._gated:
-                self._settle()
-        if self._gated and not self._waiting_inp and self._gate_code() == 0:
-            self._gated = False
-            self._settle()
-
-    def _settle(self) -> None:
-        """A move is done: Standstill, except in Homing (the homing sequence goes on)."""
-        if self._state is not S.HOMING:
-            self._state = transition(self._state, S.STANDSTILL, self.name)
 
     def snapshot(self) -> tuple:
         """Everything a refused command must leave unchanged (used by tests)."""

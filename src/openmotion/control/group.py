@@ -133,11 +133,11 @@ class Group(GroupChecks):
         self._blend = False
         self._feed = 0.0
         self._acc_time = 20.0 * controller.period
-        self._sys_max = float(max(a._max_speed / k for a, k in zip(ax, self._ppu, strict=True)))
+        self._sys_max = float(max(a.max_speed / k for a, k in zip(ax, self._ppu, strict=True)))
         self.set_feed(feed)
         if acc_time is not None:
             self.set_acc_time(acc_time)
-        self._vmax = np.array([a._max_speed for a in ax], dtype=float)
+        self._vmax = np.array([a.max_speed for a in ax], dtype=float)
         self._amax = np.full(len(ax), math.inf)
         self._refuse = True
         self._ptp_ratio = 10.0
@@ -343,7 +343,7 @@ class Group(GroupChecks):
             raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
         specs = []
         for k, a in enumerate(self.axes):
-            v = min(a._max_speed, self._vmax[k]) * self._ptp_ratio / 100.0
+            v = min(a.max_speed, self._vmax[k]) * self._ptp_ratio / 100.0
             specs.append(MoveSpec(self._ptp_shape, 0.0, v, self._acc_time, self._acc_time,
                                   0.0, 0.0))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
@@ -494,8 +494,8 @@ class Group(GroupChecks):
         if r is not None and r.kind == "ptp" and not self._dry:
             for a, spec in zip(self.axes, r.cmds[0].specs, strict=True):
                 if a.motion is not None and a.state is AxisState.DISCRETE_MOTION:
-                    a.fix_speed_range(min(a._max_speed, spec.max_vel * 2.0))
+                    a.fix_speed_range(min(a.max_speed, spec.max_vel * 2.0))
                     # too close to the target: the move finishes at its speed
                     with contextlib.suppress(InfeasibleError):
-                        a.change_speed(min(a._max_speed, spec.max_vel * self._ptp_override),
+                        a.change_speed(min(a.max_speed, spec.max_vel * self._ptp_override),
                                        spec.tacc)

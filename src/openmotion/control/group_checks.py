@@ -165,7 +165,7 @@ class GroupChecks(GroupEngine):
             return
         if sv > feed * (1 + 1e-12):
             raise GroupError(ERR_SPEED, f"StrVel {sv:g} must be <= the feed {feed:g}")
-        caps = np.minimum(self._vmax, [a._max_speed for a in self.axes])
+        caps = np.minimum(self._vmax, [a.max_speed for a in self.axes])
         need = sv * tan * self._ppu
         bad = np.nonzero(need > caps * (1 + 1e-12))[0]
         if len(bad):

@@ -117,7 +117,7 @@ class Homing:
         c = self.config
         ax = self.axis
         for name in ("str_vel", "max_vel"):
-            ax._speed_in(name, getattr(c, name), False)
+            ax.check_speed(name, getattr(c, name))
         if c.max_overrun is not None:
             worst = self.overrun(c.max_vel)
             if worst > c.max_overrun:

@@ -127,7 +127,7 @@ class ServoLoop:
     def _command_counts(self, t: float) -> float:
         ax = self.axis
         m = ax.motion
-        p = ax._pos if m is None else m.state(t)[0]  # raw pulse frame, like the encoder
+        p = ax.raw_position if m is None else m.state(t)[0]  # raw pulse frame, like the encoder
         return p * self.ratio
 
     def _open(self, t: float) -> None:
@@ -140,7 +140,7 @@ class ServoLoop:
         ax = self.axis
         if self.tripped and ax.state is not AxisState.ERROR_STOP:
             self.tripped = False  # the fault was reset: close again on the current position
-        if not ax._powered or self.tripped:  # SVON off, or after a following-error trip
+        if not ax.powered or self.tripped:  # SVON off, or after a following-error trip
             self._open(t)
             return
         fb = float(self._hw.read_axis(ax.index).encoder)
