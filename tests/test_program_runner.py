@@ -304,23 +304,100 @@ def test_cam_example_streams_without_resting():
     assert len(cruise) > 0.9 * len(v) and float(cruise.min()) > 1.0
 
 
-def test_small_window_stays_linear_and_ends_exactly():
-    """A window far smaller than the program: each window is one chain (the runner does not
-    push command by command into a running chain); the end point is exact."""
+def _raster(rows: int, *, synced: dict[tuple[int, int], str] | None = None) -> str:
+    """A raster of `rows` rows 10 mm long, 0.5 mm apart, each cut in 200 collinear
+    segments of 0.05 mm (F3000 = 50 mm/s, G64 P0.01); `synced`: (row, segment) -> a line
+    put before that segment (M62/M63)."""
+    out = ["G21 G90 G64 P0.01 F3000"]
+    for r in range(rows):
+        if r:
+            out.append(f"G1 Y{r * 0.5:g}")
+        for k in range(1, 201):
+            if synced and (r, k) in synced:
+                out.append(synced[(r, k)])
+            out.append(f"G1 X{(k if r % 2 == 0 else 200 - k) * 0.05:.2f}")
+    return "\n".join(out) + "\nM2\n"
+
+
+def _raster_point(row: int, k: int) -> np.ndarray:
+    """Where segment k of a row ends (k = 0: where the row starts)."""
+    return np.array([(k if row % 2 == 0 else 200 - k) * 0.05, row * 0.5])
+
+
+def test_a_program_longer_than_the_window_streams_without_resting():
+    """2,000 short segments through a window of 32: the runner keeps the group's queue
+    topped up while the chain runs, so the path never rests between its start and its
+    end (the old runner waited for the chain to end at every window: it rested about 60
+    times on such a program), the feed is kept, M62/M63 fire at their corners and the end
+    is exact."""
     ctl = iso_ctl()
-    text = "G21 G90 G64 P0.01 F3000\n" + "\n".join(
-        f"G1 X{10 * math.cos(k / 50):.4f} Y{10 * math.sin(k / 50):.4f}" for k in range(300)) \
-        + "\nM2\n"
-    run = ProgramRunner(ctl, text, options=RunOptions(window=100))
-    starts = []
+    window = 32
+    text = _raster(10, synced={(3, 100): "M62 P3", (7, 41): "M63 P3"})
+    run = ProgramRunner(ctl, text, options=RunOptions(window=window))
     run.start()
-    ctl.add_cycle_hook(lambda c, t: starts.append(run.group.queue_length
-                                                  if run.group is not None else 0))
-    assert run.wait(120) and run.state is RunState.DONE
-    assert max(starts) <= 100
-    end = units(run)
-    assert end[0] == pytest.approx(round(10 * math.cos(299 / 50), 4), abs=1e-9)
-    assert end[1] == pytest.approx(round(10 * math.sin(299 / 50), 4), abs=1e-9)
+    ql = []
+    ctl.add_cycle_hook(lambda c, t: ql.append(run.group.queue_length if run.group else 0))
+    assert run.wait(60) and run.state is RunState.DONE
+    assert max(ql) <= window and len(run.op_of) == 2009
+    t, idx, p = run.trace()
+    v = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(t)
+    moving = np.nonzero(v > 0.0)[0]
+    inside = v[moving[0]:moving[-1] + 1]
+    assert len(inside) > 2000 and float(inside.min()) > 0.0   # no rest inside
+    assert float(v.max()) <= 50.0 * (1 + 1e-9)
+    assert float(np.mean(inside > 49.0)) > 0.45  # cruises along the rows (ramps: 0.1 s per row)
+    assert np.array_equal(units(run)[:2], _raster_point(9, 200))   # exact end
+    # the synced outputs fire once each, at the exact time the path passes their corner
+    # (collinear: passed at speed); G64 P0.01 opens the window 0.01 mm wide per axis
+    ev = {(e.index, e.level): e.t for e in run.events if e.kind == "sync_output"}
+    assert set(ev) == {(3, True), (3, False)}
+    for level, (row, k) in ((True, (3, 100)), (False, (7, 41))):
+        te = ev[(3, level)]
+        at = np.array([ctl.history.state_at(i, te).p for i in (0, 1)])   # pulses
+        assert np.all(np.abs(at - 1000.0 * _raster_point(row, k - 1)) <= 10.0 + 2e-6)
+        assert abs(ctl.history.state_at(0, te).v) > 40_000.0   # pulses/s: at speed
+        assert abs(te / ctl.period - round(te / ctl.period)) > 1e-6  # inside a cycle
+
+
+def test_pause_resume_abort_and_single_block_while_streaming():
+    """Hold, continue and abort act on a chain that is streaming past the window; single
+    block stops exactly on every block also when the program is longer than the window."""
+    ctl = iso_ctl()
+    run = ProgramRunner(ctl, _raster(3), options=RunOptions(window=16))
+    run.start()
+    ctl.advance(0.3)
+    run.pause()
+    ctl.advance(0.3)
+    held = units(run)
+    ctl.advance(0.2)
+    assert np.array_equal(units(run), held) and run.progress < 1.0
+    run.resume()
+    assert run.wait(30) and run.state is RunState.DONE
+    assert np.array_equal(units(run)[:2], _raster_point(2, 200))
+
+    ctl2 = iso_ctl()
+    run2 = ProgramRunner(ctl2, _raster(3), options=RunOptions(window=16))
+    run2.start()
+    ctl2.advance(0.3)
+    run2.abort()
+    ctl2.advance(0.5)
+    assert run2.state is RunState.ABORTED and not any(a.is_moving for a in ctl2.axes)
+    assert run2.group is not None and run2.group.queue_length == 0
+    x, y = units(run2)[:2]
+    assert y == 0.5 and 0.0 < x < 10.0                 # stopped on the second row
+
+    ctl3 = iso_ctl()
+    prog = "G21 G90 G1 F600\n" + "".join(f"G1 X{k * 0.5:g} Y{(k % 2) * 0.5:g}\n"
+                                           for k in range(1, 13)) + "M2\n"
+    run3 = ProgramRunner(ctl3, prog, options=RunOptions(window=4, single_block=True))
+    run3.start()
+    stops = []
+    while ctl3.run_until(lambda: run3.state is not RunState.RUNNING, 30) \
+            and run3.state is RunState.PAUSED:
+        stops.append(tuple(np.round(units(run3)[:2], 9)))
+        run3.resume()
+    assert run3.state is RunState.DONE
+    assert stops == [(k * 0.5, (k % 2) * 0.5) for k in range(1, 13)]
 
 
 @pytest.mark.parametrize(("blend", "early_mm"), [("G61", 1e-9), ("G64 P0.01", 0.01)])

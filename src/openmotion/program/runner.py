@@ -9,13 +9,14 @@ The whole program is compiled (G-code front end) and converted to operations in 
 units (convert.py) in the constructor: any error raises before anything moves. The group is
 opened with `units=` (signed pulses per machine unit of each axis), so F is the true tool
 speed and G2/G3 are true arcs also on axes with different pulses per mm. Execution is a
-controller cycle hook that streams the operations into the group queue, at most `window`
-commands at a time (default 8192, so a huge program never sits in the queue at once). The
-look-ahead spans what is queued when a chain starts: a program of up to `window` blended
-moves (the 4,000-segment CAM example) runs as one chain without resting; a longer one
-rests briefly every `window` moves. The runner never pushes into an empty queue while a
-chain runs, because the group would re-plan the whole running chain per pushed command
-(O(n^2): the CAM file took minutes; it now takes about 5 s). Semantics:
+controller cycle hook that streams the operations into the group queue and keeps it topped
+up to `window` commands (default 1024). The group's look-ahead is lazy (groupexec.py): a
+running chain holds the queued commands up to twice its braking distance and joins more
+from the queue when it runs short, dropping the elements it has travelled, so a program of
+any length runs as one chain without resting and the work per command stays bounded. The
+window only has to hold what the chain needs ahead (twice the braking distance from the
+feed: about 90 segments of 0.05 mm at 40 mm/s and acc_time 0.05 s); a smaller one still
+streams, but joins a command or two at a time (a re-plan each). Semantics:
 
 - G0: straight line at the rapid feed (convert.py); G1/G2/G3: group line/arc at the feed
   (machine units/s).
@@ -25,13 +26,9 @@ chain runs, because the group would re-plan the whole running chain per pushed c
   until resume(). M2/M30: end of one pass; `repeat` passes in all.
 - M64/M65: output set when the runner reaches the command (immediately, not waiting for the
   motion queued before it). M62/M63: set at the exact position where the next motion
-  command starts: while the move before it runs, a compare-engine window job (control/
-  compare.py, WindowJob on the command positions, +-1e-6 pulse, or +-the blend tolerance
-  with G64 P) is armed on that corner; the engine switches the output at the exact crossing
-  time (timed hardware). A move that starts from rest starts at a cycle boundary, where the
-  output is set in that cycle (also exact); a corner missed by the window (or G64 without
-  P) falls back to the cycle in which the move starts. M3/M4/M5, M7/M8/M9: wait for the
-  motion to end, then set their outputs. M6: logged, ignored. (MSG)/(DEBUG): logged.
+  command starts (syncout.py: a compare-engine window on that corner, or the cycle in which
+  the move starts from rest). M3/M4/M5, M7/M8/M9: wait for the motion to end, then set
+  their outputs. M6: logged, ignored. (MSG)/(DEBUG): logged.
 - pause() holds the path (decelerating along it), resume() continues, abort() stops along
   the path and drops the rest; single_block pauses after every source line.
 """
@@ -54,6 +51,7 @@ from .convert import ConvertOptions, Op, Scales, convert
 from .interp import compile_text
 from .options import AXIS_LETTERS, GCodeOptions
 from .source import GCodeError, read_program
+from .syncout import SyncedOutputs
 
 if TYPE_CHECKING:
     from ..control.compare import CompareEngine
@@ -90,7 +88,7 @@ class RunOptions:
     feed_mode: str = "uniform"
     chord_tol: float = 0.001        # machine units
     acc_time: float = 0.05          # s from rest to the feed (path accel = feed / acc_time)
-    window: int = 8192              # commands queued in the group at most
+    window: int = 1024              # commands queued in the group at most
     repeat: int = 1
     single_block: bool = False
     optional_stop: bool = False
@@ -155,18 +153,6 @@ def travel_limits(ctl: Controller, index: int) -> tuple[float, float] | None:
 
 
 @dataclass
-class _Armed:
-    """An M62/M63 bound to the move `index` that starts at `corner` (pulses) after `prev`."""
-
-    index: int
-    op: Op
-    corner: np.ndarray
-    prev: int | None
-    tol: float | None
-    job: object = None
-
-
-@dataclass
 class _Pass:
     ops: list[Op]
     start: np.ndarray
@@ -190,7 +176,6 @@ class ProgramRunner:
         if compare is not None and (not isinstance(compare, CompareEngine)
                                     or compare.ctl is not ctl):
             raise MotionError("compare must be a CompareEngine of the same controller")
-        self._compare = compare
         self.options = RunOptions() if options is None else options
         if not isinstance(self.options, RunOptions):
             raise MotionError(f"options must be RunOptions, got {type(options).__name__}")
@@ -242,11 +227,9 @@ class ProgramRunner:
         self.op_of: dict[int, Op] = {}
         self.starts_of: dict[int, np.ndarray] = {}   # start point (pulses) of each move
         self._cursor = self._pass.start
-        self._synced: list[Op] = []
-        self._armed: list[_Armed] = []   # M62/M63 waiting for their move to start
-        self._prev_motion: int | None = None   # index of the last pushed line/arc
-        self._window_tol: float | None = 1e-6  # pulses; None: blending without a bound
-        self._levels: dict[int, bool] = {}
+        self.synced = SyncedOutputs(ctl, self.axis_indices, compare, self._set_output,
+                                    self._record_synced)
+        self._pushed = 0
         self._last_line = 0
         self._step_line: int | None = None
         self.t_start = self.t_end = 0.0
@@ -383,8 +366,12 @@ class ProgramRunner:
 
     def _set_output(self, op: Op, index: int, level: bool, kind: str) -> None:
         self._ctl.hardware.write_output(None, f"do{index}", level)
-        self._levels[index] = level
+        self.synced.levels[index] = level
         self._event(kind, op.line, f"do{index} = {int(level)}", index=index, level=level)
+
+    def _record_synced(self, t: float, op: Op, index: int, level: bool) -> None:
+        self.events.append(RunEvent(t, "sync_output", op.line, f"do{index} = {int(level)}",
+                                    index=index, level=level))
 
     def _finish(self, state: RunState, text: str) -> None:
         self.state = state
@@ -426,7 +413,7 @@ class ProgramRunner:
         self._trace_t.append(t)
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
-        self._fire_armed(g)
+        self.synced.fire(g.current_index, self._idle_past)
         if self.state is not RunState.RUNNING:
             return
         try:
@@ -438,56 +425,6 @@ class ProgramRunner:
             self.error = f"line {line}: {err}"
             self._event("fault", line, str(err))
             self._finish(RunState.ERROR, self.error)
-
-    def _fire_armed(self, g: Group) -> None:
-        cur = g.current_index
-        for a in list(self._armed):
-            started = 0 <= a.index <= cur or (cur < 0 and self._idle_past(a.index))
-            job = a.job
-            if job is not None and job.hits > 0:  # type: ignore[attr-defined]
-                self._record_fired(a)
-                continue
-            if started:  # from rest (cycle boundary) or the window was missed
-                if job is not None:
-                    self._engine().remove(job.id)  # type: ignore[attr-defined]
-                self._armed.remove(a)
-                self._set_output(a.op, a.op.index, a.op.level, "sync_output")
-                continue
-            if job is None and a.prev is not None and a.tol is not None and cur >= a.prev:
-                self._arm_window(a)
-
-    def _engine(self) -> CompareEngine:
-        from ..control.compare import CompareEngine
-
-        if self._compare is None:
-            self._compare = CompareEngine(self._ctl)
-        return self._compare
-
-    def _arm_window(self, a: _Armed) -> None:
-        from ..control.compare import SetLevel, WindowJob
-
-        eng = self._engine()
-        n = a.op.index
-        line = eng.output(n)
-        known = self._levels.get(n, False)
-        if line.level_at(self._ctl.time) != known:  # an M64/M65 written around the engine
-            line.set(self._ctl.time, known)
-        assert a.tol is not None
-        job = WindowJob(self.axis_indices, a.corner[None, :], a.tol,
-                        SetLevel(n, a.op.level),
-                        name=f"M6{2 if a.op.level else 3} line {a.op.line}")
-        eng.add(job)
-        a.job = job
-
-    def _record_fired(self, a: _Armed) -> None:
-        n, level = a.op.index, a.op.level
-        edges = [t for t, lv in self._engine().output(n).edges if lv == level]
-        t = edges[-1] if edges else self._ctl.time
-        self._engine().remove(a.job.id)  # type: ignore[attr-defined]
-        self._armed.remove(a)
-        self._levels[n] = level
-        self.events.append(RunEvent(t, "sync_output", a.op.line, f"do{n} = {int(level)}",
-                                    index=n, level=level))
 
     def _idle_past(self, index: int) -> bool:
         # the command already ran (a short move started and ended within one cycle)
@@ -506,8 +443,6 @@ class ProgramRunner:
                 self._event("single_block", self._last_line, "block done")
                 return
             if op.kind in ("line", "arc", "delay"):
-                if self._would_extend(g):
-                    return
                 idx = self._push(g, op)
                 self._line_of[idx] = op.line
                 self.op_of[idx] = op
@@ -515,14 +450,10 @@ class ProgramRunner:
                     self.starts_of[idx] = self._cursor
                     self._cursor = op.target
                 if op.kind != "delay":
-                    for s in self._synced:
-                        self._armed.append(_Armed(idx, s, self.starts_of[idx],
-                                                  self._prev_motion, self._window_tol))
-                    self._synced.clear()
-                    self._prev_motion = idx
+                    self.synced.bind(idx, self.starts_of[idx])
             elif op.kind == "output":
                 if op.synced:
-                    self._synced.append(op)
+                    self.synced.pending.append(op)
                 else:
                     self._set_output(op, op.index, op.level, "output")
             elif op.kind == "action" and not op.barrier:
@@ -533,15 +464,9 @@ class ProgramRunner:
                 if op.kind == "blend":
                     if op.tolerance is None:
                         g.disable_blend()
-                        self._window_tol = 1e-6
                     else:
                         g.enable_blend(op.tolerance)
-                        # G64 without P (UNBOUNDED_BLEND) has no window: per-cycle fallback.
-                        # A corner rounded within tol (machine units) is within
-                        # tol * |pulses/unit| pulses on each axis: the window uses the largest.
-                        k = float(np.max(np.abs(self.scales.ppu)))
-                        self._window_tol = (float(op.tolerance) * k + 1e-6
-                                            if op.tolerance < 1e9 else None)
+                    self.synced.set_blend(op.tolerance, float(np.max(np.abs(self.scales.ppu))))
                 elif op.kind == "action":
                     for index, level in op.outputs:
                         self._set_output(op, index, level, "output")
@@ -560,21 +485,11 @@ class ProgramRunner:
             self._last_line = op.line
             if opts.single_block:
                 self._step_line = op.line
-        if p.pc >= len(p.ops) and self._idle() and not self._armed:
+        if p.pc >= len(p.ops) and self._idle() and not self.synced.armed:
             self._end_of_pass()
 
-    @staticmethod
-    def _would_extend(g: Group) -> bool:
-        # A path command pushed into an empty queue while a chain runs joins that chain and
-        # re-plans all of it (groupexec._extend_running): one push per command would cost
-        # O(n^2) over a long program. The runner waits instead; the next window is queued
-        # as soon as the running chain ends (a rest at window boundaries, see the docstring).
-        from ..control.group import GroupState
-
-        return g.state is not GroupState.IDLE and g.queue_length == 0
-
     def _push(self, g: Group, op: Op) -> int:
-        self._pushed = getattr(self, "_pushed", 0) + 1
+        self._pushed += 1
         if op.kind == "delay":
             return g.delay(op.seconds)
         g.set_feed(op.feed)
@@ -586,9 +501,7 @@ class ProgramRunner:
                      turns=op.turns)
 
     def _end_of_pass(self) -> None:
-        for op in self._synced:  # M62/M63 with no motion after them
-            self._set_output(op, op.index, op.level, "sync_output")
-        self._synced.clear()
+        self.synced.flush()
         self.passes_done += 1
         if self.passes_done >= self.options.repeat:
             self._finish(RunState.DONE, f"{self.passes_done} pass(es) done")
