@@ -1,10 +1,12 @@
 """SimMachine: the simulated machine behind the `Hardware` boundary.
 
-Per axis: a pulse generator (the commanded cubic), a drive/motor plant, the transmission
-(backlash, pitch error), switches at mechanical positions, and the encoder as decoded by
-the board. `advance(t)` cuts [now, t] at scenario action times, lets every plant produce
-its monotone motor pieces, and finds every switch/index edge on them by solving for the
-exact crossing time. Each edge carries every axis's decoded encoder count at its instant.
+Per axis (simaxis.py, `SimAxis`): a pulse generator (the commanded cubic), a drive/motor
+plant, the transmission (backlash, pitch error), switches at mechanical positions, and the
+encoder as decoded by the board. `advance(t)` cuts [now, t] at scenario action times, lets
+every axis run (its plant's monotone motor pieces, every switch/index edge on them at the
+exact crossing time) and gives each edge every axis's decoded encoder count at its instant.
+The machine itself is the board: the Hardware protocol, outputs, digital I/O, E-stop, the
+scenario's actions, and the extras tests and tools read.
 
 Signal levels are electrical: a switch's level is (active XOR contact is NC), where the
 contact type is AxisConfig.logic[signal] ("no" default). The SD/LTC pin is one input: with
@@ -13,127 +15,21 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 
 from __future__ import annotations
 
-import copy
-from typing import TYPE_CHECKING
-
-from openmotion.config import DRIVE_TYPES, AxisConfig, MachineConfig
+from openmotion.config import MachineConfig
 from openmotion.errors import MotionError, check_finite, check_nonnegative
 from openmotion.hw.interface import AXIS_INPUTS, AXIS_OUTPUTS, AxisCommand, AxisReadback, InputEdge
 
 from .cubic import Cubic
-from .encoder import Decoder, EncoderWiring, default_wiring
-from .mechanics import PitchTable, Transmission
+from .encoder import EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
-from .pieces import JumpPiece, Piece
+from .pieces import JumpPiece
 from .plant import StepperPlant
 from .pulserecord import PulseRecord, check_capacity
-from .pulses import PulseGenerator
 from .scenario import Scenario
-from .switches import IndexSwitch, Switch
+from .simaxis import SimAxis
+from .switches import Switch
 
-if TYPE_CHECKING:
-    from .dcservo import DCServoPlant
-    from .servo import ServoPlant
-
-#: Safety bound on toggles of one switch within one piece (an EZ window per revolution).
-_MAX_TOGGLES = 100_000
 SWITCH_SIGNALS = ("pel", "mel", "org", "sd", "ltc")
-
-
-class _Axis:
-    """Everything the sim keeps for one axis."""
-
-    def __init__(self, index: int, cfg: AxisConfig, wiring: EncoderWiring | None) -> None:
-        drv = cfg.drive
-        if drv.type not in DRIVE_TYPES:
-            raise MotionError(f"axes[{index}].drive.type must be one of {DRIVE_TYPES}, "
-                              f"got {drv.type!r}")
-        self.index = index
-        self.cfg = cfg
-        self.gen = PulseGenerator()
-        if drv.type == "servo":
-            from .servo import ServoPlant
-            self.plant: StepperPlant | ServoPlant | DCServoPlant = ServoPlant(drv)
-        elif drv.type == "dc_servo":
-            from .dcservo import DCServoPlant
-            self.plant = DCServoPlant(cfg)
-        else:
-            self.plant = StepperPlant(drv.type == "ideal_stepper", drv.pullout_speed,
-                                      drv.pullout_accel)
-        self.is_servo = drv.type == "servo"
-        self.is_dc = drv.type == "dc_servo"  # motor driven by command_effort, not pulses
-        check_nonnegative(f"axes[{index}].drive.backlash", drv.backlash)
-        screw = cfg.pulses_per_rev * cfg.gear_ratio
-        self.trans = Transmission(drv.backlash, PitchTable(drv.pitch_error, screw))
-        self.y = self.trans.y_of(0.0)
-        self.decoder = Decoder(wiring or default_wiring(cfg), cfg, self.y)
-        self.nc = {s: cfg.logic.get(s, "no") == "nc" for s in (*AXIS_INPUTS, "emg")}
-        self.switches: dict[str, Switch | IndexSwitch] = {}
-        for name in ("pel", "mel", "org", "sd"):
-            sc = getattr(cfg, name)
-            if sc is not None:
-                self.switches[name] = Switch(sc.position, sc.width, sc.hysteresis, self.y)
-        wiring_ = wiring or default_wiring(cfg)
-        self.z_flip = wiring_.invert_z != cfg.invert_z
-        lines = cfg.encoder_lines_per_rev
-        ez_width = cfg.pulses_per_rev / (4.0 * lines) if lines > 0 else 1.0
-        self.switches["ez"] = IndexSwitch(float(cfg.pulses_per_rev), ez_width, self.y)
-        self.outputs = {s: False for s in AXIS_OUTPUTS}
-        self.alarm = False
-        # armed edge stops: signal -> (electrical level, direction 0/+1/-1); see arm_stop
-        self.armed: dict[str, tuple[bool, int]] = {}
-        self.stop_time: float | None = None
-        # pieces of the current run, with the state at each piece's start (for peeks)
-        self.record: list[tuple[Piece, float, tuple[int, int, int]]] = []
-        self.run_start: tuple[float, tuple[int, int, int]] = (self.trans.z, self._dec_state())
-
-    # -- levels ----------------------------------------------------------------------------
-    def active(self, sig: str) -> bool:
-        sw = self.switches.get(sig)
-        if sig == "ltc" and sw is None:
-            sw = self.switches.get("sd")
-        if sw is not None:
-            return sw.active
-        if sig == "alm":
-            return self.alarm
-        if sig == "rdy" and self.is_dc:
-            return self.outputs["svon"] and not self.alarm
-        if sig == "rdy":
-            return self.plant.ready(self.outputs["svon"], self.alarm) if self.is_servo \
-                else not self.alarm
-        if sig == "inp":
-            return self.plant.in_position if self.is_servo else True
-        return False
-
-    def level(self, sig: str) -> bool:
-        shared = sig == "ltc" and "ltc" not in self.switches
-        nc = self.nc["sd" if shared else sig]
-        lv = self.active(sig) != nc
-        if sig == "ez":
-            lv = lv != self.z_flip
-        return lv
-
-    def _dec_state(self) -> tuple[int, int, int]:
-        d = self.decoder
-        return (d.q, d.last_dir, d.count)
-
-    def encoder_at(self, t: float) -> int:
-        """Decoded count at time t within the current run (t >= run start)."""
-        rec = self.record
-        k = len(rec) - 1
-        while k >= 0 and rec[k][0].t0 > t:
-            k -= 1
-        if k < 0:
-            return self.run_start[1][2] if not rec else rec[0][2][2]
-        piece, z0, st = rec[k]
-        return self._peek(piece, z0, st, piece.m_at(t))
-
-    def _peek(self, piece: Piece, z0: float, st: tuple[int, int, int], m: float) -> int:
-        d = piece.direction
-        y = self.trans.y_of(self.trans.z_after(z0, m, d))
-        dec = self.decoder
-        q1 = dec.index_after(y, st[0], d)
-        return st[2] + dec.increment(st[0], q1, st[1])
 
 
 class SimMachine:
@@ -157,7 +53,7 @@ class SimMachine:
             if not isinstance(n, int) or n < 0:
                 raise MotionError(f"{name} must be an int >= 0, got {n!r}")
         self.config = config
-        self._axes = [_Axis(i, a, wiring.get(i)) for i, a in enumerate(config.axes)]
+        self._axes = [SimAxis(i, a, wiring.get(i)) for i, a in enumerate(config.axes)]
         self._t = 0.0
         self._emg_active = False
         self._emg_armed: bool | None = None  # level at which EMG cuts every axis's pulses
@@ -192,8 +88,9 @@ class SimMachine:
         for f in ("t0", "p0", "v0", "a0", "j"):
             check_finite(f"cmd.{f}", getattr(cmd, f))
         check_nonnegative("cmd.dt", cmd.dt)
-        self._set_command(ax, Cubic(float(cmd.p0), float(cmd.v0), float(cmd.a0),
-                                    float(cmd.j)), float(cmd.t0), float(cmd.t0) + float(cmd.dt))
+        t0 = float(cmd.t0)
+        ax.set_command(Cubic(float(cmd.p0), float(cmd.v0), float(cmd.a0), float(cmd.j)),
+                       t0, t0 + float(cmd.dt), self._t)
 
     def advance(self, t: float) -> list[InputEdge]:
         """Move every plant to time t; return the input edges since the last call."""
@@ -405,7 +302,7 @@ class SimMachine:
         return rec
 
     # -- internals ----------------------------------------------------------------------------
-    def _axis(self, axis: int) -> _Axis:
+    def _axis(self, axis: int) -> SimAxis:
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._axes):
             raise MotionError(f"axis must be an int in 0..{len(self._axes) - 1}, got {axis!r}")
         return self._axes[axis]
@@ -421,144 +318,14 @@ class SimMachine:
     def _run(self, ta: float, tb: float, raw: list) -> None:
         """Move every axis over [ta, tb], appending raw edges."""
         for ax in self._axes:
-            armed = [s for s in ax.armed if s in ax.switches and s != "ez"]
-            if armed and not ax.is_dc and ax.gen.te > ta:
-                self._run_armed(ax, ta, tb, raw, armed)
-            else:
-                self._run_axis(ax, ta, tb, raw, ax.plant.pieces(ax.gen, ta, tb))
-
-    def _run_axis(self, ax: _Axis, ta: float, tb: float, raw: list,
-                  pieces: list[Piece]) -> None:
-        if pieces:
-            self._scan(ax, pieces, raw)
-        if ax.is_servo:
-            ax.plant.status_edges(ax, ta, tb, raw)
-
-    def _run_armed(self, ax: _Axis, ta: float, tb: float, raw: list, armed: list[str]
-                   ) -> None:
-        """`_run` for an axis with an armed switch: find the first armed edge on the
-        pieces without touching the switches; if there is one, run again up to its time
-        (plant and count restored), hold the command there, and run on to tb."""
-        rec = ax.gen.record
-        saved = (ax.gen.count, copy.copy(ax.plant), rec.mark() if rec is not None else 0)
-        pieces = ax.plant.pieces(ax.gen, ta, tb)
-        hit = self._first_armed(ax, pieces, armed)
-        if hit is None:
-            self._run_axis(ax, ta, tb, raw, pieces)
-            return
-        ts, sig = hit
-        ax.gen.count, ax.plant, mark = saved
-        if rec is not None:
-            rec.rewind(mark)
-        n0 = len(raw)
-        self._run_axis(ax, ta, ts, raw, ax.plant.pieces(ax.gen, ta, ts))
-        if not any(e[1] == ax.index and e[2] == sig for e in raw[n0:]):
-            # rounding left the motor a hair short of the switch: the edge is at ts
-            sw = ax.switches[sig]
-            sw.active = not sw.active
-            raw.append((ts, ax.index, sig, ax.level(sig), ax.decoder.count))
-        self._cut_pulses(ax, ts)
-        self._run_axis(ax, ts, tb, raw, ax.plant.pieces(ax.gen, ts, tb))
-
-    def _first_armed(self, ax: _Axis, pieces: list[Piece], armed: list[str]
-                     ) -> tuple[float, str] | None:
-        """(time, signal) of the first armed switch edge on `pieces` (a dry scan)."""
-        trans = ax.trans
-        dry = {s: copy.copy(ax.switches[s]) for s in armed}
-        z, y = trans.z, ax.y
-        for p in pieces:
-            d = p.direction
-            if d == 0:
-                continue
-            z1 = trans.z_after(z, p.m1, d)
-            y1 = trans.y_of(z1)
-            best: tuple[float, str] | None = None
-            for s, sw in dry.items():
-                level, want = ax.armed[s]
-                yy = y
-                for _ in range(_MAX_TOGGLES):
-                    thr = sw.next_threshold(yy, d)
-                    if thr is None or (y1 < thr if d > 0 else y1 >= thr):
-                        break
-                    sw.active = not sw.active
-                    if (sw.active != ax.nc[s]) == level and want in (0, d):
-                        t = p.time_at(trans.motor_level(thr, d))[0]
-                        if best is None or t < best[0]:
-                            best = (t, s)
-                        break
-                    yy = thr
-            if best is not None:
-                return best
-            z, y = z1, y1
-        return None
-
-    def _cut_pulses(self, ax: _Axis, t: float) -> None:
-        """The pulse output of `ax` stops at time t: the command holds the count emitted.
-
-        A card's command is its count; holding the float command instead would leave it up
-        to half a pulse off the count (a switch tripped by pulse k fires with the command at
-        k -/+ 1/2), and the next move would start between pulses.
-        """
-        self._set_command(ax, Cubic(float(ax.gen.count)), t, t, t)
-        ax.stop_time = t
-
-    def _set_command(self, ax: _Axis, cubic: Cubic, tc: float, te: float,
-                     now: float | None = None) -> None:
-        ax.gen.set(cubic, tc, te)
-        if ax.gen.record is not None:
-            ax.gen.record.command(self._t if now is None else now, cubic, tc, te)
-
-    def _armed_hit(self, ax: _Axis, sig: str, level: bool) -> None:
-        """An input of `ax` changed at the current time: cut the pulses if armed."""
-        arm = ax.armed.get(sig)
-        if arm is None or arm[0] != level:
-            return
-        v = ax.gen.vel(self._t)
-        d = 1 if v > 0.0 else (-1 if v < 0.0 else 0)
-        if arm[1] in (0, d):
-            self._cut_pulses(ax, self._t)
-
-    def _scan(self, ax: _Axis, pieces: list[Piece], raw: list) -> None:
-        trans = ax.trans
-        dec = ax.decoder
-        for p in pieces:
-            d = p.direction
-            z0 = trans.z
-            st = (dec.q, dec.last_dir, dec.count)
-            ax.record.append((p, z0, st))
-            if d == 0:
-                continue
-            z1 = trans.z_after(z0, p.m1, d)
-            y1 = trans.y_of(z1)
-            if y1 != ax.y:
-                for name, sw in ax.switches.items():
-                    self._scan_switch(ax, name, sw, p, z0, st, y1, raw)
-            trans.z = z1
-            ax.y = y1
-            dec.advance(y1, d)
-
-    def _scan_switch(self, ax: _Axis, name: str, sw: Switch | IndexSwitch, p: Piece,
-                     z0: float, st: tuple[int, int, int], y1: float, raw: list) -> None:
-        d = p.direction
-        y = ax.y
-        for _ in range(_MAX_TOGGLES):
-            thr = sw.next_threshold(y, d)
-            if thr is None or (y1 < thr if d > 0 else y1 >= thr):
-                return
-            t, m = p.time_at(ax.trans.motor_level(thr, d))
-            sw.active = not sw.active
-            own = ax._peek(p, z0, st, m)
-            raw.append((t, ax.index, name, ax.level(name), own))
-            if name == "sd" and "ltc" not in ax.switches:
-                raw.append((t, ax.index, "ltc", ax.level("ltc"), own))
-            y = thr
+            ax.run(ta, tb, raw)
 
     # -- scenario actions (called by Scenario at their time, inside advance) ------------------
-    def _edge(self, raw: list, ax: _Axis, sig: str, before: bool) -> None:
+    def _edge(self, raw: list, ax: SimAxis, sig: str, before: bool) -> None:
         lv = ax.level(sig)
         if lv != before:
             raw.append((self._t, ax.index, sig, lv, ax.decoder.count))
-            self._armed_hit(ax, sig, lv)
+            ax.armed_hit(sig, lv, self._t)
 
     def _place(self, axis: int, signal: str, spec: tuple[float, float, float] | None,
                raw: list) -> None:
@@ -591,7 +358,7 @@ class SimMachine:
             raw.append((self._t, None, "emg", lv, None))
             if self._emg_armed is not None and lv == self._emg_armed:
                 for ax in self._axes:
-                    self._cut_pulses(ax, self._t)
+                    ax.cut_pulses(self._t)
 
     def _set_di(self, signal: str, level: bool, raw: list) -> None:
         k = self._board_index(signal, "di", len(self._di))
@@ -605,4 +372,4 @@ class SimMachine:
         m0 = plant.motor(ax.gen)
         plant.lost += pulses
         if pulses:
-            self._scan(ax, [JumpPiece(self._t, m0, m0 - pulses)], raw)
+            ax.scan([JumpPiece(self._t, m0, m0 - pulses)], raw)
