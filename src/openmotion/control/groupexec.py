@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InfeasibleError, MotionError
-from ..path import blend_corner
+from ..path import blend_corner, speed_caps
 from ..path.geometry import PathElement
 from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
@@ -335,13 +335,24 @@ class GroupEngine(LookaheadSettings):
     def _blend_pair(self, prev: PathElement, el: PathElement,
                     cmd: _Cmd) -> tuple[PathElement, PathElement, PathElement] | None:
         """The corner prev -> el (any Line/Arc/Arc3D pair) rounded within the tolerance
-        (trimmed prev, the blend, the trimmed el), or None: blending off, no corner, or an
-        exact stop is faster."""
+        (trimmed prev, the blend, the trimmed el), or None: blending off, no corner, or
+        taking the corner unrounded (an exact stop, or the corner velocity when one is set)
+        is faster."""
         if not (self._blend and self._blend_tol > 0.0):
             return None
         b = blend_corner(prev, el, self._blend_tol)
-        if b is None or not _blend_pays(b, min(cmd.accel, float(np.min(self._caps()[1]))),
-                                        cmd.feed):
+        if b is None:
+            return None
+        vmax, amax = self._caps()
+        accel = min(cmd.accel, float(np.min(amax)))
+        v_corner = 0.0
+        corner = self._corner_limits()
+        if corner["square_corner_velocity"] > 0.0 and prev.length > 0.0 and el.length > 0.0:
+            v_corner = speed_caps([prev, el], cmd.feed, cmd.accel, axis_vmax=vmax,
+                                  axis_amax=amax,
+                                  square_corner_velocity=corner["square_corner_velocity"],
+                                  axis_vjump=corner["axis_vjump"])[1][1]
+        if not _blend_pays(b, accel, cmd.feed, v_corner):
             return None
         return b.first, b.arc, b.second
 
@@ -355,7 +366,7 @@ class GroupEngine(LookaheadSettings):
             spec = cmd.specs[k]
             if self._ptp_override != 1.0:
                 spec = MoveSpec(spec.shape, spec.str_vel,
-                                min(a._max_speed, spec.max_vel * self._ptp_override),
+                                min(a.max_speed, spec.max_vel * self._ptp_override),
                                 spec.tacc, spec.tdec, spec.vs_acc, spec.vs_dec)
             if self._dry:
                 profiles.append(planning.position_move(spec, float(start[k]),
@@ -442,8 +453,9 @@ class GroupEngine(LookaheadSettings):
                 a.stop_immediately()
 
 
-def _blend_pays(b: Any, accel: float, feed: float) -> bool:
-    """Whether rounding a corner is faster than stopping exactly at it (an estimate).
+def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> bool:
+    """Whether rounding a corner is faster than taking it unrounded: stopping exactly at it
+    or, with a corner velocity, passing it at `v_corner` (an estimate).
 
     The blend arc (radius R = 1/kappa, sweep phi = L/R) starts d = R*tan(phi/2) before the
     corner and is crossed at v_c = min(F, sqrt(a_n*R)), a_n = sqrt(3)/2*A (the look-ahead's
@@ -474,4 +486,5 @@ def _blend_pays(b: Any, accel: float, feed: float) -> bool:
             return (math.sqrt(v0 * v0 + 2.0 * accel * dist) - v0) / accel
         return (feed - v0) / accel + (dist - d_acc) / feed
 
-    return length / v_c + 2.0 * time(max(0.0, span - d), v_c) < 2.0 * time(span, 0.0)
+    v_corner = min(v_corner, feed)
+    return length / v_c + 2.0 * time(max(0.0, span - d), v_c) < 2.0 * time(span, v_corner)
