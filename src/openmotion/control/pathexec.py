@@ -39,8 +39,11 @@ from ..errors import InfeasibleError
 from ..path import ElementSpeeds, Line, plan_speeds
 from ..path.contour import contour_error  # noqa: F401 - re-exported (was defined here)
 from ..path.geometry import PathElement
-from ..path.lookahead import speed_caps
+from ..path.lookahead import speed_caps, tangential_accels
 from ..profile.segments import Profile, ProfileBuilder, State
+
+#: plan_speeds' default tangential share of an arc's acceleration budget (lookahead step 1)
+ARC_TANGENTIAL_RATIO = 0.5
 
 
 # -------------------------------------------------------------------------- speed curves
@@ -254,33 +257,37 @@ def _cat(a: np.ndarray | None, b: Sequence[float] | None) -> np.ndarray | None:
 
 
 class Trimmed:
-    """An element from local position `offset` on (for re-planning mid-element). The
-    look-ahead bounds (max curvature, per-axis weights) are the whole element's: valid."""
+    """The part of an element from local position `offset` on, `length` long (default: to
+    its end), for re-planning mid-element and for splitting a curve at a guard zone's
+    edge. The look-ahead bounds (max curvature, per-axis weights) are the whole element's:
+    valid."""
 
-    def __init__(self, base: PathElement, offset: float) -> None:
+    def __init__(self, base: PathElement, offset: float, length: float | None = None) -> None:
         self.base = base
         self.offset = float(offset)
-        self.length = max(0.0, base.length - self.offset)
+        self._stop = base.length if length is None else min(base.length,
+                                                               self.offset + float(length))
+        self.length = max(0.0, self._stop - self.offset)
         self.dim = base.dim
         self.start = base.point(self.offset)
-        self.end = base.end
+        self.end = base.end if length is None else base.point(self._stop)
         self.start_tangent = base.tangent(self.offset)
-        self.end_tangent = base.end_tangent
+        self.end_tangent = base.end_tangent if length is None else base.tangent(self._stop)
         self.max_curvature = base.max_curvature
         self.max_abs_tangent = base.max_abs_tangent
         self.axis_accel_weight = base.axis_accel_weight
 
+    def _local(self, s):  # noqa: ANN001, ANN202
+        return np.minimum(np.asarray(s, dtype=float) + self.offset, self._stop)
+
     def point(self, s):  # noqa: ANN001, ANN201 - same contract as PathElement
-        return self.base.point(np.minimum(np.asarray(s, dtype=float) + self.offset,
-                                          self.base.length))
+        return self.base.point(self._local(s))
 
     def tangent(self, s):  # noqa: ANN001, ANN201
-        return self.base.tangent(np.minimum(np.asarray(s, dtype=float) + self.offset,
-                                            self.base.length))
+        return self.base.tangent(self._local(s))
 
     def curvature(self, s):  # noqa: ANN001, ANN201
-        return self.base.curvature(np.minimum(np.asarray(s, dtype=float) + self.offset,
-                                              self.base.length))
+        return self.base.curvature(self._local(s))
 
 
 @dataclass(frozen=True)
@@ -315,7 +322,7 @@ def _chain_limits(chain: Chain, k0: int, lim: Limits) -> tuple[Any, Any]:
 
 
 def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
-               old: SpeedCurve | None = None, *, guard: float = 0.0,
+               old: SpeedCurve | None = None, *, window: float = 0.0,
                jump: bool = False) -> SpeedCurve:
     """Speed curve for the rest of `chain` from s0 at speed v0, ending at rest or, with a
     StrVel (`lim.str_vel`), at a speed <= StrVel from which it jumps to rest.
@@ -325,14 +332,18 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     When v0 is above what the new limits allow (a lower override), the path decelerates at
     the smallest tangential acceleration of the remaining elements until it meets the new
     plan, and never exceeds the `old` curve it was following (see the module doc).
-    `guard` > 0 (an S-curve's smoothing distance, see `guarded`) extends every speed cap
-    that far along the path on both sides. The curve's `a_min` is the smallest tangential
-    acceleration of the remaining elements (what a hold may use everywhere).
+    `window` > 0 (an S path's smoothing window tj, see `guarded`) holds every speed cap and
+    tangential acceleration cap*tj/2 beyond its element or corner. The curve's `a_min` is
+    the smallest tangential acceleration of the remaining elements (what a hold may use everywhere).
     """
-    els, k0 = chain.tail_elements(s0)
-    feeds, accels = _chain_limits(chain, k0, lim)
-    if guard > 0.0:
-        els, feeds, accels = guarded(els, feeds, accels, lim, guard)
+    if window > 0.0:  # the elements the executed position may still be on cap what follows
+        k0 = chain.locate(max(0.0, s0 - _top_feed(chain, lim) * window))
+        feeds, accels = _chain_limits(chain, k0, lim)
+        els, feeds, accels = guarded(list(chain.elements[k0:]), feeds, accels, lim, window,
+                                     cut=s0 - float(chain.cum[k0]))
+    else:
+        els, k0 = chain.tail_elements(s0)
+        feeds, accels = _chain_limits(chain, k0, lim)
     kw = dict(square_corner_velocity=lim.square_corner_velocity, end_speed=lim.str_vel,
               axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax, axis_vjump=lim.axis_vjump,
               min_cruise_ratio=lim.min_cruise_ratio)
@@ -356,6 +367,13 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     return _with_amin(_pinned(curve_min(joined, old.tail(s0)), chain.length), sp)
 
 
+def _top_feed(chain: Chain, lim: Limits) -> float:
+    """The highest feed any element of the chain may run at (override included)."""
+    if chain.feeds is None:
+        return lim.feed
+    return min(lim.feed, float(np.max(chain.feeds)) * lim.scale)
+
+
 def _highest_start(els: Sequence[PathElement], feeds: Any, accels: Any, v0: float,
                    kw: dict) -> float:
     """The highest start speed <= v0 the look-ahead accepts on `els` (bisection)."""
@@ -375,54 +393,96 @@ def _with_amin(curve: SpeedCurve, sp: Sequence[ElementSpeeds]) -> SpeedCurve:
     return SpeedCurve(curve.s, curve.v2, min(acc) if acc else math.inf, curve.jump)
 
 
-def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits,
-            w: float) -> tuple[list[PathElement], list[float], list[float]]:
-    """Elements whose speed caps hold `w` beyond each element's ends (and each corner's
-    junction speed `w` around it), for a path speed that is later smoothed by a moving
-    average: the smoothed position lies within v*tj <= w of every raw position in its
-    window, so the smoothed speed (an average of raw speeds) keeps every cap the raw speed
-    keeps over that reach. Lines longer than 2w are split so that only their first and last
-    w are slowed for a neighbour; shorter lines and curved elements take the smallest cap
-    within w of either end on their whole length (safe, a little slower)."""
+def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: float,
+            cut: float = 0.0) -> tuple[list[PathElement], list[float], list[float]]:
+    """Elements on which a raw path speed keeps, after a moving average of window tj, every
+    speed cap and tangential acceleration of the elements it is averaged over.
+
+    Why a cap c of an element E (or of a corner crossed at speed) must hold c*tj/2 beyond
+    E: if the raw speed is <= c within d = c*tj/2 of E, a window whose average position
+    (the executed one) lies on E holds only raw positions within d of E. (Had the raw
+    motion reached d beyond E at time tau <= t, it would have moved at <= c before tau, so
+    its average over [t - tj, t] would be at least the far end of E. The same holds behind
+    E.) The executed speed and acceleration are averages of raw ones in the window, so
+    they keep E's cap and E's tangential acceleration when the raw motion keeps them over
+    that reach. An arc's speed cap bounds its centripetal acceleration, its tangential
+    share the rest, so axis accelerations stay within the limits there too.
+
+    Each element's cap and tangential acceleration therefore hold over a zone c*tj/2 around
+    it (a corner's junction speed too). Elements are split at the zone edges of their
+    neighbours, so only the part a neighbour reaches is slowed. Exact-stop
+    corners (junction cap 0) are barriers: the raw motion rests tj there (s_profile's
+    dwell), so no window holds raw positions of both sides. The elements before path
+    position `cut` (from the start of `els`) cap what follows within their zones and are
+    then dropped (a re-plan mid-chain: the executed position lags behind the raw one)."""
     n = len(els)
     fl = [float(x) for x in feeds] if isinstance(feeds, list) else [float(feeds)] * n
     al = [float(x) for x in accels] if isinstance(accels, list) else [float(accels)] * n
     caps, jcaps = speed_caps(els, fl, al, square_corner_velocity=lim.square_corner_velocity,
                              axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax,
                              axis_vjump=lim.axis_vjump)
+    tacc = np.asarray(tangential_accels(els, al, axis_amax=lim.axis_amax))
     cum = np.concatenate([[0.0], np.cumsum([el.length for el in els])])
-    cap = np.asarray(caps)
+    cap = np.minimum(np.asarray(caps), fl)
     jc = np.asarray(jcaps)  # jc[k]: at the start of element k (jc[0] = inf)
+    # zones: every element, and every corner crossed at a finite speed > 0
+    corners = np.nonzero((jc > 0.0) & np.isfinite(jc))[0]
+    z_cap = np.concatenate([cap, jc[corners]])
+    z_acc = np.concatenate([tacc, np.full(len(corners), np.inf)])
+    reach = z_cap * (0.5 * tj * (1.0 + 1e-9))
+    z_lo = np.concatenate([cum[:-1], cum[corners]]) - reach
+    z_hi = np.concatenate([cum[1:], cum[corners]]) + reach
+    # sections between exact stops clip the zones (the chain's ends bound them too)
+    stops = np.concatenate([[0], np.nonzero(jc[1:] <= 0.0)[0] + 1, [n]])
+    owner = np.concatenate([np.arange(n), corners])
+    q = np.searchsorted(stops, owner, side="right")
+    z_lo = np.maximum(z_lo, cum[stops[q - 1]])
+    z_hi = np.minimum(z_hi, cum[stops[q]])
 
-    def low(x0: float, x1: float) -> float:
-        """Smallest element cap over (x0, x1) and junction cap over [x0, x1]."""
-        i0 = max(int(np.searchsorted(cum, x0, side="right")) - 1, 0)
-        i1 = min(int(np.searchsorted(cum, x1, side="left")), n)
-        c = float(np.min(cap[i0:max(i1, i0 + 1)]))
-        j0 = int(np.searchsorted(cum, x0, side="left"))
-        j1 = int(np.searchsorted(cum, x1, side="right"))
-        if j1 > j0:
-            c = min(c, float(np.min(jc[j0:min(j1, n)], initial=math.inf)))
-        return c
+    def low(x0: float, x1: float) -> tuple[float, float]:
+        """Smallest cap and tangential acceleration of the zones overlapping (x0, x1)."""
+        hit = (z_lo < x1) & (z_hi > x0)
+        return float(np.min(z_cap[hit])), float(np.min(z_acc[hit]))
 
+    def accel_for(k: int, a_low: float) -> float:
+        """The path acceleration to give element k so its tangential one is <= a_low."""
+        if a_low >= tacc[k]:
+            return al[k]
+        if els[k].max_curvature == 0.0:
+            return min(al[k], a_low)
+        return min(al[k], a_low / ARC_TANGENTIAL_RATIO)  # lowers the arc's whole budget
+
+    slack = 1e-9 * max(1.0, float(cum[-1]))
     out: list[PathElement] = []
     of: list[float] = []
     oa: list[float] = []
     for k, el in enumerate(els):
         a, b = float(cum[k]), float(cum[k + 1])
-        if isinstance(el, Line) and el.length > 2.0 * w:
-            head = Line(el.start, el.point(w))
-            mid = Line(head.end, el.point(el.length - w))
-            tail = Line(mid.end, el.end)
-            for piece, c in ((head, low(a - w, a + 2.0 * w)), (mid, fl[k]),
-                             (tail, low(b - 2.0 * w, b + w))):
-                out.append(piece)
-                of.append(min(fl[k], c))
-                oa.append(al[k])
-        else:
-            out.append(el)
-            of.append(min(fl[k], low(a - w, b + w)))
-            oa.append(al[k])
+        if b <= cut + slack or el.length <= 0.0:
+            continue
+        a0 = max(a, cut)
+        inner = np.concatenate([z_lo, z_hi])  # split at the zone edges inside it
+        cuts = np.unique(np.concatenate([[a0], inner[(inner > a0 + slack)
+                                                     & (inner < b - slack)], [b]]))
+        pieces: list[tuple[float, float, float, float]] = []
+        for x0, x1 in zip(cuts[:-1], cuts[1:], strict=True):
+            c, am = low(float(x0), float(x1))
+            f, acc = min(fl[k], c), accel_for(k, am)
+            if pieces and pieces[-1][2:] == (f, acc):
+                pieces[-1] = (pieces[-1][0], float(x1), f, acc)
+            else:
+                pieces.append((float(x0), float(x1), f, acc))
+        for x0, x1, f, acc in pieces:
+            if x0 <= a and x1 >= b:
+                piece: PathElement = el
+            elif isinstance(el, Line):
+                piece = Line(el.start if x0 <= a else el.point(x0 - a),
+                             el.end if x1 >= b else el.point(x1 - a))
+            else:
+                piece = Trimmed(el, x0 - a, None if x1 >= b else x1 - x0)
+            out.append(piece)
+            of.append(f)
+            oa.append(acc)
     return out, of, oa
 
 

@@ -4,9 +4,9 @@ One mechanism for T and S paths. The look-ahead gives a speed curve v**2(s) (pat
 that curve becomes the *raw* motion s(t), piecewise constant acceleration. A T path
 executes the raw motion itself; an S path executes the raw motion smoothed by a moving
 average of window tj (path/smoothing.py), which bounds the path jerk by |delta a|/tj. For
-the smoothed motion to keep the raw motion's speed caps, the caps are held a distance
-`guard` = tj * (highest speed) beyond every element and corner (pathexec.guarded), and the
-raw motion rests tj at every exact-stop corner so the smoothed one passes it at rest.
+the smoothed motion to keep the raw motion's speed caps and tangential accelerations, each
+cap c is held c*tj/2 beyond its element or corner (pathexec.guarded), and the raw motion
+rests tj at every exact-stop corner so the smoothed one passes it at rest.
 
 Every change while running is the same operation: take the raw state now, plan a new raw
 tail from it over the (possibly longer) chain, splice it onto the raw motion, and smooth
@@ -59,19 +59,11 @@ class PathPlan:
         return self.sprof.end.p < self.chain.length
 
 
-def guard_of(chain: px.Chain, lim: px.Limits, tj: float) -> float:
-    """The guard distance of an S path: tj times the highest feed of the chain."""
-    if tj <= 0.0:
-        return 0.0
-    f = lim.feed if chain.feeds is None else min(lim.feed, float(np.max(chain.feeds)) * lim.scale)
-    return tj * f
-
-
 def start(chain: px.Chain, lim: px.Limits, tj: float, t: float, s0: float = 0.0) -> PathPlan:
     """A chain from rest at path position s0 (0: its start; a held chain continues),
     with the StrVel jump of its limits."""
     sv = lim.str_vel  # a StrVel path starts with a jump to it (T paths only)
-    curve = px.plan_curve(chain, s0, sv, lim, guard=guard_of(chain, lim, tj), jump=sv > 0.0)
+    curve = px.plan_curve(chain, s0, sv, lim, window=tj, jump=sv > 0.0)
     raw = px.s_profile(curve, chain.length, chain.cum[1:-1], dwell=tj)
     sprof = fir_smooth(raw, tj) if tj > 0.0 else raw
     return drop_travelled(PathPlan(chain, curve, raw, t, sprof, t, tj, lim, _amin(curve, lim)))
@@ -90,14 +82,13 @@ def replan(plan: PathPlan, t: float, *, chain: px.Chain | None = None,
     raw = _rest_until(plan.raw, u)
     rs = raw.state_at(u)
     s0, v0 = rs.p, max(0.0, rs.v)
-    guard = guard_of(chain, lim, tj)
     lead = 0.0
     if hold:
         curve = px.hold_curve(plan.curve, s0, v0, plan.a_min)
         s_end = px.stop_point(curve) if v0 > 0.0 else s0
     else:
         old = plan.curve.tail(s0) if chain is plan.chain else None
-        curve = px.plan_curve(chain, s0, v0, lim, old, guard=guard)
+        curve = px.plan_curve(chain, s0, v0, lim, old, window=tj)
         s_end = chain.length
         if v0 == 0.0 and tj > 0.0 and chain is not plan.chain:
             lead = tj  # joined at rest (the raw motion had ended): stop out the corner

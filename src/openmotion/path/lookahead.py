@@ -359,3 +359,17 @@ def speed_caps(elements: Sequence[PathElement], feed: float | Sequence[float],
         jcaps.append(_junction_cap(prev, nxt, min(accels[k - 1], accels[k]), scv, amax_ax,
                                    vjump_ax))
     return caps, jcaps
+
+
+def tangential_accels(elements: Sequence[PathElement], accel: float | Sequence[float], *,
+                      axis_amax: ArrayLike | None = None,
+                      arc_tangential_ratio: float = 0.5) -> list[float]:
+    """The tangential acceleration `plan_speeds` allows on each element (step 1 of the
+    module doc): the path acceleration, lowered by the axis limits, times the tangential
+    share on curved elements."""
+    n = len(elements)
+    dim = elements[0].dim if n else 0
+    accels = _per_element("accel", accel, n)
+    amax_ax = _axis_limits("axis_amax", axis_amax, dim)
+    return [_element_limits(el, a, a, None, amax_ax, arc_tangential_ratio)[0]
+            if el.length > 0.0 else a for el, a in zip(elements, accels, strict=True)]
