@@ -440,8 +440,9 @@ def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: fl
     z_hi = np.minimum(z_hi, cum[stops[q]])
 
     def low(x0: float, x1: float) -> tuple[float, float]:
-        """Smallest cap and tangential acceleration of the zones overlapping (x0, x1)."""
-        hit = (z_lo < x1) & (z_hi > x0)
+        """Smallest cap and tangential acceleration of the zones overlapping (x0, x1) by
+        more than the rounding slack."""
+        hit = (z_lo < x1 - slack) & (z_hi > x0 + slack)
         return float(np.min(z_cap[hit])), float(np.min(z_acc[hit]))
 
     def accel_for(k: int, a_low: float) -> float:
@@ -510,6 +511,11 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     n = int(math.floor(dur / period + 1e-9))
     grid = np.arange(n + 1) * period
     brk = np.union1d(sp.t0, [dur])
+    # the instants s(t) crosses an element boundary are knots too (a smoothed S path's
+    # breaks are not there): an interval then never straddles a change of curvature, which
+    # the cubic would smear into an acceleration overshoot
+    cross = _crossings(sp, chain.cum[1:-1])
+    brk = np.union1d(brk, cross[~_near(cross, brk, 1e-6 * period)]) if len(cross) else brk
     # grid knots closer than 1e-6 period to a break of s(t) are dropped: a tiny interval
     # would make the Hermite coefficients (divided by h**2, h**3) lose all precision
     near = _near(grid, brk, 1e-6 * period)
@@ -571,6 +577,24 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
             start=State(float(pos[0, i]), float(v0[0, i]) if sp.start.v else 0.0, 0.0),
             end=State(float(pos[-1, i]), 0.0, 0.0), labels=labels, dt=dts.copy()))
     return out
+
+
+def _crossings(sp: Profile, levels: np.ndarray) -> np.ndarray:
+    """Times at which a non-decreasing s(t) reaches each of `levels` inside its range
+    (vectorised bisection in the segment that holds the level)."""
+    lv = levels[(levels > sp.start.p) & (levels < sp.end.p)]
+    n = sp.n_segments
+    if not len(lv) or not n:
+        return np.zeros(0)
+    k = np.clip(np.searchsorted(sp.p0, lv, side="right") - 1, 0, n - 1)
+    dts = sp.dt if sp.dt is not None else np.diff(np.append(sp.t0, sp.duration))
+    lo, hi = np.zeros(len(lv)), np.asarray(dts, dtype=float)[k].copy()
+    p0, v0, a0, j = sp.p0[k], sp.v0[k], sp.a0[k], sp.j[k]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        below = p0 + mid * (v0 + mid * (a0 / 2.0 + mid * j / 6.0)) < lv
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return np.unique(sp.t0[k] + hi)
 
 
 def _end_speed(sp: Profile) -> float:

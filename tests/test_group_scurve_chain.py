@@ -1,0 +1,216 @@
+"""S-curve path chains (issue 4): blended, exact-stop, arc, streamed, overridden, held and
+mixed-feed chains on recorded runs (`ctl.history.sample`) and on the executed plans
+themselves (`g._run.plan.sprof` holds the exact path motion, so the path jerk and the speed
+on each element are checked exactly)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from openmotion.control import Controller
+from openmotion.control.group import Group, GroupState
+from openmotion.control.pathexec import contour_error
+from openmotion.path import Arc, Line, speed_caps
+
+VMAX, AMAX = 50_000.0, 500_000.0       # per-axis pulse speed and acceleration limits
+FEED, ACC_T, JERK = 40_000.0, 0.1, 2.0e7  # path: 400 000 pps^2, window tj = 0.04 s
+REL = 1e-9                               # relative slack of every limit check
+
+# line -> line (45 deg) -> line (45 deg) -> line (104 deg)
+LL = [("line", [20_000, 0]), ("line", [30_000, 10_000]), ("line", [30_000, 30_000]),
+      ("line", [10_000, 35_000])]
+# line -> arc (90 deg corner) -> line (45 deg corner)
+LAL = [("line", [20_000, 0]), ("arc", [25_000, 0], [30_000, 0], "CW"),
+       ("line", [40_000, -10_000])]
+
+
+class Recorder:
+    """Every plan the group executes (a cycle hook after the group's own)."""
+
+    def __init__(self, ctl: Controller, g: Group) -> None:
+        self.g = g
+        self.plans: list = []
+        ctl.add_cycle_hook(self)
+
+    def __call__(self, ctl: Controller, t: float) -> None:
+        r = self.g._run
+        if r is not None and r.plan is not None and (
+                not self.plans or self.plans[-1] is not r.plan):
+            self.plans.append(r.plan)
+
+    def path_jerk(self) -> float:
+        """Largest |jerk| of every planned path motion s(t) (exact: its segments)."""
+        return max(float(np.max(np.abs(p.sprof.j), initial=0.0)) for p in self.plans)
+
+    def executed(self, n: int = 4000):
+        """(plan, s, v) samples of each plan over the time it was the one executed."""
+        for i, p in enumerate(self.plans):
+            end = min(p.t_end, self.plans[i + 1].t0) if i + 1 < len(self.plans) else p.t_end
+            if end <= p.t0:
+                continue
+            smp = p.sprof.sample(np.linspace(0.0, end - p.t0, n))
+            yield p, smp.p, smp.v
+
+
+def make(*, jerk: float | None = JERK, tol: float | None = 40.0, feed: float = FEED,
+         acc_t: float = ACC_T, policy: str = "refuse", queue_size: int = 1024):
+    ctl = Controller()
+    ctl.enable_all()
+    for k in range(len(ctl.axes)):
+        ctl.hardware.scenario.remove_switch(k, "mel")
+    g = Group(ctl, ["x", "y"], feed=feed, acc_time=acc_t, queue_size=queue_size)
+    g.set_max_pulse_speed([VMAX, VMAX])
+    g.set_max_pulse_acc([AMAX, AMAX])
+    g.set_axis_limit_policy(policy)
+    if jerk is not None:
+        g.set_path_shape("S", jerk=jerk)
+    if tol is not None:
+        g.enable_blend(tol)
+    return ctl, g, Recorder(ctl, g)
+
+
+def push(g: Group, prog) -> None:
+    for cmd in prog:
+        if cmd[0] == "line":
+            g.line(cmd[1])
+        elif cmd[0] == "arc":
+            g.arc(cmd[1], cmd[2], direction=cmd[3])
+        else:
+            g.set_feed(cmd[1])
+
+
+def elements(prog, start=(0.0, 0.0)) -> list:
+    els, p = [], np.array(start, dtype=float)
+    for cmd in prog:
+        if cmd[0] == "line":
+            els.append(Line(p, cmd[1]))
+        elif cmd[0] == "arc":
+            els.append(Arc(p, cmd[1], cmd[2], direction=cmd[3]))
+        else:
+            continue
+        p = np.array(els[-1].end, dtype=float)
+    return els
+
+
+def finish(ctl: Controller, g: Group, timeout: float = 60.0) -> float:
+    ctl.step()
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
+                         and not any(a.is_moving for a in g.axes), timeout)
+    return ctl.time
+
+
+def recorded(ctl: Controller, g: Group, t0: float, t1: float, n: int = 40_001):
+    t = np.linspace(t0, t1, n)
+    return t, [ctl.history.sample(a.index, t) for a in g.axes]
+
+
+def check_axes(sx, sy) -> None:
+    """Per-axis speed and acceleration within the limits at every sample."""
+    for s in (sx, sy):
+        assert np.abs(s.v).max() <= VMAX * (1 + REL)
+        assert np.abs(s.a).max() <= AMAX * (1 + REL)
+
+
+def speed(sx, sy) -> np.ndarray:
+    return np.hypot(sx.v, sy.v)
+
+
+def min_cruise_speed(sx, sy, feed: float = FEED) -> float:
+    """Smallest speed between the first and the last instant above half the feed: a stop
+    anywhere inside the chain shows as ~0."""
+    v = speed(sx, sy)
+    fast = np.nonzero(v > 0.5 * feed)[0]
+    return float(v[fast[0]:fast[-1] + 1].min())
+
+
+def caps_held(rec: Recorder) -> float:
+    """Largest ratio of the executed path speed to the speed cap (feed, axis speeds,
+    centripetal share on arcs) of the element it is on, over every executed plan."""
+    worst = 0.0
+    for p, s, v in rec.executed():
+        ch, lim = p.chain, p.limits
+        feeds = np.minimum(ch.feeds * lim.scale, lim.feed)
+        caps, _ = speed_caps(list(ch.elements), feeds.tolist(), ch.accels.tolist(),
+                             axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax)
+        k = np.clip(np.searchsorted(ch.cum, s, side="right") - 1, 0, len(ch.elements) - 1)
+        worst = max(worst, float(np.max(v / np.asarray(caps)[k])))
+    return worst
+
+
+def run_prog(prog, **kw):
+    ctl, g, rec = make(**kw)
+    t0 = ctl.time
+    push(g, prog)
+    t1 = finish(ctl, g)
+    t, (sx, sy) = recorded(ctl, g, t0, t1)
+    return t1 - t0, g, rec, t, sx, sy
+
+
+# ------------------------------------------------------------------ 1. blended chains
+@pytest.mark.parametrize("prog", [LL, LAL], ids=["line-line", "line-arc-line"])
+def test_blended_chain_runs_through_within_limits(prog):
+    tol = 40.0
+    els = elements(prog)
+    t_t, *_ = run_prog(prog, jerk=None, tol=tol)
+    t_s, g, rec, t, sx, sy = run_prog(prog, tol=tol)
+    assert g.position.tolist() == list(els[-1].end)  # exact end
+    assert min_cruise_speed(sx, sy) > 1000.0  # no stop inside the chain
+    err = contour_error(np.stack([sx.p, sy.p], axis=1), els)
+    assert 0.5 * tol < err.max() <= tol * (1 + 1e-6)  # corners rounded within T
+    check_axes(sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    assert caps_held(rec) <= 1 + REL
+    # the smoothing adds about one window per chain, not one per corner
+    assert t_t < t_s < t_t + 0.2
+
+
+# ------------------------------------------------------------------ 2. exact-stop corners
+ZIGZAG = [("line", [10_000.0 * (k + 1), 6_000.0 * (k % 2 == 0)]) for k in range(6)]
+
+
+def test_exact_stop_zigzag_passes_each_corner_at_rest():
+    els = elements(ZIGZAG)
+    _, g, rec, t, sx, sy = run_prog(ZIGZAG, tol=None)  # blending off: exact stops
+    assert g.position.tolist() == [60_000.0, 0.0]
+    check_axes(sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    xy = np.stack([sx.p, sy.p], axis=1)
+    assert contour_error(xy, els).max() < 1e-6  # the path is followed exactly
+    dt = t[1] - t[0]
+    for el in els[:-1]:  # the recorded motion is at rest at each corner instant
+        i = int(np.argmin(np.linalg.norm(xy - el.end, axis=1)))
+        assert np.linalg.norm(xy[i] - el.end) < 1e-3
+        assert speed(sx, sy)[i] < 1e-3 * FEED
+        assert np.hypot(sx.a[i], sy.a[i]) < JERK * 2 * dt
+    # no acceleration spike: every axis acceleration is continuous (jerk-bounded steps),
+    # where a T path flips -A*u1 -> +A*u2 at the corner
+    for s in (sx, sy):
+        assert np.abs(np.diff(s.a)).max() <= JERK * dt * (1 + 1e-6)
+    _, _, _, _, tx, ty = run_prog(ZIGZAG, tol=None, jerk=None)
+    assert np.abs(np.diff(tx.a)).max() > 0.5 * AMAX  # (the T path does spike)
+
+
+# ------------------------------------------------------------------ 3. arcs at high feed
+@pytest.mark.parametrize("radius", [1_000.0, 3_000.0])
+def test_arc_centripetal_share_held_at_high_feed(radius):
+    """Feed 50 000 pps, path acceleration = the axis limit: the arc's centripetal cap
+    sqrt(sqrt(3)/2 * A * R) binds. A short line from rest accelerates into it, so the
+    smoothing window holds raw motion of both (the guard keeps the arc's cap and tangential
+    share there); the recorded axis accelerations stay within the limit, also where the
+    curvature steps at the arc's ends (knots at the element boundaries)."""
+    r = radius
+    prog = [("line", [1_000, 0]), ("arc", [1_000, r], [1_000 + r, r], "CCW"),
+            ("line", [1_000 + r, r + 5_000])]
+    _, g, rec, t, sx, sy = run_prog(prog, jerk=5e6, tol=None, feed=50_000.0, acc_t=0.1,
+                                    policy="slow")
+    assert g.position.tolist() == [1_000 + r, r + 5_000]
+    check_axes(sx, sy)
+    assert caps_held(rec) <= 1 + REL  # the speed on the arc within its centripetal cap
+    assert rec.path_jerk() <= 5e6 * (1 + REL)
+    xy = np.stack([sx.p, sy.p], axis=1)
+    on_arc = np.abs(np.hypot(xy[:, 0] - 1_000, xy[:, 1] - r) - r) < 1e-6
+    on_arc &= xy[:, 0] > 1_000 + 1e-6
+    a_n = speed(sx, sy)[on_arc] ** 2 / r
+    assert a_n.max() <= np.sqrt(0.75) * AMAX * (1 + 1e-6)  # recorded (Hermite error 1e-6)
+    assert a_n.max() > 0.9 * np.sqrt(0.75) * AMAX  # the cap is reached: the test binds
