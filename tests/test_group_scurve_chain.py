@@ -214,3 +214,125 @@ def test_arc_centripetal_share_held_at_high_feed(radius):
     a_n = speed(sx, sy)[on_arc] ** 2 / r
     assert a_n.max() <= np.sqrt(0.75) * AMAX * (1 + 1e-6)  # recorded (Hermite error 1e-6)
     assert a_n.max() > 0.9 * np.sqrt(0.75) * AMAX  # the cap is reached: the test binds
+
+
+# ------------------------------------------------------------------ 4. streaming
+def _raw_state(g: Group, t: float):
+    p = g._run.plan
+    return p.raw.state_at(t - p.raw_t0), p
+
+
+def _check_stream(ctl, g, rec, t0, els, tol):
+    t1 = finish(ctl, g)
+    t, (sx, sy) = recorded(ctl, g, t0, t1)
+    assert g.position.tolist() == list(els[-1].end)
+    check_axes(sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    assert caps_held(rec) <= 1 + REL
+    err = contour_error(np.stack([sx.p, sy.p], axis=1), els)
+    assert err.max() <= tol * (1 + 1e-6)
+    return t, sx, sy
+
+
+def test_commands_pushed_while_running_join_and_blend():
+    ctl, g, rec = make()
+    t0 = ctl.time
+    for k, cmd in enumerate(LAL):
+        push(g, [cmd])
+        if k < len(LAL) - 1:
+            ctl.advance(0.08)  # the rest joins the running chain
+    _, sx, sy = _check_stream(ctl, g, rec, t0, elements(LAL), 40.0)
+    assert min_cruise_speed(sx, sy) > 1000.0  # joined and blended: no stop
+    assert len({p.chain.owners[-1] for p in rec.plans}) == 3  # three joins/starts
+
+
+def test_push_after_raw_motion_ended_joins_at_rest():
+    """The raw motion has ended (it rests at the chain's end) while the smoothed one still
+    moves: the next command joins (a re-plan with a lead of tj), the corner is passed at
+    rest and no limit is exceeded."""
+    ctl, g, rec = make()
+    t0 = ctl.time
+    g.line([10_000, 0])
+    ctl.step()
+    plan = g._run.plan
+    t_raw_end = plan.raw_t0 + plan.raw.duration
+    assert ctl.run_until(lambda: ctl.time > t_raw_end + 0.01, 5)
+    assert g._run is not None and ctl.time < g._run.plan.t_end  # still moving
+    assert g.axes[0].velocity > 0.0
+    g.line([10_000, 10_000])
+    assert g._run.plan.chain.owners[-1] == 1  # joined the running chain at once
+    g.line([0, 10_000])
+    els = elements([("line", [10_000, 0]), ("line", [10_000, 10_000]), ("line", [0, 10_000])])
+    t, sx, sy = _check_stream(ctl, g, rec, t0, els, 40.0)
+    _at_rest_without_spike(t, sx, sy, [10_000, 0])  # the corner the raw motion stopped at
+
+
+def _at_rest_without_spike(t, sx, sy, corner) -> None:
+    """The motion passes `corner` at rest, its axis accelerations continuous around it
+    (the next corner may be blended: a blend's curvature step is not checked here)."""
+    xy = np.stack([sx.p, sy.p], axis=1)
+    i = int(np.argmin(np.linalg.norm(xy - corner, axis=1)))
+    assert np.linalg.norm(xy[i] - corner) < 1e-3
+    assert speed(sx, sy)[i] < 1e-3 * FEED
+    near = slice(max(0, i - 2000), i + 2000)
+    for s in (sx, sy):
+        assert np.abs(np.diff(s.a[near])).max() <= JERK * (t[1] - t[0]) * (1 + 1e-6)
+
+
+def test_late_push_while_braking_keeps_limits():
+    """A command pushed while the chain brakes for its end, too late for a blend: it joins
+    with an exact stop (or starts after the chain), within every limit."""
+    ctl, g, rec = make()
+    t0 = ctl.time
+    g.line([20_000, 0])
+    ctl.step()
+
+    def braking() -> bool:
+        rs, p = _raw_state(g, ctl.time)
+        return rs.a < 0.0 and p.chain.length - rs.p < 1_000.0
+    assert ctl.run_until(braking, 5)
+    g.line([20_000, 10_000])
+    g.line([30_000, 20_000])
+    els = elements([("line", [20_000, 0]), ("line", [20_000, 10_000]),
+                    ("line", [30_000, 20_000])])
+    t, sx, sy = _check_stream(ctl, g, rec, t0, els, 40.0)
+    _at_rest_without_spike(t, sx, sy, [20_000, 0])
+
+
+def cam_polyline(n: int, seg: float, seed: int = 1) -> np.ndarray:
+    """n short segments turning 1.5-4 deg at each corner, the turn changing side every 150
+    segments (a CAM contour: S-bends of polylines), rounded to 1e-3 pulse."""
+    rng = np.random.default_rng(seed)
+    turn = rng.uniform(1.5, 4.0, n) * np.where((np.arange(n) // 150) % 2, 1.0, -1.0)
+    head = np.cumsum(np.deg2rad(turn))
+    return np.round(np.cumsum(np.stack([np.cos(head), np.sin(head)], axis=1) * seg, axis=0), 3)
+
+
+def test_long_stream_keeps_a_short_chain_and_never_stops():
+    n, tol = 2000, 20.0
+    pts = cam_polyline(n, 300.0)
+    ctl, g, rec = make(tol=tol)
+    todo = iter(pts.tolist())
+    sizes: list[int] = []
+
+    def feeder(c: Controller, t: float) -> None:  # a CAM sender keeping 200 queued
+        while g.queue_length < 200:
+            nxt = next(todo, None)
+            if nxt is None:
+                return
+            g.line(nxt)
+        if g._run is not None and g._run.plan is not None:
+            sizes.append(len(g._run.plan.chain.elements))
+    ctl.add_cycle_hook(feeder)
+    t0 = ctl.time
+    t1 = finish(ctl, g, 120.0)
+    assert g.position.tolist() == pts[-1].tolist()
+    assert len(sizes) > 1000 and max(sizes) <= 150  # of 2n elements: the look-ahead reach
+    t, (sx, sy) = recorded(ctl, g, t0, t1, 100_001)
+    inner = (t > t0 + 0.2) & (t < t1 - 0.2)  # past the start's and before the end's ramp
+    assert speed(sx, sy)[inner].min() > 0.5 * FEED  # never stops, never crawls
+    check_axes(sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    els = elements([("line", p) for p in pts])
+    xy = np.stack([sx.p, sy.p], axis=1)[::5]
+    assert contour_error(xy, els).max() <= tol * (1 + 1e-6)
