@@ -124,13 +124,15 @@ def min_cruise_speed(sx, sy, feed: float = FEED) -> float:
     return float(v[fast[0]:fast[-1] + 1].min())
 
 
-def caps_held(rec: Recorder) -> float:
+def caps_held(rec: Recorder, scale: float | None = None) -> float:
     """Largest ratio of the executed path speed to the speed cap (feed, axis speeds,
-    centripetal share on arcs) of the element it is on, over every executed plan."""
+    centripetal share on arcs) of the element it is on, over every executed plan (with the
+    feed override `scale` instead of each plan's own: a lower override is reached by a
+    deceleration, not at once)."""
     worst = 0.0
     for p, s, v in rec.executed():
         ch, lim = p.chain, p.limits
-        feeds = np.minimum(ch.feeds * lim.scale, lim.feed)
+        feeds = np.minimum(ch.feeds * (scale or lim.scale), lim.feed)
         caps, _ = speed_caps(list(ch.elements), feeds.tolist(), ch.accels.tolist(),
                              axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax)
         k = np.clip(np.searchsorted(ch.cum, s, side="right") - 1, 0, len(ch.elements) - 1)
@@ -336,3 +338,190 @@ def test_long_stream_keeps_a_short_chain_and_never_stops():
     els = elements([("line", p) for p in pts])
     xy = np.stack([sx.p, sy.p], axis=1)[::5]
     assert contour_error(xy, els).max() <= tol * (1 + 1e-6)
+
+
+# ------------------------------------------------------------------ 5. override, hold, abort
+LONG = [("line", [40_000, 0]), ("line", [60_000, 20_000]), ("line", [60_000, 60_000]),
+        ("line", [20_000, 70_000])]
+
+
+def _smooth_run(t, sx, sy) -> None:
+    """No velocity jump (each step within the acceleration limit) and no acceleration jump
+    on the lines (each step within the path jerk)."""
+    dt = t[1] - t[0]
+    for s in (sx, sy):
+        assert np.abs(np.diff(s.v)).max() <= AMAX * dt * (1 + 1e-6)
+
+
+def test_feed_override_up_and_down_mid_chain_is_smooth():
+    ctl, g, rec = make()
+    t0 = ctl.time
+    push(g, LONG)
+    ctl.advance(0.4)
+    g.set_override(150)   # faster (the axes' 50 000 pps cap the diagonal)
+    ctl.advance(0.5)
+    g.set_override(40)    # slower: decelerates to the new feed along the plan
+    ctl.advance(0.5)
+    g.set_override(100)
+    t1 = finish(ctl, g)
+    t, (sx, sy) = recorded(ctl, g, t0, t1)
+    assert g.position.tolist() == [20_000.0, 70_000.0]
+    assert len(rec.plans) >= 4
+    check_axes(sx, sy)
+    _smooth_run(t, sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    assert caps_held(rec, 1.5) <= 1 + REL
+    v = speed(sx, sy)
+    assert v[(t > t0 + 0.85) & (t < t0 + 0.9)].max() > 1.2 * FEED  # the override took
+    assert v[(t > t0 + 1.3) & (t < t0 + 1.4)].max() < 0.41 * FEED
+    assert contour_error(np.stack([sx.p, sy.p], axis=1), elements(LONG)).max() <= 40.0
+
+
+def _uninterrupted_end() -> list[float]:
+    return elements(LONG)[-1].end.tolist()
+
+
+def test_hold_stops_on_the_path_and_continue_ends_exactly():
+    ctl, g, rec = make()
+    t0 = ctl.time
+    push(g, LONG)
+    ctl.advance(0.7)
+    g.hold()
+    assert ctl.run_until(lambda: g.state is GroupState.HELD, 5)
+    t_held = ctl.time
+    assert not any(a.is_moving for a in g.axes)
+    t, (sx, sy) = recorded(ctl, g, t0, t_held)
+    check_axes(sx, sy)
+    _smooth_run(t, sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    held = g.position.copy()
+    assert contour_error(held[None, :], elements(LONG))[0] <= 40.0  # on the path
+    assert 0.0 < held[0] < 60_000.0
+    ctl.advance(0.2)
+    g.cont()
+    t1 = finish(ctl, g)
+    assert g.position.tolist() == _uninterrupted_end()
+    t, (sx, sy) = recorded(ctl, g, t0, t1)
+    check_axes(sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    assert contour_error(np.stack([sx.p, sy.p], axis=1), elements(LONG)).max() <= 40.0
+
+
+def test_abort_stops_on_the_path_and_takes_new_commands():
+    ctl, g, rec = make()
+    t0 = ctl.time
+    push(g, LONG)
+    ctl.advance(1.0)
+    g.abort()
+    assert g.queue_length == 0
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE
+                         and not any(a.is_moving for a in g.axes), 5)
+    t, (sx, sy) = recorded(ctl, g, t0, ctl.time)
+    check_axes(sx, sy)
+    _smooth_run(t, sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    stop = g.position.copy()
+    assert contour_error(stop[None, :], elements(LONG))[0] <= 40.0
+    assert stop.tolist() != _uninterrupted_end()
+    g.line([0, 0])
+    finish(ctl, g)
+    assert g.position.tolist() == [0.0, 0.0]
+
+
+# ------------------------------------------------------------------ 6. mixed commands
+FEEDS = [("line", [20_000, 0]), ("feed", 15_000.0), ("line", [30_000, 8_000]),
+         ("line", [40_000, 8_000]), ("feed", 40_000.0), ("line", [60_000, 20_000])]
+
+
+@pytest.mark.parametrize("jerk", [None, JERK], ids=["T", "S"])
+def test_per_command_feeds_blend_in_one_chain(jerk):
+    """A program changing F keeps blending: one chain, each element within its own feed
+    (the slower command's cap reaches tj*F/2 into its neighbours on an S path)."""
+    els = elements(FEEDS)
+    _, g, rec, t, sx, sy = run_prog(FEEDS, jerk=jerk, tol=40.0)
+    assert g.position.tolist() == [60_000.0, 20_000.0]
+    assert speed(sx, sy)[(t > t[0] + 0.2) & (t < t[-1] - 0.2)].min() > 5_000.0  # no stop
+    assert any(len(set(p.chain.feeds)) > 1 for p in rec.plans)  # mixed feeds in a chain
+    assert caps_held(rec) <= 1 + REL   # each element's own feed
+    check_axes(sx, sy)
+    err = contour_error(np.stack([sx.p, sy.p], axis=1), els)
+    assert 20.0 < err.max() <= 40.0 * (1 + 1e-6)
+    if jerk:
+        assert rec.path_jerk() <= JERK * (1 + REL)
+
+
+def _element_jerk_ratio(rec: Recorder, jerk_of: dict[int, float]) -> float:
+    """Largest |path jerk| / the jerk limit of the command owning the element the executed
+    position is on."""
+    worst = 0.0
+    for i, p in enumerate(rec.plans):
+        end = min(p.t_end, rec.plans[i + 1].t0) if i + 1 < len(rec.plans) else p.t_end
+        smp = p.sprof.sample(np.linspace(0.0, max(0.0, end - p.t0), 4000))
+        k = np.clip(np.searchsorted(p.chain.cum, smp.p, side="right") - 1, 0,
+                    len(p.chain.elements) - 1)
+        lim = np.array([jerk_of[p.chain.owners[q]] for q in k])
+        worst = max(worst, float(np.max(np.abs(smp.j) / lim)))
+    return worst
+
+
+def test_command_with_a_smaller_window_joins_and_keeps_each_jerk():
+    """Command 1 has twice the acceleration and four times the jerk (half the window): it
+    joins the chain; the guard keeps the other commands' accelerations near it, so every
+    element keeps its own command's jerk limit."""
+    ctl, g, rec = make(tol=40.0, policy="slow")
+    t0 = ctl.time
+    g.line([20_000, 0])
+    g.set_acc_time(ACC_T / 2)
+    g.set_path_shape("S", jerk=4 * JERK)
+    g.line([30_000, 10_000])
+    g.set_acc_time(ACC_T)
+    g.set_path_shape("S", jerk=JERK)
+    g.line([30_000, 30_000])
+    t1 = finish(ctl, g)
+    assert g.position.tolist() == [30_000.0, 30_000.0]
+    assert any(len(p.chain.owners) and set(p.chain.owners) >= {0, 1} for p in rec.plans)
+    assert _element_jerk_ratio(rec, {0: JERK, 1: 4 * JERK, 2: JERK}) <= 1 + REL
+    t, (sx, sy) = recorded(ctl, g, t0, t1)
+    check_axes(sx, sy)
+    assert speed(sx, sy)[(t > t0 + 0.2) & (t < t1 - 0.2)].min() > 1_000.0
+
+
+def test_command_with_a_larger_window_starts_a_new_chain():
+    """A lower jerk (a window longer than the running chain's) must not join: the chain
+    stops exactly at the corner and the command runs as a new chain with its own window."""
+    ctl, g, rec = make(tol=40.0)
+    t0 = ctl.time
+    g.line([20_000, 0])
+    g.line([30_000, 10_000])
+    g.set_path_shape("S", jerk=JERK / 4)
+    g.line([30_000, 30_000])
+    t1 = finish(ctl, g)
+    assert g.position.tolist() == [30_000.0, 30_000.0]
+    for p in rec.plans:  # never both windows in one chain
+        assert not {1, 2} <= set(p.chain.owners)
+    assert {round(p.tj, 9) for p in rec.plans} == {0.04, 0.16}
+    assert _element_jerk_ratio(rec, {0: JERK, 1: JERK, 2: JERK / 4}) <= 1 + REL
+    t, (sx, sy) = recorded(ctl, g, t0, t1)
+    check_axes(sx, sy)
+    xy = np.stack([sx.p, sy.p], axis=1)
+    i = int(np.argmin(np.linalg.norm(xy - [30_000, 10_000], axis=1)))
+    assert speed(sx, sy)[i] < 1e-3 * FEED  # exact stop between the chains
+    assert np.linalg.norm(xy[i] - [30_000, 10_000]) < 1e-3
+
+
+def test_higher_acceleration_next_to_a_short_move_keeps_its_jerk():
+    """Two short collinear moves: 200 000 pps^2 and jerk 1e7, then 400 000 pps^2 and jerk
+    4e7 (window 0.02 s <= 0.04 s: it joins). The second's raw motion accelerates and brakes
+    within one window of the first's executed position: without the acceleration guard its
+    jerk would reach 1.5 times the first command's limit."""
+    ctl, g, rec = make(tol=None)
+    g.set_acc_time(0.2)
+    g.set_path_shape("S", jerk=1e7)
+    g.line([300, 0])
+    g.set_acc_time(0.1)
+    g.set_path_shape("S", jerk=4e7)
+    g.line([800, 0])
+    finish(ctl, g)
+    assert g.position.tolist() == [800.0, 0.0]
+    assert [p.chain.owners for p in rec.plans] == [(0, 1)]
+    assert _element_jerk_ratio(rec, {0: 1e7, 1: 4e7}) <= 1 + REL
