@@ -11,7 +11,7 @@ import pytest
 from openmotion.control import Controller
 from openmotion.control.group import Group, GroupState
 from openmotion.control.pathexec import contour_error
-from openmotion.path import Arc, Line, speed_caps
+from openmotion.path import Arc, Line, plan_speeds, speed_caps, tangential_accels
 
 VMAX, AMAX = 50_000.0, 500_000.0       # per-axis pulse speed and acceleration limits
 FEED, ACC_T, JERK = 40_000.0, 0.1, 2.0e7  # path: 400 000 pps^2, window tj = 0.04 s
@@ -525,3 +525,46 @@ def test_higher_acceleration_next_to_a_short_move_keeps_its_jerk():
     assert g.position.tolist() == [800.0, 0.0]
     assert [p.chain.owners for p in rec.plans] == [(0, 1)]
     assert _element_jerk_ratio(rec, {0: 1e7, 1: 4e7}) <= 1 + REL
+
+
+# ------------------------------------------------------------------ the guard itself
+def _limits(feed: float = FEED, accel: float = 400_000.0):
+    from openmotion.control.pathexec import Limits
+    return Limits(feed, accel, np.array([VMAX, VMAX]), np.array([AMAX, AMAX]))
+
+
+def test_guard_zone_is_half_a_window_of_the_cap():
+    """A line into an arc of cap c: the line's last c*tj/2 runs at c (and at the arc's
+    tangential acceleration), the rest at the feed; the arc keeps its own cap."""
+    from openmotion.control.pathexec import guarded
+    tj = 0.04
+    arc = Arc([10_000, 0], [10_000, 1_000], [11_000, 1_000], direction="CCW")
+    els = [Line([0, 0], [10_000, 0]), arc]
+    caps, _ = speed_caps(els, FEED, 400_000.0, axis_vmax=[VMAX, VMAX],
+                         axis_amax=[AMAX, AMAX])
+    c = caps[1]
+    assert c < FEED
+    out, feeds, accels = guarded(els, FEED, 400_000.0, _limits(), tj)
+    assert [round(e.length, 6) for e in out] == [round(10_000 - c * tj / 2, 6),
+                                                 round(c * tj / 2, 6), round(arc.length, 6)]
+    assert feeds == [FEED, pytest.approx(c), pytest.approx(c)]
+    assert accels[0] == 400_000.0
+    assert accels[1] == pytest.approx(tangential_accels([arc], 400_000.0,
+                                                        axis_amax=[AMAX, AMAX])[0])
+
+
+def test_guard_does_not_cross_an_exact_stop():
+    """An exact-stop corner (junction speed 0) is a barrier: neither side is slowed for the
+    other, and no element gets a 0 feed (which used to crash the join)."""
+    from openmotion.control.pathexec import guarded
+    els = [Line([0, 0], [10_000, 0]), Line([10_000, 0], [10_000, 10_000])]
+    out, feeds, _ = guarded(els, [FEED, 10_000.0], [400_000.0, 400_000.0], _limits(), 0.04)
+    assert len(out) == 2 and feeds == [FEED, 10_000.0]
+
+
+def test_tangential_accels_match_the_look_ahead():
+    els = [Line([0, 0], [3, 4]), Arc([3, 4], [3, 6], [3, 8], direction="CW"),
+           Line([3, 8], [3, 20])]
+    sp = plan_speeds(els, 100.0, [50.0, 80.0, 90.0], axis_amax=[40.0, 60.0])
+    assert tangential_accels(els, [50.0, 80.0, 90.0], axis_amax=[40.0, 60.0]) == \
+        [x.accel for x in sp]

@@ -10,7 +10,13 @@ from .blend import BLEND_DIST_FRACTION, Blend, blend_corner, centripetal_speed, 
 from .contour import contour_error
 from .extent import element_extent
 from .geometry import Direction, Line, PathElement
-from .lookahead import ElementSpeeds, acceleration_reversals, plan_speeds, speed_caps
+from .lookahead import (
+    ElementSpeeds,
+    acceleration_reversals,
+    plan_speeds,
+    speed_caps,
+    tangential_accels,
+)
 
 __all__ = [
     "ARC_TOL",
@@ -30,4 +36,5 @@ __all__ = [
     "element_extent",
     "plan_speeds",
     "speed_caps",
+    "tangential_accels",
 ]
