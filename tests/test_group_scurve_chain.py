@@ -377,6 +377,32 @@ def test_feed_override_up_and_down_mid_chain_is_smooth():
     assert contour_error(np.stack([sx.p, sy.p], axis=1), elements(LONG)).max() <= 40.0
 
 
+
+def test_override_while_resting_at_an_exact_stop_keeps_the_rest():
+    """An override re-plans from the raw state; at an exact-stop corner the raw motion is
+    resting out its tj. The re-plan completes that rest, so the corner is still passed at
+    rest (it used to leave at once: a 3 422 pps velocity step at the corner)."""
+    ctl, g, rec = make(tol=None)
+    t0 = ctl.time
+    g.line([10_000, 0])
+    g.line([10_000, 10_000])
+    ctl.step()
+
+    def resting() -> bool:
+        rs, _ = _raw_state(g, ctl.time)
+        return rs.v == 0.0 and rs.p > 5_000.0
+    assert ctl.run_until(resting, 5)
+    ctl.advance(0.003)
+    g.set_override(120)
+    t1 = finish(ctl, g)
+    assert g.position.tolist() == [10_000.0, 10_000.0]
+    t, (sx, sy) = recorded(ctl, g, t0, t1)
+    check_axes(sx, sy)
+    _smooth_run(t, sx, sy)
+    assert rec.path_jerk() <= JERK * (1 + REL)
+    _at_rest_without_spike(t, sx, sy, [10_000, 0])
+
+
 def _uninterrupted_end() -> list[float]:
     return elements(LONG)[-1].end.tolist()
 

@@ -90,8 +90,10 @@ def replan(plan: PathPlan, t: float, *, chain: px.Chain | None = None,
         old = plan.curve.tail(s0) if chain is plan.chain else None
         curve = px.plan_curve(chain, s0, v0, lim, old, window=tj)
         s_end = chain.length
-        if v0 == 0.0 and tj > 0.0 and chain is not plan.chain:
-            lead = tj  # joined at rest (the raw motion had ended): stop out the corner
+        if v0 == 0.0 and tj > 0.0:  # at rest at a stop (an exact-stop corner, or the end
+            # a join continues from): rest out the tj the executed motion needs to pass it
+            # at rest, whatever the re-plan (an override in the dwell used to cut it short)
+            lead = max(0.0, tj - _rested(raw, u))
     if s_end > s0:
         tail = px.s_profile(curve, s_end, chain.cum[1:-1], dwell=tj, lead=lead)
     else:
@@ -146,6 +148,20 @@ def _rest_until(raw: Profile, u: float) -> Profile:
     if u <= raw.duration:
         return raw
     return raw.splice(raw.duration, _still(raw.end.p, u - raw.duration))
+
+
+def _rested(raw: Profile, u: float) -> float:
+    """How long the raw motion has been at rest up to time u (0 if it moves at u)."""
+    if raw.state_at(u).v != 0.0:
+        return 0.0
+    rest = max(0.0, u - raw.duration)  # resting after its end
+    t_end = min(u, raw.duration)
+    k = int(np.searchsorted(raw.t0, t_end, side="left")) - 1  # the segment before t_end
+    while k >= 0 and raw.v0[k] == 0.0 and raw.a0[k] == 0.0:
+        rest += t_end - float(raw.t0[k])
+        t_end = float(raw.t0[k])
+        k -= 1
+    return rest
 
 
 def _rebased(p: Profile, u: float) -> Profile:
