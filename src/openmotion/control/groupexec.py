@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import weakref
 from collections import deque
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import TYPE_CHECKING, Any
@@ -278,16 +279,7 @@ class GroupEngine(LookaheadSettings):
         new = self._take(plan.tj, have, [r.cmds[-1]])
         if not new:
             return
-        s_raw = plan.chain.length - have
-        last = plan.chain.elements[-1]
-        options = []
-        first, els, owners = self._elements(new, last)
-        if first is not last and s_raw < float(plan.chain.cum[-2]) + first.length:
-            options.append(plan.chain.joined(els, owners, *self._per(owners, new),
-                                             replace_last=first))
-        _, els, owners = self._elements(new)
-        options.append(plan.chain.joined(els, owners, *self._per(owners, new)))
-        for chain in options:
+        for chain in self._join_options(plan, have, new):
             try:
                 p2 = pathrun.replan(plan, t, chain=chain,
                                     limits=self._limits(chain, plan.limits.str_vel))
@@ -299,6 +291,20 @@ class GroupEngine(LookaheadSettings):
                 self._fault(getattr(err, "code", ERR_AXIS_STATE), f"join refused: {err}")
             return
         self._queue.extendleft(reversed(new))
+
+    def _join_options(self, plan: pathrun.PathPlan, have: float,
+                      new: list[_Cmd]) -> Iterator[px.Chain]:
+        """The running chain joined with `new`: first with the corner between them blended
+        (when the path has not reached the blend's start yet), then with that corner kept
+        as it is. Lazy: the second is built only when the first is missing or refused."""
+        s_raw = plan.chain.length - have
+        last = plan.chain.elements[-1]
+        first, els, owners = self._elements(new, last)
+        if first is not last and s_raw < float(plan.chain.cum[-2]) + first.length:
+            yield plan.chain.joined(els, owners, *self._per(owners, new), replace_last=first)
+        if first is not last:  # without the blend the new elements differ: rebuild them
+            _, els, owners = self._elements(new)
+        yield plan.chain.joined(els, owners, *self._per(owners, new))
 
     @staticmethod
     def _per(owners: list[int], cmds: list[_Cmd]) -> tuple[list[float], list[float]]:

@@ -41,6 +41,7 @@ from ..path.contour import contour_error  # noqa: F401 - re-exported (was define
 from ..path.geometry import PathElement
 from ..path.lookahead import speed_caps, tangential_accels
 from ..profile.segments import Profile, ProfileBuilder, State
+from .pathpoints import ElementTable
 
 #: plan_speeds' default tangential share of an arc's acceleration budget (lookahead step 1)
 ARC_TANGENTIAL_RATIO = 0.5
@@ -193,10 +194,18 @@ class Chain:
         self.accels = None if accels is None else np.asarray(accels, dtype=float)
         self.cum = cum if cum is not None else np.concatenate(
             [[0.0], np.cumsum([el.length for el in self.elements])])
+        self._table: ElementTable | None = None
 
     @property
     def length(self) -> float:
         return float(self.cum[-1])
+
+    @property
+    def table(self) -> ElementTable:
+        """The elements' parameters as arrays, built once (pathpoints.py)."""
+        if self._table is None:
+            self._table = ElementTable(self.elements)
+        return self._table
 
     def locate(self, s: float) -> int:
         k = int(np.searchsorted(self.cum, s, side="right")) - 1
@@ -534,12 +543,11 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
                         np.zeros(0)) for x in p0]
     n_el = len(chain.elements)
     cum = chain.cum
+    table = chain.table  # every element's parameters as arrays (pathpoints.py)
+    lens = table.lengths
     # positions per knot (continuous: consecutive elements join bit for bit)
-    pos = np.empty((len(t), dim))
     k = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, n_el - 1)
-    for i, m in _runs(k):
-        el = chain.elements[i]
-        pos[m] = el.point(np.clip(s[m] - cum[i], 0.0, el.length))
+    pos = table.point(k, np.clip(s - cum[k], 0.0, lens[k]))
     pos[0] = starts
     if s[-1] >= chain.length:
         pos[-1] = chain.elements[-1].end
@@ -547,26 +555,19 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     # speed (junction deviation) the velocity jumps between two intervals, not inside one
     s_mid = sp.sample(0.5 * (t[:-1] + t[1:])).p
     km = np.clip(np.searchsorted(cum, s_mid, side="right") - 1, 0, n_el - 1)
-    v0 = np.empty((len(t) - 1, dim))
-    v1 = np.empty((len(t) - 1, dim))
-    for i, m in _runs(km):
-        el = chain.elements[i]
-        l0 = np.clip(s[:-1][m] - cum[i], 0.0, el.length)
-        l1 = np.clip(s[1:][m] - cum[i], 0.0, el.length)
-        v0[m] = el.tangent(l0) * sd[:-1][m][:, None]
-        v1[m] = el.tangent(l1) * sd[1:][m][:, None]
+    v0 = table.tangent(km, np.clip(s[:-1] - cum[km], 0.0, lens[km])) * sd[:-1][:, None]
+    v1 = table.tangent(km, np.clip(s[1:] - cum[km], 0.0, lens[km])) * sd[1:][:, None]
     h = np.diff(t)[:, None]
     dp = np.diff(pos, axis=0)
     a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
     jj = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
     # on a line the axis motion is u*s(t) exactly: take a and j from s(t), not the fit
     ss = sp.sample(t[:-1])
-    for i, m in _runs(km):
-        el = chain.elements[i]
-        if el.max_curvature == 0.0:
-            u = np.asarray(el.tangent(0.0))
-            a0[m] = ss.a[m][:, None] * u
-            jj[m] = ss.j[m][:, None] * u
+    straight = table.curvature[km] == 0.0
+    if np.any(straight):
+        u = table.line_tangents(km[straight])
+        a0[straight] = ss.a[straight][:, None] * u
+        jj[straight] = ss.j[straight][:, None] * u
     out = []
     dts = np.diff(t)
     labels = ("path",) * len(dts)
@@ -629,11 +630,3 @@ def _near(grid: np.ndarray, brk: np.ndarray, tol: float) -> np.ndarray:
     k = np.clip(np.searchsorted(brk, grid), 1, len(brk) - 1)
     return np.minimum(np.abs(grid - brk[k - 1]), np.abs(grid - brk[k])) <= tol
 
-
-def _runs(k: np.ndarray) -> list[tuple[int, slice]]:
-    """(value, slice) of each run of equal values in a sorted index array."""
-    if len(k) == 0:
-        return []
-    starts = np.concatenate([[0], np.nonzero(np.diff(k))[0] + 1])
-    ends = np.concatenate([starts[1:], [len(k)]])
-    return [(int(k[a]), slice(int(a), int(b))) for a, b in zip(starts, ends, strict=True)]
