@@ -34,6 +34,7 @@ class ElementTable:
         self.kind = np.zeros(n, dtype=np.int8)
         self.trimmed = np.zeros(n, dtype=bool)
         self.offset = np.zeros(n)
+        self.stop = np.zeros(n)            # a Trimmed's end on its base
         self.blen = np.zeros(n)            # length of the evaluated (base) element
         self.start = np.zeros((n, dim))
         self.end = np.zeros((n, dim))
@@ -54,6 +55,7 @@ class ElementTable:
                 base = el.base
                 self.trimmed[i] = True
                 self.offset[i] = el.offset
+                self.stop[i] = el._stop
             if type(base) is Line:
                 self.kind[i] = _LINE
                 self.dirn[i] = base.direction
@@ -73,12 +75,12 @@ class ElementTable:
             self.start[i], self.end[i] = base.start, base.end
 
     def _base_s(self, k: np.ndarray, u: np.ndarray) -> np.ndarray:
-        """Local s on the evaluated element: a Trimmed adds its offset (capped at its
-        base's length), then s is clipped to the element like `path_positions` does."""
+        """Local s on the evaluated element: a Trimmed adds its offset (capped at its end
+        on the base), then s is clipped to the element like `path_positions` does."""
         ub = u.astype(float, copy=True)
         t = self.trimmed[k]
         if np.any(t):
-            ub[t] = np.minimum(u[t] + self.offset[k[t]], self.blen[k[t]])
+            ub[t] = np.minimum(u[t] + self.offset[k[t]], self.stop[k[t]])
         return np.clip(ub, 0.0, self.blen[k])
 
     def point(self, k: np.ndarray, u: np.ndarray) -> Array:
