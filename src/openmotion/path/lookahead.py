@@ -36,8 +36,10 @@ length L is linear: v1**2 = v0**2 + 2*a*L.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -98,9 +100,31 @@ def _limit_along(limit: float, axis: Array | None, weight: Array) -> float:
         return min(limit, float(np.min(axis[mask] / weight[mask])))
 
 
+#: Memo of `_element_limits`: one entry per element, its last parameters and result. The
+#: elements are immutable and a streaming chain asks about the same ones at every re-plan
+#: (most of a long chain's planning time otherwise). Weak keys: no element is kept alive.
+_LIMITS: weakref.WeakKeyDictionary[Any, tuple[tuple, tuple[float, float]]] = \
+    weakref.WeakKeyDictionary()
+
+
 def _element_limits(el: PathElement, feed: float, accel: float, vmax_ax: Array | None,
                     amax_ax: Array | None, ratio: float) -> tuple[float, float]:
-    """(tangential accel, speed cap) of one element."""
+    """(tangential accel, speed cap) of one element (memoized)."""
+    key = (feed, accel, ratio, None if vmax_ax is None else vmax_ax.tobytes(),
+           None if amax_ax is None else amax_ax.tobytes())
+    try:
+        hit = _LIMITS.get(el)
+    except TypeError:  # an element that is not hashable or weak-referenceable
+        return _limits_of(el, feed, accel, vmax_ax, amax_ax, ratio)
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    out = _limits_of(el, feed, accel, vmax_ax, amax_ax, ratio)
+    _LIMITS[el] = (key, out)
+    return out
+
+
+def _limits_of(el: PathElement, feed: float, accel: float, vmax_ax: Array | None,
+               amax_ax: Array | None, ratio: float) -> tuple[float, float]:
     vmax = _limit_along(feed, vmax_ax, el.max_abs_tangent)
     kappa = el.max_curvature
     if kappa == 0.0:
