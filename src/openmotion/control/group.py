@@ -116,6 +116,8 @@ class Group(GroupChecks):
         self._k = k_units                       # signed pulses per logical unit, per axis
         self._ppu = np.abs(k_units)
         self._queue: deque[_Cmd] = deque()
+        self._pre: dict[int, tuple[Any, ...]] = {}  # corners blended ahead (groupexec)
+        self._pre_tail: tuple[int, Any] | None = None
         self._queue_size = queue_size
         self._next_index = 0
         self._state = GroupState.IDLE
