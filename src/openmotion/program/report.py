@@ -69,7 +69,9 @@ def contour_errors(run: ProgramRunner) -> tuple[np.ndarray, np.ndarray]:
         best = np.full(len(sel), np.inf)
         for n in (k - 1, k, k + 1):
             o = run.op_of.get(int(n))
-            if o is None or o.kind not in ("line", "arc") or o.rapid:
+            # a rapid neighbour counts: a G64 blend joins it to the cut, and the blend
+            # starts on the rapid (the executed path is within P of the programmed one)
+            if o is None or o.kind not in ("line", "arc"):
                 continue
             if isinstance(o.source, canon.ArcMove):
                 d = _arc_dist(pos[sel], o.source)
