@@ -234,7 +234,6 @@ def test_bad_str_vel_is_refused(value):
     (lambda g: g.set_str_vel(FEED * 1.01), ERR_SPEED),                      # above the feed
     (lambda g: (g.set_axis_limit_policy("slow"),                            # above an axis
                 g.set_max_pulse_speed([3000, 50_000])), ERR_SPEED),
-    (lambda g: g.set_path_shape("S", 1e7), ERR_ARGUMENT),                   # S-curve path
 ])
 def test_commands_with_a_bad_str_vel_are_refused_and_change_nothing(setup, code):
     ctl, g = make()

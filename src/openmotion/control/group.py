@@ -308,7 +308,7 @@ class Group(GroupChecks):
         pps or user units/s (default 0, as MCCL): a chain starts at rest with a jump to this
         vector speed, and ends at it with a jump to rest. Checked when a command is queued:
         <= its feed and StrVel*|u_i| <= each axis's maximum speed (GroupError ERR_SPEED).
-        T-curve paths only: an S-curve path command with StrVel > 0 is refused."""
+        T and S paths (an S path: jump to StrVel, then an S acceleration from a = 0)."""
         v = check_finite("speed", speed)
         if v < 0.0:
             raise GroupError(ERR_ARGUMENT, f"speed (StrVel) must be >= 0, got {speed!r}")

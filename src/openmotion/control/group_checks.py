@@ -160,7 +160,7 @@ class GroupChecks(GroupEngine):
 
     def _check_str_vel(self, sv: float, feed: float, tan: np.ndarray) -> None:
         """StrVel of a path command: <= its feed, within every axis's maximum speed along
-        the move (a jump cannot be slowed down), T-curve only."""
+        the move (a jump cannot be slowed down); T and S paths."""
         if sv == 0.0:
             return
         if sv > feed * (1 + 1e-12):
@@ -173,10 +173,6 @@ class GroupChecks(GroupEngine):
             raise GroupError(ERR_SPEED, f"axis {self.names[k]} would jump to {need[k]:g} pps "
                                         f"at StrVel {sv:g}, above its maximum speed "
                                         f"{caps[k]:g} pps")
-        if self._path_jerk:
-            raise GroupError(ERR_ARGUMENT, "StrVel > 0 needs the T path shape: S-curve paths "
-                                           "start and end at rest (set_str_vel(0) or "
-                                           "set_path_shape('T'))")
 
     def _push(self, cmd: _Cmd, end: np.ndarray | None) -> int:
         self._check_accepting()

@@ -23,8 +23,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..errors import InfeasibleError
 from ..path.smoothing import fir_smooth
-from ..profile.segments import Profile, ProfileBuilder
+from ..profile.segments import Profile, ProfileBuilder, State
 from . import pathexec as px
 
 
@@ -41,6 +42,7 @@ class PathPlan:
     tj: float              # smoothing window (0: T path)
     limits: px.Limits
     a_min: float           # tangential acceleration every remaining element allows
+    v_end: float = 0.0     # S path with StrVel: the raw speed past its end (0: ends at rest)
 
     @property
     def t_end(self) -> float:
@@ -62,11 +64,76 @@ class PathPlan:
 def start(chain: px.Chain, lim: px.Limits, tj: float, t: float, s0: float = 0.0) -> PathPlan:
     """A chain from rest at path position s0 (0: its start; a held chain continues),
     with the StrVel jump of its limits."""
-    sv = lim.str_vel  # a StrVel path starts with a jump to it (T paths only)
+    if tj > 0.0 and s0 >= chain.length:  # a hold that ended on the end: nothing left
+        end = _still(chain.length, 0.0)
+        curve = px.SpeedCurve(np.array([chain.length]), np.array([0.0]))
+        return drop_travelled(PathPlan(chain, curve, end, t, end, t, tj, lim, lim.accel))
+    sv = lim.str_vel  # a StrVel path starts with a jump to it
+    if tj > 0.0 and sv > 0.0:
+        try:
+            return _start_strvel(chain, lim, tj, t, s0)
+        except InfeasibleError:  # too short to jump (or not from s0): an S path from rest
+            lim, sv = replace(lim, str_vel=0.0), 0.0
     curve = px.plan_curve(chain, s0, sv, lim, window=tj, jump=sv > 0.0)
     raw = px.s_profile(curve, chain.length, chain.cum[1:-1], dwell=tj)
     sprof = fir_smooth(raw, tj) if tj > 0.0 else raw
     return drop_travelled(PathPlan(chain, curve, raw, t, sprof, t, tj, lim, _amin(curve, lim)))
+
+
+def _start_strvel(chain: px.Chain, lim: px.Limits, tj: float, t: float,
+                  s0: float) -> PathPlan:
+    """An S path with the StrVel jump (see the smoothing module doc): the raw motion starts
+    d = v*tj/2 ahead of s0 at the jump speed v, with a history at v, so the executed one
+    starts on s0 at v with a = 0; it ends with tj/2 at its end speed (`_cruise_end`)."""
+    room = chain.length - s0
+    v = min(lim.str_vel, room / tj)  # the start and end stretches need v*tj of path
+    for _ in range(8):  # the jump speed the look-ahead allows from s0 + d (d shrinks with v)
+        if not v > 1e-12 * max(1.0, lim.str_vel) or room <= 0.0:
+            break
+        d = min(0.5 * v * tj, room)
+        curve = px.plan_curve(chain, s0 + d, v, lim, window=tj, jump=True)
+        curve, ve = _cruise_end(curve, tj, lim.str_vel, lim.accel)
+        v1 = math.sqrt(curve.v2[0])
+        if v1 < v * (1.0 - 1e-12):
+            v = v1
+            continue
+        curve = replace(curve, jump=False)  # the history before the start is at v
+        raw = px.s_profile(curve, chain.length, chain.cum[1:-1], dwell=tj)
+        sprof = fir_smooth(raw, tj, v_after=ve)
+        sprof = replace(sprof, start=State(sprof.start.p, 0.0, 0.0))  # at rest before: jump
+        return drop_travelled(PathPlan(chain, curve, raw, t, sprof, t, tj, lim,
+                                       _amin(curve, lim), ve))
+    raise InfeasibleError("no StrVel start fits the chain")
+
+
+def _cruise_end(curve: px.SpeedCurve, tj: float, sv: float,
+                accel: float) -> tuple[px.SpeedCurve, float]:
+    """The curve (which ends at <= StrVel `sv`) lowered so that it holds its end speed ve
+    over the last ve*tj/2 before its end: the executed (averaged) motion then ends on the
+    chain's end at ve with a = 0 (smoothing module doc). Lowered by a ramp at the smallest
+    tangential acceleration of the curve's elements, so it keeps every limit. Raises
+    InfeasibleError when that would lower the curve's start (the raw is already too fast)."""
+    s, v2 = curve.s, curve.v2
+    end = float(s[-1])
+    lo = max(float(s[0]), end - 0.5 * sv * tj)
+    inside = v2[(s > lo) & (s < end)]
+    ve2 = min(sv * sv, curve.at(lo), float(v2[-1]), *(float(x) for x in inside))
+    if ve2 <= 0.0:
+        return curve, 0.0  # ends at rest after all (a stop right at the end)
+    ve = math.sqrt(ve2)
+    knee = end - 0.5 * ve * tj
+    if knee < float(s[0]) - 1e-9 * max(1.0, end):
+        raise InfeasibleError("no room for the StrVel end")
+    a = curve.a_min if math.isfinite(curve.a_min) else accel
+    if knee > float(s[0]):
+        cap = px.SpeedCurve(np.array([float(s[0]), knee, end]),
+                            np.array([ve2 + 2.0 * a * (knee - float(s[0])), ve2, ve2]))
+    else:
+        cap = px.SpeedCurve(np.array([float(s[0]), end]), np.array([ve2, ve2]))
+    out = px.curve_min(curve, cap)
+    if out.v2[0] < curve.v2[0] * (1.0 - 1e-9):
+        raise InfeasibleError("the path cannot slow down to its StrVel end in time")
+    return px.SpeedCurve(out.s, out.v2, curve.a_min, curve.jump), ve
 
 
 def replan(plan: PathPlan, t: float, *, chain: px.Chain | None = None,
@@ -79,6 +146,8 @@ def replan(plan: PathPlan, t: float, *, chain: px.Chain | None = None,
     lim = limits or plan.limits
     tj = plan.tj
     u = t - plan.raw_t0
+    if plan.v_end > 0.0:
+        return _replan_strvel(plan, t, chain, lim, hold)
     raw = _rest_until(plan.raw, u)
     rs = raw.state_at(u)
     s0, v0 = rs.p, max(0.0, rs.v)
@@ -109,6 +178,55 @@ def replan(plan: PathPlan, t: float, *, chain: px.Chain | None = None,
     new = PathPlan(chain, curve, new_raw, raw_t0, sprof, t, tj, lim,
                    plan.a_min if hold else _amin(curve, lim))
     return drop_travelled(new)
+
+
+def _replan_strvel(plan: PathPlan, t: float, chain: px.Chain, lim: px.Limits,
+                   hold: bool) -> PathPlan:
+    """`replan` for an S path that ends with the StrVel jump (plan.v_end > 0): the new raw
+    tail ends the same way (`_cruise_end`), or at rest for a hold. Once the raw motion
+    cruises into its end (its last tj/2) or cannot slow down in time, a hold or an
+    override leaves it unchanged (the path finishes with its end jump within tj) and a join
+    raises InfeasibleError (the joined commands start after the chain)."""
+    tj, u, raw = plan.tj, t - plan.raw_t0, plan.raw
+    joined = chain is not plan.chain
+    keep = u >= raw.duration - 0.5 * tj
+    if not keep:
+        rs = raw.state_at(u)
+        s0, v0 = rs.p, max(0.0, rs.v)
+        lead = 0.0
+        try:
+            if hold:
+                curve = px.hold_curve(plan.curve, s0, v0, plan.a_min)
+                s_end = px.stop_point(curve) if v0 > 0.0 else s0
+                if curve.at(s_end) > 0.0:
+                    raise InfeasibleError("cannot stop before the StrVel end")
+                ve = 0.0
+            else:
+                old = None if joined else plan.curve.tail(s0)
+                curve = px.plan_curve(chain, s0, v0, lim, old, window=tj)
+                curve, ve = _cruise_end(curve, tj, lim.str_vel, lim.accel)
+                s_end = chain.length
+                if v0 == 0.0:  # resting at an exact stop: complete the rest to tj
+                    lead = max(0.0, tj - _rested(raw, u))
+        except InfeasibleError:
+            if joined:
+                raise
+            keep = True
+    if keep:
+        if joined:
+            raise InfeasibleError("the chain already cruises into its StrVel end")
+        chain, curve, ve, spliced = plan.chain, plan.curve, plan.v_end, raw
+    else:
+        tail = px.s_profile(curve, s_end, chain.cum[1:-1], dwell=tj, lead=lead) \
+            if s_end > s0 else _still(s0, 0.0)
+        spliced = raw.splice(u, tail)
+    sprof = fir_smooth(spliced, tj, t_out=u, v_after=ve)
+    cut = max(0.0, u - tj)  # keep a window of raw history for the next re-plan
+    new_raw, raw_t0 = (spliced, plan.raw_t0) if cut <= 0.0 else \
+        (_rebased(spliced, cut), plan.raw_t0 + cut)
+    a_min = plan.a_min if hold or keep else _amin(curve, lim)
+    return drop_travelled(PathPlan(chain, curve, new_raw, raw_t0, sprof, t, tj, lim, a_min,
+                                   ve))
 
 
 def drop_travelled(plan: PathPlan) -> PathPlan:

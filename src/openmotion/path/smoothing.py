@@ -12,9 +12,18 @@ speeds (v_f <= max v) and whose jerk is |delta a|/tj. The total travel is unchan
 motion takes tj longer. The breaks of s_f are the breaks of s and those shifted by tj, so
 each row below is computed from closed forms (no accumulation): the position from the
 antiderivative I(t) of s(t), p_f = (I(b) - I(b - tj))/tj.
+
+A StrVel path (PCL6045: jump to StrVel, S acceleration from a = 0; S deceleration to
+StrVel reaching a = 0, jump to rest) is the same average of a raw motion that moved at
+StrVel before its start (its start state (p, v) is that history) and keeps its end speed
+after its end (`v_after`): at t = 0 the average moves at StrVel with a = 0 and lies
+StrVel*tj/2 behind the raw start; a raw that ends with tj/2 at constant speed v_after
+gives an average that reaches the raw end point at raw end + tj/2 with v = v_after, a = 0.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -44,23 +53,31 @@ def _antiderivative(raw: Profile, t: np.ndarray) -> np.ndarray:
     return out
 
 
-def fir_smooth(raw: Profile, tj: float, t_out: float = 0.0) -> Profile:
+def fir_smooth(raw: Profile, tj: float, t_out: float = 0.0, *,
+               v_after: float = 0.0) -> Profile:
     """The moving average over `tj` of a constant-acceleration Profile `raw` (see the module
     doc), from raw time `t_out` on (rebased to 0) until it rests at raw's end.
 
-    With t_out = 0 the raw motion must start at rest (the window then reaches back into the
-    rest before it); with t_out >= tj the window lies inside `raw` (re-planning a running
-    S-curve: raw = the old plan up to now, spliced with the new one).
+    Before its time 0 the raw motion is its start state extended (at rest, or at the speed
+    of a StrVel start); with t_out >= tj the window lies inside `raw` (re-planning a
+    running S-curve: raw = the old plan up to now, spliced with the new one). `v_after` > 0:
+    the raw motion keeps that speed after its end (which it must reach tj/2 before its end
+    and hold), and the result ends tj/2 after raw's end, on raw's end point, at speed
+    v_after (its last segment; the end state is rest: a StrVel end jumps to it).
     """
     if not tj > 0.0 or not np.isfinite(tj):
         raise MotionError(f"tj must be a finite number > 0, got {tj!r}")
     if raw.n_segments and np.any(raw.j != 0.0):
         raise MotionError("raw must have constant acceleration on every segment")
     if raw.end.v != 0.0:
-        raise MotionError("raw must end at rest")
-    if t_out < tj and raw.start.v != 0.0:
-        raise MotionError("raw must start at rest when the window reaches before it")
+        raise MotionError("raw must end at rest (a speed after its end is v_after)")
+    if not (v_after >= 0.0 and np.isfinite(v_after)):
+        raise MotionError(f"v_after must be a finite number >= 0, got {v_after!r}")
     end_t = raw.duration + tj
+    if v_after > 0.0:
+        _check_cruise_end(raw, tj, v_after)
+        raw = replace(raw, end=State(raw.end.p, float(v_after), 0.0))
+        end_t = raw.duration + 0.5 * tj
     brk = np.concatenate([raw.t0, raw.t0 + tj, [raw.duration, end_t, t_out]])
     brk = np.unique(brk[(brk >= t_out) & (brk <= end_t)])
     # merge breaks closer than 1e-12 s (float noise of t0 + tj); keep t_out and the end
@@ -88,6 +105,16 @@ def fir_smooth(raw: Profile, tj: float, t_out: float = 0.0) -> Profile:
                    start=State(float(p0[0]), float(v0[0]), float(a0[0])),
                    end=State(float(raw.end.p), 0.0, 0.0),
                    labels=("s-curve",) * len(t0), dt=dts)
+
+
+def _check_cruise_end(raw: Profile, tj: float, v: float) -> None:
+    """raw must move at constant speed v over its last tj/2 (a StrVel end; see the module
+    doc), else the average would not end on raw's end point at speed v."""
+    h = 0.5 * tj
+    st = raw.state_at(raw.duration - h)
+    if raw.duration < h * (1.0 - 1e-9) or abs(st.v - v) > 1e-6 * v or \
+            abs(st.p + v * h - raw.end.p) > 1e-9 * max(1.0, abs(raw.end.p)):
+        raise MotionError(f"raw must move at v_after = {v!r} over its last tj/2")
 
 
 def jerk_window(accel: float, jerk: float) -> float:
