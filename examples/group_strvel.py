@@ -1,6 +1,7 @@
 """StrVel on a group path (HSL-4XMO 4.6): the vector speed jumps from rest to StrVel, ramps
 to the feed, ramps down to StrVel and jumps to rest, as a PCL6045 interpolation does. The
-same XY contour runs with StrVel 0 (MCCL) and 5 mm/s on the simulated XYZU table.
+same XY contour runs with StrVel 0 (MCCL) and 5 mm/s on the simulated XYZU table, as a
+T-curve path and as an S-curve path (jump to StrVel, then an S acceleration from a = 0).
 
 Run: python examples/group_strvel.py
 """
@@ -13,13 +14,16 @@ from openmotion.control import Controller
 from openmotion.control.group import Group, GroupState
 
 
-def run(str_vel: float) -> dict:
-    """Run the contour with `str_vel` (mm/s); the speeds just after the start and just
-    before the end (from the recorded history), the time and the end position."""
+def run(str_vel: float, jerk: float | None = None) -> dict:
+    """Run the contour with `str_vel` (mm/s), as an S path with `jerk` (mm/s^3) if given;
+    the speeds and path accelerations just after the start and just before the end (from
+    the recorded history), the time and the end position."""
     ctl = Controller()
     ctl.enable_all()
     g = Group(ctl, ["x", "y"], feed=20.0, acc_time=0.1, units=True)  # mm/s, s
     g.set_str_vel(str_vel)
+    if jerk is not None:
+        g.set_path_shape("S", jerk=jerk)
     g.enable_blend(0.05)  # mm
     g.line([30.0, 0.0])
     g.line([30.0, 20.0])
@@ -32,17 +36,22 @@ def run(str_vel: float) -> dict:
     first = [np.nonzero((r["v0"] != 0.0) | (r["a0"] != 0.0))[0][0] for r in rec]
     t_start = min(float(r["ts"][k]) for r, k in zip(rec, first, strict=True))
     t_end = max(ctl.history.end_time(a.index) for a in g.axes)
-    v = np.array([ctl.history.sample(a.index, [t_start, t_end - 1e-9]).v for a in g.axes])
-    speed = np.linalg.norm(v / ppu[:, None], axis=0)
-    return {"str_vel": str_vel, "start_speed": float(speed[0]), "end_speed": float(speed[1]),
+    smp = [ctl.history.sample(a.index, [t_start, t_end - 1e-9]) for a in g.axes]
+    speed = np.linalg.norm(np.array([s.v for s in smp]) / ppu[:, None], axis=0)
+    acc = np.linalg.norm(np.array([s.a for s in smp]) / ppu[:, None], axis=0)
+    return {"str_vel": str_vel, "shape": "T" if jerk is None else "S",
+            "start_speed": float(speed[0]), "end_speed": float(speed[1]),
+            "start_accel": float(acc[0]), "end_accel": float(acc[1]),
             "time": t_end - t_start, "end": g.position.tolist()}
 
 
 def main() -> list[dict]:
-    out = [run(0.0), run(5.0)]
+    out = [run(0.0), run(5.0), run(0.0, 4000.0), run(5.0, 4000.0)]
     for r in out:
-        print(f"StrVel {r['str_vel']:4.1f} mm/s: speed after the start {r['start_speed']:.3f}, "
-              f"before the end {r['end_speed']:.3f} mm/s, {r['time']:.3f} s, ends at {r['end']}")
+        print(f"{r['shape']} StrVel {r['str_vel']:4.1f} mm/s: after the start "
+              f"{r['start_speed']:.3f} mm/s, {r['start_accel']:.3f} mm/s^2; before the end "
+              f"{r['end_speed']:.3f} mm/s, {r['end_accel']:.3f} mm/s^2; {r['time']:.3f} s, "
+              f"ends at {r['end']}")
     return out
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.group import ERR_ARGUMENT, ERR_SPEED, Group, GroupError, GroupState
+from openmotion.control.group import ERR_SPEED, Group, GroupError, GroupState
 from openmotion.errors import MotionError
 from openmotion.profile.pcl import trapezoid
 
@@ -295,12 +295,20 @@ def test_example_runs_with_and_without_str_vel():
     spec = importlib.util.spec_from_file_location("group_strvel_example", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    mccl, pcl = mod.main()
-    assert mccl["start_speed"] == 0.0 and mccl["end_speed"] == pytest.approx(0.0, abs=1e-6)
-    assert pcl["start_speed"] == pytest.approx(5.0, rel=1e-9)
-    assert pcl["end_speed"] == pytest.approx(5.0, rel=1e-6)
-    assert mccl["end"] == pcl["end"] == [10.0, 20.0]
-    assert pcl["time"] < mccl["time"]  # the ramps start and end at StrVel
+    runs = mod.main()
+    for mccl, pcl in (runs[:2], runs[2:]):  # T, then S paths
+        # (an S path from rest shows its first record one cycle in, at j*dt**2/2)
+        assert mccl["start_speed"] == pytest.approx(0.0, abs=0.01)
+        assert mccl["end_speed"] == pytest.approx(0.0, abs=1e-6)
+        assert pcl["start_speed"] == pytest.approx(5.0, rel=1e-9)
+        assert pcl["end_speed"] == pytest.approx(5.0, rel=1e-6)
+        assert mccl["end"] == pcl["end"] == [10.0, 20.0]
+        assert pcl["time"] < mccl["time"]  # the ramps start and end at StrVel
+    # S with StrVel: no acceleration right after the jump (a line); before the end (an arc
+    # of radius 10 mm) only the centripetal 5**2/10, no tangential one
+    s_pcl = runs[3]
+    assert s_pcl["start_accel"] <= 1e-6
+    assert s_pcl["end_accel"] == pytest.approx(2.5, rel=1e-3)
 
 
 def test_safety_stops_a_str_vel_path():
