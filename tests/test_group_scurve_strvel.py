@@ -120,8 +120,11 @@ def test_hold_stops_at_rest_and_continue_jumps_to_str_vel_again():
         check_limits(t, sx, sy)
 
 
-def test_hold_in_the_last_window_finishes_with_the_end_jump():
-    ctl, g = make()
+@pytest.mark.parametrize("sv", [0.0, SV])
+def test_hold_in_the_last_window_finishes_with_the_end_jump(sv):
+    """Too late to stop before the end: the path ends on the target (with StrVel: its end
+    jump), the group is held, and continue has nothing left to do (S paths raised)."""
+    ctl, g = make(sv)
     g.line([20_000, 0])
     ctl.step()
     plan = g._run.plan

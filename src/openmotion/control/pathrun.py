@@ -14,6 +14,11 @@ from now on. The smoothed motion up to now depends only on the raw motion up to 
 continues without a jump in position, speed or acceleration. Elements the path has left
 behind are dropped at each re-plan (their s is subtracted from everything), so a chain
 that streams commands for hours stays as short as its look-ahead.
+
+An S path with StrVel (`_start_strvel`) averages a raw motion that moved at the jump speed
+before its start (the raw start state) and keeps its end speed after its end
+(`PathPlan.v_end`): it starts with the jump and a = 0 and ends on the chain's end at the
+end speed with a = 0 (path/smoothing.py).
 """
 
 from __future__ import annotations
