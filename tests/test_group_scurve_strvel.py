@@ -230,3 +230,17 @@ def test_fir_smooth_with_a_str_vel_history_and_end():
         fir_smooth(raw, tj, v_after=3.0)    # the raw does not end at that speed
     with pytest.raises(MotionError, match="v_after"):
         fir_smooth(raw, tj, v_after=-1.0)
+
+
+def test_dry_run_plans_the_jump_with_a_zero_acceleration():
+    ctl, g = make()
+    g.enable_dry_run()
+    g.line([10_000, 0])
+    seen = []
+    ctl.add_cycle_hook(lambda c, t: seen.append(g.position[0]))
+    finish_group(ctl, g)
+    assert g.position.tolist() == [10_000.0, 0.0]
+    assert [a.position for a in g.axes] == [0.0, 0.0]
+    first = next(p for p in seen if p > 0.0)  # one period after the start: SV*h + J'h**3/6
+    h = ctl.period
+    assert SV * h < first < SV * h * (1 + 1e-3)
