@@ -392,8 +392,23 @@ class GroupEngine(LookaheadSettings):
             el = c.elements[0]
             b = self._blend_new(prev, el, c)
             pre[c.index] = (prev, el, key, b)
+            if b is not None and r.plan.tj == 0.0:
+                # the trimmed prev belongs to the command before c, the blend arc to c
+                self._warm_limits(b[0], q[i - 1] if i > 0 else r.cmds[-1])
+                self._warm_limits(b[1], c)
             prev = b[2] if b is not None else el
             self._pre_tail = (c.index, prev)
+            i += 1
+
+    def _warm_limits(self, el: PathElement, cmd: _Cmd) -> None:
+        """Have the look-ahead's per-element memo (path/lookahead.py) hold the limits of a
+        new piece with the values the join's plan will ask for (a T chain's feed x
+        override capped by the system maximum, the command's acceleration, the axis caps):
+        the join then computes only the junctions and the passes."""
+        if el.length > 0.0:
+            vmax, amax = self._caps()
+            speed_caps([el], min(cmd.feed * self._override, self._sys_max), cmd.accel,
+                       axis_vmax=vmax, axis_amax=amax)
 
     def _blend_new(self, prev: PathElement, el: PathElement,
                    cmd: _Cmd) -> tuple[PathElement, PathElement, PathElement] | None:
