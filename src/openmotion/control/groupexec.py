@@ -7,7 +7,8 @@ acceleration, and with blending on the corners between lines and arcs are rounde
 (`path.blend_corner`) within the tolerance; other corners stop exactly (or are taken at the
 corner velocity). The look-ahead is lazy (Klipper's flush): a chain holds the queued
 commands up to twice the distance it needs to brake from its feed, and joins the next ones
-when it runs short, so a program of any length streams through a bounded plan. Joining,
+when it runs short, so a program of any length streams through a bounded plan; quiet
+cycles blend the queued corners ahead of the join (`_preblend`). Joining,
 hold, continue and the feed override are all one re-plan of the running chain from the
 present state (pathrun.py). A group axis going to ErrorStop (the controller's fault hooks,
 when present, and a check every cycle) or reaching the limit switch ahead of it stops every
