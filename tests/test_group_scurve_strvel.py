@@ -244,3 +244,47 @@ def test_dry_run_plans_the_jump_with_a_zero_acceleration():
     first = next(p for p in seen if p > 0.0)  # one period after the start: SV*h + J'h**3/6
     h = ctl.period
     assert SV * h < first < SV * h * (1 + 1e-3)
+
+
+def _speed_near(sp, s: float, ds: float = 1e-6) -> float:
+    smp = sp.sample(np.linspace(0.0, sp.duration, 200_001))
+    return float(smp.v[np.abs(smp.p - s) <= ds].max())
+
+
+def test_exact_stop_near_the_start_lowers_the_jump_and_is_passed_at_rest():
+    """The raw motion starts StrVel*tj/2 ahead and must stop at the corner: the jump speed
+    v solves v*tj/2 + v**2/(2A) = 150 (5565 pps), not StrVel (the corner would be skipped)."""
+    ctl, g = make(8000.0)
+    g.line([150, 0])
+    g.line([150, 20_000])
+    ctl.step()
+    plan = g._run.plan
+    sp = plan.sprof
+    h = plan.tj / 2
+    assert sp.v0[0] == pytest.approx(ACC * (np.sqrt(h * h + 2 * 150 / ACC) - h), rel=1e-9)
+    assert _speed_near(sp, 150.0) <= 0.1  # at rest at the exact-stop corner
+    finish_group(ctl, g)
+    assert [a.position for a in g.axes] == [150.0, 20_000.0]
+
+
+def test_exact_stop_near_the_end_lowers_the_end_speed():
+    """100 pulses after an exact stop: the end stretch (ve*tj/2) and the rise from rest
+    need v*tj/2 + v**2/(2A) <= 100, so the path ends at 4000 pps with a = 0 (the second
+    command joins the running chain)."""
+    ctl, g = make(8000.0)
+    plans = []
+    ctl.add_cycle_hook(lambda c, t: plans.append(g._run.plan) if g._run is not None and
+                       g._run.plan is not None and (not plans or plans[-1] is not g._run.plan)
+                       else None)
+    g.line([20_000, 0])
+    g.line([20_000, 100])
+    t0 = ctl.time
+    t1 = finish_group(ctl, g)
+    assert [a.position for a in g.axes] == [20_000.0, 100.0]
+    sp = plans[-1].sprof
+    assert end_speed(sp) == pytest.approx(4000.0, rel=1e-9)
+    assert abs(end_accel(sp)) <= 1e-6 * ACC
+    t, (sx, sy) = recorded(ctl, g, t0, t1, 200_001)
+    check_limits(t, sx, sy)
+    at = (np.abs(sx.p - 20_000.0) <= 1e-6) & (sy.p <= 1e-6)
+    assert at.any() and np.hypot(sx.v, sy.v)[at].max() <= 0.1  # the corner at rest

@@ -92,6 +92,13 @@ def _start_strvel(chain: px.Chain, lim: px.Limits, tj: float, t: float,
     starts on s0 at v with a = 0; it ends with tj/2 at its end speed (`_cruise_end`)."""
     room = chain.length - s0
     v = min(lim.str_vel, room / tj)  # the start and end stretches need v*tj of path
+    if v > 0.0:  # the raw start must lie before the first exact stop (a barrier), with room
+        ahead = px.plan_curve(chain, s0, v, lim, window=tj, jump=True)
+        stop = px.stop_point(ahead)
+        if stop < chain.length and ahead.at(stop) <= 0.0:  # d + v**2/(2a) <= the way
+            a = ahead.a_min if math.isfinite(ahead.a_min) else lim.accel
+            h = 0.5 * tj
+            v = min(v, a * (math.sqrt(h * h + 2.0 * (stop - s0) / a) - h))
     for _ in range(8):  # the jump speed the look-ahead allows from s0 + d (d shrinks with v)
         if not v > 1e-12 * max(1.0, lim.str_vel) or room <= 0.0:
             break
@@ -120,16 +127,21 @@ def _cruise_end(curve: px.SpeedCurve, tj: float, sv: float,
     InfeasibleError when that would lower the curve's start (the raw is already too fast)."""
     s, v2 = curve.s, curve.v2
     end = float(s[-1])
-    lo = max(float(s[0]), end - 0.5 * sv * tj)
+    a = curve.a_min if math.isfinite(curve.a_min) else accel
+    h = 0.5 * tj
+    near = s[(v2 <= 0.0) & (s >= end - sv * h) & (s < end)]
+    if len(near):  # an exact stop within the end stretch: start it after the stop, and
+        # reach its speed from rest there (v*tj/2 + v**2/(2a) <= the way to the end)
+        sv = min(sv, a * (math.sqrt(h * h + 2.0 * (end - float(near[-1])) / a) - h))
+    lo = max(float(s[0]), end - sv * h)
     inside = v2[(s > lo) & (s < end)]
     ve2 = min(sv * sv, curve.at(lo), float(v2[-1]), *(float(x) for x in inside))
-    if ve2 <= 0.0:
-        return curve, 0.0  # ends at rest after all (a stop right at the end)
+    if not ve2 > 0.0:
+        raise InfeasibleError("the path stops within its StrVel end")
     ve = math.sqrt(ve2)
-    knee = end - 0.5 * ve * tj
+    knee = end - ve * h
     if knee < float(s[0]) - 1e-9 * max(1.0, end):
         raise InfeasibleError("no room for the StrVel end")
-    a = curve.a_min if math.isfinite(curve.a_min) else accel
     if knee > float(s[0]):
         cap = px.SpeedCurve(np.array([float(s[0]), knee, end]),
                             np.array([ve2 + 2.0 * a * (knee - float(s[0])), ve2, ve2]))
