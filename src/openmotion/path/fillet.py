@@ -381,6 +381,12 @@ def _build(first: Any, second: Any, a: Array, b: Array, sol: _Solution,
     sweep += 2.0 * math.pi * round((sol.sweep - sweep) / (2.0 * math.pi))
     if not 0.0 < sweep <= 2.0 * math.pi:
         return None
+    # A fillet is no longer than the two stretches it replaces (equal for a straight
+    # corner, (turn/2)/tan(turn/2) of them between lines). A huge nearly flat fillet
+    # (unbounded G64 between two nearly tangent arcs) can come out the long way round
+    # when rounding flips the tiny sweep: refuse it.
+    if sol.r * sweep > 2.0 * (sol.d1 + sol.d2) + 1e-9 * max(1.0, sol.r):
+        return None
     p_start = np.array(f_first.end)
     centre = p_start + side * sol.r
     ideal_end = centre + sol.r * (math.cos(sweep) * e1 + math.sin(sweep) * t1)
