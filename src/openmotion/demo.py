@@ -173,13 +173,15 @@ def run_realtime_demo(seconds: float = 2.0) -> int:
     ctl.enable_all()
     with ctl.start_realtime():
         t_end = time.monotonic() + seconds
-        direction = 1.0
+        # each axis goes back and forth on its own (a shared direction flipped by the
+        # polling loop made axes that finish at different times drift onto their -EL)
+        direction = [1.0] * len(ctl.axes)
         while time.monotonic() < t_end:
             for k, ax in enumerate(ctl.axes):
                 if not ax.is_moving:
-                    ax.move_relative(direction * (5.0 + k), max_vel=50.0, tacc=0.1,
+                    ax.move_relative(direction[k] * (5.0 + k), max_vel=50.0, tacc=0.1,
                                      shape="S" if k % 2 else "T", units=True)
-            direction = -direction
+                    direction[k] = -direction[k]
             time.sleep(0.02)
         stats = ctl.cycle_stats()
     ctl.stop_realtime()
