@@ -225,6 +225,7 @@ class Group(GroupChecks):
         """Abort everything immediately and release the axes for other groups."""
         self._stop_axes()
         self._queue.clear()
+        self._stop_join_worker()
         self._run = self._held = None
         self._ctl.remove_cycle_hook(self._on_cycle)
         if hasattr(self._ctl, "remove_fault_hook"):
@@ -453,6 +454,7 @@ class Group(GroupChecks):
     def abort(self) -> None:
         """MCC_AbortMotion: stop along the path (or discard a hold) and empty the queue."""
         self._queue.clear()
+        self._drop_join()  # a join in flight (real time) drops its commands too
         if self._state is GroupState.HELD:
             self._held = None
             self._state = GroupState.IDLE

@@ -38,6 +38,7 @@ from ..profile.segments import Profile
 from . import pathexec as px
 from . import pathrun, planning
 from .group_corners import LookaheadSettings
+from .groupjoin import AsyncJoin
 from .states import AxisState
 
 if TYPE_CHECKING:
@@ -120,7 +121,7 @@ PREBLEND_PER_CYCLE = 4
 PREBLEND_AHEAD = 256
 
 
-class GroupEngine(LookaheadSettings):
+class GroupEngine(AsyncJoin, LookaheadSettings):
     """Queue execution and re-planning; `Group` adds the commands and settings."""
 
     _ctl: Controller
@@ -184,6 +185,8 @@ class GroupEngine(LookaheadSettings):
             return
         if self._run is not None and not self._dry and self._check_faults():
             return
+        if self._job is not None and self._poll_join(t):
+            return  # a join in flight (real time), or installed this cycle
         r = self._run
         if r is not None and t >= r.t_end - 1e-12 and (self._dry or not any(
                 a.is_moving for a in self.axes)):
@@ -253,7 +256,10 @@ class GroupEngine(LookaheadSettings):
         from its feed (override included), plus a few cycles and the smoothing window, so
         joining commands never makes the running motion brake for the chain's end."""
         f = min(cmd.feed * self._override, self._sys_max)
-        return 2.0 * (f * f / (2.0 * cmd.accel) + f * (4.0 * self._ctl.period + tj))
+        ahead = 4.0 * self._ctl.period + tj
+        if self._ctl.realtime:  # a join in flight (groupjoin.py) must not see the end
+            ahead += (self._lead_cycles() + 2) * self._ctl.period
+        return 2.0 * (f * f / (2.0 * cmd.accel) + f * ahead)
 
     def _take(self, tj: float, have: float, cmds: list[_Cmd]) -> list[_Cmd]:
         """Pop the queued commands that join a chain with `have` length ahead until it
@@ -277,9 +283,13 @@ class GroupEngine(LookaheadSettings):
         corner keeps its exact stop (or junction speed). A join that cannot be followed
         from the present speed leaves the commands queued (they start after the chain)."""
         r = self._run
-        if r is None or r.plan is None or self._state is not GroupState.MOVING:
+        if r is None or r.plan is None or self._state is not GroupState.MOVING or \
+                self._job is not None:
             return
         plan = r.plan
+        worker = self._use_worker(plan)
+        if worker is None:
+            return  # the previous worker is still running (late): wait for it
         if not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
             return
         have = plan.remaining(t)
@@ -289,6 +299,11 @@ class GroupEngine(LookaheadSettings):
         new = self._take(plan.tj, have, [r.cmds[-1]])
         if not new:
             return
+        if worker:
+            self._join_async(r, new)
+            return
+        if self._ctl.realtime:
+            self.sync_joins += 1
         for chain in self._join_options(plan, have, new):
             try:
                 p2 = pathrun.replan(plan, t, chain=chain,
@@ -302,14 +317,15 @@ class GroupEngine(LookaheadSettings):
             return
         self._queue.extendleft(reversed(new))
 
-    def _join_options(self, plan: pathrun.PathPlan, have: float,
-                      new: list[_Cmd]) -> Iterator[px.Chain]:
+    def _join_options(self, plan: pathrun.PathPlan, have: float, new: list[_Cmd],
+                      pre: dict[int, tuple[Any, ...]] | None = None) -> Iterator[px.Chain]:
         """The running chain joined with `new`: first with the corner between them blended
         (when the path has not reached the blend's start yet), then with that corner kept
-        as it is. Lazy: the second is built only when the first is missing or refused."""
+        as it is. Lazy: the second is built only when the first is missing or refused.
+        `pre`: the pre-blend cache to use (the join worker's copy; default the group's)."""
         s_raw = plan.chain.length - have
         last = plan.chain.elements[-1]
-        first, els, owners = self._elements(new, last)
+        first, els, owners = self._elements(new, last, pre)
         if first is not last and s_raw < float(plan.chain.cum[-2]) + first.length:
             yield plan.chain.joined(els, owners, *self._per(owners, new), replace_last=first)
         if first is not last:  # without the blend the new elements differ: rebuild them
@@ -327,7 +343,8 @@ class GroupEngine(LookaheadSettings):
         _, els, owners = self._elements(cmds)
         return px.Chain(els, owners, *self._per(owners, cmds))
 
-    def _elements(self, cmds: list[_Cmd], prev: PathElement | None = None
+    def _elements(self, cmds: list[_Cmd], prev: PathElement | None = None,
+                  pre: dict[int, tuple[Any, ...]] | None = None
                   ) -> tuple[PathElement | None, list[PathElement], list[int]]:
         """The commands' elements (and owners), each corner blended where that pays; with
         `prev` (the last element before them) the first corner too: `prev` comes back
@@ -336,7 +353,7 @@ class GroupEngine(LookaheadSettings):
         owners: list[int] = [-1] if prev is not None else []
         for c in cmds:
             el = c.elements[0]
-            b = self._blend_pair(els[-1], el, c) if els else None
+            b = self._blend_pair(els[-1], el, c, pre) if els else None
             if b is not None:
                 els[-1] = b[0]
                 els.append(b[1])
@@ -354,11 +371,12 @@ class GroupEngine(LookaheadSettings):
         return (self._blend, self._blend_tol, self._corner_velocity, vmax.tobytes(),
                 amax.tobytes())
 
-    def _blend_pair(self, prev: PathElement, el: PathElement,
-                    cmd: _Cmd) -> tuple[PathElement, PathElement, PathElement] | None:
+    def _blend_pair(self, prev: PathElement, el: PathElement, cmd: _Cmd,
+                    pre: dict[int, tuple[Any, ...]] | None = None
+                    ) -> tuple[PathElement, PathElement, PathElement] | None:
         """`_blend_new`, or its result from `_preblend` when computed for the same
         elements and settings (the same objects: the chain is the same bit for bit)."""
-        hit = self._pre.pop(cmd.index, None)
+        hit = (self._pre if pre is None else pre).pop(cmd.index, None)
         if hit is not None and hit[0] is prev and hit[1] is el and hit[2] == self._blend_key():
             return hit[3]
         return self._blend_new(prev, el, cmd)
@@ -459,6 +477,11 @@ class GroupEngine(LookaheadSettings):
         """Run `plan` from now: per-axis profiles along the chain, started all or none."""
         profiles = self._pulse_profiles(px.axis_profiles(plan.chain, plan.sprof,
                                                          self._ctl.period, self.position))
+        self._install(plan, profiles, cmds, t)
+
+    def _install(self, plan: pathrun.PathPlan, profiles: list[Profile], cmds: list[_Cmd],
+                 t: float) -> None:
+        """Start `plan`'s axis profiles (all or none) and make it the running chain."""
         if not self._dry:
             self._run_profiles(profiles, plan.limits.str_vel)
         first = plan.chain.owners[0]
@@ -519,6 +542,7 @@ class GroupEngine(LookaheadSettings):
         """Stop every axis of the group at once and drop the queue (MCCL 2.6.3 VI)."""
         self._stop_axes()
         self._queue.clear()
+        self._drop_join()
         self._run = self._held = None
         self._error, self._error_msg = code, message
         self._state = GroupState.ERROR
