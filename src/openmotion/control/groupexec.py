@@ -281,15 +281,13 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         the next queued path commands and re-plan from now. The corner with the running
         chain is blended when the path has not yet reached the blend's start; otherwise the
         corner keeps its exact stop (or junction speed). A join that cannot be followed
-        from the present speed leaves the commands queued (they start after the chain)."""
+        from the present speed leaves the commands queued (they start after the chain).
+        In real-time mode the re-plan runs on the join worker (groupjoin.py)."""
         r = self._run
         if r is None or r.plan is None or self._state is not GroupState.MOVING or \
                 self._job is not None:
             return
         plan = r.plan
-        worker = self._use_worker(plan)
-        if worker is None:
-            return  # the previous worker is still running (late): wait for it
         if not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
             return
         have = plan.remaining(t)
@@ -299,7 +297,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         new = self._take(plan.tj, have, [r.cmds[-1]])
         if not new:
             return
-        if worker:
+        if self._use_worker(plan):
             self._join_async(r, new)
             return
         if self._ctl.realtime:

@@ -79,10 +79,11 @@ class AsyncJoin:
     def _lead_cycles(self) -> int:
         return lead_cycles(self._ctl.period)  # type: ignore[attr-defined]
 
-    def _use_worker(self, plan: pathrun.PathPlan) -> bool | None:
-        """How a due join is done: True on the worker (real-time mode), False in the cycle
-        (virtual time, dry run, after MAX_MISSES misses in a row, or a chain that ends
-        before the worker's cycle), None: not now (the last worker is still running)."""
+    def _use_worker(self, plan: pathrun.PathPlan) -> bool:
+        """Whether a due join goes to the worker (real-time mode) or is done in the cycle:
+        virtual time, dry run, after MAX_MISSES misses in a row, a chain that ends before
+        the worker's cycle, or the worker still busy with a late job (waiting for it
+        would let the chain brake for its end)."""
         ctl = self._ctl  # type: ignore[attr-defined]
         if not ctl.realtime or self._dry:  # type: ignore[attr-defined]
             return False
@@ -91,9 +92,7 @@ class AsyncJoin:
             return False
         if plan.t_end <= ctl.time + (self._lead_cycles() + 1) * ctl.period:
             return False
-        if self._last_job is not None and not self._last_job.done.is_set():
-            return None
-        return True
+        return self._last_job is None or self._last_job.done.is_set()
 
     def _join_async(self, r: Any, new: list[Any]) -> None:
         """Start the worker on a join of `new` to the running chain at t + K cycles."""

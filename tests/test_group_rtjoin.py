@@ -1,0 +1,215 @@
+"""Joins planned off the real-time cycle (control/groupjoin.py): a streamed program in
+real-time mode ends exactly, never rests inside, keeps its limits, and its join re-plans
+run on the worker thread; hold, override and abort while a join is in flight keep the
+queue and the path consistent; a late or failing worker falls back to joins in the cycle.
+
+Real time on a shared machine: generous timeouts, no wall-clock asserts."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from openmotion.config import AxisConfig, MachineConfig
+from openmotion.control import Controller, groupjoin, pathrun
+from openmotion.control.group import Group, GroupState
+
+FEED, ACC_TIME, PPU = 40.0, 0.05, 1000.0  # mm/s, s, pulses/mm (lead 10 mm, 10000 ppr)
+N = 300
+
+
+def _setup(n: int = N) -> tuple[Controller, Group, list[tuple[float, float]], dict]:
+    """n short blended segments (0.05 mm, 1.25 ms each at the feed), fed a few per cycle
+    by a cycle hook; `info` counts the cycles the path rested while moving."""
+    axes = tuple(AxisConfig(name=c, lead=10.0, max_speed=200.0) for c in "xy")
+    ctl = Controller(MachineConfig(name="rtjoin", axes=axes))
+    ctl.enable_all()
+    g = Group(ctl, ["x", "y"], units=True, feed=FEED, acc_time=ACC_TIME, queue_size=1024)
+    g.enable_blend(0.005)
+    pts = [(0.05 * k, 0.5 * math.sin(k / 15.0)) for k in range(1, n + 1)]
+    it = iter(pts)
+    info = {"rests": 0, "fed": 0, "stop": False}
+
+    def feed(c: Controller, t: float) -> None:
+        for _ in range(3):
+            p = next(it, None) if g.queue_length < 256 and not info["stop"] else None
+            if p is None:
+                return
+            g.line(p)
+            info["fed"] += 1
+
+    def watch(c: Controller, t: float) -> None:
+        if g.state is GroupState.MOVING and (g.queue_length or g._job is not None) \
+                and not any(a.is_moving for a in g.axes):
+            info["rests"] += 1
+
+    ctl.add_cycle_hook(feed)
+    ctl.add_cycle_hook(watch)
+    return ctl, g, pts, info
+
+
+def _wait(ctl: Controller, cond: Callable[[], bool], timeout: float = 60.0) -> bool:
+    """Poll `cond` under the controller lock while real time runs."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        with ctl.lock:
+            if cond():
+                return True
+        time.sleep(0.001)
+    return False
+
+
+def _done(g: Group) -> Callable[[], bool]:
+    return lambda: (g.state in (GroupState.IDLE, GroupState.ERROR) and g.queue_length == 0
+                    and g._job is None and not any(a.is_moving for a in g.axes))
+
+
+def _ends_exactly(g: Group, end: tuple[float, float]) -> None:
+    assert [a.position for a in g.axes] == [e * PPU for e in end]  # bit for bit
+    assert not any(a.is_moving for a in g.axes)
+
+
+def _check_limits(ctl: Controller, g: Group) -> None:
+    """The recorded motion keeps the path feed and a bounded acceleration on every axis."""
+    t = np.linspace(0.0, ctl.time, 40_001)
+    sx, sy = (ctl.history.sample(a.index, t) for a in g.axes)
+    assert np.hypot(sx.v, sy.v).max() <= FEED * PPU * (1.0 + 1e-6)
+    a_max = FEED / ACC_TIME * PPU
+    assert max(np.abs(sx.a).max(), np.abs(sy.a).max()) <= math.sqrt(1.75) * a_max * 1.01
+
+
+def _replan_threads(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """Names of the threads each join re-plan (one that gets a longer chain) ran on."""
+    names: list[str] = []
+    orig = pathrun.replan
+
+    def replan(plan, t, *, chain=None, limits=None, hold=False):  # noqa: ANN001, ANN202
+        if chain is not None and chain is not plan.chain:
+            names.append(threading.current_thread().name)
+        return orig(plan, t, chain=chain, limits=limits, hold=hold)
+
+    monkeypatch.setattr(pathrun, "replan", replan)
+    return names
+
+
+def test_streamed_program_joins_on_the_worker(monkeypatch):
+    names = _replan_threads(monkeypatch)
+    ctl, g, pts, info = _setup()
+    with ctl.start_realtime():
+        assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
+    assert g.state is GroupState.IDLE and g.error_code == 0
+    _ends_exactly(g, pts[-1])
+    assert info["rests"] == 0  # the path never stopped inside
+    assert g.async_joins >= 1
+    assert "openmotion-join" in names
+    assert names.count("openmotion-join") >= g.async_joins
+    _check_limits(ctl, g)
+    g.close()
+
+
+def test_virtual_time_never_uses_the_worker(monkeypatch):
+    names = _replan_threads(monkeypatch)
+    ctl, g, pts, info = _setup(150)
+    assert ctl.run_until(lambda: info["fed"] == 150 and _done(g)(), 30.0)
+    _ends_exactly(g, pts[-1])
+    assert names and set(names) == {threading.current_thread().name}
+    assert g.async_joins == 0 and g._jobs is None
+
+
+def _in_flight(ctl: Controller, g: Group) -> None:
+    """Wait for a join in flight once the stream is well under way."""
+    assert _wait(ctl, lambda: g._job is not None and g.current_index > 50), \
+        "no join went in flight"
+
+
+def _indices(g: Group) -> list[int]:
+    """Command indices of the running or held chain and the queue, in order."""
+    r = g._run or g._held
+    run = [c.index for c in r.cmds] if r is not None else []
+    return run + [c.index for c in g._queue]
+
+
+def test_hold_and_continue_while_a_join_is_in_flight():
+    ctl, g, pts, info = _setup()
+    with ctl.start_realtime():
+        _in_flight(ctl, g)
+        with ctl.lock:
+            taken = [c.index for c in g._job.new]
+            g.hold()
+        assert _wait(ctl, lambda: g.state is GroupState.HELD)
+        with ctl.lock:
+            assert g._job is None
+            order = _indices(g)
+            # the commands the join had taken are back at the queue front, in order
+            assert [c.index for c in list(g._queue)[:len(taken)]] == taken
+            assert order == sorted(order) and len(set(order)) == len(order)
+            g.cont()
+        assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
+    assert g.state is GroupState.IDLE
+    _ends_exactly(g, pts[-1])
+    _check_limits(ctl, g)
+
+
+def test_override_while_a_join_is_in_flight():
+    ctl, g, pts, info = _setup()
+    with ctl.start_realtime():
+        _in_flight(ctl, g)
+        with ctl.lock:
+            job = g._job
+            g.set_override(60.0)
+        assert _wait(ctl, lambda: g._job is not job)
+        assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
+    assert g.state is GroupState.IDLE and g.error_code == 0
+    _ends_exactly(g, pts[-1])
+    assert info["rests"] == 0
+
+
+def test_abort_while_a_join_is_in_flight_drops_its_commands():
+    ctl, g, pts, info = _setup()
+    with ctl.start_realtime():
+        _in_flight(ctl, g)
+        seen: set[int] = set()
+        with ctl.lock:
+            taken = {c.index for c in g._job.new}
+            g.abort()
+            info["stop"] = True  # the program is given up: the feeder stops too
+            ctl.add_cycle_hook(lambda c, t: seen.add(g.current_index))
+        assert _wait(ctl, lambda: g.state is GroupState.IDLE
+                     and not any(a.is_moving for a in g.axes))
+        time.sleep(0.05)  # more cycles: nothing the join had taken comes back
+        with ctl.lock:
+            assert g._job is None and g.queue_length == 0
+            assert g.state is GroupState.IDLE and not any(a.is_moving for a in g.axes)
+    assert taken and not seen & taken  # no command the join had taken ever ran
+    assert g.error_code == 0
+
+
+@pytest.mark.parametrize("fault", ["late", "fails"])
+def test_a_late_or_failing_worker_falls_back_to_joins_in_the_cycle(monkeypatch, fault):
+    orig = groupjoin.pathaxes.axis_profiles
+
+    def slow(*a):  # noqa: ANN002, ANN202
+        if threading.current_thread().name == "openmotion-join":
+            if fault == "fails":
+                raise RuntimeError("worker failure (test)")
+            time.sleep(3 * groupjoin.JOIN_LEAD)
+        return orig(*a)
+
+    monkeypatch.setattr(groupjoin.pathaxes, "axis_profiles", slow)
+    ctl, g, pts, info = _setup()
+    with ctl.start_realtime():
+        assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
+    assert g.state is GroupState.IDLE and g.error_code == 0
+    _ends_exactly(g, pts[-1])
+    assert g.async_joins == 0 and g.sync_joins >= 1
+    assert g._join_misses <= groupjoin.MAX_MISSES
+
+
+def test_lead_cycles():
+    assert groupjoin.lead_cycles(0.001) == 25
+    assert groupjoin.lead_cycles(0.1) == 2
