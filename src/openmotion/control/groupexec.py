@@ -10,7 +10,8 @@ commands up to twice the distance it needs to brake from its feed, and joins the
 when it runs short, so a program of any length streams through a bounded plan; quiet
 cycles blend the queued corners ahead of the join (`_preblend`). Joining,
 hold, continue and the feed override are all one re-plan of the running chain from the
-present state (pathrun.py). A group axis going to ErrorStop (the controller's fault hooks,
+present state (pathrun.py); in real-time mode joins are planned on a worker thread
+(groupjoin.py). A group axis going to ErrorStop (the controller's fault hooks,
 when present, and a check every cycle) or reaching the limit switch ahead of it stops every
 axis of the group at once and puts the group in error (MCCL 2.6.3 VI: all motion commands
 stop).
