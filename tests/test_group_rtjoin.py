@@ -23,7 +23,8 @@ FEED, ACC_TIME, PPU = 40.0, 0.05, 1000.0  # mm/s, s, pulses/mm (lead 10 mm, 1000
 N = 300
 
 
-def _setup(n: int = N) -> tuple[Controller, Group, list[tuple[float, float]], dict]:
+def _setup(n: int = N, shape: str = "") -> tuple[Controller, Group, list[tuple[float, float]],
+                                                dict]:
     """n short blended segments (0.05 mm, 1.25 ms each at the feed), fed a few per cycle
     by a cycle hook; `info` counts the cycles the path rested while moving."""
     axes = tuple(AxisConfig(name=c, lead=10.0, max_speed=200.0) for c in "xy")
@@ -31,6 +32,10 @@ def _setup(n: int = N) -> tuple[Controller, Group, list[tuple[float, float]], di
     ctl.enable_all()
     g = Group(ctl, ["x", "y"], units=True, feed=FEED, acc_time=ACC_TIME, queue_size=1024)
     g.enable_blend(0.005)
+    if shape == "corner":
+        g.set_corner_velocity(5.0)
+    elif shape == "S":
+        g.set_path_shape("S", jerk=40_000.0)  # tj = 20 ms
     pts = [(0.05 * k, 0.5 * math.sin(k / 15.0)) for k in range(1, n + 1)]
     it = iter(pts)
     info = {"rests": 0, "fed": 0, "stop": False}
@@ -97,9 +102,10 @@ def _replan_threads(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     return names
 
 
-def test_streamed_program_joins_on_the_worker(monkeypatch):
+@pytest.mark.parametrize("shape", ["", "corner", "S"])
+def test_streamed_program_joins_on_the_worker(monkeypatch, shape):
     names = _replan_threads(monkeypatch)
-    ctl, g, pts, info = _setup()
+    ctl, g, pts, info = _setup(shape=shape)
     with ctl.start_realtime():
         assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
     assert g.state is GroupState.IDLE and g.error_code == 0
@@ -155,13 +161,17 @@ def test_hold_and_continue_while_a_join_is_in_flight():
     _check_limits(ctl, g)
 
 
-def test_override_while_a_join_is_in_flight():
+@pytest.mark.parametrize("change", ["override", "corner velocity"])
+def test_override_or_settings_while_a_join_is_in_flight(change):
     ctl, g, pts, info = _setup()
     with ctl.start_realtime():
         _in_flight(ctl, g)
         with ctl.lock:
             job = g._job
-            g.set_override(60.0)
+            if change == "override":
+                g.set_override(60.0)
+            else:  # the join was planned with other corners: it is planned again
+                g.set_corner_velocity(5.0)
         assert _wait(ctl, lambda: g._job is not job)
         assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
     assert g.state is GroupState.IDLE and g.error_code == 0

@@ -73,8 +73,9 @@ class AsyncJoin:
 
     def _join_key(self) -> tuple:
         """Everything besides the plan and the commands a join's result depends on."""
+        # the blend key holds the blend and corner settings and the axis caps
         return (self._blend_key(), self._override, self._sys_max,  # type: ignore[attr-defined]
-                tuple(sorted(self._corner_limits().items(), key=lambda kv: kv[0])))  # type: ignore[attr-defined]
+                self._cruise_ratio)  # type: ignore[attr-defined]
 
     def _lead_cycles(self) -> int:
         return lead_cycles(self._ctl.period)  # type: ignore[attr-defined]
