@@ -134,27 +134,22 @@ class GroupChecks(GroupEngine):
         self._check_soft_limits(el)
         feed, sv = self._feed, self._str_vel
         tan = el.max_abs_tangent
-        vmax, amax = self._caps()
-        self._check_str_vel(sv, feed, tan)
-        if not self._refuse:  # the planner slows the path down to the axis limits
-            return self._push(_Cmd(-1, "path", elements=(el,), feed=feed,
-                                   accel=feed / self._acc_time, jerk=self._path_jerk,
-                                   str_vel=sv), end)
-        need = feed * tan * self._ppu
-        bad = np.nonzero(need > vmax * self._ppu * (1 + 1e-12))[0]
-        if len(bad):
-            k = int(bad[0])
-            raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps at "
-                                        f"feed {feed:g}, above its maximum pulse speed "
-                                        f"{self._vmax[k]:g} pps")
         accel = feed / self._acc_time
-        needa = accel * tan * self._ppu
-        bad = np.nonzero(needa > amax * self._ppu * (1 + 1e-12))[0]
-        if len(bad):
-            k = int(bad[0])
-            raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} pps^2, "
-                                        f"above its maximum pulse acceleration "
-                                        f"{self._amax[k]:g} pps^2")
+        self._check_str_vel(sv, feed, tan)
+        if self._refuse:  # MCCL: refused; "slow": the planner slows down to the axis limits
+            vmax, amax = self._caps()
+            need = feed * tan * self._ppu
+            k = _first_over(need, vmax * self._ppu)
+            if k is not None:
+                raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps "
+                                            f"at feed {feed:g}, above its maximum pulse speed "
+                                            f"{self._vmax[k]:g} pps")
+            needa = accel * tan * self._ppu
+            k = _first_over(needa, amax * self._ppu)
+            if k is not None:
+                raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} "
+                                            f"pps^2, above its maximum pulse acceleration "
+                                            f"{self._amax[k]:g} pps^2")
         return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
                                jerk=self._path_jerk, str_vel=sv), end)
 
@@ -167,9 +162,8 @@ class GroupChecks(GroupEngine):
             raise GroupError(ERR_SPEED, f"StrVel {sv:g} must be <= the feed {feed:g}")
         caps = np.minimum(self._vmax, [a.max_speed for a in self.axes])
         need = sv * tan * self._ppu
-        bad = np.nonzero(need > caps * (1 + 1e-12))[0]
-        if len(bad):
-            k = int(bad[0])
+        k = _first_over(need, caps)
+        if k is not None:
             raise GroupError(ERR_SPEED, f"axis {self.names[k]} would jump to {need[k]:g} pps "
                                         f"at StrVel {sv:g}, above its maximum speed "
                                         f"{caps[k]:g} pps")
@@ -202,3 +196,9 @@ def unit_scales(controller: Controller, axes: Sequence[Axis],
     else:
         raise MotionError(f"units must be a bool or {len(axes)} AxisUnits, got {units!r}")
     return np.array([u.sign * u.pulses_per_unit for u in au], dtype=float)
+
+
+def _first_over(need: np.ndarray, cap: np.ndarray) -> int | None:
+    """Index of the first axis whose need exceeds its cap (beyond rounding), or None."""
+    bad = np.nonzero(need > cap * (1 + 1e-12))[0]
+    return int(bad[0]) if len(bad) else None
