@@ -1,0 +1,37 @@
+"""Suite-wide options: long fuzz, soak and property runs stay out of the normal run."""
+
+from __future__ import annotations
+
+import pytest
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("openmotion long runs")
+    group.addoption("--fuzz-long", action="store_true", default=False,
+                    help="run the fuzz suite with 100k inputs per entry point family")
+    group.addoption("--soak-long", action="store_true", default=False,
+                    help="run the soak test for its long duration")
+    group.addoption("--long", action="store_true", default=False,
+                    help="run heavy property and comparison runs in full")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", "long: a heavy run, reduced unless --long is given")
+
+
+@pytest.fixture
+def fuzz_long(request: pytest.FixtureRequest) -> bool:
+    """True when the suite was started with --fuzz-long."""
+    return bool(request.config.getoption("--fuzz-long"))
+
+
+@pytest.fixture
+def soak_long(request: pytest.FixtureRequest) -> bool:
+    """True when the suite was started with --soak-long."""
+    return bool(request.config.getoption("--soak-long"))
+
+
+@pytest.fixture
+def long_run(request: pytest.FixtureRequest) -> bool:
+    """True when the suite was started with --long."""
+    return bool(request.config.getoption("--long"))
