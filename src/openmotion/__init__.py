@@ -5,9 +5,13 @@ program -> cli. See docs/architecture.md. The most used names are re-exported he
 `Controller` is loaded on first use so `import openmotion.profile` stays light.
 """
 
+from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
-__version__ = "0.1.0"
+try:
+    __version__ = version("openmotion")  # one source of truth: pyproject.toml
+except PackageNotFoundError:  # running from a source tree that was never installed
+    __version__ = "0+unknown"
 
 __all__ = ["Controller", "MotionError", "__version__", "default_machine", "load_machine"]
 

@@ -117,7 +117,10 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     ap = argparse.ArgumentParser(prog="openmotion", description=__doc__)
+    ap.add_argument("--version", action="version", version=f"openmotion {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     _add_profile_parser(sub)
     d = sub.add_parser("demo", help="run the demo on the simulated XYZU table")
