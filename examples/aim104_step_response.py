@@ -1,6 +1,6 @@
 """Step response of the simulated DC servo under the HCTL-1100 position loop: the chip's
 reset filter (A=E5h, B=40h, K=40h), a well-tuned one, and a gain far too high (K=FFh),
-plotted into the PNG path given on the command line (default aim104_step_response.png)."""
+plotted into the PNG path given on the command line (default out/aim104_step_response.png)."""
 
 import sys
 
@@ -13,7 +13,7 @@ from openmotion.compat.hctl1100_step import (
 )
 
 
-def main(path: str = "aim104_step_response.png", step: int = 200) -> dict:
+def main(path: str = "out/aim104_step_response.png", step: int = 200) -> dict:
     filters = {"default": DEFAULT_FILTER, "tuned": TUNED_FILTER, "gain too high": (0xE5, 0x40,
                                                                                   0xFF)}
     runs = {name: step_response(*f, step=step, samples=600) for name, f in filters.items()}

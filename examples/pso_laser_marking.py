@@ -17,8 +17,9 @@ from openmotion.control.group import Group
 MM = 1000.0  # pulses per mm
 
 
-def main(outdir: str = ".") -> dict:
+def main(outdir: str = "out") -> dict:
     out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
     c = Controller(MachineConfig("laser", (AxisConfig(name="x"), AxisConfig(name="y"))))
     c.enable_all()
     eng = CompareEngine(c)

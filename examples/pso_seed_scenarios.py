@@ -6,7 +6,7 @@
 3. HSL-4XMO 4.12 CCD camera scan: 0 -> 36000 at 6000 pps, trigger points 1001..35000 every
    pulse ("="), 34,000 CMP pulses.
 
-Writes <outdir>/pso_2d.png, pso_2d.csv and pso_ccd.npz (default outdir: current folder).
+Writes <outdir>/pso_2d.png, pso_2d.csv and pso_ccd.npz (default outdir: out/).
 Run: python examples/pso_seed_scenarios.py [outdir]
 """
 
@@ -105,8 +105,9 @@ def scenario_ccd(out: Path) -> dict:
     return {"fired": int(a["time"].size), "rate": rate}
 
 
-def main(outdir: str = ".") -> dict:
+def main(outdir: str = "out") -> dict:
     out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
     out.mkdir(parents=True, exist_ok=True)
     return {"2d": scenario_2d(out), "3d": scenario_3d(), "ccd": scenario_ccd(out)}
 

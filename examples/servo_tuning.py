@@ -68,9 +68,10 @@ def main(out: str) -> None:
     ax.set_title(f"dc_servo closed loop: {STEP}-count step, 0.5 ms sample")
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "servo_tuning.png")
+    main(sys.argv[1] if len(sys.argv) > 1 else "out/servo_tuning.png")

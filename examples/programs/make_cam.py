@@ -1,6 +1,7 @@
-"""Write cam_rose.ngc: a CAM-style finishing pass, a rose curve r = 30 cos(3t) cut in
-thousands of short G1 segments (about 0.05 mm each), the kind of file the look-ahead
-exists for. Run: python examples/programs/make_cam.py [N]  (default 4000 segments)."""
+"""Write a CAM-style finishing pass, a rose curve r = 30 cos(3t) cut in thousands of short
+G1 segments (about 0.05 mm each), the kind of file the look-ahead exists for.
+Run: python examples/programs/make_cam.py [N] [PATH]  (default 4000 segments into
+out/cam_rose.ngc; the shipped examples/programs/cam_rose.ngc is this output for N=4000)."""
 
 import math
 import sys
@@ -20,4 +21,7 @@ def rose(n: int) -> str:
 
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 4000
-    Path(__file__).with_name("cam_rose.ngc").write_text(rose(n))
+    path = Path(sys.argv[2] if len(sys.argv) > 2 else "out/cam_rose.ngc")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(rose(n))
+    print(f"wrote {path} ({n} segments)")
