@@ -21,6 +21,7 @@ import contextlib
 import math
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from functools import wraps
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -64,6 +65,25 @@ __all__ = [
 
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+
+@dataclass(frozen=True)
+class CommandInfo:
+    """The command a group executes: index, kind (ptp, path, delay), element type (Line,
+    Arc, Arc3D), arc direction ("CW", "CCW", "3D" or None), feed (PtP: the speed
+    ratio %), target (logical units; None for a delay)."""
+
+    index: int
+    kind: str
+    element: str
+    direction: str | None
+    feed: float
+    target: np.ndarray | None
+
+#: MCCL 2.6.4: an axis sends at most 32768 pulses per interpolation period (max pulse speed
+#: = 32768 / T); MCC_SetMaxPulseSpeed / MCC_SetMaxPulseAcc default to 30000.
+PERIOD_PULSES_MAX = 32768
+PERIOD_PULSES_DEFAULT = 30000.0
 
 
 def _locked(fn: F) -> F:
@@ -140,13 +160,18 @@ class Group(GroupChecks):
         self.set_feed(feed)
         if acc_time is not None:
             self.set_acc_time(acc_time)
-        self._vmax = np.array([a.max_speed for a in ax], dtype=float)
-        self._amax = np.full(len(ax), math.inf)
+        self._vmax_pps = np.array([a.max_speed for a in ax], dtype=float)
+        self._amax_pps = np.full(len(ax), math.inf)
+        self._period_pulses = np.full(len(ax), PERIOD_PULSES_DEFAULT)
+        self._period_pulse_acc = np.full(len(ax), PERIOD_PULSES_DEFAULT)
+        self._update_caps()
         self._refuse = True
         self._ptp_ratio = 10.0
         self._path_jerk = 0.0   # 0: T-curve path speed; > 0: S-curve with this path jerk
         self._str_vel = 0.0     # StrVel of the following path commands (0: from/to rest)
-        self._ptp_shape = "T"
+        self._ptp_shapes = ("T",) * len(ax)
+        self._ptp_acc_time: float | None = None  # None: the path commands' times
+        self._ptp_dec_time: float | None = None
         for a in ax:
             owners[a.index] = self
         controller.add_cycle_hook(self._on_cycle)
@@ -194,6 +219,45 @@ class Group(GroupChecks):
             return self._units_of(np.array([p.state_at(min(max(u, 0.0), p.duration)).p
                                             for p in r.profiles]))
         return self._units_of(self._dry_pos)
+
+    @property
+    def end_point(self) -> np.ndarray:
+        """Where the last queued command ends (logical units): the start point of a
+        relative command; the position when nothing is queued or running."""
+        if self._tail is None or (self._run is None and not self._queue
+                                  and self._held is None):
+            return self.position
+        return self._tail.copy()
+
+    @property
+    def current_command(self) -> CommandInfo | None:
+        """The command being executed (MCC_GetCurCommand), None when none is."""
+        r = self._run or self._held
+        if r is None:
+            return None
+        idx = self.current_index
+        cmd = next((c for c in r.cmds if c.index == idx), r.cmds[0])
+        el = cmd.elements[0] if cmd.elements else None
+        target = cmd.target if cmd.kind == "ptp" else (
+            None if el is None else np.array(el.end, dtype=float))
+        direction = str(getattr(getattr(el, "direction", None), "name", "")) or None
+        if el is not None and getattr(el, "via", None) is not None:
+            direction = "3D"
+        feed = self._ptp_ratio if cmd.kind == "ptp" else cmd.feed
+        return CommandInfo(cmd.index, cmd.kind, type(el).__name__ if el is not None
+                           else cmd.kind, direction, feed,
+                           None if target is None else np.asarray(target, float).copy())
+
+    @property
+    def commands_pending(self) -> int:
+        """Commands accepted and not yet started (MCC_GetCommandCount): the queue and the
+        commands a running chain has taken in ahead of the one it executes."""
+        r = self._run or self._held
+        ahead = 0
+        if r is not None:
+            cur = self.current_index
+            ahead = sum(1 for c in r.cmds if c.index > cur)
+        return len(self._queue) + ahead
 
     @property
     def units(self) -> bool:
@@ -285,8 +349,45 @@ class Group(GroupChecks):
         return self._acc_time if self._dec_time is None else self._dec_time
 
     def set_max_pulse_speed(self, pps: Sequence[float]) -> None:
-        """MCC_SetMaxPulseSpeed per logical axis (pps); default the axes' maximum speed."""
-        self._vmax = self._axis_values("pps", pps)
+        """Speed cap per logical axis (pps); default the axes' maximum speed. The
+        per-period cap (set_period_pulse_caps) applies on top of it."""
+        self._vmax_pps = self._axis_values("pps", pps)
+        self._update_caps()
+
+    def set_period_pulse_caps(self, speed: Sequence[float] | None = None,
+                              acc: Sequence[float] | None = None) -> None:
+        """MCC_SetMaxPulseSpeed / MCC_SetMaxPulseAcc (MCCL 2.6.4): per logical axis, the
+        most pulses an axis may send in one interpolation period (`speed`) and the largest
+        change of that count between two neighbouring periods (`acc`), each a whole
+        number 1..32768 (default 30000). They cap the axis at speed/T pps and acc/T**2
+        pps^2 (T the period) for every group command: refused above them (policy
+        "refuse"), or planned below them ("slow"). All checked before either changes."""
+        new = []
+        for name, val in (("speed", speed), ("acc", acc)):
+            if val is None:
+                new.append(None)
+                continue
+            arr = self._axis_values(name, val)
+            if np.any(arr != np.round(arr)) or np.any(arr > PERIOD_PULSES_MAX):
+                raise MotionError(f"{name} must be {len(self.axes)} whole numbers of pulses "
+                                  f"in 1..{PERIOD_PULSES_MAX}, got {val!r}")
+            new.append(arr)
+        if new[0] is not None:
+            self._period_pulses = new[0]
+        if new[1] is not None:
+            self._period_pulse_acc = new[1]
+        self._update_caps()
+
+    @property
+    def period_pulse_caps(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(pulses per period, change of pulses per period) of each logical axis."""
+        return tuple(self._period_pulses.tolist()), tuple(self._period_pulse_acc.tolist())
+
+    def _update_caps(self) -> None:
+        """The effective per-axis caps: the pps caps and the per-period pulse caps."""
+        T = self._ctl.period
+        self._vmax = np.minimum(self._vmax_pps, self._period_pulses / T)
+        self._amax = np.minimum(self._amax_pps, self._period_pulse_acc / (T * T))
 
     def set_axis_limit_policy(self, policy: str) -> None:
         """"refuse" (default, MCCL): a path command whose feed or acceleration would take an
@@ -297,8 +398,10 @@ class Group(GroupChecks):
         self._refuse = policy == "refuse"
 
     def set_max_pulse_acc(self, pps2: Sequence[float]) -> None:
-        """MCC_SetMaxPulseAcc per logical axis (pps^2, inf = unlimited, the default)."""
-        self._amax = self._axis_values("pps2", pps2)
+        """Acceleration cap per logical axis (pps^2, inf = unlimited, the default); the
+        per-period cap (set_period_pulse_caps) applies on top of it."""
+        self._amax_pps = self._axis_values("pps2", pps2)
+        self._update_caps()
 
     def enable_blend(self, tolerance: float) -> None:
         """Blend consecutive path commands: corners between lines and arcs are rounded so
@@ -345,7 +448,43 @@ class Group(GroupChecks):
             raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
         if shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
-        self._ptp_ratio, self._ptp_shape = r, shape
+        self._ptp_ratio, self._ptp_shapes = r, (shape,) * len(self.axes)
+
+    def set_ptp_shapes(self, shapes: Sequence[str]) -> None:
+        """MCC_SetPtPAccType per axis: "T" or "S" for each logical axis's PtP profile."""
+        if isinstance(shapes, str) or not isinstance(shapes, Sequence) or \
+                len(shapes) != len(self.axes) or any(x not in ("T", "S") for x in shapes):
+            raise MotionError(f"shapes must be {len(self.axes)} of 'T'/'S', got {shapes!r}")
+        self._ptp_shapes = tuple(shapes)
+
+    def set_ptp_acc_time(self, seconds: float) -> None:
+        """MCC_SetPtPAccStep x T: acceleration time of point-to-point axes (default: the
+        path commands' set_acc_time)."""
+        t = check_finite("seconds", seconds)
+        if t <= 0.0:
+            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        self._ptp_acc_time = t
+
+    def set_ptp_dec_time(self, seconds: float) -> None:
+        """MCC_SetPtPDecStep x T: deceleration time of point-to-point axes (default: the
+        PtP acceleration time)."""
+        t = check_finite("seconds", seconds)
+        if t <= 0.0:
+            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        self._ptp_dec_time = t
+
+    @property
+    def ptp_times(self) -> tuple[float, float]:
+        """(acceleration, deceleration) time of point-to-point axes (s)."""
+        acc = self._acc_time if self._ptp_acc_time is None else self._ptp_acc_time
+        if self._ptp_dec_time is not None:
+            return acc, self._ptp_dec_time
+        return acc, (self.dec_time if self._ptp_acc_time is None else acc)
+
+    @property
+    def ptp_settings(self) -> tuple[float, tuple[str, ...]]:
+        """(speed ratio %, the shape of each axis) of point-to-point commands."""
+        return self._ptp_ratio, self._ptp_shapes
 
     @_locked
     def enable_dry_run(self, on: bool = True) -> None:
@@ -360,18 +499,25 @@ class Group(GroupChecks):
 
     # ------------------------------------------------------------------ commands
     @_locked
-    def ptp(self, target: Sequence[float], *, relative: bool = False) -> int:
+    def ptp(self, target: Sequence[float], *, relative: bool = False,
+            ratio: float | None = None) -> int:
         """Point-to-point: every axis to its target with its own T/S profile at the PtP
-        speed ratio; the next command waits for all axes."""
+        speed ratio (or `ratio` % for this command: a jog); the next command waits for
+        all axes."""
+        if ratio is not None:
+            ratio = check_finite("ratio", ratio)
+            if not 0.0 < ratio <= 100.0:
+                raise GroupError(ERR_SPEED, f"ratio must be in (0, 100] percent, got "
+                                            f"{ratio!r}")
         start = self._start_point()
         p = self._point("target", target, start if relative else None)
         if np.all(p == start):
             raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
         specs = []
+        tacc, tdec = self.ptp_times
         for k, a in enumerate(self.axes):
-            v = min(a.max_speed, self._vmax[k]) * self._ptp_ratio / 100.0
-            specs.append(MoveSpec(self._ptp_shape, 0.0, v, self._acc_time, self.dec_time,
-                                  0.0, 0.0))
+            v = min(a.max_speed, self._vmax[k]) * (ratio or self._ptp_ratio) / 100.0
+            specs.append(MoveSpec(self._ptp_shapes[k], 0.0, v, tacc, tdec, 0.0, 0.0))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
 
     @_locked
@@ -428,11 +574,20 @@ class Group(GroupChecks):
 
     @_locked
     def delay(self, seconds: float) -> int:
-        """MCC_DelayMotion: wait `seconds` after the previous command ends."""
+        """MCC_DelayMotion: wait `seconds` after the previous command ends (its exact end
+        time), then start the next one at the first cycle at or after that. Queued on an
+        idle group it starts counting now, so the next command starts `seconds` from now
+        (not one period later, as a queued motion command does)."""
         t = check_finite("seconds", seconds)
         if t < 0.0:
             raise GroupError(ERR_ARGUMENT, f"seconds must be >= 0, got {seconds!r}")
-        return self._push(_Cmd(-1, "delay", seconds=t), None)
+        idle = self._state is GroupState.IDLE and self._run is None and not self._queue \
+            and self._held is None and self._job is None
+        index = self._push(_Cmd(-1, "delay", seconds=t), None)
+        if idle:
+            self._ended_at = None
+            self._start_next(self._ctl.time)
+        return index
 
     def reset_command_index(self) -> None:
         self._next_index = 0

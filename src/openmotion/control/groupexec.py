@@ -159,6 +159,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     _vmax: np.ndarray
     _amax: np.ndarray
     _k: np.ndarray      # signed pulses per logical unit (1.0: the group works in pulses)
+    _ended_at: float | None = None  # when the last finished run ended (a delay counts from it)
     _ppu: np.ndarray
 
     def _units_of(self, pulses: np.ndarray) -> np.ndarray:
@@ -203,6 +204,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         if r is not None and t >= r.t_end - 1e-12 and (self._dry or not any(
                 a.is_moving for a in self.axes)):
             self._run = None
+            self._ended_at = r.t_end
             if r.kind in ("path", "ptp") and r.target is not None and self._dry:
                 self._dry_pos = self._pulses_of(r.target) if r.kind == "path" \
                     else r.target.copy()
@@ -241,7 +243,11 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     def _start_queued(self, t: float) -> None:
         cmd = self._queue.popleft()
         if cmd.kind == "delay":
-            self._run = _Run("delay", [cmd], t, t_until=t + cmd.seconds)
+            # counted from the exact end of the command before it when that ended within
+            # this cycle (MCCL 2.6.3 V: "after finishing A, it will delay"), else from now
+            end = self._ended_at
+            base = end if end is not None and 0.0 <= t - end < self._ctl.period else t
+            self._run = _Run("delay", [cmd], base, t_until=base + cmd.seconds)
         elif cmd.kind == "ptp":
             self._launch_ptp(cmd, t)
         else:
