@@ -36,8 +36,8 @@ from ..path.geometry import PathElement
 from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
+from . import pathaxes, pathrun, planning
 from . import pathexec as px
-from . import pathrun, planning
 from .group_corners import LookaheadSettings
 from .groupjoin import AsyncJoin
 from .states import AxisState
@@ -201,6 +201,16 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         if self._job is not None and self._poll_join(t):
             return  # a join in flight (real time), or installed this cycle
         r = self._run
+        if r is not None and r.kind == "delay" and self._queue and \
+                self._state is GroupState.MOVING and \
+                1e-12 < r.t_until - t < self._ctl.period - 1e-12 and \
+                self._queue[0].kind == "path" and not self._queue[0].str_vel:
+            # the delay ends inside the coming cycle: start the path now, at rest until
+            # the delay's exact end (MCC_DelayMotion is exact, not rounded to a cycle)
+            self._run = None
+            self._ended_at = r.t_until
+            self._start_next(t, start=r.t_until)
+            return
         if r is not None and t >= r.t_end - 1e-12 and (self._dry or not any(
                 a.is_moving for a in self.axes)):
             self._run = None
@@ -234,13 +244,15 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             if len(self._queue) == n:  # no join this cycle
                 self._preblend()
 
-    def _start_next(self, t: float) -> None:
+    def _start_next(self, t: float, start: float | None = None) -> None:
         try:
-            self._start_queued(t)
+            self._start_queued(t, start)
         except MotionError as err:  # an axis refused (safety check, state): stop the group
             self._fault(getattr(err, "code", ERR_AXIS_STATE), f"command refused at start: {err}")
 
-    def _start_queued(self, t: float) -> None:
+    def _start_queued(self, t: float, start: float | None = None) -> None:
+        """Start the next queued command now (a path: from `start` >= t within this
+        cycle, at rest until then)."""
         cmd = self._queue.popleft()
         if cmd.kind == "delay":
             # counted from the exact end of the command before it when that ended within
@@ -254,7 +266,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             tj = jerk_window(cmd.window_accel, cmd.jerk) if cmd.jerk else 0.0
             cmds = [cmd, *self._take(tj, cmd.elements[0].length, [cmd])]
             chain = self._chain(cmds)
-            self._launch(pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t),
+            t_s = t if start is None else start
+            self._launch(pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t_s),
                          cmds, t)
         self._state = GroupState.MOVING
 
@@ -306,8 +319,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 self._job is not None:
             return
         plan = r.plan
-        if not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
-            return
+        if t < plan.t0 or not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
+            return  # (a plan starting later in this cycle joins from the next one)
         have = plan.remaining(t)
         if have >= self._reach(self._queue[0], plan.tj) and have >= self._reach(
                 r.cmds[-1], plan.tj):
@@ -496,6 +509,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         """Run `plan` from now: per-axis profiles along the chain, started all or none."""
         profiles = self._pulse_profiles(px.axis_profiles(plan.chain, plan.sprof,
                                                          self._ctl.period, self.position))
+        lead = plan.t0 - t
+        if lead > 1e-12:  # the plan starts later in this cycle (an exact delay)
+            profiles = [pathaxes.delayed(p, lead) for p in profiles]
         self._install(plan, profiles, cmds, t)
 
     def _install(self, plan: pathrun.PathPlan, profiles: list[Profile], cmds: list[_Cmd],
@@ -532,11 +548,12 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     def _replan(self, r: _Run, *, hold: bool) -> None:
         """Re-plan the running chain from now: a hold (to rest) or a new override."""
         assert r.plan is not None
-        t = self._ctl.time
+        now = self._ctl.time
+        t = max(now, r.plan.t0)  # (a plan that starts later in this cycle)
         if t >= r.plan.t_end:
             return
         lim = r.plan.limits if hold else self._limits(r.plan.chain, r.plan.limits.str_vel)
-        self._launch(pathrun.replan(r.plan, t, limits=lim, hold=hold), r.cmds, t)
+        self._launch(pathrun.replan(r.plan, t, limits=lim, hold=hold), r.cmds, now)
 
     def _on_axis_fault(self, axis: Axis, reason: str) -> None:
         """Controller fault hook: a group axis went to ErrorStop."""

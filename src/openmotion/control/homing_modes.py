@@ -111,7 +111,7 @@ def mccl_phases(kind: str, same_direction: bool) -> tuple[Phase, ...]:
     Phase 0 searches the sensor at the homing speed and must stop on it; phase 1 leaves it
     in wPhase1Dir at 1/10 speed; phase 2 goes on in wPhase1Dir to the nearest index; phase 3
     (the offset move to the logical home) is the engine's final move. INDEX_ONLY runs
-    phase 2 from rest in wPhase1Dir, relative here to the homing direction (+1). Phases
+    phase 2 from rest in wPhase1Dir (the manual's phase 2 direction). Phases
     1, 2 and 3 run at about 1/10 of the phase-0 speed (HomeConfig.speed: "creep").
     """
     d1 = 1 if same_direction else -1
@@ -122,8 +122,8 @@ def mccl_phases(kind: str, same_direction: bool) -> tuple[Phase, ...]:
     if kind == "home_only":
         return (p0, P("phase 1: leave home sensor", "org", "off", d1, "creep", "stop",
                       mark=True))
-    if kind == "index_only":
-        return (_ez("phase 2: index", 1, "creep", counted=False),)
+    if kind == "index_only":  # phase 2 moves in wPhase1Dir (manual 2.7), as in NORMAL
+        return (_ez("phase 2: index", d1, "creep", counted=False),)
     raise ValueError(kind)
 
 
