@@ -404,6 +404,7 @@ class MCCL(MCCLMotion):
         gs = self._g(wGroupIndex)
         assert self._inpos is not None
         self._inpos.enable([a.index for a in gs.group.axes])
+        gs.group.set_wait_in_position(True)
         return D.NO_ERR
 
     @_api
@@ -411,6 +412,7 @@ class MCCL(MCCLMotion):
         gs = self._g(wGroupIndex)
         assert self._inpos is not None
         self._inpos.disable([a.index for a in gs.group.axes])
+        gs.group.set_wait_in_position(False)
         return D.NO_ERR
 
     @_api

@@ -414,6 +414,14 @@ class Group(GroupChecks):
     def disable_blend(self) -> None:
         self._blend = False
 
+    def set_wait_in_position(self, on: bool) -> None:
+        """MCCL 2.10.2: with in-position checks on (control.inposition), each command
+        ends on its own (no join or blend with the next), so the next starts only once
+        the axes are within their tolerance. Applies to the commands not started yet."""
+        if not isinstance(on, bool):
+            raise MotionError(f"on must be a bool, got {on!r}")
+        self._wait_inpos = on
+
     def set_path_shape(self, shape: str, jerk: float | None = None) -> None:
         """Speed profile of the following path commands: "T" (constant path acceleration)
         or "S" (jerk-limited: the jerk of the path position stays within `jerk`, pps^3 or

@@ -160,6 +160,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     _amax: np.ndarray
     _k: np.ndarray      # signed pulses per logical unit (1.0: the group works in pulses)
     _ended_at: float | None = None  # when the last finished run ended (a delay counts from it)
+    _wait_inpos: bool = False       # every command ends alone: in-position between commands
     _ppu: np.ndarray
 
     def _units_of(self, pulses: np.ndarray) -> np.ndarray:
@@ -276,7 +277,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         """Whether `cmd` can join a chain smoothed with window tj (0: a T chain) that starts
         and ends at `str_vel`: a path command of the same shape and StrVel whose own window
         fits in tj (its jerk stays bounded)."""
-        if cmd.kind != "path" or cmd.str_vel != str_vel:
+        if cmd.kind != "path" or cmd.str_vel != str_vel or self._wait_inpos:
             return False
         if tj == 0.0 or not cmd.jerk:
             return tj == 0.0 and not cmd.jerk
