@@ -126,6 +126,13 @@ class MCCLBase:
         self.last_error = ""
         self._reset()
 
+    def simulate(self, axis_setup: Callable[[int, int], dict[str, Any]] | None) -> None:
+        """Describe the simulated machine before MCC_InitSystem: axis_setup(card, channel)
+        gives extra AxisConfig fields (home sensor and limit switch positions, drive)."""
+        if axis_setup is not None and not callable(axis_setup):
+            raise MotionError(f"axis_setup must be callable or None, got {axis_setup!r}")
+        self._axis_setup = axis_setup
+
     def _reset(self) -> None:
         self.controller: Controller | None = None
         self._period = 0.0
