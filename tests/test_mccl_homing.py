@@ -113,3 +113,13 @@ def test_home_acc_and_dec_steps():
     a = np.gradient(v, t)[:stop0]
     assert a.min() == pytest.approx(-5.0 / 0.05, rel=1e-2)   # accelerating downwards
     assert a.max() == pytest.approx(5.0 / 0.2, rel=1e-2)     # braking the search
+
+
+def test_go_home_refused_while_an_axis_moves():
+    lib = setup()
+    lib.MCC_SetFeedSpeed(10.0, 0)
+    assert lib.MCC_Line(0, 5, 0, 0, 0, 0, 0) == 0      # y moves
+    lib.advance(0.1)
+    assert lib.MCC_GoHome(20, 20, 0, 0, 0, 0, 0, 0, -1, -1) == D.COMMAND_NOTACCEPTED_ERR
+    assert all(a.state.value != "Homing" for a in lib.controller.axes)  # none started
+    assert lib.MCC_GetGoHomeStatus() == D.HOME_COMMAND_NOTCALLED_ERR

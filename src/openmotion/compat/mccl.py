@@ -28,6 +28,7 @@ from openmotion.control.homing_sequence import HomeSequence
 from openmotion.control.inposition import INPOS_TIMEOUT
 from openmotion.control.jog import MAX_JOG_PULSES
 from openmotion.control.softlimits import working_interval
+from openmotion.control.states import AxisState
 from openmotion.errors import check_nonnegative
 
 from . import mccl_defs as D
@@ -287,8 +288,17 @@ class MCCL(MCCLMotion):
             plan[ax.index] = (cfg, orders[ch])
         if not plan:
             raise Refused(D.PARAMETER_ERR, "no axis to home (every order < 0)")
+        for i in plan:
+            ax = ctl.axes[int(i)]
+            if ax.is_moving or ax.state is not AxisState.STANDSTILL:
+                raise Refused(D.COMMAND_NOTACCEPTED_ERR, f"axis {ax.name} must be at "
+                                                         f"standstill (state {ax.state.value})")
         seq = HomeSequence(ctl, plan)
-        seq.start()
+        try:
+            seq.start()
+        except BaseException:
+            seq.abort()  # an axis refused: none keeps homing
+            raise
         self._home = seq
         return D.NO_ERR
 
