@@ -215,6 +215,10 @@ def test_absolute_increase_inch_arcs_and_circles():
     lib.MCC_SetAbsolute(0)
     # arc through (30, 10) to (40, 0): a half circle around (30, 0), clockwise
     assert lib.MCC_ArcXY(30, 10, 40, 0, 0) >= 0
+    lib.advance(0.3)
+    info = COMMAND_INFO()
+    lib.MCC_GetCurCommand(info, 0)
+    assert info.nType == D.CMD_CW                      # over the top from (20, 0): clockwise
     assert lib.wait_motion(0)
     assert lib.MCC_GetCurPos(0)[1:3] == pytest.approx((40.0, 0.0), abs=1e-9)
     assert lib.MCC_CircleXY(35, 0, D.CIR_CCW, 0) >= 0

@@ -69,6 +69,19 @@ __all__ = [
 F = TypeVar("F", bound=Callable[..., Any])
 
 
+def _turn(basis: tuple[np.ndarray, np.ndarray]) -> str:
+    """CW / CCW of a 3-D arc seen in the first of the planes xy, yz, zx it is not edge-on
+    to (the plane of an MCC_ArcXY / YZ / ZX), "3D" when it is edge-on to all."""
+    e1, e2 = basis
+    n = len(e1)
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        if i < n and j < n:
+            z = float(e1[i] * e2[j] - e1[j] * e2[i])
+            if abs(z) > 1e-9:
+                return "CCW" if z > 0.0 else "CW"
+    return "3D"
+
+
 @dataclass(frozen=True)
 class CommandInfo:
     """The command a group executes: index, kind (ptp, path, delay), element type (Line,
@@ -240,7 +253,7 @@ class Group(GroupSettings):
             None if el is None else np.array(el.end, dtype=float))
         direction = str(getattr(getattr(el, "direction", None), "name", "")) or None
         if el is not None and getattr(el, "via", None) is not None:
-            direction = "3D"
+            direction = _turn(el.basis)
         feed = self._ptp_ratio if cmd.kind == "ptp" else cmd.feed
         return CommandInfo(cmd.index, cmd.kind, type(el).__name__ if el is not None
                            else cmd.kind, direction, feed,
