@@ -149,3 +149,24 @@ def test_jog_space_and_jog_conti_to_the_working_interval_border():
     assert lib.wait_motion(0)
     x = lib.MCC_GetCurPos(0)[1]
     assert -49995.0 < x < 25.0
+
+
+@pytest.mark.parametrize("mode", [0, 1])
+def test_limit_switch_check_modes(mode):
+    from openmotion.config import SwitchConfig
+    # y starts on its engaged -OT switch (active up to 0.5 mm); the line moves y up, away
+    lib = open_lib(axis_setup=lambda card, ch: {"mel": SwitchConfig(250.0, -100000.0)}
+                   if ch == 1 else {})
+    assert lib.MCC_GetLimitSwitchStatus(1, 1, 0) == (0, 1)
+    assert lib.MCC_EnableLimitSwitchCheck(mode) == 0
+    lib.MCC_SetFeedSpeed(10.0, 0)
+    assert lib.MCC_Line(0, 2, 0, 0, 0, 0, 0) == 0
+    lib.wait_motion(0)
+    if mode == 0:   # direction sensitive: moving away from the switch is allowed
+        assert lib.MCC_GetErrorCode(0) == D.ERROR_NONE
+        assert lib.MCC_GetCurPos(0)[2] == 2.0
+    else:           # any engaged switch stops the moving group
+        assert lib.MCC_GetErrorCode(0) == D.ERROR_LIMIT_SWITCH
+        assert lib.MCC_GetCurPos(0)[2] < 0.5
+    assert lib.MCC_EnableLimitSwitchCheck(2) == D.PARAMETER_ERR
+    assert lib.MCC_DisableLimitSwitchCheck() == 0

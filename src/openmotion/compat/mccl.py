@@ -98,20 +98,22 @@ class MCCL(MCCLMotion):
 
     @_api
     def MCC_EnableLimitSwitchCheck(self, nMode: int = 0) -> int:
-        """Limit switch check, mode 0 (direction sensitive). The core always stops a
-        group whose axis reaches the switch ahead (openmotion's safety rule), so this
-        records the setting; mode 1 (any engaged switch stops) is not supported."""
+        """Limit switch check (2.4): mode 0 stops a group whose axis moves into the
+        switch ahead of it, mode 1 stops it on any engaged switch of a moving axis. The
+        core always applies mode 0 (openmotion's safety rule: limits stop motion)."""
         self._ctl()
         m = _int("nMode", nMode, 0, 1)
-        if m == 1:
-            raise Refused(D.PARAMETER_ERR, "mode 1 (not direction sensitive) is not supported")
+        for gs in self._groups.values():
+            gs.group.set_limit_mode("any" if m == 1 else "direction")
         self._limit_check = True
         return D.NO_ERR
 
     @_api
     def MCC_DisableLimitSwitchCheck(self) -> int:
-        """Recorded; limit switches still stop motion (see MCC_EnableLimitSwitchCheck)."""
+        """Back to mode 0: switches ahead still stop motion (the safety rule)."""
         self._ctl()
+        for gs in self._groups.values():
+            gs.group.set_limit_mode("direction")
         self._limit_check = False
         return D.NO_ERR
 

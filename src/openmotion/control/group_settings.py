@@ -24,6 +24,14 @@ PERIOD_PULSES_DEFAULT = 30000.0
 class GroupSettings(GroupChecks):
     """Base of `Group`: its settings (see the module doc)."""
 
+    def set_limit_mode(self, mode: str) -> None:
+        """Which limit switches stop the moving group (MCC_EnableLimitSwitchCheck):
+        "direction" (default, mode 0: the switch ahead of an axis) or "any" (mode 1: any
+        engaged switch of a moving axis)."""
+        if mode not in ("direction", "any"):
+            raise MotionError(f"mode must be 'direction' or 'any', got {mode!r}")
+        self._limit_any = mode == "any"
+
     _vmax_pps: np.ndarray
     _amax_pps: np.ndarray
     _period_pulses: np.ndarray

@@ -161,6 +161,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     _k: np.ndarray      # signed pulses per logical unit (1.0: the group works in pulses)
     _ended_at: float | None = None  # when the last finished run ended (a delay counts from it)
     _wait_inpos: bool = False       # every command ends alone: in-position between commands
+    _limit_any: bool = False        # any engaged limit switch stops a moving group
     _ppu: np.ndarray
 
     def _units_of(self, pulses: np.ndarray) -> np.ndarray:
@@ -569,8 +570,10 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 self._fault(ERR_AXIS_FAULT, f"axis {a.name} in ErrorStop ({a.fault})")
                 return True
             v = a.velocity
-            if (v > 0.0 and self._ctl.input_active(a.index, "pel")) or \
-                    (v < 0.0 and self._ctl.input_active(a.index, "mel")):
+            pel = v > 0.0 or (self._limit_any and v != 0.0)
+            mel = v < 0.0 or (self._limit_any and v != 0.0)
+            if (pel and self._ctl.input_active(a.index, "pel")) or \
+                    (mel and self._ctl.input_active(a.index, "mel")):
                 self._fault(ERR_LIMIT, f"limit switch reached on axis {self.names[k]}")
                 return True
         return False
