@@ -32,7 +32,7 @@ from openmotion.control.states import AxisState
 from openmotion.errors import check_nonnegative
 
 from . import mccl_defs as D
-from .mccl_base import GroupState, Refused, _api, _int, _num
+from .mccl_base import GroupSlot, Refused, _api, _int, _num
 from .mccl_defs import *  # noqa: F403 - the header's names, as `#include "MCCL.h"`
 from .mccl_motion import MCCLMotion
 
@@ -57,7 +57,7 @@ class MCCL(MCCLMotion):
             lambda: self.MCC_GetMotionStatus(wGroupIndex) == D.GMS_STOP, timeout)
 
     # ------------------------------------------------------------------ limits
-    def _apply_soft_limits(self, gs: GroupState) -> None:
+    def _apply_soft_limits(self, gs: GroupSlot) -> None:
         """Over-travel check of the group's axes: soft limits at the working interval."""
         ctl = self._ctl()
         soft = ctl.safety.soft if ctl.safety is not None else None
@@ -126,7 +126,7 @@ class MCCL(MCCLMotion):
         return D.NO_ERR, int(self._ctl().input_active(ax.index, "pel" if ud == 0 else "mel"))
 
     # ------------------------------------------------------------------ jog
-    def _jog_group(self, cAxis: object, wGroupIndex: int) -> tuple[GroupState, int]:
+    def _jog_group(self, cAxis: object, wGroupIndex: int) -> tuple[GroupSlot, int]:
         gs = self._g(wGroupIndex)
         a = _int("cAxis", cAxis, 0, 5)
         if a not in gs.slots:
@@ -377,9 +377,6 @@ class MCCL(MCCLMotion):
         return D.NO_ERR
 
     # ------------------------------------------------------------------ in-position
-    def _tol_axes(self, gs: GroupState) -> list[Any]:
-        return list(gs.group.axes)
-
     @_api
     def MCC_SetInPosTolerance(self, pdfTolerance: Sequence[float], wGroupIndex: int = 0) -> int:
         """In-position tolerance of each axis x..w (unit; 2.10.2)."""

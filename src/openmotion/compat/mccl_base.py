@@ -90,7 +90,7 @@ def _num(name: str, value: object) -> float:
 
 
 @dataclass
-class GroupState:
+class GroupSlot:
     """What MCCL keeps per group besides the core Group."""
 
     group: Group
@@ -139,7 +139,7 @@ class MCCLBase:
         self._n_cards = 0
         self._mach: dict[tuple[int, int], D.SYS_MACH_PARAM] = {}
         self._group_cfg: D.SYS_GROUP_CONFIG | None = None
-        self._groups: dict[int, GroupState] = {}
+        self._groups: dict[int, GroupSlot] = {}
         self._enc_rate: dict[tuple[int, int], int] = {}
         self._comp_params: dict[tuple[int, int], D.SYS_COMP_PARAM] = {}
         self._comp: dict[int, Compensation] = {}
@@ -157,7 +157,7 @@ class MCCLBase:
             raise Refused(D.INITIAL_MOTION_ERR, "MCC_InitSystem has not been called")
         return self.controller
 
-    def _g(self, index: object) -> GroupState:
+    def _g(self, index: object) -> GroupSlot:
         self._ctl()
         if isinstance(index, bool) or not isinstance(index, int) or index not in self._groups:
             raise Refused(D.GROUP_PARAMETER_ERR, f"group {index!r} is not a configured group "
@@ -189,22 +189,22 @@ class MCCLBase:
         return min(a, b), max(a, b)
 
     # ------------------------------------------------------------------ argument helpers
-    def _six(self, gs: GroupState, values: Sequence[float]) -> list[float]:
+    def _six(self, gs: GroupSlot, values: Sequence[float]) -> list[float]:
         """The six x..w arguments -> the group's logical coordinates (mm)."""
         vals = [_num(f"argument {k}", v) for k, v in enumerate(values)]
         return [vals[s] * gs.scale for s in gs.slots]
 
-    def _target(self, gs: GroupState, values: Sequence[float]) -> tuple[list[float], bool]:
+    def _target(self, gs: GroupSlot, values: Sequence[float]) -> tuple[list[float], bool]:
         return self._six(gs, values), gs.coord == D.COORD_INCREASE
 
-    def _out6(self, gs: GroupState, logical: Sequence[float]) -> list[float]:
+    def _out6(self, gs: GroupSlot, logical: Sequence[float]) -> list[float]:
         """Logical coordinates (mm) -> the six x..w values in the group's unit."""
         out = [0.0] * D.GROUP_AXES
         for s, v in zip(gs.slots, logical, strict=True):
             out[s] = float(v) / gs.scale
         return out
 
-    def _idle(self, gs: GroupState) -> bool:
+    def _idle(self, gs: GroupSlot) -> bool:
         g = gs.group
         return g.state is G.GroupState.IDLE and g.queue_length == 0 and \
             not any(a.is_moving for a in g.axes)
@@ -238,13 +238,13 @@ class MCCLBase:
             fields.update(extra)
         return AxisConfig(**fields)
 
-    def _build_groups(self, ctl: Controller) -> dict[int, GroupState]:
+    def _build_groups(self, ctl: Controller) -> dict[int, GroupSlot]:
         cfg = self._group_cfg
         if cfg is None:  # the default: group 0 on channels 0..3 of card 0
             cfg = D.SYS_GROUP_CONFIG()
             cfg.nGroupUsed[0] = 0
             cfg.stGroupInfo[0] = D.SYS_GROUP_INFO(0, [0, 1, 2, 3, -1, -1])
-        out: dict[int, GroupState] = {}
+        out: dict[int, GroupSlot] = {}
         used: set[int] = set()
         try:
             for g in range(D.MAX_GROUP):
@@ -270,14 +270,14 @@ class MCCLBase:
                 # feed 10 % of the maximum speed (as the PtP default), acc 20 periods
                 grp = Group(ctl, names, units=units, acc_time=20 * ctl.period,
                             feed=0.1 * max(u.max_speed for u in units))
-                out[g] = GroupState(grp, card, tuple(chans[:4]), slots)
+                out[g] = GroupSlot(grp, card, tuple(chans[:4]), slots)
         except BaseException:
             for gs in out.values():
                 gs.group.close()
             raise
         return out
 
-    def _apply_caps(self, gs: GroupState) -> None:
+    def _apply_caps(self, gs: GroupSlot) -> None:
         """MCC_SetMaxPulseSpeed/Acc values of the group's channels -> the core caps."""
         sp, ac = [], []
         for k in gs.slots:

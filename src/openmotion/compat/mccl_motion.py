@@ -12,7 +12,7 @@ import numpy as np
 from openmotion.control import group as G
 
 from . import mccl_defs as D
-from .mccl_base import GroupState, Refused, _api, _int, _num
+from .mccl_base import GroupSlot, Refused, _api, _int, _num
 from .mccl_speed import MCCLSpeed
 
 
@@ -206,13 +206,13 @@ class MCCLMotion(MCCLSpeed):
         p, rel = self._target(gs, (dfX, dfY, dfZ, dfU, dfV, dfW))
         return gs.group.line(p, relative=rel)
 
-    def _plane(self, gs: GroupState, a: int, b: int) -> tuple[int, int]:
+    def _plane(self, gs: GroupSlot, a: int, b: int) -> tuple[int, int]:
         if a not in gs.slots or b not in gs.slots:
             raise Refused(D.GROUP_PARAMETER_ERR, f"group axes {'xyzu'[a]}{'xyzu'[b]} are not "
                                                  "both dispatched")
         return gs.slots.index(a), gs.slots.index(b)
 
-    def _arc3(self, gs: GroupState, ref: dict[int, float], end: dict[int, float]) -> int:
+    def _arc3(self, gs: GroupSlot, ref: dict[int, float], end: dict[int, float]) -> int:
         """An arc through `ref` to `end` (slot -> value): the other axes stay."""
         g = gs.group
         base = np.zeros(len(gs.slots)) if gs.coord == D.COORD_INCREASE else g.end_point

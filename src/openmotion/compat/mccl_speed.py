@@ -11,7 +11,7 @@ import numpy as np
 from openmotion.control import group as G
 
 from . import mccl_defs as D
-from .mccl_base import GroupState, MCCLBase, Refused, _api, _int, _num
+from .mccl_base import GroupSlot, MCCLBase, Refused, _api, _int, _num
 
 
 class MCCLSpeed(MCCLBase):
@@ -184,7 +184,7 @@ class MCCLSpeed(MCCLBase):
             raise Refused(D.PARAMETER_ERR, f"{name} must be 'T' or 'S', got {c!r}")
         return str(c).upper()
 
-    def _update_shapes(self, gs: GroupState) -> None:
+    def _update_shapes(self, gs: GroupSlot) -> None:
         """The group's path shape from its acc type: S = jerk-limited (s-factor 1: a
         triangular acceleration over the acceleration time, jerk 4 F / Tacc**2)."""
         g = gs.group
