@@ -178,7 +178,8 @@ def test_ez_count_skips_index_pulses():
     ("mccl_normal", False, 10000),    # leave ORG upwards (5050), nearest index above
     ("mccl_home_only", False, 5050),  # the sensor's release edge is the origin
     ("mccl_normal", True, 0),         # leave ORG downwards (1949), nearest index below
-    ("mccl_index_only", False, 0),    # from 3000 down: the first index
+    ("mccl_index_only", True, 0),     # from 3000 in wPhase1Dir (down): the first index
+    ("mccl_index_only", False, 10000),  # from 3000 in wPhase1Dir (up): the first index
 ])
 def test_mccl_phases(kind, same, mark):
     ctl, ax = make(20000 if kind != "mccl_index_only" else 3000)

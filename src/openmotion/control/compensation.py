@@ -109,6 +109,30 @@ class PitchCompTable:
                               f"got {fw[h]} and {bw[h]}")
         return cls(iv, h, fw, bw)
 
+    @classmethod
+    def from_slots(cls, interval: int, home_index: int, forward: Sequence[int],
+                   backward: Sequence[int], stroke: tuple[float, float]) -> PitchCompTable:
+        """A table from MCCL's fixed slots (SYS_COMP_PARAM: 256 per direction, no count):
+        the points the stroke (lo, hi) in pulses (home = 0) needs, home_index -
+        ceil(-lo/interval) .. home_index + ceil(hi/interval). Refused (MotionError) when
+        the slots cannot cover the stroke ("the compensation range must cover the whole
+        stroke": +interval*(last - home), -interval*home)."""
+        iv = _check_int("interval", interval, 1, 2**27 - 1)
+        n = min(len(forward), len(backward)) if isinstance(forward, Sequence) and \
+            isinstance(backward, Sequence) else 0
+        h = _check_int("home_index", home_index, 0, max(0, n - 1))
+        lo = check_finite("stroke[0]", stroke[0])
+        hi = check_finite("stroke[1]", stroke[1])
+        below = math.ceil(-lo / iv - 1e-9) if lo < 0.0 else 0
+        above = math.ceil(hi / iv - 1e-9) if hi > 0.0 else 0
+        first, last = h - below, h + max(above, 1 if below == 0 else 0)
+        if first < 0 or last > n - 1:
+            raise MotionError(f"the compensation range [{-h * iv}, {(n - 1 - h) * iv}] "
+                              f"pulses (interval {iv}, home point {h}) must cover the "
+                              f"stroke [{lo:g}, {hi:g}]")
+        return cls.make(iv, h - first, list(forward[first:last + 1]),
+                        list(backward[first:last + 1]))
+
     @property
     def span(self) -> tuple[int, int]:
         """Positions (pulses, home = 0) covered by the table."""

@@ -21,17 +21,19 @@ import contextlib
 import math
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from functools import wraps
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
-from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
+from ..errors import InfeasibleError, MotionError, check_finite
 from ..path import Arc, Arc3D, Line
 from ..profile.pcl import MoveSpec
 from ..units import AxisUnits
 from . import pathrun
-from .group_checks import GroupChecks, unit_scales
+from .group_checks import unit_scales
+from .group_settings import PERIOD_PULSES_DEFAULT, PERIOD_PULSES_MAX, GroupSettings
 from .groupexec import (
     ERR_ACCEL,
     ERR_ARC,
@@ -57,6 +59,7 @@ if TYPE_CHECKING:
     from .controller import Controller
 
 __all__ = [
+    "PERIOD_PULSES_DEFAULT", "PERIOD_PULSES_MAX",
     "ERR_ACCEL", "ERR_ARC", "ERR_ARGUMENT", "ERR_AXIS_BUSY", "ERR_AXIS_FAULT", "ERR_AXIS_STATE",
     "ERR_GROUP", "ERR_LIMIT", "ERR_QUEUE_FULL", "ERR_SPEED", "ERR_STATE", "Group", "GroupError",
     "GroupState",
@@ -64,6 +67,34 @@ __all__ = [
 
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _turn(basis: tuple[np.ndarray, np.ndarray]) -> str:
+    """CW / CCW of a 3-D arc seen in the first of the planes xy, yz, zx it is not edge-on
+    to (the plane of an MCC_ArcXY / YZ / ZX), "3D" when it is edge-on to all."""
+    e1, e2 = basis
+    n = len(e1)
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        if i < n and j < n:
+            z = float(e1[i] * e2[j] - e1[j] * e2[i])
+            if abs(z) > 1e-9:
+                return "CCW" if z > 0.0 else "CW"
+    return "3D"
+
+
+@dataclass(frozen=True)
+class CommandInfo:
+    """The command a group executes: index, kind (ptp, path, delay), element type (Line,
+    Arc, Arc3D), arc direction ("CW", "CCW", "3D" or None), feed (PtP: the speed
+    ratio %), target (logical units; None for a delay)."""
+
+    index: int
+    kind: str
+    element: str
+    direction: str | None
+    feed: float
+    target: np.ndarray | None
+
 
 
 def _locked(fn: F) -> F:
@@ -77,7 +108,7 @@ def _locked(fn: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
-class Group(GroupChecks):
+class Group(GroupSettings):
     """Coordinated axes of `controller` with a command queue.
 
     axes: logical name -> controller axis (name or index), or a sequence of controller axes
@@ -135,17 +166,23 @@ class Group(GroupChecks):
         self._blend = False
         self._feed = 0.0
         self._acc_time = 20.0 * controller.period
+        self._dec_time: float | None = None  # None: deceleration follows the acceleration
         self._sys_max = float(max(a.max_speed / k for a, k in zip(ax, self._ppu, strict=True)))
         self.set_feed(feed)
         if acc_time is not None:
             self.set_acc_time(acc_time)
-        self._vmax = np.array([a.max_speed for a in ax], dtype=float)
-        self._amax = np.full(len(ax), math.inf)
+        self._vmax_pps = np.array([a.max_speed for a in ax], dtype=float)
+        self._amax_pps = np.full(len(ax), math.inf)
+        self._period_pulses = np.full(len(ax), PERIOD_PULSES_DEFAULT)
+        self._period_pulse_acc = np.full(len(ax), PERIOD_PULSES_DEFAULT)
+        self._update_caps()
         self._refuse = True
         self._ptp_ratio = 10.0
         self._path_jerk = 0.0   # 0: T-curve path speed; > 0: S-curve with this path jerk
         self._str_vel = 0.0     # StrVel of the following path commands (0: from/to rest)
-        self._ptp_shape = "T"
+        self._ptp_shapes = ("T",) * len(ax)
+        self._ptp_acc_time: float | None = None  # None: the path commands' times
+        self._ptp_dec_time: float | None = None
         for a in ax:
             owners[a.index] = self
         controller.add_cycle_hook(self._on_cycle)
@@ -195,6 +232,45 @@ class Group(GroupChecks):
         return self._units_of(self._dry_pos)
 
     @property
+    def end_point(self) -> np.ndarray:
+        """Where the last queued command ends (logical units): the start point of a
+        relative command; the position when nothing is queued or running."""
+        if self._tail is None or (self._run is None and not self._queue
+                                  and self._held is None):
+            return self.position
+        return self._tail.copy()
+
+    @property
+    def current_command(self) -> CommandInfo | None:
+        """The command being executed (MCC_GetCurCommand), None when none is."""
+        r = self._run or self._held
+        if r is None:
+            return None
+        idx = self.current_index
+        cmd = next((c for c in r.cmds if c.index == idx), r.cmds[0])
+        el = cmd.elements[0] if cmd.elements else None
+        target = cmd.target if cmd.kind == "ptp" else (
+            None if el is None else np.array(el.end, dtype=float))
+        direction = str(getattr(getattr(el, "direction", None), "name", "")) or None
+        if el is not None and getattr(el, "via", None) is not None:
+            direction = _turn(el.basis)
+        feed = self._ptp_ratio if cmd.kind == "ptp" else cmd.feed
+        return CommandInfo(cmd.index, cmd.kind, type(el).__name__ if el is not None
+                           else cmd.kind, direction, feed,
+                           None if target is None else np.asarray(target, float).copy())
+
+    @property
+    def commands_pending(self) -> int:
+        """Commands accepted and not yet started (MCC_GetCommandCount): the queue and the
+        commands a running chain has taken in ahead of the one it executes."""
+        r = self._run or self._held
+        ahead = 0
+        if r is not None:
+            cur = self.current_index
+            ahead = sum(1 for c in r.cmds if c.index > cur)
+        return len(self._queue) + ahead
+
+    @property
     def units(self) -> bool:
         """Whether logical coordinates are user units (False: command pulses)."""
         return bool(np.any(self._k != 1.0))
@@ -236,94 +312,7 @@ class Group(GroupChecks):
                 del owners[a.index]
 
     # ------------------------------------------------------------------ settings
-    def set_feed(self, feed: float) -> None:
-        """MCC_SetFeedSpeed: vector speed (pps, or user units/s) of the following path
-        commands."""
-        f = check_finite("feed", feed)
-        if f <= 0.0:
-            raise GroupError(ERR_SPEED, f"feed must be > 0, got {feed!r}")
-        if hasattr(self, "_sys_max") and f > self._sys_max * (1 + 1e-12):
-            raise GroupError(ERR_SPEED, f"feed must be <= the system maximum speed "
-                                        f"{self._sys_max:g} pps, got {feed!r}")
-        self._feed = f
-
-    def set_sys_max_speed(self, speed: float) -> None:
-        """MCC_SetSysMaxSpeed: the largest feed accepted (pps, or user units/s)."""
-        v = check_finite("speed", speed)
-        if v <= 0.0:
-            raise MotionError(f"speed must be > 0, got {speed!r}")
-        self._sys_max = v
-
-    def set_acc_time(self, seconds: float) -> None:
-        """Time to accelerate from rest to the feed (MCC_SetAccStep x interpolation time)."""
-        t = check_finite("seconds", seconds)
-        if t <= 0.0:
-            raise MotionError(f"seconds must be > 0, got {seconds!r}")
-        self._acc_time = t
-
-    def set_max_pulse_speed(self, pps: Sequence[float]) -> None:
-        """MCC_SetMaxPulseSpeed per logical axis (pps); default the axes' maximum speed."""
-        self._vmax = self._axis_values("pps", pps)
-
-    def set_axis_limit_policy(self, policy: str) -> None:
-        """"refuse" (default, MCCL): a path command whose feed or acceleration would take an
-        axis past its maximum pulse speed/acceleration is refused (ERR_SPEED / ERR_ACCEL);
-        "slow": it is accepted and the look-ahead slows the path down to the axis limits."""
-        if policy not in ("refuse", "slow"):
-            raise MotionError(f"policy must be 'refuse' or 'slow', got {policy!r}")
-        self._refuse = policy == "refuse"
-
-    def set_max_pulse_acc(self, pps2: Sequence[float]) -> None:
-        """MCC_SetMaxPulseAcc per logical axis (pps^2, inf = unlimited, the default)."""
-        self._amax = self._axis_values("pps2", pps2)
-
-    def enable_blend(self, tolerance: float) -> None:
-        """Blend consecutive path commands: corners between lines and arcs are rounded so
-        that the path passes within `tolerance` (pulses, or user units with `units=`) of
-        the programmed corner point (0: exact stop). Helices and elements in different
-        planes still stop exactly at their corners."""
-        self._blend_tol = check_nonnegative("tolerance", tolerance)
-        self._blend = True
-
-    def disable_blend(self) -> None:
-        self._blend = False
-
-    def set_path_shape(self, shape: str, jerk: float | None = None) -> None:
-        """Speed profile of the following path commands: "T" (constant path acceleration)
-        or "S" (jerk-limited: the jerk of the path position stays within `jerk`, pps^3 or
-        user units/s^3). S paths blend, stream, hold and take overrides like T paths: the
-        T plan is smoothed by a moving average of window 2*accel/jerk, its speed caps held
-        that much further along the path, exact-stop corners passed at rest."""
-        if shape not in ("T", "S"):
-            raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
-        if shape == "T":
-            self._path_jerk = 0.0
-            return
-        j = check_finite("jerk", jerk) if jerk is not None else math.nan
-        if not j > 0.0:
-            raise MotionError(f"jerk must be a finite number > 0 for shape 'S', got {jerk!r}")
-        self._path_jerk = j
-
-    def set_str_vel(self, speed: float) -> None:
-        """Start velocity (PCL6045 StrVel, HSL-4XMO 4.6) of the following path commands, in
-        pps or user units/s (default 0, as MCCL): a chain starts at rest with a jump to this
-        vector speed, and ends at it with a jump to rest. Checked when a command is queued:
-        <= its feed and StrVel*|u_i| <= each axis's maximum speed (GroupError ERR_SPEED).
-        T and S paths (an S path: jump to StrVel, then an S acceleration from a = 0)."""
-        v = check_finite("speed", speed)
-        if v < 0.0:
-            raise GroupError(ERR_ARGUMENT, f"speed (StrVel) must be >= 0, got {speed!r}")
-        self._str_vel = v
-
-    def set_ptp_speed(self, ratio: float, *, shape: str = "T") -> None:
-        """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10)."""
-        r = check_finite("ratio", ratio)
-        if not 0.0 < r <= 100.0:
-            raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
-        if shape not in ("T", "S"):
-            raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
-        self._ptp_ratio, self._ptp_shape = r, shape
-
+    # (feed, times, caps, blending, shapes, PtP: group_settings.py)
     @_locked
     def enable_dry_run(self, on: bool = True) -> None:
         """Plan and report positions without sending pulses (only while idle)."""
@@ -337,18 +326,25 @@ class Group(GroupChecks):
 
     # ------------------------------------------------------------------ commands
     @_locked
-    def ptp(self, target: Sequence[float], *, relative: bool = False) -> int:
+    def ptp(self, target: Sequence[float], *, relative: bool = False,
+            ratio: float | None = None) -> int:
         """Point-to-point: every axis to its target with its own T/S profile at the PtP
-        speed ratio; the next command waits for all axes."""
+        speed ratio (or `ratio` % for this command: a jog); the next command waits for
+        all axes."""
+        if ratio is not None:
+            ratio = check_finite("ratio", ratio)
+            if not 0.0 < ratio <= 100.0:
+                raise GroupError(ERR_SPEED, f"ratio must be in (0, 100] percent, got "
+                                            f"{ratio!r}")
         start = self._start_point()
         p = self._point("target", target, start if relative else None)
         if np.all(p == start):
             raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
         specs = []
+        tacc, tdec = self.ptp_times
         for k, a in enumerate(self.axes):
-            v = min(a.max_speed, self._vmax[k]) * self._ptp_ratio / 100.0
-            specs.append(MoveSpec(self._ptp_shape, 0.0, v, self._acc_time, self._acc_time,
-                                  0.0, 0.0))
+            v = min(a.max_speed, self._vmax[k]) * (ratio or self._ptp_ratio) / 100.0
+            specs.append(MoveSpec(self._ptp_shapes[k], 0.0, v, tacc, tdec, 0.0, 0.0))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
 
     @_locked
@@ -405,11 +401,20 @@ class Group(GroupChecks):
 
     @_locked
     def delay(self, seconds: float) -> int:
-        """MCC_DelayMotion: wait `seconds` after the previous command ends."""
+        """MCC_DelayMotion: wait `seconds` after the previous command ends (its exact end
+        time), then start the next one at the first cycle at or after that. Queued on an
+        idle group it starts counting now, so the next command starts `seconds` from now
+        (not one period later, as a queued motion command does)."""
         t = check_finite("seconds", seconds)
         if t < 0.0:
             raise GroupError(ERR_ARGUMENT, f"seconds must be >= 0, got {seconds!r}")
-        return self._push(_Cmd(-1, "delay", seconds=t), None)
+        idle = self._state is GroupState.IDLE and self._run is None and not self._queue \
+            and self._held is None and self._job is None
+        index = self._push(_Cmd(-1, "delay", seconds=t), None)
+        if idle:
+            self._ended_at = None
+            self._start_next(self._ctl.time)
+        return index
 
     def reset_command_index(self) -> None:
         self._next_index = 0

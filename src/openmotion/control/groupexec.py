@@ -36,8 +36,8 @@ from ..path.geometry import PathElement
 from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
+from . import pathaxes, pathrun, planning
 from . import pathexec as px
-from . import pathrun, planning
 from .group_corners import LookaheadSettings
 from .groupjoin import AsyncJoin
 from .states import AxisState
@@ -88,10 +88,21 @@ class _Cmd:
     elements: tuple[PathElement, ...] = ()
     feed: float = 0.0
     accel: float = 0.0
+    decel: float | None = None     # path deceleration (None: follows accel)
     specs: tuple[MoveSpec, ...] = ()
     seconds: float = 0.0
     jerk: float = 0.0              # path jerk limit (0: T-curve)
     str_vel: float = 0.0           # StrVel: a path starts/ends with a jump from/to rest
+
+    @property
+    def dec(self) -> float:
+        """The path deceleration (the acceleration unless set apart)."""
+        return self.accel if self.decel is None else self.decel
+
+    @property
+    def window_accel(self) -> float:
+        """The acceleration an S path's smoothing window is sized for (the larger one)."""
+        return self.accel if self.decel is None else max(self.accel, self.decel)
 
 
 @dataclass
@@ -148,6 +159,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     _vmax: np.ndarray
     _amax: np.ndarray
     _k: np.ndarray      # signed pulses per logical unit (1.0: the group works in pulses)
+    _ended_at: float | None = None  # when the last finished run ended (a delay counts from it)
+    _wait_inpos: bool = False       # every command ends alone: in-position between commands
+    _limit_any: bool = False        # any engaged limit switch stops a moving group
     _ppu: np.ndarray
 
     def _units_of(self, pulses: np.ndarray) -> np.ndarray:
@@ -189,9 +203,20 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         if self._job is not None and self._poll_join(t):
             return  # a join in flight (real time), or installed this cycle
         r = self._run
+        if r is not None and r.kind == "delay" and self._queue and \
+                self._state is GroupState.MOVING and \
+                1e-12 < r.t_until - t < self._ctl.period - 1e-12 and \
+                self._queue[0].kind == "path" and not self._queue[0].str_vel:
+            # the delay ends inside the coming cycle: start the path now, at rest until
+            # the delay's exact end (MCC_DelayMotion is exact, not rounded to a cycle)
+            self._run = None
+            self._ended_at = r.t_until
+            self._start_next(t, start=r.t_until)
+            return
         if r is not None and t >= r.t_end - 1e-12 and (self._dry or not any(
                 a.is_moving for a in self.axes)):
             self._run = None
+            self._ended_at = r.t_end
             if r.kind in ("path", "ptp") and r.target is not None and self._dry:
                 self._dry_pos = self._pulses_of(r.target) if r.kind == "path" \
                     else r.target.copy()
@@ -221,23 +246,30 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             if len(self._queue) == n:  # no join this cycle
                 self._preblend()
 
-    def _start_next(self, t: float) -> None:
+    def _start_next(self, t: float, start: float | None = None) -> None:
         try:
-            self._start_queued(t)
+            self._start_queued(t, start)
         except MotionError as err:  # an axis refused (safety check, state): stop the group
             self._fault(getattr(err, "code", ERR_AXIS_STATE), f"command refused at start: {err}")
 
-    def _start_queued(self, t: float) -> None:
+    def _start_queued(self, t: float, start: float | None = None) -> None:
+        """Start the next queued command now (a path: from `start` >= t within this
+        cycle, at rest until then)."""
         cmd = self._queue.popleft()
         if cmd.kind == "delay":
-            self._run = _Run("delay", [cmd], t, t_until=t + cmd.seconds)
+            # counted from the exact end of the command before it when that ended within
+            # this cycle (MCCL 2.6.3 V: "after finishing A, it will delay"), else from now
+            end = self._ended_at
+            base = end if end is not None and 0.0 <= t - end < self._ctl.period else t
+            self._run = _Run("delay", [cmd], base, t_until=base + cmd.seconds)
         elif cmd.kind == "ptp":
             self._launch_ptp(cmd, t)
         else:
-            tj = jerk_window(cmd.accel, cmd.jerk) if cmd.jerk else 0.0
+            tj = jerk_window(cmd.window_accel, cmd.jerk) if cmd.jerk else 0.0
             cmds = [cmd, *self._take(tj, cmd.elements[0].length, [cmd])]
             chain = self._chain(cmds)
-            self._launch(pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t),
+            t_s = t if start is None else start
+            self._launch(pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t_s),
                          cmds, t)
         self._state = GroupState.MOVING
 
@@ -246,11 +278,11 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         """Whether `cmd` can join a chain smoothed with window tj (0: a T chain) that starts
         and ends at `str_vel`: a path command of the same shape and StrVel whose own window
         fits in tj (its jerk stays bounded)."""
-        if cmd.kind != "path" or cmd.str_vel != str_vel:
+        if cmd.kind != "path" or cmd.str_vel != str_vel or self._wait_inpos:
             return False
         if tj == 0.0 or not cmd.jerk:
             return tj == 0.0 and not cmd.jerk
-        return jerk_window(cmd.accel, cmd.jerk) <= tj * (1.0 + 1e-12)
+        return jerk_window(cmd.window_accel, cmd.jerk) <= tj * (1.0 + 1e-12)
 
     def _reach(self, cmd: _Cmd, tj: float) -> float:
         """Path length a chain should keep ahead for `cmd`: twice what it takes to brake
@@ -260,7 +292,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         ahead = 4.0 * self._ctl.period + tj
         if self._ctl.realtime:  # a join in flight (groupjoin.py) must not see the end
             ahead += (self._lead_cycles() + 2) * self._ctl.period
-        return 2.0 * (f * f / (2.0 * cmd.accel) + f * ahead)
+        return 2.0 * (f * f / (2.0 * cmd.dec) + f * ahead)
 
     def _take(self, tj: float, have: float, cmds: list[_Cmd]) -> list[_Cmd]:
         """Pop the queued commands that join a chain with `have` length ahead until it
@@ -289,8 +321,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 self._job is not None:
             return
         plan = r.plan
-        if not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
-            return
+        if t < plan.t0 or not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
+            return  # (a plan starting later in this cycle joins from the next one)
         have = plan.remaining(t)
         if have >= self._reach(self._queue[0], plan.tj) and have >= self._reach(
                 r.cmds[-1], plan.tj):
@@ -332,10 +364,13 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         yield plan.chain.joined(els, owners, *self._per(owners, new))
 
     @staticmethod
-    def _per(owners: list[int], cmds: list[_Cmd]) -> tuple[list[float], list[float]]:
-        """Feed and acceleration of each element, from the command that owns it."""
+    def _per(owners: list[int], cmds: list[_Cmd]
+             ) -> tuple[list[float], list[float], list[float] | None]:
+        """Feed, acceleration and deceleration (None when no command sets one apart) of
+        each element, from the command that owns it."""
         by = {c.index: c for c in cmds}
-        return [by[o].feed for o in owners], [by[o].accel for o in owners]
+        dec = None if all(c.decel is None for c in cmds) else [by[o].dec for o in owners]
+        return [by[o].feed for o in owners], [by[o].accel for o in owners], dec
 
     def _chain(self, cmds: list[_Cmd]) -> px.Chain:
         """The commands' elements end to end, corners blended where that pays."""
@@ -440,7 +475,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         if b is None:
             return None
         vmax, amax = self._caps()
-        accel = min(cmd.accel, float(np.min(amax)))
+        accel = min(cmd.accel, cmd.dec, float(np.min(amax)))
         v_corner = 0.0
         corner = self._corner_limits()
         if corner["square_corner_velocity"] > 0.0 and prev.length > 0.0 and el.length > 0.0:
@@ -469,13 +504,16 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                                                        float(target[k])))
             elif target[k] != a.position:
                 a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
-                                shape=spec.shape)
+                                tdec=spec.tdec, shape=spec.shape)
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
 
     def _launch(self, plan: pathrun.PathPlan, cmds: list[_Cmd], t: float) -> None:
         """Run `plan` from now: per-axis profiles along the chain, started all or none."""
         profiles = self._pulse_profiles(px.axis_profiles(plan.chain, plan.sprof,
                                                          self._ctl.period, self.position))
+        lead = plan.t0 - t
+        if lead > 1e-12:  # the plan starts later in this cycle (an exact delay)
+            profiles = [pathaxes.delayed(p, lead) for p in profiles]
         self._install(plan, profiles, cmds, t)
 
     def _install(self, plan: pathrun.PathPlan, profiles: list[Profile], cmds: list[_Cmd],
@@ -512,11 +550,12 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     def _replan(self, r: _Run, *, hold: bool) -> None:
         """Re-plan the running chain from now: a hold (to rest) or a new override."""
         assert r.plan is not None
-        t = self._ctl.time
+        now = self._ctl.time
+        t = max(now, r.plan.t0)  # (a plan that starts later in this cycle)
         if t >= r.plan.t_end:
             return
         lim = r.plan.limits if hold else self._limits(r.plan.chain, r.plan.limits.str_vel)
-        self._launch(pathrun.replan(r.plan, t, limits=lim, hold=hold), r.cmds, t)
+        self._launch(pathrun.replan(r.plan, t, limits=lim, hold=hold), r.cmds, now)
 
     def _on_axis_fault(self, axis: Axis, reason: str) -> None:
         """Controller fault hook: a group axis went to ErrorStop."""
@@ -531,8 +570,10 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 self._fault(ERR_AXIS_FAULT, f"axis {a.name} in ErrorStop ({a.fault})")
                 return True
             v = a.velocity
-            if (v > 0.0 and self._ctl.input_active(a.index, "pel")) or \
-                    (v < 0.0 and self._ctl.input_active(a.index, "mel")):
+            pel = v > 0.0 or (self._limit_any and v != 0.0)
+            mel = v < 0.0 or (self._limit_any and v != 0.0)
+            if (pel and self._ctl.input_active(a.index, "pel")) or \
+                    (mel and self._ctl.input_active(a.index, "mel")):
                 self._fault(ERR_LIMIT, f"limit switch reached on axis {self.names[k]}")
                 return True
         return False

@@ -106,9 +106,9 @@ class Homing:
         c = self.config
         b = ProfileBuilder(0.0, speed)
         if c.jerk is None:
-            ramp_accel(b, 0.0, c.accel)
+            ramp_accel(b, 0.0, c.decel)
         else:
-            ramp_jerk(b, 0.0, c.accel, c.jerk)
+            ramp_jerk(b, 0.0, c.decel, c.jerk)
         return speed * self.ctl.period + b.state.p
 
     def start(self) -> None:
@@ -196,9 +196,9 @@ class Homing:
 
     def _run(self, profile: Profile) -> None:
         c = self.config
-        j = c.jerk if c.jerk is not None else c.accel / self.ctl.period
+        j = c.jerk if c.jerk is not None else c.decel / self.ctl.period
         try:
-            self.axis.run_profile(profile, stop_accel=c.accel, stop_jerk=j,
+            self.axis.run_profile(profile, stop_accel=c.decel, stop_jerk=j,
                                   replace_running=self.axis.motion is not None)
         except MotionError as err:  # refused (e.g. by a safety motion check): stop here
             if self.running:
@@ -206,10 +206,13 @@ class Homing:
 
     def _ramp(self, b: ProfileBuilder, v1: float) -> None:
         c = self.config
+        v0 = b.state.v
+        slower = abs(v1) < abs(v0) or v1 * v0 < 0.0
+        acc = c.decel if slower else c.accel
         if c.jerk is None:
-            ramp_accel(b, v1, c.accel, label="homing ramp")
+            ramp_accel(b, v1, acc, label="homing ramp")
         else:
-            ramp_jerk(b, v1, c.accel, c.jerk, label="homing ramp")
+            ramp_jerk(b, v1, acc, c.jerk, label="homing ramp")
 
     def _cruise(self, v: float) -> None:
         """From the current state: ramp to v (signed), cruise search_range, stop."""
@@ -231,13 +234,15 @@ class Homing:
         p = self.axis.position
         if target == p:
             return
+        v = c.speed("str")  # StrVel (HSL); MaxVel/10 (MCCL phase 3)
         if c.jerk is None:
-            spec = MoveSpec("T", 0.0, c.str_vel, c.tacc, c.tacc, 0.0, 0.0)
-            # StrVel reached at the homing acceleration, not in Tacc
-            spec = replace(spec, tacc=c.str_vel / c.accel, tdec=c.str_vel / c.accel)
+            spec = MoveSpec("T", 0.0, v, c.tacc, c.tacc, 0.0, 0.0)
+            # the speed reached at the homing acceleration, not in Tacc
+            spec = replace(spec, tacc=v / c.accel, tdec=v / c.decel)
             prof = planning.position_move(spec, p, target)
         else:
-            prof = planning.jerk_move(p, target, c.str_vel, c.accel, c.jerk, None)
+            prof = planning.jerk_move(p, target, v, c.accel, c.jerk,
+                                      None if c.tdec is None else c.decel)
         self._run(prof)
 
     # ------------------------------------------------------------------ sequencing
@@ -401,7 +406,7 @@ class Homing:
         if then == "pass":
             self._next()
         elif then == "slow":
-            v = self._abs(ph.direction) * self.config.str_vel
+            v = self._abs(ph.direction) * self.config.speed("str")
             self._cruise(v)
             self._next()
         elif then == "halt":

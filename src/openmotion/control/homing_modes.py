@@ -111,7 +111,8 @@ def mccl_phases(kind: str, same_direction: bool) -> tuple[Phase, ...]:
     Phase 0 searches the sensor at the homing speed and must stop on it; phase 1 leaves it
     in wPhase1Dir at 1/10 speed; phase 2 goes on in wPhase1Dir to the nearest index; phase 3
     (the offset move to the logical home) is the engine's final move. INDEX_ONLY runs
-    phase 2 from rest in wPhase1Dir, relative here to the homing direction (+1).
+    phase 2 from rest in wPhase1Dir (the manual's phase 2 direction). Phases
+    1, 2 and 3 run at about 1/10 of the phase-0 speed (HomeConfig.speed: "creep").
     """
     d1 = 1 if same_direction else -1
     p0 = P("phase 0: enter home sensor", "org", "on", 1, "max", "stop", must_stay_on=True)
@@ -121,8 +122,8 @@ def mccl_phases(kind: str, same_direction: bool) -> tuple[Phase, ...]:
     if kind == "home_only":
         return (p0, P("phase 1: leave home sensor", "org", "off", d1, "creep", "stop",
                       mark=True))
-    if kind == "index_only":
-        return (_ez("phase 2: index", 1, "creep", counted=False),)
+    if kind == "index_only":  # phase 2 moves in wPhase1Dir (manual 2.7), as in NORMAL
+        return (_ez("phase 2: index", d1, "creep", counted=False),)
     raise ValueError(kind)
 
 
@@ -167,6 +168,7 @@ class HomeConfig:
     max_overrun: float | None = None
     settle_s: float = 0.0
     timeout_s: float = 600.0
+    tdec: float | None = None   # deceleration time (MCC_SetGoHomeDecStep); None: tacc
 
     def __post_init__(self) -> None:
         m = self.mode
@@ -183,6 +185,8 @@ class HomeConfig:
         if sv == 0.0:
             raise MotionError("str_vel must be > 0 (the slow search speed)")
         check_positive("tacc", self.tacc)
+        if self.tdec is not None:
+            check_positive("tdec", self.tdec)
         if self.jerk is not None:
             check_positive("jerk", self.jerk)
         e = self.ez_count
@@ -202,10 +206,24 @@ class HomeConfig:
         check_positive("timeout_s", self.timeout_s)
 
     @property
+    def mccl(self) -> bool:
+        """An MCCL mode: no StrVel; phases 1-3 (and any escape) run at MaxVel/10."""
+        return isinstance(self.mode, str)
+
+    @property
     def accel(self) -> float:
-        """Ramp acceleration (pps^2): (MaxVel - StrVel) / Tacc, or MaxVel/Tacc if equal."""
+        """Ramp acceleration (pps^2): (MaxVel - StrVel) / Tacc, or MaxVel/Tacc if equal;
+        MCCL modes: MaxVel / Tacc (MCC_SetGoHomeAccStep: the time from rest to MaxVel)."""
         dv = self.max_vel - self.str_vel
-        return (dv if dv > 0.0 else self.max_vel) / self.tacc
+        return (dv if dv > 0.0 and not self.mccl else self.max_vel) / self.tacc
+
+    @property
+    def decel(self) -> float:
+        """Ramp deceleration (pps^2): as `accel` with tdec (default tacc)."""
+        if self.tdec is None:
+            return self.accel
+        dv = self.max_vel - self.str_vel
+        return (dv if dv > 0.0 and not self.mccl else self.max_vel) / self.tdec
 
     def phases(self) -> tuple[Phase, ...]:
         if isinstance(self.mode, int):
@@ -213,7 +231,11 @@ class HomeConfig:
         return mccl_phases(self.mode[5:], self.phase1_same_direction)
 
     def speed(self, name: str) -> float:
-        return {"max": self.max_vel, "str": self.str_vel, "creep": self.max_vel / 10.0}[name]
+        """A phase speed (pps). MCCL modes have no StrVel: their slow moves (escape, the
+        phase 3 move to the logical home) creep at MaxVel/10 like phases 1 and 2."""
+        creep = self.max_vel / 10.0
+        return {"max": self.max_vel, "str": creep if self.mccl else self.str_vel,
+                "creep": creep}[name]
 
 
 @dataclass

@@ -51,6 +51,30 @@ class SoftLimit:
     decelerate: bool = False
 
 
+def working_interval(high: float, low: float, high_offset: float = 0.0,
+                     low_offset: float = 0.0) -> tuple[float, float]:
+    """MCCL 2.4 working interval [low + low_offset, high - high_offset] (any one unit).
+
+    `high` (dfHighLimit) must be > 0 and `low` (dfLowLimit) < 0, relative to the logical
+    home; the offsets (dfHighLimitOffset / dfLowLimitOffset) must be >= 0 and at most
+    `high` / |low|. MotionError naming the parameter otherwise."""
+    hi = check_finite("high", high)
+    lo = check_finite("low", low)
+    ho = check_finite("high_offset", high_offset)
+    lo_off = check_finite("low_offset", low_offset)
+    if not hi > 0.0:
+        raise MotionError(f"high (dfHighLimit) must be > 0, got {high!r}")
+    if not lo < 0.0:
+        raise MotionError(f"low (dfLowLimit) must be negative, got {low!r}")
+    if not 0.0 <= ho <= hi:
+        raise MotionError(f"high_offset (dfHighLimitOffset) must be in [0, dfHighLimit = "
+                          f"{hi!r}], got {high_offset!r}")
+    if not 0.0 <= lo_off <= -lo:
+        raise MotionError(f"low_offset (dfLowLimitOffset) must be in [0, |dfLowLimit| = "
+                          f"{-lo!r}], got {low_offset!r}")
+    return lo + lo_off, hi - ho
+
+
 def profile_extent(profile: Profile, u0: float, u1: float) -> tuple[float, float]:
     """(min, max) position of `profile` over local times [u0, u1] (u1 may be inf; past the
     end the end state continues at its velocity). Exact: segment ends and velocity zeros."""
