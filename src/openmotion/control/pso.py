@@ -239,16 +239,19 @@ class ZPso:
     def kind(self, axis: int) -> str:
         return self._kind[_int("axis", axis, 0, len(self._kind) - 1)]
 
-    def _vector(self) -> VectorSource:
-        b = base_axes(self._base, None, len(self._units))
+    def _vector(self, axis: int | None = None) -> VectorSource:
+        n = len(self._units)
+        head = self._base if axis is None or axis == self._base[0] else \
+            (_int("axis", axis, 0, n - 1),)
+        b = base_axes(head, None, n)
         return VectorSource(b, tuple(self._units[a] for a in b))
 
-    def vector_moved(self) -> float:
-        """VECTOR_MOVED of the BASE axes, in units."""
-        return self.eng.vector_moved(self._vector())
+    def vector_moved(self, axis: int | None = None) -> float:
+        """VECTOR_MOVED of the BASE axes (or of `axis` as the main axis), in units."""
+        return self.eng.vector_moved(self._vector(axis))
 
-    def set_vector_moved(self, value: float = 0.0) -> None:
-        self.eng.set_vector_moved(self._vector(), value)
+    def set_vector_moved(self, value: float = 0.0, axis: int | None = None) -> None:
+        self.eng.set_vector_moved(self._vector(axis), value)
 
     def remaining(self, axis: int | None = None) -> int:
         """?HW_PSWITCH2(axis): free compare buffer space."""
