@@ -291,9 +291,9 @@ class ZController:
         if g is not None and self._group_units[key] == units:
             return g
         for k, other in list(self._groups.items()):
-            if set(k) & set(axes):
-                if other.state is not GroupState.IDLE or other.queue_length:
-                    raise ZMotionError(command, "axes", f"axes {k!r} are still moving in "
+            if set(k) & set(axes) and (other.state is not GroupState.IDLE
+                                       or other.queue_length):
+                raise ZMotionError(command, "axes", f"axes {k!r} are still moving in "
                                        "another interpolation; WAIT IDLE first", ZERR_STATE)
         for k, other in list(self._groups.items()):
             if set(k) & set(axes):
@@ -410,6 +410,18 @@ class ZController:
             elif g.state is not GroupState.IDLE or g.queue_length:
                 g.abort()
         self.ctl.stop_all(immediately=mode == 3)
+
+    @_command("WAIT UNTIL")
+    def WAIT_UNTIL(self, condition: Callable[[], bool], timeout: float = 3600.0  # noqa: N802
+                   ) -> float:
+        """WAIT UNTIL condition: run virtual time until `condition()` is true."""
+        if not callable(condition):
+            raise ZMotionError("WAIT UNTIL", "condition", f"condition must be callable, "
+                               f"got {condition!r}")
+        if not self.ctl.run_until(condition, check_positive("timeout", timeout)):
+            raise ZMotionError("WAIT UNTIL", "condition", f"still false after {timeout:g} s",
+                               ZERR_TIMEOUT)
+        return self.ctl.time
 
     # ------------------------------------------------------------------ convenience
     def run(self, seconds: float) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
+from ..control.pso import base_axes
 from ..errors import MotionError
 
 #: Error codes of refused commands (ours: the article lists none).
@@ -65,13 +66,14 @@ class AxisParam:
         self._put({self._axis(axis): value})
 
     def assign(self, values: Any) -> None:
-        """`c.NAME = v0, v1, ...`: the BASE axes in order (one value: the first BASE axis)."""
+        """`c.NAME = v0, v1, ...`: the BASE axes in order (one value: the first BASE axis),
+        the list extended by the following axes as for a move (pso.base_axes)."""
         vals = list(values) if isinstance(values, tuple | list) else [values]
-        base = list(self._base())
-        if len(vals) > len(base):
-            raise ZMotionError(self.name, "values", f"{len(vals)} values for the "
-                               f"{len(base)} BASE axes {tuple(base)!r}")
-        self._put(dict(zip(base, vals, strict=False)))
+        try:
+            axes = base_axes(self._base(), len(vals), self._n)
+        except MotionError as e:
+            raise ZMotionError(self.name, "values", str(e)) from None
+        self._put(dict(zip(axes, vals, strict=True)))
 
     def __iter__(self) -> Iterator[Any]:
         return (self._get(a) for a in self._base())

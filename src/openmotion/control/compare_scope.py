@@ -9,6 +9,7 @@ so a 50 us pulse keeps its width however long the cycle. `plot_scope` draws both
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -84,7 +85,7 @@ class Scope:
 
     def arrays(self) -> dict[str, NDArray]:
         """time (s since the trigger), dpos / mpos (cycles x axes, in units), and for each
-        output `do<n>`: its level at the trigger and its exact edges after it."""
+        output `do<n>`: its level just before the trigger and its exact edges from it on."""
         if self.t_trigger is None:
             raise MotionError("the scope was never triggered (call trigger() first)")
         r = np.array(self._rows, dtype=np.float64).reshape(len(self._rows), -1)
@@ -96,11 +97,24 @@ class Scope:
         t0 = self.t_trigger
         for o in self.outputs:
             line = self.eng.output(o)
-            edges = [(t - t0, lv) for t, lv in line.edges if t > t0]
-            out[f"do{o}_start"] = np.array([line.level_at(t0)], dtype=bool)
+            edges = [(t - t0, lv) for t, lv in line.edges if t >= t0]
+            out[f"do{o}_start"] = np.array([line.level_at(math.nextafter(t0, -math.inf))],
+                                           dtype=bool)
             out[f"do{o}_edges"] = np.array([t for t, _ in edges], dtype=np.float64)
             out[f"do{o}_levels"] = np.array([lv for _, lv in edges], dtype=bool)
         return out
+
+    def pulse_widths(self, output: int, active: bool = True) -> Array:
+        """Durations of the `active`-level stretches of `do<output>` that began and ended
+        after the trigger (what the scope's cursors would measure)."""
+        if output not in self.outputs:
+            raise MotionError(f"output must be one of the scope's outputs {self.outputs}, "
+                              f"got {output!r}")
+        a = self.arrays()
+        t, lv = a[f"do{output}_edges"], a[f"do{output}_levels"]
+        starts = np.flatnonzero(lv == active)
+        starts = starts[starts + 1 < t.size]
+        return t[starts + 1] - t[starts]
 
     def level_trace(self, output: int) -> tuple[Array, Array]:
         """(times, levels) of output `do<output>` as a step trace from the trigger to the
