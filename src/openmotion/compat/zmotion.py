@@ -311,7 +311,10 @@ class ZController:
         if not values:
             raise ZMotionError(command, "distance", "needs at least one value")
         vals = [check_finite(f"value[{i}]", v) for i, v in enumerate(values)]
-        axes = base_axes(self.pso.base_list, len(vals), self._n)
+        try:
+            axes = base_axes(self.pso.base_list, len(vals), self._n)
+        except MotionError as e:
+            raise ZMotionError(command, "axes", str(e)) from None
         main = axes[0]
         if len(axes) == 1:
             return self._move_axis(command, main, vals[0], relative)

@@ -36,7 +36,10 @@ class ZMotionError(MotionError):
 def parameter_of(message: str) -> str:
     """The parameter a core message names first ("maxerr must be > 0" -> "maxerr")."""
     head = message.split(" ", 1)[0].rstrip(":,")
-    return head if head.replace("_", "").replace("[", "").replace("]", "").isalnum() else ""
+    bare = head
+    for ch in "_[]()":
+        bare = bare.replace(ch, "")
+    return head if bare.isalnum() and head[:1].isalpha() else ""
 
 
 class AxisParam:

@@ -220,9 +220,11 @@ class ZPso:
         if len(set(chk)) != len(chk):
             raise MotionError(f"axes must be distinct, got {axes!r}")
         self._base = chk
+        self.eng.track_vector(self._vector())  # VECTOR_MOVED accumulates from now on
 
     def set_units(self, axis: int, units: float) -> None:
         self._units[_int("axis", axis, 0, len(self._units) - 1)] = check_positive("units", units)
+        self.eng.track_vector(self._vector())
 
     def source(self, axis: int, kind: str) -> None:
         if kind not in ("dpos", "mpos"):
