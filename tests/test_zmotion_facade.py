@@ -1,5 +1,6 @@
 """ZMotion facade: commands, axis parameters, motion, I/O, and refusals that change nothing."""
 
+import contextlib
 import math
 
 import numpy as np
@@ -273,3 +274,42 @@ def test_decel_different_from_accel():
     c.MOVE(10)
     c.WAIT_IDLE(2)
     assert c.DPOS[2] == 10
+
+
+ODD = [None, "x", [1], (), object(), math.nan, -1, 1e300, True, np.array([1.0, 2.0])]
+
+
+def test_odd_values_only_ever_raise_zmotion_errors():
+    c = ctl()
+    before = _state(c)
+    calls = []
+    for name in ("ATYPE", "UNITS", "SPEED", "ACCEL", "DECEL", "MERGE", "SRAMP", "DPOS", "MPOS",
+                 "VECTOR_MOVED"):
+        calls += [lambda v, n=name: getattr(c, n).__setitem__(0, v),
+                  lambda v, n=name: getattr(c, n).__getitem__(v)]
+    calls += [lambda v: c.BASE(v), lambda v: c.TABLE(0, v), lambda v: c.TABLE(v),
+              lambda v: c.OP(0, v), lambda v: c.OP(v), lambda v: c.MOVE(v, 1),
+              lambda v: c.HW_PSWITCH2(v), lambda v: c.HW_PSWITCH2(25, 0, 1, v, 8, 0),
+              lambda v: c.HW_TIMER(2, v, 100, 1, 0, 0), lambda v: c.RAPIDSTOP(v),
+              lambda v: c.WAIT_IDLE(v), lambda v: c.IDLE(v)]
+    for call in calls:
+        for v in ODD:
+            with contextlib.suppress(ZMotionError):  # anything else fails the test
+                call(v)
+            c.RAPIDSTOP(3)
+            c.WAIT_IDLE(0)
+            for a in range(3):
+                c.DPOS[a] = 0
+                c.MPOS[a] = 0
+            c.VECTOR_MOVED[0] = 0
+            c.UNITS = 100, 100, 100
+            c.SPEED = 100, 100, 100
+            c.ATYPE = 1, 1, 1
+            c.MERGE = 0, 0, 0
+            c.SRAMP = 0, 0, 0
+            c.BASE(0, 1, 2)
+            c.OP(0, OFF)
+            c.HW_PSWITCH2(2)
+            c.HW_TIMER(0, 10000, 6000, 1, OFF, 0)
+            c.TABLE[0:20] = [0.0] * 20
+    assert _state(c)[1:3] == before[1:3]

@@ -115,7 +115,7 @@ class ZController:
         self._speed = [100.0] * n  # units/s
         self._accel = [1000.0] * n
         self._decel = [1000.0] * n
-        self._merge = [False] * n
+        self._merge = [0] * n
         self._sramp = [0.0] * n
         self._groups: dict[tuple[int, ...], Group] = {}
         self._group_units: dict[tuple[int, ...], tuple[float, ...]] = {}
@@ -176,7 +176,7 @@ class ZController:
     @_command("ATYPE")
     def _put_atype(self, values: dict[int, Any]) -> None:
         for a, v in values.items():
-            if v not in ATYPES or isinstance(v, bool):
+            if isinstance(v, bool) or not isinstance(v, int) or v not in ATYPES:
                 raise ZMotionError("ATYPE", f"ATYPE({a})", f"ATYPE({a}) must be 1 (pulse "
                                    f"axis, compares DPOS) or 4 (pulse axis with encoder, "
                                    f"compares MPOS), got {v!r}", ZERR_UNSUPPORTED)
@@ -400,11 +400,13 @@ class ZController:
     def RAPIDSTOP(self, mode: int = 2) -> None:  # noqa: N802
         """RAPIDSTOP(2): every interpolation decelerates along its path at its deceleration
         and the buffered moves are dropped; RAPIDSTOP(3): every axis stops at once."""
-        if mode in (0, 1) and not isinstance(mode, bool):
+        if isinstance(mode, bool) or not isinstance(mode, int) or mode not in (0, 1, 2, 3):
+            raise ZMotionError("RAPIDSTOP", "mode", f"mode must be 2 or 3, got {mode!r}")
+        if mode in (0, 1):
             raise ZMotionError("RAPIDSTOP", "mode", f"mode {mode} (cancel only the current "
                                "or only the buffered move) is not provided; use 2 or 3",
                                ZERR_UNSUPPORTED)
-        if isinstance(mode, bool) or mode not in (2, 3):
+        if mode not in (2, 3):
             raise ZMotionError("RAPIDSTOP", "mode", f"mode must be 2 or 3, got {mode!r}")
         for k, g in list(self._groups.items()):
             if mode == 3:
@@ -435,7 +437,7 @@ class ZController:
 def _on_off(name: str, v: Any) -> int:
     if isinstance(v, bool):
         return int(v)
-    if v in (0, 1) and isinstance(v, int | float):
+    if isinstance(v, int | float) and v in (0, 1):
         return int(v)
     raise MotionError(f"{name} must be ON (1) or OFF (0), got {v!r}")
 

@@ -66,7 +66,8 @@ def base_axes(base: Sequence[int], count: int | None, n_axes: int) -> tuple[int,
 
 
 def _int(name: str, value: object, lo: int, hi: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | float) or value != int(value):
+    if isinstance(value, bool) or not isinstance(value, int | float) \
+            or not math.isfinite(value) or value != int(value):
         raise MotionError(f"{name} must be an integer, got {value!r}")
     v = int(value)
     if v < lo or (hi is not None and v > hi):
