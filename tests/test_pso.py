@@ -92,8 +92,6 @@ def test_modes_4_5_fixed_pulses_every_distance():
 
 def test_modes_6_7_use_the_timer():
     c, eng, z = setup(2)
-    with pytest.raises(MotionError, match="HW_TIMER"):
-        z.hw_pswitch2(6, 0, 1, 10, 20)
     z.hw_timer(2, 2000, 1000, 2, 0, 0)
     jid6 = z.hw_pswitch2(6, 0, 1, 10, 20, 4)  # at 10, 30, 50, 70 units
     line_to(c, (60, 80))
@@ -242,3 +240,69 @@ def test_timer_train_still_running_counts_an_overrun():
     assert eng.log.for_job(jid)["time"].size == 3  # every point still fires (logged) ...
     assert z.timer.overruns == 2                     # ... but only the first starts a train
     np.testing.assert_allclose(eng.output(0).pulse_widths(), [0.05, 0.05], atol=1e-9)
+
+
+def test_mode26_36_accept_hw_pswitch2_before_hw_timer():
+    """Seed order: HW_PSWITCH2(26, ...) then HW_TIMER(2, 100000, 50000, 2, OFF, 0)."""
+    c, eng, z = setup(2)
+    z.table(0, *SEED_2D)
+    jid = z.hw_pswitch2(26, 0, 1, 10, 8, 0)  # no timer yet: accepted
+    z.hw_timer(2, 100000, 50000, 2, 0, 0)
+    pts = np.array(SEED_2D, float).reshape(8, 2)
+    for p in [*pts[1:], pts[0]]:
+        line_to(c, p, v=10_000)
+    c.advance(0.3)
+    assert eng.log.for_job(jid)["time"].size == 8
+    np.testing.assert_allclose(eng.output(0).pulse_widths(), [0.05] * 16, atol=1e-9)
+    c3, eng3, z3 = setup(3)
+    z3.table(0, *SEED_3D)
+    jid3 = z3.hw_pswitch2(36, 0, 1, 10, 6, 0)
+    z3.hw_timer(2, 100000, 50000, 1, 0, 0)
+    for p in np.array(SEED_3D, float).reshape(6, 3):
+        line_to(c3, p, v=10_000)
+    c3.advance(0.2)
+    assert eng3.log.for_job(jid3)["time"].size == 6
+    np.testing.assert_allclose(eng3.output(0).pulse_widths(), [0.05] * 6, atol=1e-9)
+
+
+def test_hw_timer_edited_while_a_timer_job_runs():
+    c, eng, z = setup(1)
+    z.table(0, 10, 20, 30)
+    z.hw_pswitch2(7, 0, 1, 0, 2)              # vector table, a train per point
+    z.hw_timer(2, 10000, 2000, 1, 0, 0)       # 2 ms pulses
+    line_to(c, (15,), v=10_000)
+    z.hw_timer(2, 10000, 5000, 2, 0, 0)       # edited: two 5 ms pulses per point
+    line_to(c, (35,), v=10_000)
+    c.advance(0.1)
+    np.testing.assert_allclose(eng.output(0).pulse_widths(), [0.002] + [0.005] * 4, atol=1e-9)
+    # a point reached while the timer is stopped fires nothing but its log entry
+    z.hw_timer(0, 10000, 6000, 1, 0, 0)
+    z.table(0, 40)
+    jid = z.hw_pswitch2(7, 0, 1, 0, 0)
+    line_to(c, (45,), v=10_000)
+    assert eng.log.for_job(jid)["time"].size == 1 and z.timer.ignored == 1
+    assert eng.output(0).pulse_widths().size == 5
+
+
+def test_mode35_with_hw_timer_pulses_instead_of_inverting():
+    """Seed 3-D example: HW_TIMER(2, 100000, 50000, 1, OFF, 0) -> one 50 ms pulse per point."""
+    c, eng, z = setup(3)
+    z.table(0, *SEED_3D)
+    jid = z.hw_pswitch2(35, 0, 1, 10, 6, 0)
+    z.hw_timer(2, 100000, 50000, 1, 0, 0)
+    for p in np.array(SEED_3D, float).reshape(6, 3):
+        line_to(c, p, v=10_000)
+    c.advance(0.2)
+    log = eng.log.for_job(jid)
+    assert log["state"].tolist() == [1] * 6  # every point drives the pulse level
+    w = eng.output(0).pulse_widths()
+    np.testing.assert_allclose(w, [0.05] * 6, atol=1e-9)
+    starts = [t for t, lv in eng.output(0).edges if lv]
+    np.testing.assert_allclose(starts, log["time"], atol=1e-12)
+    # without a timer on the output, mode 35 inverts at each point
+    z.hw_timer(0, 10000, 6000, 1, 0, 0)
+    line_to(c, (0, 0, 0))
+    jid2 = z.hw_pswitch2(35, 0, 1, 10, 6, 0)
+    for p in np.array(SEED_3D, float).reshape(6, 3):
+        line_to(c, p, v=10_000)
+    assert eng.log.for_job(jid2)["state"].tolist() == [1, 0, 1, 0, 1, 0]

@@ -29,7 +29,7 @@ from openmotion.control.servo import LeadFilter
 from openmotion.errors import MotionError, check_nonnegative, check_positive
 
 from . import hctl1100_regs as R
-from .hctl1100_commutator import PHASE_A, PHASE_D, commutator_mask
+from .hctl1100_commutator import PHASE_A, PHASE_D, commutator_mask, phase_advance
 from .hctl1100_io import _CONTROL_FLAGS, RegisterAccess, _duty
 from .hctl1100_profile import IntegralVelocity, trapezoid_commands
 from .hctl1100_regs import Mode
@@ -103,6 +103,7 @@ class HCTL1100(RegisterAccess):
         self._act_latch = (0, 0)
         self._last_actual = 0
         self._prev_actual = 0
+        self._rotor_rate = 0.0  # quadrature counts/s over the last sample (phase advance)
         self._ring_origin = self.plant.counts  # commutator logic cleared
         self._ring_hold = 0
         self._comm = {R.R_COMM_RING: 0, R.R_COMM_VEL_TIMER: 0, R.R_COMM_X: 0, R.R_COMM_Y: 0,
@@ -253,9 +254,11 @@ class HCTL1100(RegisterAccess):
 
     def _sample(self) -> None:
         """The chip's work at one sample boundary."""
+        elapsed = self._period
         self._t_reg = self._t_buffer
         self._period = R.sample_time(self._t_reg, self.clock_hz)
         actual = self.actual_position
+        self._rotor_rate = R.wrap24(actual - self._last_actual) / elapsed
         self._last_actual = actual
         mode = self.mode
         if mode is Mode.INIT_IDLE:
@@ -316,7 +319,17 @@ class HCTL1100(RegisterAccess):
             pos //= 4
         c = self._comm
         return commutator_mask(pos, c[R.R_COMM_RING], c[R.R_COMM_X], c[R.R_COMM_Y],
-                               R.signed8(c[R.R_COMM_OFFSET]), sign)
+                               R.signed8(c[R.R_COMM_OFFSET]), sign,
+                               0 if frozen else self.commutator_advance)
+
+    @property
+    def commutator_advance(self) -> int:
+        """Phase advance now in effect (commutator counts, signed like the rotor speed):
+        the rotor speed measured over the last sample, in full counts/s, through
+        `phase_advance` with R19H and R1FH."""
+        c = self._comm
+        return phase_advance(self._rotor_rate / 4.0, c[R.R_COMM_VEL_TIMER],
+                             c[R.R_COMM_ADVANCE], self.clock_hz)
 
     @property
     def align_phase(self) -> str | None:

@@ -7,7 +7,17 @@ leaves the rotor on the PHD detent at ring position 0, so the detent of phase j 
 alone is at (j+1)*Ring/4 and that of the pair (j, j+1) half a sector further. For torque in
 the direction of the motor command the commutator energises the state ahead of the rotor
 (ahead by more than 0 and at most one sector plus the overlap); the negative direction is
-the mirror image. Phase advance / velocity timer are stored but not modelled.
+the mirror image.
+
+Phase advance (AIM104 "Commutator register descriptions", equations 11-14): at speed the
+commutator switches earlier by `phase_advance(...)` counts in the direction of rotation.
+The chip measures the rotor speed over the velocity-timer interval
+dt = 16 (R19H + 1) / fclk [14]; the advance is the encoder counts in that interval,
+Advance = N_f v dt [13] (N_f full counts per revolution, v in revolutions/s), capped at
+Max. Phase Advance R1FH. The manual's design helpers: `switching_angle_deg` [11] (the
+optimum angle tan^-1(wL/R)/p), `advance_counts` (angle/360 x counts per revolution) and
+`velocity_timer_register` ([13] solved for R19H). Its example - 200 steps, L = 20.4 mH,
+R = 7.4 ohm, 500-line encoder, 20 Hz - gives 0.38 deg, 2 quadrature counts and R19H = 24.
 
 Board drive logic (configuration bits 0-1): one-phase-on maps A/B/C/D to winding currents
 (1,0)/(0,1)/(-1,0)/(0,-1); two-phases-on maps them to the diagonals (the board's logic
@@ -51,16 +61,96 @@ def detent_mask(d: int) -> int:
     return _PHASE_BITS[j] | _PHASE_BITS[(j + 1) % 4]
 
 
-def commutator_mask(position: int, ring: int, x: int, y: int, offset: int, sign: int) -> int:
+def _clock(clock_hz: float) -> float:
+    if not (isinstance(clock_hz, int | float) and math.isfinite(clock_hz) and clock_hz > 0):
+        raise MotionError(f"clock_hz must be a finite number > 0, got {clock_hz!r}")
+    return float(clock_hz)
+
+
+def velocity_timer_interval(vel_timer: int, clock_hz: float = 2.0e6) -> float:
+    """dt = 16 (R19H + 1) / fclk, seconds (manual equation 14)."""
+    if isinstance(vel_timer, bool) or not isinstance(vel_timer, int) or not 0 <= vel_timer <= 255:
+        raise MotionError(f"vel_timer (R19H) must be an integer in [0, 255], got {vel_timer!r}")
+    return 16.0 * (vel_timer + 1) / _clock(clock_hz)
+
+
+def phase_advance(full_counts_per_s: float, vel_timer: int, max_advance: int,
+                  clock_hz: float = 2.0e6) -> int:
+    """Advance (counts, signed like the speed) at a rotor speed of `full_counts_per_s`
+    (N_f v): the whole counts in one velocity-timer interval, N_f v dt (equation 13),
+    capped at Max. Phase Advance `max_advance` (R1FH). Both registers 0: no advance."""
+    if isinstance(max_advance, bool) or not isinstance(max_advance, int) \
+            or not 0 <= max_advance <= 127:
+        raise MotionError(f"max_advance (R1FH) must be an integer in [0, 127], "
+                          f"got {max_advance!r}")
+    v = float(full_counts_per_s)
+    if not math.isfinite(v):
+        raise MotionError(f"full_counts_per_s must be finite, got {full_counts_per_s!r}")
+    counts = min(math.floor(abs(v) * velocity_timer_interval(vel_timer, clock_hz) + 1e-9),
+                 max_advance)
+    return int(math.copysign(counts, v)) if counts else 0
+
+
+def switching_angle_deg(freq_hz: float, inductance_h: float, resistance_ohm: float,
+                        rotor_teeth: float) -> float:
+    """Optimum switching angle tan^-1(w L / R) / p in mechanical degrees (equation 11),
+    w = 2 pi freq_hz, p = rotor teeth (90 / step angle)."""
+    for name, val in (("freq_hz", freq_hz), ("inductance_h", inductance_h),
+                      ("resistance_ohm", resistance_ohm), ("rotor_teeth", rotor_teeth)):
+        if not (isinstance(val, int | float) and math.isfinite(val) and val > 0):
+            raise MotionError(f"{name} must be a finite number > 0, got {val!r}")
+    w = 2.0 * math.pi * freq_hz
+    return math.degrees(math.atan(w * inductance_h / resistance_ohm)) / rotor_teeth
+
+
+def advance_counts(angle_deg: float, counts_per_rev: int) -> int:
+    """Max. Phase Advance for a switching angle: angle / 360 x counts per revolution, to
+    whole counts (the manual: 0.38 deg of 2000 quadrature counts = 2.1 => 2)."""
+    if not (isinstance(angle_deg, int | float) and math.isfinite(angle_deg) and angle_deg >= 0):
+        raise MotionError(f"angle_deg must be a finite number >= 0, got {angle_deg!r}")
+    if isinstance(counts_per_rev, bool) or not isinstance(counts_per_rev, int) \
+            or counts_per_rev < 1:
+        raise MotionError(f"counts_per_rev must be an integer >= 1, got {counts_per_rev!r}")
+    n = math.floor(angle_deg / 360.0 * counts_per_rev + 1e-9)
+    if n > 127:
+        raise MotionError(f"advance {n} counts exceeds the 7-bit R1FH (127); use full counts")
+    return n
+
+
+def velocity_timer_register(max_advance: int, full_counts_per_rev: int, rev_per_s: float,
+                            clock_hz: float = 2.0e6) -> int:
+    """R19H for which the advance reaches `max_advance` at `rev_per_s`: equation 13,
+    max_advance = N_f v 16 (R19H + 1) / fclk, solved for R19H (manual example: 24)."""
+    if isinstance(max_advance, bool) or not isinstance(max_advance, int) \
+            or not 1 <= max_advance <= 127:
+        raise MotionError(f"max_advance must be an integer in [1, 127], got {max_advance!r}")
+    if isinstance(full_counts_per_rev, bool) or not isinstance(full_counts_per_rev, int) \
+            or full_counts_per_rev < 1:
+        raise MotionError(f"full_counts_per_rev must be an integer >= 1, "
+                          f"got {full_counts_per_rev!r}")
+    if not (isinstance(rev_per_s, int | float) and math.isfinite(rev_per_s) and rev_per_s > 0):
+        raise MotionError(f"rev_per_s must be a finite number > 0, got {rev_per_s!r}")
+    reg = round(max_advance * _clock(clock_hz) / (16.0 * full_counts_per_rev * rev_per_s)) - 1
+    if not 0 <= reg <= 255:
+        raise MotionError(f"R19H would be {reg}, outside [0, 255]: the speed is out of the "
+                          "velocity timer's range")
+    return int(reg)
+
+
+def commutator_mask(position: int, ring: int, x: int, y: int, offset: int, sign: int,
+                    advance: int = 0) -> int:
     """Phases (bit mask A=1 .. D=8) on at ring `position` for motor command sign `sign`.
 
     `position` is the ring-counter input in commutator counts (already divided for full
     counts); 0 outputs nothing (no drive) and an unusable ring (X + Y = 0) does the same.
+    `advance` (signed, commutator counts, from `phase_advance`) moves the switching points
+    earlier in the direction of rotation: the commutator acts as if the rotor were
+    `advance` counts further on.
     """
     q = x + y
     if sign == 0 or ring <= 0 or q <= 0:
         return 0
-    r = (position + offset) % ring
+    r = (position + offset + advance) % ring
     c = (x - y) // 2  # centre the lead on one step: full step (q/2, 3q/2], half (q/2, q]
     if sign > 0:
         return detent_mask(_positive_detent((r + c) % (4 * q), x, q))

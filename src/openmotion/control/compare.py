@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -397,8 +397,8 @@ class CompareEngine:
             axes.update(v.axes)
         self._plan_axes = sorted(axes)
         self._plan = [self._last_record(a, t1) for a in self._plan_axes]
-        timers = {id(j.action): j.action for j in self._jobs.values()
-                  if hasattr(j.action, "busy_until")}
+        timers = {id(x): x for x in (_timer_of(j.action) for j in self._jobs.values())
+                  if x is not None}
         self._snap = (
             dict(self._jobs),
             {k: (j.index, j.hits, j.active) for k, j in self._jobs.items()},
@@ -483,6 +483,12 @@ class CompareEngine:
         for line in self._lines.values():
             line.flush(hw, ta, t1)
             line.forget_before(keep)
+
+
+def _timer_of(action: Action) -> Any:
+    """The pulse timer an action drives (itself, or a trigger's `timer`), or None."""
+    tm = getattr(action, "timer", action)
+    return tm if hasattr(tm, "busy_until") else None
 
 
 def _on_command(job: CompareJob) -> bool:

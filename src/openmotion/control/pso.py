@@ -14,8 +14,17 @@ Seed: zmotion-pso-2d-3d-and-hw-timer.txt; seed-facts.md section 4. A `ZPso` sits
   maxerr window), 35/36 (3-D); `remaining(axis)` = ?HW_PSWITCH2(axis), free buffer space;
 - `hw_timer(mode, cycle_us, on_us, reptimes, opstate, opnum)` = HW_TIMER (one timer).
 
-Outputs: on the first point the output takes `opstate`, then each point inverts it (1, 3,
-25, 35); modes 26/36/6/7 start a pulse train of the timer at each point instead.
+Outputs: on the first point the output takes `opstate`, then each point inverts it (1, 3;
+25 and 35 while no HW_TIMER runs on their output). The timer modes 6, 7, 26 and 36 start a
+pulse train of the timer at each point, and so do 25 and 35 while the timer runs on their
+output (the seed: "for the mode that is matched with HW_TIMER together, the pulse output
+width is determined by HW_TIMER"). The timer is looked up when a point fires, not when
+HW_PSWITCH2 is called: the seed calls HW_PSWITCH2 first and HW_TIMER after it, and "HW_TIMER
+can be edited independently to adjust parameters dynamically" (`TimerTrigger`).
+
+BASE lists shorter than a command needs are extended with the axes numbered after the last
+BASE axis (`base_axes`): BASE(0) then MOVEABS(300, 200) moves axes 0 and 1 (seed Test_Mode3),
+and VECTOR_MOVED of BASE axis 0 is the path length of that interpolation.
 """
 
 from __future__ import annotations
@@ -40,8 +49,25 @@ from .compare import (
 MODES = (1, 2, 3, 4, 5, 6, 7, 25, 26, 35, 36)
 
 
+def base_axes(base: Sequence[int], count: int | None, n_axes: int) -> tuple[int, ...]:
+    """The first `count` axes of the BASE list extended by the axes numbered after its last
+    axis (count None: the whole extension up to `n_axes`); MotionError if there are too few."""
+    ext = list(base)
+    nxt = max(base) + 1
+    want = n_axes if count is None else count
+    while len(ext) < want and nxt < n_axes:
+        if nxt not in ext:
+            ext.append(nxt)
+        nxt += 1
+    if count is not None and len(ext) < count:
+        raise MotionError(f"{count} axes needed from BASE {tuple(base)!r}, the machine has "
+                          f"axes 0..{n_axes - 1}")
+    return tuple(ext if count is None else ext[:count])
+
+
 def _int(name: str, value: object, lo: int, hi: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | float) or value != int(value):
+    if isinstance(value, bool) or not isinstance(value, int | float) \
+            or not math.isfinite(value) or value != int(value):
         raise MotionError(f"{name} must be an integer, got {value!r}")
     v = int(value)
     if v < lo or (hi is not None and v > hi):
@@ -72,6 +98,10 @@ class PulseTimer:
     @property
     def running(self) -> bool:
         return self.mode == 2 and not self.soft_closed
+
+    def serves(self, output: int) -> bool:
+        """Is the timer configured (run, or soft-closed) on `output`?"""
+        return self.mode == 2 and self.output == output
 
     def configure(self, mode: int, cycle_us: float, on_us: float, reptimes: int,
                   opstate: bool, opnum: int) -> None:
@@ -133,6 +163,27 @@ class PulseTimer:
         return active
 
 
+class TimerTrigger:
+    """Compare action of the timer modes: at each point, the HW_TIMER train on `output` as
+    the timer is configured at that instant. While the timer is not configured on `output`
+    the point does `fallback` (25/35: invert, a Toggle) or, without one (6/7/26/36), only
+    its log entry; such firings are counted in `timer.ignored`."""
+
+    def __init__(self, timer: PulseTimer, output: int, fallback: Toggle | None = None) -> None:
+        self.timer = timer
+        self.output = output
+        self.fallback = fallback
+
+    def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
+        tm = self.timer
+        if tm.serves(self.output):
+            return tm.apply(eng, t, hit)
+        if self.fallback is not None:
+            return self.fallback.apply(eng, t, hit)
+        tm.ignored += 1
+        return eng.output(self.output).level_at(t)
+
+
 class ZPso:
     """ZMotion PSO on a CompareEngine (see module docstring).
 
@@ -170,25 +221,40 @@ class ZPso:
         if len(set(chk)) != len(chk):
             raise MotionError(f"axes must be distinct, got {axes!r}")
         self._base = chk
+        self.eng.track_vector(self._vector())  # VECTOR_MOVED accumulates from now on
 
     def set_units(self, axis: int, units: float) -> None:
         self._units[_int("axis", axis, 0, len(self._units) - 1)] = check_positive("units", units)
+        self.eng.track_vector(self._vector())
 
     def source(self, axis: int, kind: str) -> None:
         if kind not in ("dpos", "mpos"):
             raise MotionError(f"kind must be 'dpos' or 'mpos', got {kind!r}")
         self._kind[_int("axis", axis, 0, len(self._kind) - 1)] = kind
 
-    def _vector(self) -> VectorSource:
-        b = self._base
+    @property
+    def base_list(self) -> tuple[int, ...]:
+        return self._base
+
+    def units(self, axis: int) -> float:
+        return self._units[_int("axis", axis, 0, len(self._units) - 1)]
+
+    def kind(self, axis: int) -> str:
+        return self._kind[_int("axis", axis, 0, len(self._kind) - 1)]
+
+    def _vector(self, axis: int | None = None) -> VectorSource:
+        n = len(self._units)
+        head = self._base if axis is None or axis == self._base[0] else \
+            (_int("axis", axis, 0, n - 1),)
+        b = base_axes(head, None, n)
         return VectorSource(b, tuple(self._units[a] for a in b))
 
-    def vector_moved(self) -> float:
-        """VECTOR_MOVED of the BASE axes, in units."""
-        return self.eng.vector_moved(self._vector())
+    def vector_moved(self, axis: int | None = None) -> float:
+        """VECTOR_MOVED of the BASE axes (or of `axis` as the main axis), in units."""
+        return self.eng.vector_moved(self._vector(axis))
 
-    def set_vector_moved(self, value: float = 0.0) -> None:
-        self.eng.set_vector_moved(self._vector(), value)
+    def set_vector_moved(self, value: float = 0.0, axis: int | None = None) -> None:
+        self.eng.set_vector_moved(self._vector(axis), value)
 
     def remaining(self, axis: int | None = None) -> int:
         """?HW_PSWITCH2(axis): free compare buffer space."""
@@ -223,12 +289,6 @@ class ZPso:
                               f"{start!r}..{end!r}")
         return self.table_data[s:e + 1].copy()
 
-    def _timer_for(self, op: int, mode: int) -> PulseTimer:
-        if not self.timer.running or self.timer.output != op:
-            raise MotionError(f"mode {mode} needs HW_TIMER running on output {op} "
-                              "(or the pulse parameters)")
-        return self.timer
-
     def hw_pswitch2(self, mode: int, *p: float) -> int | None:
         """HW_PSWITCH2(mode, ...) on the BASE axes; returns the compare job id (None for 2).
 
@@ -260,7 +320,7 @@ class ZPso:
                            direction=1 if direction else -1, monotonic=True, name="mode1")
         elif mode in (3, 7):
             pts = self._slice(p[2], p[3])
-            action = Toggle(op, opstate) if mode == 3 else self._timer_for(op, 7)
+            action = Toggle(op, opstate) if mode == 3 else TimerTrigger(self.timer, op)
             job = LevelJob(self._vector(), pts, action, direction=1, monotonic=True,
                            name=f"mode{mode}")
         elif mode in (4, 5):
@@ -275,7 +335,7 @@ class ZPso:
             period = check_positive("period", p[3])
             count = _int("count", p[4], 1) if len(p) == 5 else None
             job = LevelJob(self._vector(), LevelSeq(start, period, count),
-                           self._timer_for(op, 6), direction=1, name="mode6")
+                           TimerTrigger(self.timer, op), direction=1, name="mode6")
         else:
             job = self._window_job(mode, op, opstate, p)
         jid = self.eng.add(job)  # may refuse (buffer); nothing was changed before this
@@ -284,9 +344,7 @@ class ZPso:
 
     def _window_job(self, mode: int, op: int, opstate: bool, p: tuple[float, ...]) -> WindowJob:
         dim = 2 if mode in (25, 26) else 3
-        if len(self._base) < dim:
-            raise MotionError(f"mode {mode} needs {dim} BASE axes, got {self._base!r}")
-        axes = self._base[:dim]
+        axes = base_axes(self._base, dim, len(self._units))
         maxerr = check_finite("maxerr", p[2])
         if maxerr <= 0.0:
             raise MotionError(f"maxerr must be > 0 (never 0), got {p[2]!r}")
@@ -299,19 +357,18 @@ class ZPso:
         kinds = {self._kind[a] for a in axes}
         if len(kinds) != 1:
             raise MotionError("the BASE axes must share one compare source (dpos or mpos)")
-        if mode in (25, 35):
-            return WindowJob(axes, pts, maxerr, Toggle(op, opstate), kind=kinds.pop(),
-                             name=f"mode{mode}")
-        if len(p) == 8:
+        kind = kinds.pop()
+        if mode in (25, 35):  # invert, or the timer's pulse while it runs on this output
+            return WindowJob(axes, pts, maxerr, TimerTrigger(self.timer, op, Toggle(op, opstate)),
+                             kind=kind, name=f"mode{mode}")
+        job = WindowJob(axes, pts, maxerr, TimerTrigger(self.timer, op), kind=kind,
+                        name=f"mode{mode}")
+        if len(p) == 8:  # ophwtimeus, ophwtimes, hwcyctimeus: configure the timer too
             on_us, reps, cyc_us = p[5], p[6], p[7]
-            # validate on a scratch timer, so a refusal changes nothing
             _int("ophwtimes", reps, 1)
             self.timer.check(2, cyc_us, on_us, reps, op)
-            job = WindowJob(axes, pts, maxerr, self.timer, kind=kinds.pop(), name=f"mode{mode}")
             if self.eng.buffer_free() < num:
                 raise MotionError(f"table too long: {num} points, buffer has "
                                   f"{self.eng.buffer_free()} free")
             self.timer.configure(2, cyc_us, on_us, reps, not opstate, op)
-            return job
-        return WindowJob(axes, pts, maxerr, self._timer_for(op, mode), kind=kinds.pop(),
-                         name=f"mode{mode}")
+        return job
