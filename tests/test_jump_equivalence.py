@@ -21,7 +21,7 @@ from openmotion.config import MachineConfig, SwitchConfig, default_machine
 from openmotion.control import Controller
 from openmotion.control.group import Group
 from openmotion.control.homing import HomeConfig, home_search
-from openmotion.control.jump import first_cycle_at, plan_jump
+from openmotion.control.jump import FIRST_CHUNK, first_cycle_at, plan_jump
 from openmotion.errors import MotionError
 
 AXES = 3
@@ -243,3 +243,23 @@ def test_a_cycle_hook_without_due_keeps_every_cycle():
     ctl.add_cycle_hook(lambda c, t: seen.append(t))
     ctl.advance(0.05)
     assert len(seen) == 50
+
+
+@pytest.mark.parametrize("cycle", [FIRST_CHUNK - 1, FIRST_CHUNK, FIRST_CHUNK + 1,
+                                   3 * FIRST_CHUNK])
+def test_an_edge_in_the_last_cycle_of_a_fed_chunk_ends_the_jump(cycle):
+    """Pieces are fed in chunks (FIRST_CHUNK, doubling): an E-stop in a chunk's last cycle
+    must land there, not be carried into the next chunk."""
+    seen = []
+    for jumping in (False, True):
+        ctl = Controller()
+        ctl.virtual_jumps = jumping
+        ctl.enable_all()
+        ctl.axes[0].move_relative(50_000, max_vel=50_000, tacc=0.05)
+        ctl.hardware.scenario.press_estop(at=(cycle - 0.5) * ctl.period)
+        ctl.advance(0.3)
+        ev = ctl.events.events("estop")
+        seen.append((ev[0].time, ev[0].position, ctl.axes[0].position,
+                     ctl.axes[0].counters.snapshot(),
+                     [v.tolist() for v in ctl.history.records(0).values()]))
+    assert seen[0] == seen[1]

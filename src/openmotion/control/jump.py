@@ -129,7 +129,7 @@ def jump(ctl: Controller, land: int) -> None:
             hw.queue_pieces(ax.index, pieces)
             ends.append(p1v1)
         run = hw.run_cycles(origin, period, n, stop, wake)
-        if run.cycle < stop or stop >= land:
+        if run.cycle < stop or run.edges or stop >= land:
             break
         n = stop
         t0 = origin + n * period
