@@ -518,9 +518,12 @@ def _alarm_hook(ctl: Controller, edge: InputEdge) -> None:
 
 def _io_word(ctl: Controller, axis: int) -> int:
     """get_io_status-style bit field of an axis's logical input levels (+ EMG bit 6)."""
+    ctl._sync(axis)  # one readback; then input_active's rule on each signal
+    inputs = ctl._inputs[axis]
+    nc = ctl._nc[axis]
     word = 0
     for sig, bit in IO_BITS:
-        if ctl.input_active(axis, sig):
+        if inputs.get(sig, False) != (sig in nc):
             word |= 1 << bit
     if ctl._estop:
         word |= 1 << 6
