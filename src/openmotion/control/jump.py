@@ -126,7 +126,12 @@ def jump(ctl: Controller, land: int) -> None:
                 pieces.append(AxisCommand(ta, t1 - ta, p0, v0, a0, j))
                 p1v1.append((p1, v1 if t1 < t_end or velocity else 0.0))
                 ta = t1
-            hw.queue_pieces(ax.index, pieces)
+            try:
+                hw.queue_pieces(ax.index, pieces)
+            except BaseException:
+                for other in movers:  # nothing half-queued stays behind
+                    hw.clear_queue(other.index)
+                raise
             ends.append(p1v1)
         run = hw.run_cycles(origin, period, n, stop, wake)
         if run.cycle < stop or run.edges or stop >= land:
