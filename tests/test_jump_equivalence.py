@@ -263,3 +263,48 @@ def test_an_edge_in_the_last_cycle_of_a_fed_chunk_ends_the_jump(cycle):
                      ctl.axes[0].counters.snapshot(),
                      [v.tolist() for v in ctl.history.records(0).values()]))
     assert seen[0] == seen[1]
+
+
+class _PlainHardware:
+    """Only the base Hardware protocol of a simulator (no QueuedHardware)."""
+
+    def __init__(self, sim) -> None:  # noqa: ANN001
+        self._sim = sim
+        self.n_axes = sim.n_axes
+
+    @property
+    def time(self) -> float:
+        return self._sim.time
+
+    def command(self, axis, cmd):  # noqa: ANN001, ANN201
+        return self._sim.command(axis, cmd)
+
+    def advance(self, t):  # noqa: ANN001, ANN201
+        return self._sim.advance(t)
+
+    def read_axis(self, axis):  # noqa: ANN001, ANN201
+        return self._sim.read_axis(axis)
+
+    def write_output(self, axis, signal, level):  # noqa: ANN001, ANN201
+        return self._sim.write_output(axis, signal, level)
+
+    def read_input(self, signal):  # noqa: ANN001, ANN201
+        return self._sim.read_input(signal)
+
+
+def test_a_back_end_without_the_queue_runs_every_cycle_with_the_same_result():
+    from openmotion.hw.interface import QueuedHardware
+    from openmotion.hw.sim import SimMachine
+
+    cfg = default_machine()
+    plain = _PlainHardware(SimMachine(cfg))
+    assert not isinstance(plain, QueuedHardware)
+    out = []
+    for hw in (SimMachine(cfg), plain):
+        ctl = Controller(cfg, hw)
+        ctl.enable_all()
+        ctl.axes[1].move_relative(12_345, max_vel=40_000, tacc=0.03)
+        assert plan_jump(ctl, 100) == (100 if hw is not plain else 1)
+        ctl.wait_motion_done(timeout=2.0)
+        out.append((ctl.time, ctl.cycles, ctl.axes[1].counters.snapshot()))
+    assert out[0] == out[1]
