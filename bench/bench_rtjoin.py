@@ -21,6 +21,7 @@ import numpy as np
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
+from openmotion.control.clock import CycleStats, pacer_baseline
 from openmotion.control.group import Group, GroupState
 
 SKIP = 30  # first cycles left out of the figures (the first chain starts there)
@@ -69,7 +70,27 @@ def run(n: int, worker: bool) -> None:
           f"overruns {s.overruns}/{s.cycles}")
 
 
+def percentiles(name: str, s: CycleStats) -> None:
+    print(f"{name:8s} cycles {s.cycles}: jitter (start lateness) mean {s.mean_jitter * 1e6:.0f}"
+          f" p99 {s.p99_jitter * 1e6:.0f} max {s.max_jitter * 1e6:.0f} us; busy mean "
+          f"{s.mean_busy * 1e6:.0f} p99 {s.p99_busy * 1e6:.0f} max {s.max_busy * 1e6:.0f} us;"
+          f" overruns {s.overruns}")
+
+
+def idle_realtime(seconds: float) -> CycleStats:
+    """4 enabled idle axes on the default machine in real time: the cycle's floor."""
+    ctl = Controller()
+    ctl.enable_all()
+    with ctl.start_realtime():
+        time.sleep(seconds)
+    return ctl.cycle_stats()
+
+
 if __name__ == "__main__":
     n_seg = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
+    print("no-op pacer beside the controller (OS wake-up lateness vs the controller's busy "
+          "time), 1 ms, 2 s each:")
+    percentiles("no-op", pacer_baseline(0.001, 2.0))
+    percentiles("4 idle", idle_realtime(2.0))
     run(n_seg, True)
     run(n_seg, False)

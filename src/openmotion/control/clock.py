@@ -127,3 +127,20 @@ class RealtimePacer:
             max_jitter=float(late.max()),
             overruns=self._overruns,
         )
+
+
+def pacer_baseline(period: float, seconds: float) -> CycleStats:
+    """Statistics of a pacer running a no-op cycle for `seconds` of wall clock at `period`:
+    the operating system's own wake-up lateness on this machine, measured the same way as
+    the controller's real-time cycle. Compare its jitter with `Controller.cycle_stats()`
+    to tell OS lateness from the controller's busy time (the busy figures here are the
+    pacer's bookkeeping floor)."""
+    period = check_period(period)
+    seconds = check_finite("seconds", seconds)
+    if not 0.0 < seconds <= 3600.0:
+        raise MotionError(f"seconds must be in (0, 3600], got {seconds!r}")
+    pacer = RealtimePacer(lambda: None, period)
+    pacer.start()
+    _time.sleep(seconds)
+    pacer.stop()
+    return pacer.stats()

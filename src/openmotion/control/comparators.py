@@ -20,6 +20,7 @@ Every firing is appended to `comparators.events` (and given to `on_event` callba
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -132,6 +133,13 @@ class Comparators:
         if source == "error":
             return float(c.error)
         return float(c.general)
+
+    def due(self) -> float:
+        """When `on_cycle` may next act: every cycle while an error-counter check or a
+        general comparator is set, else math.inf."""
+        if any(e is not None for e in self._err) or any(g is not None for g in self._gen):
+            return -math.inf
+        return math.inf
 
     def on_cycle(self, t: float) -> None:
         t_prev, self._last_t = self._last_t, t

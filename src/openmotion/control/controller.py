@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from typing import Any
 
 from ..config import MachineConfig, default_machine
@@ -31,6 +31,7 @@ from ..hw.interface import Hardware, InputEdge
 from ..recording import Recorder
 from .axis import Axis
 from .clock import CycleStats, RealtimePacer, check_period
+from .jump import jump, plan_jump
 from .motion import ActiveMotion
 from .states import AxisState
 
@@ -42,6 +43,7 @@ IO_BITS = (("rdy", 0), ("alm", 1), ("pel", 2), ("mel", 3), ("org", 4), ("ez", 9)
 
 EdgeHook = Callable[["Controller", InputEdge], None]
 CycleHook = Callable[["Controller", float], None]
+DueFn = Callable[["Controller"], float]
 PreAdvanceHook = Callable[["Controller", float, float], None]
 SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
@@ -89,7 +91,14 @@ class Controller:
         self._by_name = {a.name: a for a in self.axes}
         self.history = MotionHistory(len(self.axes), history_window_s, t_start=self._time)
         self._edge_hooks: list[EdgeHook] = [_estop_hook, _alarm_hook]
+        # hook -> the signals it acts on (a hook absent here may act on any edge)
+        self._edge_signals: dict[EdgeHook, frozenset[str]] = {
+            _estop_hook: frozenset({"emg"}), _alarm_hook: frozenset({"alm"})}
         self._cycle_hooks: list[CycleHook] = []
+        self._cycle_dues: dict[CycleHook, DueFn] = {}  # hook -> when it must next run
+        #: Virtual time jumps over the cycles nothing needs (control/jump.py); False runs
+        #: every cycle (the reference the jumps are tested against).
+        self.virtual_jumps = True
         self._pre_hooks: list[PreAdvanceHook] = []
         self._sample_hooks: list[tuple[SampleHook, int]] = []
         self._samples = 1  # sub-steps per cycle: lcm of the sample hooks' rates
@@ -169,29 +178,56 @@ class Controller:
         return level != self._emg_nc
 
     # ------------------------------------------------------------------ hooks
-    def add_edge_hook(self, hook: EdgeHook) -> None:
-        """Call `hook(controller, edge)` for every input edge, after the built-in hooks."""
+    def add_edge_hook(self, hook: EdgeHook, *, signals: Collection[str] | None = None
+                      ) -> None:
+        """Call `hook(controller, edge)` for every input edge, after the built-in hooks.
+
+        `signals`, if given, promises the hook does nothing for edges on other signals:
+        virtual time then jumps over cycles whose only edges are on signals no hook acts
+        on (control/jump.py). Without it, every edge ends a jump.
+        """
         if not callable(hook):
             raise MotionError(f"hook must be callable, got {hook!r}")
+        if signals is not None and (isinstance(signals, str) or not all(
+                isinstance(x, str) for x in signals)):
+            raise MotionError(f"signals must be a collection of signal names, got "
+                                  f"{signals!r}")
         with self._lock:
             self._edge_hooks.append(hook)
+            if signals is not None:
+                self._edge_signals[hook] = frozenset(signals)
 
     def remove_edge_hook(self, hook: EdgeHook) -> None:
         with self._lock:
             if hook in self._edge_hooks[2:]:
                 self._edge_hooks.remove(hook)
+                if hook not in self._edge_hooks:
+                    self._edge_signals.pop(hook, None)
 
-    def add_cycle_hook(self, hook: CycleHook) -> None:
-        """Call `hook(controller, t)` at the end of every cycle (t = cycle end time)."""
+    def add_cycle_hook(self, hook: CycleHook, *, due: DueFn | None = None) -> None:
+        """Call `hook(controller, t)` at the end of every cycle (t = cycle end time).
+
+        `due(controller)`, if given, returns the earliest time at which the hook may act
+        (it must run in the first cycle ending at or after it; math.inf: not before the
+        next input edge or motion change; the current time or less: every cycle). Virtual
+        time jumps only over cycles in which every cycle hook is not due (control/jump.py);
+        a hook without `due` runs every cycle and keeps time from jumping.
+        """
         if not callable(hook):
             raise MotionError(f"hook must be callable, got {hook!r}")
+        if due is not None and not callable(due):
+            raise MotionError(f"due must be callable or None, got {due!r}")
         with self._lock:
             self._cycle_hooks.append(hook)
+            if due is not None:
+                self._cycle_dues[hook] = due
 
     def remove_cycle_hook(self, hook: CycleHook) -> None:
         with self._lock:
             if hook in self._cycle_hooks:
                 self._cycle_hooks.remove(hook)
+                if hook not in self._cycle_hooks:
+                    self._cycle_dues.pop(hook, None)
 
     def add_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
         """Call `hook(controller, t0, t1)` every cycle after every axis's command for
@@ -289,19 +325,34 @@ class Controller:
             for pre in tuple(self._pre_hooks):
                 pre(self, t0, t1)
             edges = hw.advance(t1) if not self._sample_hooks else self._sampled(t0, t1)
-            self._n = n
-            self._time = t1
-            if edges:
-                hooks = self._edge_hooks
-                for e in edges:
-                    for h in hooks:
-                        h(self, e)
-            for ax in self.axes:
-                ax._cycle_end(t1)
-            for h in self._cycle_hooks:
-                h(self, t1)
-            if self.recorder is not None:
-                self._record(t1)
+            self._finish_cycle(n, edges)
+
+    def _finish_cycle(self, n: int, edges: list[InputEdge]) -> None:
+        """The end of cycle n, the hardware advanced there: edge hooks, motion ends, cycle
+        hooks, the recorder (lock held)."""
+        t1 = self._t_origin + n * self.period
+        self._n = n
+        self._time = t1
+        if edges:
+            hooks = self._edge_hooks
+            for e in edges:
+                for h in hooks:
+                    h(self, e)
+        for ax in self.axes:
+            ax._cycle_end(t1)
+        for h in self._cycle_hooks:
+            h(self, t1)
+        if self.recorder is not None:
+            self._record(t1)
+
+    def _run_cycles(self, n: int) -> None:
+        """Run up to n cycles: one jump (control/jump.py) or one step."""
+        with self._lock:
+            land = plan_jump(self, n)
+            if land > self._n + 1:
+                jump(self, land)
+            else:
+                self.step()
 
     def _sampled(self, t0: float, t1: float) -> list[InputEdge]:
         """Advance the hardware over [t0, t1] in sub-steps, running the sample hooks."""
@@ -336,29 +387,40 @@ class Controller:
         """Run the cycles covering `dt` seconds of virtual time (rounded up to whole cycles)."""
         dt = check_nonnegative("dt", dt)
         self._check_virtual()
-        n = math.ceil(dt / self.period - 1e-9)
-        for _ in range(n):
-            self.step()
+        end = self._n + math.ceil(dt / self.period - 1e-9)
+        while self._n < end:
+            self._run_cycles(end - self._n)
 
-    def run_until(self, condition: Callable[[], bool], timeout: float) -> bool:
+    def run_until(self, condition: Callable[[], bool], timeout: float, *,
+                  event_driven: bool = False) -> bool:
         """Run cycles until `condition()` is true (checked before each cycle); False if
-        `timeout` seconds of virtual time pass first. Never raises on timeout."""
+        `timeout` seconds of virtual time pass first. Never raises on timeout.
+
+        event_driven=True promises that the condition only changes when something happens
+        (a motion ends or starts, an input edge, a hook acts), never with the position
+        between cycles; virtual time may then jump (control/jump.py) and the condition is
+        checked at each landing. Otherwise every cycle runs.
+        """
         if not callable(condition):
             raise MotionError(f"condition must be callable, got {condition!r}")
         timeout = check_nonnegative("timeout", timeout)
         self._check_virtual()
-        n = math.ceil(timeout / self.period - 1e-9)
-        for _ in range(n):
+        end = self._n + math.ceil(timeout / self.period - 1e-9)
+        while self._n < end:
             if condition():
                 return True
-            self.step()
+            if event_driven:
+                self._run_cycles(end - self._n)
+            else:
+                self.step()
         return bool(condition())
 
     def wait_motion_done(self, axes: Sequence[int | str] | None = None,
                          timeout: float = 60.0) -> bool:
         """run_until every given axis (default all) reports motion_done == 0."""
         sel = self.axes if axes is None else tuple(self.axis(k) for k in axes)
-        return self.run_until(lambda: all(a.motion_done == 0 for a in sel), timeout)
+        return self.run_until(lambda: all(a.motion_done == 0 for a in sel), timeout,
+                              event_driven=True)
 
     def _check_virtual(self) -> None:
         if self._pacer.running:
@@ -456,9 +518,12 @@ def _alarm_hook(ctl: Controller, edge: InputEdge) -> None:
 
 def _io_word(ctl: Controller, axis: int) -> int:
     """get_io_status-style bit field of an axis's logical input levels (+ EMG bit 6)."""
+    ctl._sync(axis)  # one readback; then input_active's rule on each signal
+    inputs = ctl._inputs[axis]
+    nc = ctl._nc[axis]
     word = 0
     for sig, bit in IO_BITS:
-        if ctl.input_active(axis, sig):
+        if inputs.get(sig, False) != (sig in nc):
             word |= 1 << bit
     if ctl._estop:
         word |= 1 << 6

@@ -50,6 +50,7 @@ a*T^2/2, under a pulse at usual rates, plus StrVel*T when the stop ends inside t
 from __future__ import annotations
 
 import contextlib
+import math
 import weakref
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -166,8 +167,8 @@ class Safety:
         self.stops: list[StopRecord] = []
         self.soft = SoftLimits(controller, self._is_suspended)
         self.cmp = Comparators(controller)
-        controller.add_edge_hook(self._on_edge)
-        controller.add_cycle_hook(self._on_cycle)
+        controller.add_edge_hook(self._on_edge, signals=("pel", "mel", "sd"))
+        controller.add_cycle_hook(self._on_cycle, due=self._due)
         controller.add_fault_hook(self._on_fault)
         controller.add_motion_check(self._check_motion)
         _INSTALLED[controller] = self
@@ -438,6 +439,32 @@ class Safety:
                 self._sd_cycle(ax, c)
         self.soft.on_cycle(t)
         self.cmp.on_cycle(t)
+
+    def _due(self, ctl: Controller) -> float:
+        """When `_on_cycle` may next act (Controller.add_cycle_hook): an ERC pulse's end;
+        every cycle while a limit or SD input is active under a motion, an SD slow-down is
+        saved, or an ERC pulse waits for a stop to end; soft limits and comparators as they
+        say; otherwise not before something happens (math.inf)."""
+        due = math.inf
+        for ax in ctl.axes:
+            i = ax.index
+            off = self._erc_off[i]
+            if off is not None:
+                due = min(due, off - 1e-12)
+            m = ax.motion
+            if m is None:
+                if self._erc_after_stop[i] or self._sd_saved[i] is not None \
+                        or self._sd_latch[i]:
+                    return -math.inf
+                continue
+            c = self._cfg[i]
+            if c.el_enabled and ax.state is not S.ERROR_STOP and any(self._el[i].values()):
+                return -math.inf
+            if c.sd_enabled and "sd" not in c.suspended and (
+                    self._sd_saved[i] is not None or self._sd_latch[i]
+                    or ctl.input_active(i, "sd")):
+                return -math.inf
+        return min(due, self.soft.due(), self.cmp.due())
 
     def _limit_level_check(self, ax: Axis, c: AxisSafety) -> None:
         """A motion heading into a limit that is already active (the reaction was suspended

@@ -241,6 +241,22 @@ class SoftLimits:
             lo, hi = min(lo, e), max(hi, e)
         return lo, hi
 
+    def due(self) -> float:
+        """When `on_cycle` may next act: every cycle while an axis under active limits runs
+        a velocity move or a discrete move not yet found inside them, else math.inf."""
+        for ax in self.ctl.axes:
+            m = ax.motion
+            if m is None or ax.state is AxisState.ERROR_STOP and ax.fault in ("+SL", "-SL"):
+                continue
+            lim = self._raw(ax)
+            if lim is None:
+                continue
+            cached = self._safe.get(ax.index)
+            if m.kind == "velocity" or cached is None or cached[0] != id(m) \
+                    or cached[1:] != lim:
+                return -math.inf
+        return math.inf
+
     def on_cycle(self, t: float) -> None:
         """The per-cycle prediction (see the module docstring)."""
         T = self.ctl.period

@@ -10,6 +10,13 @@ The control layer never knows whether the hardware is simulated. Each cycle it:
    happened since the last call, each with its exact time (`InputEdge`);
 3. reads counters and input levels (`read_axis`), and writes outputs.
 
+A back end that implements `QueuedHardware` also takes motion ahead of time: a queue of
+timed cubic pieces per axis (a whole stretch of a profile, planned ahead), which it executes
+by itself over many cycles (`run_cycles`), reporting back only what the control layer must
+act on: the cycle in which input edges happened (with the edges, at their exact times) and
+the axes whose queue ran empty. The control layer then skips the cycles in between
+(virtual time jumps, control/jump.py); back ends without it get one command per cycle.
+
 Signal levels crossing this boundary are *electrical* (True = contact closed / line
 active-high as wired). Logic (normally open / closed, active high / low) is applied by the
 control layer from the machine configuration, as a real controller's registers do.
@@ -17,6 +24,7 @@ control layer from the machine configuration, as a real controller's registers d
 
 from __future__ import annotations
 
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -141,3 +149,50 @@ class TimedOutputHardware(Protocol):
         """Drive an output (as `write_output`) at time t (>= the hardware time). Writes are
         executed in time order (equal times in call order) inside `advance`. MotionError for
         t in the past or a bad signal/level; nothing is scheduled then."""
+
+
+@dataclass(frozen=True, slots=True)
+class QueueRun:
+    """What `QueuedHardware.run_cycles` reports: the cycle it stopped at (its end time is
+    origin + cycle * period), the input edges of that cycle (time-ordered, as `advance`
+    returns them; empty when it ran to the last cycle asked for) and the axes whose queue ran
+    empty during the run (the last piece started; the command holds its end after it)."""
+
+    cycle: int
+    edges: list[InputEdge]
+    drained: tuple[int, ...] = ()
+
+
+@runtime_checkable
+class QueuedHardware(Protocol):
+    """Optional extension: a queue of timed cubic pieces per axis, executed by the back end.
+
+    Each piece is an `AxisCommand` (a cubic with its time span); a piece becomes the axis's
+    command at its t0, exactly as `Hardware.command` would make it, and stays it until the
+    next piece starts. The back end runs cycle by cycle on the controller's grid (cycle k
+    ends at origin + k * period, computed that way, never accumulated), so everything it
+    does is what the same pieces handed over one per cycle would have done; it only returns
+    early, at the end of the first cycle that produced input edges, so that the control
+    layer reacts in that cycle as it would have cycle by cycle. Compare firing stays in the
+    control layer for now (a back end may add it as a further capability).
+    """
+
+    def queue_pieces(self, axis: int, pieces: Sequence[AxisCommand]) -> None:
+        """Append pieces to the queue of `axis`: each an AxisCommand with finite fields,
+        dt >= 0, t0 >= the hardware time, t0 >= the end of the piece queued before it.
+        MotionError naming the piece and the rule otherwise; the queue is unchanged then."""
+
+    def clear_queue(self, axis: int) -> None:
+        """Drop the pieces of `axis` that have not started (the current command stays)."""
+
+    def queued(self, axis: int) -> int:
+        """Number of pieces of `axis` that have not started yet."""
+
+    def run_cycles(self, origin: float, period: float, start: int, stop: int,
+                   wake: Collection[str] | None = None) -> QueueRun:
+        """From the end of cycle `start` (= the hardware time) run cycles start+1 .. stop,
+        each ending at origin + k * period (as `advance` would), starting queued pieces at
+        their t0; return at the end of the first cycle with an input edge on a signal in
+        `wake` (None: any signal) or a stop cut by an armed edge (EdgeStopHardware), with
+        every edge of that cycle; edges on other signals in earlier cycles are dropped (the
+        control layer declared it ignores them). MotionError for bad arguments."""

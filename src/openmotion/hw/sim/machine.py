@@ -15,13 +15,24 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Collection, Sequence
+
 from openmotion.config import MachineConfig
 from openmotion.errors import MotionError, check_finite, check_nonnegative
-from openmotion.hw.interface import AXIS_INPUTS, AXIS_OUTPUTS, AxisCommand, AxisReadback, InputEdge
+from openmotion.hw.interface import (
+    AXIS_INPUTS,
+    AXIS_OUTPUTS,
+    AxisCommand,
+    AxisReadback,
+    InputEdge,
+    QueueRun,
+)
 
 from .cubic import Cubic
 from .encoder import EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
+from .piecequeue import PieceQueue
 from .pieces import JumpPiece
 from .plant import StepperPlant
 from .pulserecord import PulseRecord, check_capacity
@@ -65,6 +76,7 @@ class SimMachine:
         self._timed = TimedOutputs()  # do<n> writes at exact times (write_output_at)
         self.output_record = OutputRecord()  # every output edge at its exact time
         self.scenario = Scenario(self)
+        self._queues = [PieceQueue() for _ in self._axes]  # QueuedHardware
 
     # -- Hardware protocol --------------------------------------------------------------------
     @property
@@ -88,15 +100,113 @@ class SimMachine:
         for f in ("t0", "p0", "v0", "a0", "j"):
             check_finite(f"cmd.{f}", getattr(cmd, f))
         check_nonnegative("cmd.dt", cmd.dt)
+        self._set_command(ax, cmd)
+
+    def _set_command(self, ax: SimAxis, cmd: AxisCommand) -> None:
         t0 = float(cmd.t0)
         ax.set_command(Cubic(float(cmd.p0), float(cmd.v0), float(cmd.a0), float(cmd.j)),
                        t0, t0 + float(cmd.dt), self._t)
 
+    # -- QueuedHardware -------------------------------------------------------------------------
+    def queue_pieces(self, axis: int, pieces: Sequence[AxisCommand]) -> None:
+        """Append timed pieces to the queue of `axis` (hw.interface.QueuedHardware); each
+        becomes the pulse generator's command at its t0, as `command` would make it."""
+        self._queues[self._axis(axis).index].extend(pieces, self._t)
+
+    def clear_queue(self, axis: int) -> None:
+        """Drop the pieces of `axis` not started yet."""
+        self._queues[self._axis(axis).index].clear()
+
+    def queued(self, axis: int) -> int:
+        """Pieces of `axis` not started yet."""
+        return len(self._queues[self._axis(axis).index])
+
+    def run_cycles(self, origin: float, period: float, start: int, stop: int,
+                   wake: Collection[str] | None = None) -> QueueRun:
+        """Run cycles start+1 .. stop on the grid origin + k * period (hw.interface.
+        QueuedHardware), starting queued pieces at their t0; stop after the first cycle
+        with an input edge on a signal in `wake` (None: any) or an armed stop. Stretches
+        with nothing to run (every axis a stepper holding its end, no piece and no scenario
+        action due) are crossed in one step."""
+        origin = check_finite("origin", origin)
+        period = check_finite("period", period)
+        if period <= 0.0:
+            raise MotionError(f"period must be > 0 s, got {period!r}")
+        for name, k in (("start", start), ("stop", stop)):
+            if isinstance(k, bool) or not isinstance(k, int):
+                raise MotionError(f"{name} must be an int cycle number, got {k!r}")
+        if stop < start:
+            raise MotionError(f"stop must be >= start ({start}), got {stop!r}")
+        queues = self._queues
+        had = [len(q) > 0 for q in queues]
+        k = start
+        edges: list[InputEdge] = []
+        first = True
+        while k < stop:
+            if not first and self._holding():
+                k, edges = self._skip_idle(origin, period, k, stop)
+                if edges or k >= stop:
+                    break
+            first = False
+            k += 1
+            edges = self.advance(origin + k * period)
+            if edges and (wake is None or any(e.signal in wake for e in edges)
+                          or any(ax.stop_time is not None for ax in self._axes)):
+                break
+            edges = []
+        drained = tuple(i for i, q in enumerate(queues) if had[i] and not q)
+        return QueueRun(k, edges, drained)
+
+    def _holding(self) -> bool:
+        """Nothing moves by itself: steppers only, each holding its command's end."""
+        if self._pending:
+            return False
+        t = self._t
+        for ax, q in zip(self._axes, self._queues, strict=True):
+            if ax.is_servo or ax.is_dc or ax.gen.te > t or q.pieces:
+                return False
+        return True
+
+    def _skip_idle(self, origin: float, period: float, k: int, stop: int
+                   ) -> tuple[int, list[InputEdge]]:
+        """Cross the cycles before the one in which the next scenario action falls (up to
+        `stop`) in one advance; returns the cycle reached (and edges, never expected)."""
+        heap = self.scenario._heap
+        last = stop
+        if heap:
+            ta = heap[0][0]
+            # the cycle whose end is the first >= ta runs normally
+            n = max(k, math.ceil((ta - origin) / period) - 1)
+            while n > k and origin + n * period >= ta:
+                n -= 1
+            while origin + (n + 1) * period < ta:
+                n += 1
+            last = min(stop, n)
+        if last > k:
+            return last, self._advance(origin + last * period)
+        return k, []
+
     def advance(self, t: float) -> list[InputEdge]:
-        """Move every plant to time t; return the input edges since the last call."""
+        """Move every plant to time t; return the input edges since the last call. Queued
+        pieces (queue_pieces) become their axis's command at their t0 on the way."""
         t = check_finite("t", t)
         if t < self._t:
             raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
+        queues = self._queues
+        if not any(q.pieces for q in queues):
+            return self._advance(t)
+        edges: list[InputEdge] = []
+        while True:
+            for ax, q in zip(self._axes, queues, strict=True):
+                pcs = q.pieces
+                while pcs and pcs[0].t0 <= self._t:
+                    self._set_command(ax, pcs.popleft())
+            tn = min(min(q.next_start() for q in queues), t)
+            edges += self._advance(tn)
+            if tn >= t:
+                return edges
+
+    def _advance(self, t: float) -> list[InputEdge]:
         raw = self._pending
         self._pending = []
         ta = self._t

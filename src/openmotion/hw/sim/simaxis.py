@@ -241,8 +241,12 @@ class SimAxis:
                 continue
             z1 = trans.z_after(z0, p.m1, d)
             y1 = trans.y_of(z1)
-            if y1 != self.y:
+            y = self.y
+            if y1 != y:
                 for name, sw in self.switches.items():
+                    thr = sw.next_threshold(y, d)  # most pieces cross no switch
+                    if thr is None or (y1 < thr if d > 0 else y1 >= thr):
+                        continue
                     self._scan_switch(name, sw, p, z0, st, y1, raw)
             trans.z = z1
             self.y = y1
