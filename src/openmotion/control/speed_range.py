@@ -25,7 +25,8 @@ within 0.2 %).
 `SpeedModel` applies the grid to the moves of an axis (`attach_speed_model`): speeds run at
 their register value (MaxVel = RFH * m), an acceleration time shorter than the range allows
 is *slowed* to the shortest one, a MaxVel above the fixed range or a time longer than the
-register can count is *refused* (InfeasibleError, nothing changes). Axes without the model stay exact.
+register can count is *refused* (InfeasibleError, nothing changes). Axes without the
+model stay exact.
 """
 
 from __future__ import annotations
