@@ -195,7 +195,9 @@ class Network:
 
 def network_from_config(cfg: NetworkConfig, *, speed_model: bool = True) -> Network:
     """Build a Network from a network file's config: one enabled Controller per module,
-    each axis on the PCL6045 speed-register grid (`speed_model`, control.speed_range)."""
+    each axis on the PCL6045 speed-register grid (`speed_model`, control.speed_range) and
+    counting with move ratio 1 (the machine file's move_ratio is the encoder's physical
+    counts per pulse; the program sets the card's ratio with set_move_ratio)."""
     from ..config_network import NetworkConfig as _NC
     from .speed_range import attach_speed_model
 
@@ -205,8 +207,11 @@ def network_from_config(cfg: NetworkConfig, *, speed_model: bool = True) -> Netw
     for m in cfg.modules:
         ctl = Controller(m.machine)
         ctl.enable_all()
-        if speed_model:
-            for ax in ctl.axes:
+        for ax in ctl.axes:
+            # the machine's move_ratio is its physical encoder resolution; the PCL6045
+            # counts with ratio 1 until told (HSL_M_set_move_ratio, 4.6)
+            ax.set_move_ratio(1.0)
+            if speed_model:
                 attach_speed_model(ax)
         modules[m.index] = ctl
     timing = NetworkTiming(cfg.rate, cfg.duplex, scale=cfg.time_scale)

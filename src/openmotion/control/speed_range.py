@@ -22,11 +22,13 @@ This reproduces the manual's worked examples: range 140000, 0 -> 5000 pps: 0.000
 31.08 s (as printed); range 5000: 0.02665 s and 873.24 s (printed 0.0267 and 873.587:
 within 0.2 %).
 
-`SpeedModel` applies the grid to the moves of an axis (`attach_speed_model`): speeds run at
-their register value (MaxVel = RFH * m), an acceleration time shorter than the range allows
-is *slowed* to the shortest one, a MaxVel above the fixed range or a time longer than the
-register can count is *refused* (InfeasibleError, nothing changes). Axes without the
-model stay exact.
+`SpeedModel` applies the grid to the moves of an axis (`attach_speed_model`): with a fixed
+range, speeds run at their register value (MaxVel = RFH * m: "the more OverVelocity is
+used, the coarser the speed interval"; unfixed, the DLL picks the multiplier per move and
+we keep the speed exact - the manual's tables are computed that way); an acceleration
+time shorter than the range allows is *slowed* to the shortest one, a MaxVel above the
+fixed range or a time longer than the register can count is *refused* (InfeasibleError,
+nothing changes). Axes without the model stay exact.
 """
 
 from __future__ import annotations
@@ -149,10 +151,9 @@ class SpeedModel:
             raise InfeasibleError(
                 f"max_vel must be <= the fixed speed range {rng.top:g} pps "
                 f"(fix_speed_range to allow more), got {spec.max_vel!r}")
-        m = rng.multiplier
-        sv = rng.start_register(spec.str_vel) * m if spec.str_vel > 0.0 else 0.0
-        mv = max(rng.speed_register(spec.max_vel), rng.start_register(spec.str_vel)) * m
-        sv = min(sv, mv)
+        sv, mv = spec.str_vel, spec.max_vel
+        if self.axis.speed_range is not None:  # the fixed range's grid
+            sv, mv = rng.grid(sv), max(rng.grid(mv), rng.grid(sv))
         ta = rng.ramp_time("tacc", spec.str_vel, spec.max_vel, spec.tacc)
         td = rng.ramp_time("tdec", spec.str_vel, spec.max_vel, spec.tdec)
         half = (mv - sv) / 2.0
@@ -160,7 +161,9 @@ class SpeedModel:
                        vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
 
     def change(self, new_vel: float, current_range: float) -> float:
-        """The speed a v_change to `new_vel` really runs (on the range's grid)."""
+        """The speed a v_change to `new_vel` really runs (on a fixed range's grid)."""
+        if self.axis.speed_range is None:
+            return abs(new_vel)
         return abs(self.range_for(current_range).grid(new_vel))
 
 
