@@ -135,6 +135,7 @@ class Group(GroupChecks):
         self._blend = False
         self._feed = 0.0
         self._acc_time = 20.0 * controller.period
+        self._dec_time: float | None = None  # None: deceleration follows the acceleration
         self._sys_max = float(max(a.max_speed / k for a, k in zip(ax, self._ppu, strict=True)))
         self.set_feed(feed)
         if acc_time is not None:
@@ -255,11 +256,33 @@ class Group(GroupChecks):
         self._sys_max = v
 
     def set_acc_time(self, seconds: float) -> None:
-        """Time to accelerate from rest to the feed (MCC_SetAccStep x interpolation time)."""
+        """Time to accelerate from rest to the feed (MCC_SetAccStep x interpolation time)
+        of the following commands; the deceleration follows it until set_dec_time."""
         t = check_finite("seconds", seconds)
         if t <= 0.0:
             raise MotionError(f"seconds must be > 0, got {seconds!r}")
         self._acc_time = t
+
+    def set_dec_time(self, seconds: float) -> None:
+        """Time to decelerate from the feed to rest (MCC_SetDecStep x interpolation time)
+        of the following commands: path commands brake at feed / seconds (the look-ahead's
+        backward pass, holds, aborts, a lower override), point-to-point axes with this
+        Tdec. Until it is called the deceleration follows set_acc_time."""
+        t = check_finite("seconds", seconds)
+        if t <= 0.0:
+            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        self._dec_time = t
+
+    @property
+    def acc_time(self) -> float:
+        """Acceleration time of the following commands (s)."""
+        return self._acc_time
+
+    @property
+    def dec_time(self) -> float:
+        """Deceleration time of the following commands (s): set_dec_time's, or the
+        acceleration time."""
+        return self._acc_time if self._dec_time is None else self._dec_time
 
     def set_max_pulse_speed(self, pps: Sequence[float]) -> None:
         """MCC_SetMaxPulseSpeed per logical axis (pps); default the axes' maximum speed."""
@@ -347,7 +370,7 @@ class Group(GroupChecks):
         specs = []
         for k, a in enumerate(self.axes):
             v = min(a.max_speed, self._vmax[k]) * self._ptp_ratio / 100.0
-            specs.append(MoveSpec(self._ptp_shape, 0.0, v, self._acc_time, self._acc_time,
+            specs.append(MoveSpec(self._ptp_shape, 0.0, v, self._acc_time, self.dec_time,
                                   0.0, 0.0))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
 

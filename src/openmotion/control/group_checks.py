@@ -49,6 +49,7 @@ class GroupChecks(GroupEngine):
     _next_index: int
     _feed: float
     _acc_time: float
+    _dec_time: float | None
     _str_vel: float
     _path_jerk: float
     _refuse: bool
@@ -135,6 +136,7 @@ class GroupChecks(GroupEngine):
         feed, sv = self._feed, self._str_vel
         tan = el.max_abs_tangent
         accel = feed / self._acc_time
+        decel = None if self._dec_time is None else feed / self._dec_time
         self._check_str_vel(sv, feed, tan)
         if self._refuse:  # MCCL: refused; "slow": the planner slows down to the axis limits
             vmax, amax = self._caps()
@@ -144,14 +146,14 @@ class GroupChecks(GroupEngine):
                 raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps "
                                             f"at feed {feed:g}, above its maximum pulse speed "
                                             f"{self._vmax[k]:g} pps")
-            needa = accel * tan * self._ppu
+            needa = max(accel, decel or 0.0) * tan * self._ppu
             k = _first_over(needa, amax * self._ppu)
             if k is not None:
                 raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} "
                                             f"pps^2, above its maximum pulse acceleration "
                                             f"{self._amax[k]:g} pps^2")
         return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
-                               jerk=self._path_jerk, str_vel=sv), end)
+                               decel=decel, jerk=self._path_jerk, str_vel=sv), end)
 
     def _check_str_vel(self, sv: float, feed: float, tan: np.ndarray) -> None:
         """StrVel of a path command: <= its feed, within every axis's maximum speed along

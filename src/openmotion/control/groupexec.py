@@ -88,10 +88,21 @@ class _Cmd:
     elements: tuple[PathElement, ...] = ()
     feed: float = 0.0
     accel: float = 0.0
+    decel: float | None = None     # path deceleration (None: follows accel)
     specs: tuple[MoveSpec, ...] = ()
     seconds: float = 0.0
     jerk: float = 0.0              # path jerk limit (0: T-curve)
     str_vel: float = 0.0           # StrVel: a path starts/ends with a jump from/to rest
+
+    @property
+    def dec(self) -> float:
+        """The path deceleration (the acceleration unless set apart)."""
+        return self.accel if self.decel is None else self.decel
+
+    @property
+    def window_accel(self) -> float:
+        """The acceleration an S path's smoothing window is sized for (the larger one)."""
+        return self.accel if self.decel is None else max(self.accel, self.decel)
 
 
 @dataclass
@@ -234,7 +245,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         elif cmd.kind == "ptp":
             self._launch_ptp(cmd, t)
         else:
-            tj = jerk_window(cmd.accel, cmd.jerk) if cmd.jerk else 0.0
+            tj = jerk_window(cmd.window_accel, cmd.jerk) if cmd.jerk else 0.0
             cmds = [cmd, *self._take(tj, cmd.elements[0].length, [cmd])]
             chain = self._chain(cmds)
             self._launch(pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t),
@@ -250,7 +261,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             return False
         if tj == 0.0 or not cmd.jerk:
             return tj == 0.0 and not cmd.jerk
-        return jerk_window(cmd.accel, cmd.jerk) <= tj * (1.0 + 1e-12)
+        return jerk_window(cmd.window_accel, cmd.jerk) <= tj * (1.0 + 1e-12)
 
     def _reach(self, cmd: _Cmd, tj: float) -> float:
         """Path length a chain should keep ahead for `cmd`: twice what it takes to brake
@@ -260,7 +271,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         ahead = 4.0 * self._ctl.period + tj
         if self._ctl.realtime:  # a join in flight (groupjoin.py) must not see the end
             ahead += (self._lead_cycles() + 2) * self._ctl.period
-        return 2.0 * (f * f / (2.0 * cmd.accel) + f * ahead)
+        return 2.0 * (f * f / (2.0 * cmd.dec) + f * ahead)
 
     def _take(self, tj: float, have: float, cmds: list[_Cmd]) -> list[_Cmd]:
         """Pop the queued commands that join a chain with `have` length ahead until it
@@ -332,10 +343,13 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         yield plan.chain.joined(els, owners, *self._per(owners, new))
 
     @staticmethod
-    def _per(owners: list[int], cmds: list[_Cmd]) -> tuple[list[float], list[float]]:
-        """Feed and acceleration of each element, from the command that owns it."""
+    def _per(owners: list[int], cmds: list[_Cmd]
+             ) -> tuple[list[float], list[float], list[float] | None]:
+        """Feed, acceleration and deceleration (None when no command sets one apart) of
+        each element, from the command that owns it."""
         by = {c.index: c for c in cmds}
-        return [by[o].feed for o in owners], [by[o].accel for o in owners]
+        dec = None if all(c.decel is None for c in cmds) else [by[o].dec for o in owners]
+        return [by[o].feed for o in owners], [by[o].accel for o in owners], dec
 
     def _chain(self, cmds: list[_Cmd]) -> px.Chain:
         """The commands' elements end to end, corners blended where that pays."""
@@ -440,7 +454,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         if b is None:
             return None
         vmax, amax = self._caps()
-        accel = min(cmd.accel, float(np.min(amax)))
+        accel = min(cmd.accel, cmd.dec, float(np.min(amax)))
         v_corner = 0.0
         corner = self._corner_limits()
         if corner["square_corner_velocity"] > 0.0 and prev.length > 0.0 and el.length > 0.0:
@@ -469,7 +483,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                                                        float(target[k])))
             elif target[k] != a.position:
                 a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
-                                shape=spec.shape)
+                                tdec=spec.tdec, shape=spec.shape)
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
 
     def _launch(self, plan: pathrun.PathPlan, cmds: list[_Cmd], t: float) -> None:

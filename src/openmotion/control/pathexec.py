@@ -56,7 +56,7 @@ class SpeedCurve:
 
     s: np.ndarray
     v2: np.ndarray
-    a_min: float = math.inf  # smallest tangential acceleration of the elements planned
+    a_min: float = math.inf  # smallest tangential deceleration of the elements planned
     jump: bool = False
 
     def at(self, s: float) -> float:
@@ -79,7 +79,7 @@ def curve_from_speeds(speeds: Sequence[ElementSpeeds], s0: float = 0.0) -> Speed
             continue
         a, vc2 = sp.accel, sp.cruise ** 2
         d_acc = max(0.0, (vc2 - sp.entry ** 2) / (2.0 * a))
-        d_dec = max(0.0, (vc2 - sp.exit ** 2) / (2.0 * a))
+        d_dec = max(0.0, (vc2 - sp.exit ** 2) / (2.0 * sp.decel))
         if d_acc + d_dec > sp.length:  # rounding: no cruise
             d_acc = max(0.0, min(sp.length, d_acc))
             d_dec = sp.length - d_acc
@@ -182,16 +182,19 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
 
 # -------------------------------------------------------------------------- chains
 class Chain:
-    """Elements laid end to end along a global path position s, with the feed and the path
-    acceleration each element was commanded with (None: the Limits' values)."""
+    """Elements laid end to end along a global path position s, with the feed, the path
+    acceleration and the path deceleration each element was commanded with (None: the
+    Limits' values; decels None: the accelerations)."""
 
     def __init__(self, elements: Sequence[PathElement], owners: Sequence[int],
                  feeds: Sequence[float] | None = None, accels: Sequence[float] | None = None,
+                 decels: Sequence[float] | None = None,
                  *, cum: np.ndarray | None = None) -> None:
         self.elements = tuple(elements)
         self.owners = tuple(owners)  # command index of each element
         self.feeds = None if feeds is None else np.asarray(feeds, dtype=float)
         self.accels = None if accels is None else np.asarray(accels, dtype=float)
+        self.decels = None if decels is None else np.asarray(decels, dtype=float)
         self.cum = cum if cum is not None else np.concatenate(
             [[0.0], np.cumsum([el.length for el in self.elements])])
         self._table: ElementTable | None = None
@@ -220,6 +223,7 @@ class Chain:
 
     def joined(self, elements: Sequence[PathElement], owners: Sequence[int],
                feeds: Sequence[float] | None, accels: Sequence[float] | None,
+               decels: Sequence[float] | None = None,
                replace_last: PathElement | None = None) -> Chain:
         """This chain (its last element replaced by `replace_last`, e.g. trimmed by a
         blend) followed by more elements; the s of the kept elements is unchanged."""
@@ -230,8 +234,13 @@ class Chain:
         lens = [el.length for el in ([replace_last] if replace_last is not None else [])
                 + list(elements)]
         tail = start + np.cumsum(lens)
+        if self.decels is None and decels is None:
+            dec = None
+        else:  # one side follows its accelerations
+            dec = _cat(self.accels if self.decels is None else self.decels,
+                       accels if decels is None else decels)
         return Chain(head + tuple(elements), self.owners + tuple(owners),
-                     _cat(self.feeds, feeds), _cat(self.accels, accels),
+                     _cat(self.feeds, feeds), _cat(self.accels, accels), dec,
                      cum=np.concatenate([cum, tail]))
 
     def dropped(self, k: int) -> tuple[Chain, float]:
@@ -241,6 +250,7 @@ class Chain:
         return Chain(self.elements[k:], self.owners[k:],
                      None if self.feeds is None else self.feeds[k:],
                      None if self.accels is None else self.accels[k:],
+                     None if self.decels is None else self.decels[k:],
                      cum=self.cum[k:] - off), off
 
     def tail_elements(self, s0: float) -> tuple[list[PathElement], int]:
@@ -322,12 +332,14 @@ class Limits:
     str_vel: float = 0.0
 
 
-def _chain_limits(chain: Chain, k0: int, lim: Limits) -> tuple[Any, Any]:
-    """Feeds and accelerations of the elements from index k0 on (scalars when uniform)."""
+def _chain_limits(chain: Chain, k0: int, lim: Limits) -> tuple[Any, Any, Any]:
+    """Feeds, accelerations and decelerations (None: the accelerations) of the elements
+    from index k0 on (scalars when uniform)."""
     if chain.feeds is None or chain.accels is None:
-        return lim.feed, lim.accel
+        return lim.feed, lim.accel, None
     return (np.minimum(chain.feeds[k0:] * lim.scale, lim.feed).tolist(),
-            chain.accels[k0:].tolist())
+            chain.accels[k0:].tolist(),
+            None if chain.decels is None else chain.decels[k0:].tolist())
 
 
 def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
@@ -343,19 +355,23 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     plan, and never exceeds the `old` curve it was following (see the module doc).
     `window` > 0 (an S path's smoothing window tj, see `guarded`) holds every speed cap and
     tangential acceleration cap*tj/2 beyond its element or corner. The curve's `a_min` is
-    the smallest tangential acceleration of the remaining elements (what a hold may use everywhere).
+    the smallest tangential deceleration of the remaining elements (what a hold may use
+    everywhere). A chain with its own decelerations brakes at them (the backward pass).
     """
     if window > 0.0:  # the elements the executed position may still be on cap what follows
         k0 = chain.locate(max(0.0, s0 - _top_feed(chain, lim) * window))
-        feeds, accels = _chain_limits(chain, k0, lim)
-        els, feeds, accels = guarded(list(chain.elements[k0:]), feeds, accels, lim, window,
-                                     cut=s0 - float(chain.cum[k0]))
+        feeds, accels, decels = _chain_limits(chain, k0, lim)
+        els, feeds, accels, decels = guarded_limits(
+            list(chain.elements[k0:]), feeds, accels, lim, window,
+            cut=s0 - float(chain.cum[k0]), decels=decels)
     else:
         els, k0 = chain.tail_elements(s0)
-        feeds, accels = _chain_limits(chain, k0, lim)
+        feeds, accels, decels = _chain_limits(chain, k0, lim)
     kw = dict(square_corner_velocity=lim.square_corner_velocity, end_speed=lim.str_vel,
               axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax, axis_vjump=lim.axis_vjump,
               min_cruise_ratio=lim.min_cruise_ratio)
+    if decels is not None:
+        kw["decel"] = decels
     try:
         sp = plan_speeds(els, feeds, accels, start_speed=v0, **kw)
         return _with_amin(_pinned(curve_from_speeds(sp, s0), chain.length,
@@ -368,7 +384,7 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     if jump:
         return _with_amin(_pinned(curve_from_speeds(sp, s0), chain.length, jump=lo > 0.0), sp)
     assert old is not None
-    a_min = min(x.accel for x in sp if x.length > 0.0)
+    a_min = min(x.decel for x in sp if x.length > 0.0)
     new = curve_from_speeds(sp, s0)
     # the new plan starts at lo < v0: join it with a ramp from v0 (max), under the old curve
     down = ramp(s0, v0, a_min, chain.length)
@@ -398,12 +414,21 @@ def _highest_start(els: Sequence[PathElement], feeds: Any, accels: Any, v0: floa
 
 
 def _with_amin(curve: SpeedCurve, sp: Sequence[ElementSpeeds]) -> SpeedCurve:
-    acc = [x.accel for x in sp if x.length > 0.0]
+    """The curve with the smallest tangential deceleration of the elements (a hold's)."""
+    acc = [x.decel for x in sp if x.length > 0.0]
     return SpeedCurve(curve.s, curve.v2, min(acc) if acc else math.inf, curve.jump)
 
 
 def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: float,
             cut: float = 0.0) -> tuple[list[PathElement], list[float], list[float]]:
+    """`guarded_limits` without decelerations: the elements, feeds and accelerations."""
+    out, of, oa, _ = guarded_limits(els, feeds, accels, lim, tj, cut)
+    return out, of, oa
+
+
+def guarded_limits(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: float,
+                   cut: float = 0.0, decels: Any = None
+                   ) -> tuple[list[PathElement], list[float], list[float], list[float] | None]:
     """Elements on which a raw path speed keeps, after a moving average of window tj, every
     speed cap and tangential acceleration of the elements it is averaged over.
 
@@ -423,14 +448,20 @@ def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: fl
     corners (junction cap 0) are barriers: the raw motion rests tj there (s_profile's
     dwell), so no window holds raw positions of both sides. The elements before path
     position `cut` (from the start of `els`) cap what follows within their zones and are
-    then dropped (a re-plan mid-chain: the executed position lags behind the raw one)."""
+    then dropped (a re-plan mid-chain: the executed position lags behind the raw one).
+    `decels` (None: the accelerations) are guarded like the accelerations and come back
+    as the fourth value (None when not given)."""
     n = len(els)
     fl = [float(x) for x in feeds] if isinstance(feeds, list) else [float(feeds)] * n
     al = [float(x) for x in accels] if isinstance(accels, list) else [float(accels)] * n
+    dl = None if decels is None else (
+        [float(x) for x in decels] if isinstance(decels, list) else [float(decels)] * n)
     caps, jcaps = speed_caps(els, fl, al, square_corner_velocity=lim.square_corner_velocity,
                              axis_vmax=lim.axis_vmax, axis_amax=lim.axis_amax,
                              axis_vjump=lim.axis_vjump)
     tacc = np.asarray(tangential_accels(els, al, axis_amax=lim.axis_amax))
+    tdec = tacc if dl is None else np.asarray(tangential_accels(els, dl,
+                                                                axis_amax=lim.axis_amax))
     cum = np.concatenate([[0.0], np.cumsum([el.length for el in els])])
     cap = np.minimum(np.asarray(caps), fl)
     jc = np.asarray(jcaps)  # jc[k]: at the start of element k (jc[0] = inf)
@@ -438,6 +469,7 @@ def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: fl
     corners = np.nonzero((jc > 0.0) & np.isfinite(jc))[0]
     z_cap = np.concatenate([cap, jc[corners]])
     z_acc = np.concatenate([tacc, np.full(len(corners), np.inf)])
+    z_dec = z_acc if dl is None else np.concatenate([tdec, np.full(len(corners), np.inf)])
     reach = z_cap * (0.5 * tj * (1.0 + 1e-9))
     z_lo = np.concatenate([cum[:-1], cum[corners]]) - reach
     z_hi = np.concatenate([cum[1:], cum[corners]]) + reach
@@ -448,24 +480,28 @@ def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: fl
     z_lo = np.maximum(z_lo, cum[stops[q - 1]])
     z_hi = np.minimum(z_hi, cum[stops[q]])
 
-    def low(x0: float, x1: float) -> tuple[float, float]:
-        """Smallest cap and tangential acceleration of the zones overlapping (x0, x1) by
-        more than the rounding slack."""
+    def low(x0: float, x1: float) -> tuple[float, float, float]:
+        """Smallest cap, tangential acceleration and deceleration of the zones
+        overlapping (x0, x1) by more than the rounding slack."""
         hit = (z_lo < x1 - slack) & (z_hi > x0 + slack)
-        return float(np.min(z_cap[hit])), float(np.min(z_acc[hit]))
+        return float(np.min(z_cap[hit])), float(np.min(z_acc[hit])), \
+            float(np.min(z_dec[hit]))
 
-    def accel_for(k: int, a_low: float) -> float:
-        """The path acceleration to give element k so its tangential one is <= a_low."""
-        if a_low >= tacc[k]:
-            return al[k]
+    def accel_for(k: int, a_low: float, base: list[float] = al,
+                  tang: np.ndarray = tacc) -> float:
+        """The path acceleration (or deceleration: `base`, `tang`) to give element k so
+        its tangential one is <= a_low."""
+        if a_low >= tang[k]:
+            return base[k]
         if els[k].max_curvature == 0.0:
-            return min(al[k], a_low)
-        return min(al[k], a_low / ARC_TANGENTIAL_RATIO)  # lowers the arc's whole budget
+            return min(base[k], a_low)
+        return min(base[k], a_low / ARC_TANGENTIAL_RATIO)  # lowers the arc's whole budget
 
     slack = 1e-9 * max(1.0, float(cum[-1]))
     out: list[PathElement] = []
     of: list[float] = []
     oa: list[float] = []
+    od: list[float] = []
     for k, el in enumerate(els):
         a, b = float(cum[k]), float(cum[k + 1])
         if b <= cut + slack or el.length <= 0.0:
@@ -474,15 +510,16 @@ def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: fl
         inner = np.concatenate([z_lo, z_hi])  # split at the zone edges inside it
         cuts = np.unique(np.concatenate([[a0], inner[(inner > a0 + slack)
                                                      & (inner < b - slack)], [b]]))
-        pieces: list[tuple[float, float, float, float]] = []
+        pieces: list[tuple[float, float, float, float, float]] = []
         for x0, x1 in zip(cuts[:-1], cuts[1:], strict=True):
-            c, am = low(float(x0), float(x1))
+            c, am, dm = low(float(x0), float(x1))
             f, acc = min(fl[k], c), accel_for(k, am)
-            if pieces and pieces[-1][2:] == (f, acc):
-                pieces[-1] = (pieces[-1][0], float(x1), f, acc)
+            dec = acc if dl is None else accel_for(k, dm, dl, tdec)
+            if pieces and pieces[-1][2:] == (f, acc, dec):
+                pieces[-1] = (pieces[-1][0], float(x1), f, acc, dec)
             else:
-                pieces.append((float(x0), float(x1), f, acc))
-        for x0, x1, f, acc in pieces:
+                pieces.append((float(x0), float(x1), f, acc, dec))
+        for x0, x1, f, acc, dec in pieces:
             if x0 <= a and x1 >= b:
                 piece: PathElement = el
             elif isinstance(el, Line):
@@ -493,7 +530,8 @@ def guarded(els: list[PathElement], feeds: Any, accels: Any, lim: Limits, tj: fl
             out.append(piece)
             of.append(f)
             oa.append(acc)
-    return out, of, oa
+            od.append(dec)
+    return out, of, oa, None if dl is None else od
 
 
 def _pinned(curve: SpeedCurve, length: float, *, jump: bool = False) -> SpeedCurve:

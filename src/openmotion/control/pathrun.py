@@ -46,7 +46,7 @@ class PathPlan:
     t0: float
     tj: float              # smoothing window (0: T path)
     limits: px.Limits
-    a_min: float           # tangential acceleration every remaining element allows
+    a_min: float           # tangential deceleration every remaining element allows
     v_end: float = 0.0     # S path with StrVel: the raw speed past its end (0: ends at rest)
 
     @property

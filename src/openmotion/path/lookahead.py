@@ -15,8 +15,10 @@ length L is linear: v1**2 = v0**2 + 2*a*L.
    junction-deviation corner speed (blend.corner_speed) with the acceleration limited per
    axis along u2 - u1 (grbl's limit_value_by_axis_maximum), and v*|u2_i - u1_i| <= vjump_i
    (the step of axis i's velocity at the corner) when `axis_vjump` is given.
-3. Backward pass from the end speed, then forward pass from the start speed.
-4. Cruise: the highest speed reachable between entry and exit: v**2 = (vin**2+vout**2)/2 + a*L.
+3. Backward pass from the end speed at the deceleration d_k (`decel`, default the
+   acceleration), then forward pass from the start speed at the acceleration a_k.
+4. Cruise: the highest speed reachable between entry and exit:
+   v**2 = (d*vin**2 + a*vout**2 + 2*a*d*L)/(a + d), i.e. (vin**2+vout**2)/2 + a*L for d = a.
 5. Minimum cruise ratio r (Klipper's minimum_cruise_ratio, anchors b1), when r > 0: steps
    3 and 4 run once more on lowered caps. A smoothed plan W (steps 3 with the pseudo
    acceleration a_s = (1 - r)*a_k) sets them. Each element of W is rising (W climbs by the
@@ -56,7 +58,7 @@ _KNOWN = (Line, Arc, Arc3D)
 @dataclass(frozen=True)
 class ElementSpeeds:
     """Planned speeds of one element: accelerate at `accel` from `entry` up to `cruise`,
-    hold, decelerate at `accel` to `exit` (trapezoid along the path)."""
+    hold, decelerate at `decel` (default `accel`) to `exit` (trapezoid along the path)."""
 
     entry: float
     cruise: float
@@ -64,17 +66,22 @@ class ElementSpeeds:
     accel: float
     vmax: float
     length: float
+    decel: float = math.nan
+
+    def __post_init__(self) -> None:
+        if math.isnan(self.decel):
+            object.__setattr__(self, "decel", self.accel)
 
     @property
     def duration(self) -> float:
         """Time of the trapezoid entry -> cruise -> exit over `length`."""
         if self.length == 0.0 or self.cruise == 0.0:
             return 0.0
-        a, vc = self.accel, self.cruise
+        a, d, vc = self.accel, self.decel, self.cruise
         d_acc = (vc * vc - self.entry**2) / (2.0 * a)
-        d_dec = (vc * vc - self.exit**2) / (2.0 * a)
+        d_dec = (vc * vc - self.exit**2) / (2.0 * d)
         hold = max(0.0, self.length - d_acc - d_dec)
-        return (vc - self.entry) / a + (vc - self.exit) / a + hold / vc
+        return (vc - self.entry) / a + (vc - self.exit) / d + hold / vc
 
 
 def _axis_limits(name: str, value: ArrayLike | None, dim: int) -> Array | None:
@@ -152,12 +159,14 @@ def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
 
 
 def _passes(jcap2: list[float], acc: list[float], length: list[float],
-            start2: float) -> tuple[list[float], list[float]]:
-    """Backward pass from the junction caps (v**2), then forward pass from start2."""
+            start2: float, dec: list[float] | None = None) -> tuple[list[float], list[float]]:
+    """Backward pass from the junction caps (v**2) at the decelerations `dec` (default
+    `acc`), then forward pass from start2 at the accelerations."""
     n = len(length)
     back = jcap2[:]
+    dec = acc if dec is None else dec
     for k in range(n - 1, -1, -1):
-        back[k] = min(jcap2[k], back[k + 1] + 2.0 * acc[k] * length[k])
+        back[k] = min(jcap2[k], back[k + 1] + 2.0 * dec[k] * length[k])
     fwd = [0.0] * (n + 1)
     fwd[0] = min(start2, back[0])
     for k in range(n):
@@ -167,7 +176,7 @@ def _passes(jcap2: list[float], acc: list[float], length: list[float],
 
 def _cruise_caps(jcap2: list[float], cap2: list[float], acc: list[float],
                  length: list[float], ratio: float,
-                 start2: float) -> tuple[list[float], list[float]]:
+                 start2: float, dec: list[float] | None = None) -> tuple[list[float], list[float]]:
     """Element and junction caps (v**2) of the minimum cruise ratio (module doc, step 5).
 
     The smoothed plan W uses the pseudo-acceleration (1 - ratio)*a_k. Its elements are
@@ -181,15 +190,19 @@ def _cruise_caps(jcap2: list[float], cap2: list[float], acc: list[float],
     feasible.
     """
     n = len(length)
+    dec = acc if dec is None else dec
     acc_s = [(1.0 - ratio) * a for a in acc]
-    _, w = _passes(jcap2, acc_s, length, start2)
-    top = [min(cap2[k], 0.5 * (w[k] + w[k + 1]) + acc_s[k] * length[k]) for k in range(n)]
+    dec_s = acc_s if dec is acc else [(1.0 - ratio) * d for d in dec]
+    _, w = _passes(jcap2, acc_s, length, start2, dec_s)
+    top = [min(cap2[k], _peak2(w[k], w[k + 1], acc_s[k], dec_s[k], length[k]))
+           for k in range(n)]
     kind = []  # +1 rising, -1 falling, 0 peak
     for k in range(n):
         d = 2.0 * acc_s[k] * length[k]
-        tol = 1e-12 * (max(w[k], w[k + 1]) + d)
+        dd = d if dec_s is acc_s else 2.0 * dec_s[k] * length[k]
+        tol = 1e-12 * (max(w[k], w[k + 1]) + max(d, dd))
         kind.append(1 if w[k] + d <= w[k + 1] + tol else
-                    -1 if w[k + 1] + d <= w[k] + tol else 0)
+                    -1 if w[k + 1] + dd <= w[k] + tol else 0)
     new_cap = cap2[:]
     new_j = jcap2[:]
     lo = 0
@@ -217,12 +230,20 @@ def _cruise_caps(jcap2: list[float], cap2: list[float], acc: list[float],
             break
         new_cap[k] = max(new_cap[k], min(cap2[k], brake))
         new_j[k] = max(new_j[k], min(jcap2[k], brake))
-        brake -= 2.0 * acc[k] * length[k]
+        brake -= 2.0 * dec[k] * length[k]
     for k in range(1, n):
         new_j[k] = min(new_j[k], new_cap[k - 1], new_cap[k])
     new_j[0] = min(new_j[0], new_cap[0])
     new_j[n] = min(new_j[n], new_cap[n - 1])
     return new_cap, new_j
+
+
+def _peak2(in2: float, out2: float, a: float, d: float, length: float) -> float:
+    """v**2 of the highest point of accelerating at a from in2 and decelerating at d to
+    out2 over `length`: in2 + 2*a*x = out2 + 2*d*(length - x)."""
+    if a == d:
+        return 0.5 * (in2 + out2) + a * length
+    return (d * in2 + a * out2 + 2.0 * a * d * length) / (a + d)
 
 
 def _per_element(name: str, value: float | Sequence[float], n: int) -> list[float]:
@@ -244,11 +265,14 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
                 end_speed: float = 0.0, axis_vmax: ArrayLike | None = None,
                 axis_amax: ArrayLike | None = None,
                 axis_vjump: ArrayLike | None = None, arc_tangential_ratio: float = 0.5,
-                min_cruise_ratio: float = 0.0) -> tuple[ElementSpeeds, ...]:
+                min_cruise_ratio: float = 0.0,
+                decel: float | Sequence[float] | None = None) -> tuple[ElementSpeeds, ...]:
     """Entry/cruise/exit speeds for each element (see the module docstring).
 
     `feed` is the path speed cap, `accel` the path acceleration limit: one value for the
-    whole path or one per element (a program that changes F keeps blending). Corners where the
+    whole path or one per element (a program that changes F keeps blending). `decel`
+    (default: `accel`) is the path deceleration limit, used where the speed falls (the
+    backward pass); the acceleration is used where it rises (the forward pass). Corners where the
     tangent turns are crossed at most at the junction-deviation speed of
     `square_corner_velocity` (0: exact stop). The path starts at exactly `start_speed` and
     ends at a speed <= `end_speed`. `axis_vmax`/`axis_amax` (N values, inf = unlimited)
@@ -273,6 +297,7 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
                               f"got {el.dim}")
     feeds = _per_element("feed", feed, len(elements))
     accels = _per_element("accel", accel, len(elements))
+    decels = accels if decel is None else _per_element("decel", decel, len(elements))
     scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
     v_start = check_nonnegative("start_speed", start_speed)
     v_end = check_nonnegative("end_speed", end_speed)
@@ -292,14 +317,20 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
         if v_start > 0.0:
             raise InfeasibleError(f"start_speed {v_start:g} cannot be stopped on a path of "
                                   "length 0")
-        return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0) for f, a in zip(feeds, accels,
-                                                                                strict=True))
+        return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0, d)
+                     for f, a, d in zip(feeds, accels, decels, strict=True))
     els = [elements[k] for k in live]
     lim = [_element_limits(el, feeds[k], accels[k], vmax_ax, amax_ax, ratio)
            for el, k in zip(els, live, strict=True)]
     acc = [x[0] for x in lim]
     cap = [x[1] for x in lim]
     length = [el.length for el in els]
+    # tangential decelerations: the same limits with the deceleration (the speed caps,
+    # centripetal included, stay the acceleration's)
+    dec = acc if decels is accels else [
+        x if decels[k] == accels[k] else _limits_of(el, feeds[k], decels[k], vmax_ax,
+                                                    amax_ax, ratio)[0]
+        for x, el, k in zip(acc, els, live, strict=True)]
 
     # jcap2[k]: v**2 cap at the entry of live element k (k = n: the end of the path).
     jcap2 = [0.0] * (n + 1)
@@ -312,22 +343,22 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
         jcap2[k] = vj * vj
 
     ccap = cap  # cruise caps (lowered by the minimum cruise ratio)
-    back, fwd = _passes(jcap2, acc, length, v_start * v_start)
+    back, fwd = _passes(jcap2, acc, length, v_start * v_start, dec)
     if v_start * v_start > back[0] * (1.0 + 1e-12):
         raise InfeasibleError(f"start_speed {v_start:g} exceeds the highest speed the path "
                               f"allows at its start, {math.sqrt(back[0]):.6g}")
     if mcr > 0.0:
         cap2, jcap2 = _cruise_caps(jcap2, [c * c for c in cap], acc, length, mcr,
-                                   v_start * v_start)
+                                   v_start * v_start, dec)
         ccap = [math.sqrt(c) for c in cap2]
-        back, fwd = _passes(jcap2, acc, length, v_start * v_start)
+        back, fwd = _passes(jcap2, acc, length, v_start * v_start, dec)
 
     planned: list[ElementSpeeds] = []
     for k in range(n):
         vin, vout = math.sqrt(fwd[k]), math.sqrt(fwd[k + 1])
-        peak2 = 0.5 * (fwd[k] + fwd[k + 1]) + acc[k] * length[k]
+        peak2 = _peak2(fwd[k], fwd[k + 1], acc[k], dec[k], length[k])
         cruise = max(vin, vout, min(ccap[k], math.sqrt(peak2)))
-        planned.append(ElementSpeeds(vin, cruise, vout, acc[k], cap[k], length[k]))
+        planned.append(ElementSpeeds(vin, cruise, vout, acc[k], cap[k], length[k], dec[k]))
 
     out: list[ElementSpeeds] = []
     nxt = 0
@@ -337,7 +368,7 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
             nxt += 1
         else:  # zero length: sits on the junction before live element nxt
             v = planned[nxt].entry if nxt < n else planned[-1].exit
-            out.append(ElementSpeeds(v, v, v, accels[k], feeds[k], 0.0))
+            out.append(ElementSpeeds(v, v, v, accels[k], feeds[k], 0.0, decels[k]))
     return tuple(out)
 
 
