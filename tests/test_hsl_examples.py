@@ -293,7 +293,6 @@ def test_tr_move_xy_example():
     ctl = hsl.controller(0)
     rec = ctl.start_recording(channels=("cmd_vel",))
     assert hsl.HSL_M_start_tr_move_xy(0, 30000.0, 40000.0, 1000.0, 5000.0, 0.1, 0.2) == 0
-    t0 = ctl.time
     wait_done(hsl, 0)
     assert (hsl.HSL_M_get_command(0), hsl.HSL_M_get_command(1)) == (30000, 40000)
     v = rec.arrays()["cmd_vel"]
@@ -301,13 +300,11 @@ def test_tr_move_xy_example():
     assert np.max(vec) == pytest.approx(5000.0, rel=1e-9)
     assert np.max(v[:, 0]) == pytest.approx(3000.0) and np.max(v[:, 1]) == pytest.approx(4000)
     # accel 1000 -> 5000 in 0.1 s, decel in 0.2 s: 300 + 600 pulses of ramps
-    t_end = ctl.axes[0].motion is None and ctl.time
     duration = 0.1 + 0.2 + (50000 - 300 - 600) / 5000
-    assert ctl.history.last_motion_end(0) - t0 == pytest.approx(duration, abs=2e-3) \
-        if hasattr(ctl.history, "last_motion_end") else t_end
     moving = vec > 0
-    t = rec.arrays()["time"][moving]
-    assert t[-1] - t[0] == pytest.approx(duration, abs=2e-3)
+    t = rec.arrays()["t"][moving]
+    # samples at cycle ends: the first after the start, the last before the end
+    assert duration - 2.001e-3 <= t[-1] - t[0] <= duration + 1e-9
     first = vec[moving]
     up = np.argmax(first >= 5000 * (1 - 1e-9))
     assert (t[up] - t[0]) == pytest.approx(0.1, abs=2e-3)
@@ -364,8 +361,9 @@ def test_sensor_driven_v_change():
     for lo, hi, speed in ((5000, 40000, 10000), (45000, 80000, 25000),
                           (85000, 120000, 50000), (125000, 195000, 100000)):
         sel = (p > lo) & (p < hi)
-        assert np.max(v[sel]) == pytest.approx(speed, rel=1e-9)
-        assert np.median(v[sel]) == pytest.approx(speed, rel=1e-9)
+        # the speeds run on the fixed range's grid: 300/196 = 1.53 pps a step
+        assert np.max(v[sel]) == pytest.approx(speed, abs=300 / 196 / 2)
+        assert np.median(v[sel]) == np.max(v[sel])
 
 
 # 4.3: one module (ID 1, 3, 5, 7) at 6M full duplex: 8 x 30.4 us = 243.2 us; 1.2 spec:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative, check_positive
 from ..hw.interface import AxisCommand
+from ..profile.onthefly import final_decel_start
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
 from ..units import MAX_PULSE_RATE, AxisUnits
@@ -467,7 +468,9 @@ class Axis(AxisEngine):
 
         The new speed may not exceed the fixed speed range (`fix_speed_range`) or, when none
         is fixed, the move's own MaxVel. Refused (InfeasibleError, motion unchanged) when a
-        positioning move has too few pulses left to reach the speed and still stop.
+        positioning move has too few pulses left to reach the speed and still stop. A
+        change to the speed the move already runs or ramps to changes nothing (a legacy loop
+        re-issuing v_change while a sensor stays on keeps its first ramp).
         """
         v = abs(self.check_speed("new_vel", new_vel, units))
         ta = check_positive("tacc", tacc)
@@ -483,6 +486,8 @@ class Axis(AxisEngine):
         if self.speed_model is not None:
             v = self.speed_model.change(v, limit)
         t = self._ctl.time
+        if v == m.spec.max_vel and t - m.t_start < final_decel_start(m.profile):
+            return  # already running (or ramping) to this speed: the registers stay as set
         profile, spec = planning.change_speed(m, t, v, ta, limit)
         self._replace(m, profile, spec, m.target)
 

@@ -414,9 +414,10 @@ class MotionFunctions(HslBase):
         d = _dir(direction)
         centre = [check_finite("center", v) for v in c]
         end = [check_finite("end", v) for v in e]
-        if profile is None:  # constant tangential speed MaxVel, no ramps
+        if profile is None:  # constant tangential speed MaxVel, no ramps: StrVel = MaxVel,
+            # and a path acceleration (1 us ramps) that never caps the arc's speed
             v = abs(check_finite("MaxVel", max_vel))
-            g = self._path(mod, local, "T", v, v, 1.0, 1.0)
+            g = self._path(mod, local, "T", v, v, 1e-6, 1e-6)
         else:
             g = self._path(mod, local, "T", *profile)
         g.arc(centre, end, plane=(0, 1), direction=d, relative=not absolute)
