@@ -134,6 +134,26 @@ def verify_speed(str_vel: float, max_vel: float,
     return rng.start_register(sv) * rng.multiplier, t_min, t_max
 
 
+def on_range(spec: MoveSpec, fixed: float | None = None) -> MoveSpec:
+    """The spec the ASIC runs for `spec` on the fixed range `fixed` (None: the move's own
+    MaxVel): InfeasibleError above the range or for a ramp longer than the registers
+    count, a too short ramp slowed, speeds on a fixed range's grid. Single-axis moves
+    (SpeedModel) and the vector profile of interpolations use it alike."""
+    rng = SpeedRange.for_speed(fixed if fixed is not None else spec.max_vel)
+    if spec.max_vel > rng.max_speed * (1 + 1e-12):
+        raise InfeasibleError(
+            f"max_vel must be <= the fixed speed range {rng.top:g} pps "
+            f"(fix_speed_range to allow more), got {spec.max_vel!r}")
+    sv, mv = spec.str_vel, spec.max_vel
+    if fixed is not None:  # the fixed range's grid
+        sv, mv = rng.grid(sv), max(rng.grid(mv), rng.grid(sv))
+    ta = rng.ramp_time("tacc", spec.str_vel, spec.max_vel, spec.tacc)
+    td = rng.ramp_time("tdec", spec.str_vel, spec.max_vel, spec.tdec)
+    half = (mv - sv) / 2.0
+    return replace(spec, str_vel=sv, max_vel=mv, tacc=ta, tdec=td,
+                   vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
+
+
 class SpeedModel:
     """The register grid applied to one axis's T/S moves and speed changes."""
 
@@ -146,19 +166,7 @@ class SpeedModel:
 
     def move(self, spec: MoveSpec) -> MoveSpec:
         """The spec the ASIC runs for `spec` (InfeasibleError when it cannot)."""
-        rng = self.range_for(spec.max_vel)
-        if spec.max_vel > rng.max_speed * (1 + 1e-12):
-            raise InfeasibleError(
-                f"max_vel must be <= the fixed speed range {rng.top:g} pps "
-                f"(fix_speed_range to allow more), got {spec.max_vel!r}")
-        sv, mv = spec.str_vel, spec.max_vel
-        if self.axis.speed_range is not None:  # the fixed range's grid
-            sv, mv = rng.grid(sv), max(rng.grid(mv), rng.grid(sv))
-        ta = rng.ramp_time("tacc", spec.str_vel, spec.max_vel, spec.tacc)
-        td = rng.ramp_time("tdec", spec.str_vel, spec.max_vel, spec.tdec)
-        half = (mv - sv) / 2.0
-        return replace(spec, str_vel=sv, max_vel=mv, tacc=ta, tdec=td,
-                       vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
+        return on_range(spec, self.axis.speed_range)
 
     def change(self, new_vel: float, current_range: float) -> float:
         """The speed a v_change to `new_vel` really runs (on a fixed range's grid)."""

@@ -82,6 +82,11 @@ def hsl_call(kind: int) -> Callable[[F], F]:
                 return self._fail(e.code, f"{fn.__name__}: {e.message}", kind)
             except MotionError as e:
                 return self._fail(classify(e), f"{fn.__name__}: {e}", kind)
+            except (TypeError, ValueError, ArithmeticError) as e:
+                # an argument of a type no C caller could pass (a list for a number...):
+                # the library's contract is a code, never an exception
+                return self._fail(ERR_InvalidParameter, f"{fn.__name__}: invalid argument "
+                                  f"({type(e).__name__}: {e})", 0)
             if kind:
                 self._net.charge(kind)
             self.last_error = HslError(ERR_NoError)

@@ -53,7 +53,7 @@ COMP_ACCEL = 1e9
 
 
 def _code(name: str, value: Any, table: dict[int, Any]) -> Any:
-    if isinstance(value, bool) or value not in table:
+    if isinstance(value, bool) or not isinstance(value, int) or value not in table:
         raise Refusal(ERR_InvalidParameter, f"{name} must be one of {sorted(table)}, "
                       f"got {value!r}")
     return table[value]

@@ -84,10 +84,14 @@ class HslLibrary(MotionFunctions, IoFunctions):
 
     @hsl_call(0)
     def HSL_close(self, card_ID: int = 0) -> None:
-        """Close the card: every axis stops at once; calls then return ERR_NotInitial."""
+        """Close the card: every axis stops at once, the interpolation groups close; calls
+        then return ERR_NotInitial."""
         self._check_card(card_ID)
         for mod in self._modules.values():
             mod.ctl.stop_all(immediately=True)
+            for g in mod.groups.values():
+                g.close()
+            mod.groups.clear()
         self._net = None
 
     @hsl_call(0)

@@ -12,12 +12,14 @@ without Tacc run at MaxVel from start to end (StrVel = MaxVel): the seed's
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 from ...control.group import Group, GroupState
 from ...control.network import GET_U16, GET_U32, ONE_AXIS, SET_U16, SET_U32, SHORT, TWO_AXIS
-from ...control.speed_range import verify_speed
-from ...errors import check_finite
+from ...control.speed_range import on_range, verify_speed
+from ...errors import check_distance, check_finite
 from ...profile.pcl import MoveSpec
 from .base import HslBase, Module, hsl_call
 from .errors import ERR_AxisBusy, ERR_InvalidParameter, Refusal
@@ -27,9 +29,14 @@ DIR_CW, DIR_CCW = 0, 1
 
 
 def _dir(code: Any) -> str:
-    if code in (DIR_CW, DIR_CCW) and not isinstance(code, bool):
+    if isinstance(code, int) and not isinstance(code, bool) and code in (DIR_CW, DIR_CCW):
         return "CW" if code == DIR_CW else "CCW"
     raise Refusal(ERR_InvalidParameter, f"DIR must be 0 (CW) or 1 (CCW), got {code!r}")
+
+
+def _push_arc(g: Group, *, centre: list[float], end: list[float], direction: str,
+              absolute: bool) -> None:
+    g.arc(centre, end, plane=(0, 1), direction=direction, relative=not absolute)
 
 
 class MotionFunctions(HslBase):
@@ -232,7 +239,11 @@ class MotionFunctions(HslBase):
         return None
 
     def _group(self, mod: Module, local: tuple[int, ...]) -> Group:
-        """The module's group over exactly these axes (others sharing an axis closed)."""
+        """The module's group over exactly these axes. Another group sharing an axis is
+        closed first (closing stops its axes, so only when none of them moves)."""
+        for i in local:
+            if mod.ctl.axes[i].is_moving:
+                raise Refusal(ERR_AxisBusy, f"axis {mod.index * 4 + i} is moving")
         g = mod.groups.get(local)
         if g is not None:
             if g.state is not GroupState.IDLE or g.queue_length:
@@ -240,8 +251,10 @@ class MotionFunctions(HslBase):
             return g
         for axes, other in list(mod.groups.items()):
             if set(axes) & set(local):
-                if other.state is not GroupState.IDLE or other.queue_length:
-                    raise Refusal(ERR_AxisBusy, f"axes {list(axes)} are still interpolating")
+                if other.state is not GroupState.IDLE or other.queue_length or \
+                        any(a.is_moving for a in other.axes):
+                    raise Refusal(ERR_AxisBusy, f"axes {list(axes)} of module {mod.index} "
+                                  "are moving")
                 other.close()
                 del mod.groups[axes]
         g = Group(mod.ctl, list(local))
@@ -250,27 +263,37 @@ class MotionFunctions(HslBase):
 
     def _path(self, mod: Module, local: tuple[int, ...], shape: str, StrVel: float,
               MaxVel: float, Tacc: float, Tdec: float, SVacc: float = 0.0,
-              SVdec: float = 0.0) -> Group:
-        """A group set up for one PCL6045 vector profile (validated before any change)."""
-        spec = MoveSpec(shape, abs(check_finite("StrVel", StrVel)),
-                        abs(check_finite("MaxVel", MaxVel)), Tacc, Tdec, SVacc, SVdec)
+              SVdec: float = 0.0, *, push: Callable[[Group], object]) -> None:
+        """Set a group up for one PCL6045 vector profile and `push` its command; a refusal
+        anywhere leaves no trace (a group created for this call is closed again)."""
+        spec = on_range(MoveSpec(shape, abs(check_finite("StrVel", StrVel)),
+                                 abs(check_finite("MaxVel", MaxVel)), Tacc, Tdec, SVacc,
+                                 SVdec))     # the vector speed registers' range
+        new = local not in mod.groups
         g = self._group(mod, local)
-        r = spec.rates
-        mv = spec.max_vel
-        g.set_feed(mv)
-        g.set_str_vel(spec.str_vel)
-        g.set_acc_time(mv / r.accel if r.accel > 0.0 else Tacc)
-        g.set_dec_time(mv / r.decel if r.decel > 0.0 else Tdec)
-        if shape == "S" and math.isfinite(r.jerk_acc):
-            g.set_path_shape("S", min(r.jerk_acc, r.jerk_dec))
-        else:
-            g.set_path_shape("T")
-        return g
+        try:
+            r = spec.rates
+            mv = spec.max_vel
+            g.set_feed(mv)
+            g.set_str_vel(spec.str_vel)
+            g.set_acc_time(mv / r.accel if r.accel > 0.0 else spec.tacc)
+            g.set_dec_time(mv / r.decel if r.decel > 0.0 else spec.tdec)
+            if shape == "S" and math.isfinite(r.jerk_acc):
+                g.set_path_shape("S", min(r.jerk_acc, r.jerk_dec))
+            else:
+                g.set_path_shape("T")
+            push(g)
+        except BaseException:
+            if new:
+                g.close()
+                del mod.groups[local]
+            raise
 
     def _line(self, mod: Module, local: tuple[int, ...], target: tuple[float, ...],
               absolute: bool, shape: str, *profile: float) -> None:
-        g = self._path(mod, local, shape, *profile)
-        g.line([check_finite("position", p) for p in target], relative=not absolute)
+        p = [check_distance("position", v) for v in target]   # 28-bit counters
+        self._path(mod, local, shape, *profile,
+                   push=lambda g: g.line(p, relative=not absolute))
 
     def _xy(self, M_No: int, first: int, target: tuple[float, ...], absolute: bool,
             shape: str, *profile: float) -> None:
@@ -412,15 +435,15 @@ class MotionFunctions(HslBase):
              e: tuple[float, float], direction: Any, absolute: bool,
              profile: tuple[float, ...] | None, max_vel: float) -> None:
         d = _dir(direction)
-        centre = [check_finite("center", v) for v in c]
-        end = [check_finite("end", v) for v in e]
+        centre = [check_distance("center", v) for v in c]
+        end = [check_distance("end", v) for v in e]
+        push = partial(_push_arc, centre=centre, end=end, direction=d, absolute=absolute)
         if profile is None:  # constant tangential speed MaxVel, no ramps: StrVel = MaxVel,
             # and a path acceleration (1 us ramps) that never caps the arc's speed
             v = abs(check_finite("MaxVel", max_vel))
-            g = self._path(mod, local, "T", v, v, 1e-6, 1e-6)
+            self._path(mod, local, "T", v, v, 1e-6, 1e-6, push=push)
         else:
-            g = self._path(mod, local, "T", *profile)
-        g.arc(centre, end, plane=(0, 1), direction=d, relative=not absolute)
+            self._path(mod, local, "T", *profile, push=push)
 
     def _arc_args(self, rest: tuple[Any, ...]) -> tuple[Any, float]:
         """(DIR, MaxVel) from `MaxVel` (the manual's example, DIR = CW) or `DIR, MaxVel`."""
