@@ -49,7 +49,7 @@ class ModuleConfig:
     machine: MachineConfig
 
     def __post_init__(self) -> None:
-        check_int("modules index", self.index, 0, MAX_MODULES - 1)
+        check_int("modules connect index", self.index, 0, MAX_MODULES - 1)
         check_int(f"modules.{self.index}.slave_id", self.slave_id, 1, 63)
         if not isinstance(self.machine, MachineConfig):
             raise MotionError(f"modules.{self.index}.machine must be a MachineConfig")
