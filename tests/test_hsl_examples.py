@@ -378,3 +378,27 @@ def test_scan_time_examples():
     half.HSL_initial(0)
     assert half.HSL_get_scan_time(0) == pytest.approx(236e-6)  # "240 us for one module"
     assert [hsl.HSL_connect_status(0, i) for i in range(1, 9)] == [1, 0, 1, 0, 1, 0, 1, 0]
+
+
+# 4.6 "Home Search Example (Home mode=1)", figure 4-29: 1 search (-), 2 -EL: slow down and
+# reverse (+), 3 ORG: slow down, 4 escape ORG by the ORG offset, 5 search again (-),
+# 6-7 ORG found at search speed: the end of ORG is home.
+def test_home_search_example():
+    hsl = library()
+    sim = HslSim(hsl)
+    sim.place_switch(0, "mel", -10000, -1e9)
+    sim.place_switch(0, "org", 20000, 500)
+    assert hsl.HSL_M_set_home_config(0, 1, 0, 0, 0, 0) == 0
+    assert hsl.HSL_M_home_search(0, 500, -20000, 0.1, 1000) == 0
+    ax = hsl.controller(0).axes[0]
+    low = high = 0.0
+    while hsl.HSL_M_motion_done(0):
+        low, high = min(low, ax.position), max(high, ax.position)
+    steps = hsl._modules[0].homing[0].status.history
+    assert steps[:2] == ["search ORG", "MEL hit: reverse"]
+    assert "back off by org_offset" in steps and steps[-1] == "end of ORG"
+    assert steps.index("back off by org_offset") < len(steps) - 2   # searched again
+    assert low <= -10000 and high >= 20500 + 1000 - 1               # the offset escape
+    assert hsl.HSL_M_get_command(0) == 0                            # counters cleared
+    assert hsl.HSL_M_get_target_pos(0) != 0                         # the recorder is not
+    assert hsl.HSL_M_reset_target_pos(0, 0) == 0
