@@ -11,11 +11,12 @@ rewired by software). Codes: logic 0 = as wired normally open / not inverted ("n
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 from ...control.compare import CompareEngine
 from ...control.compensation import Compensation
-from ...control.homing import escape_home, home_move
+from ...control.homing import escape_home, home_move, home_search
 from ...control.homing_modes import HomeConfig
 from ...control.hsl_trigger import HslTrigger
 from ...control.latch import Latch
@@ -370,8 +371,7 @@ class IoFunctions(HslBase):
             g = saf.cmp.general_comparator(ax.index)
             v = None if g is None else g[3]
         elif CompType == 3:
-            e = saf.cmp._err[ax.index]
-            v = None if e is None else e[0]
+            v = saf.cmp.error_counter_check(ax.index)
         else:
             lim = saf.soft.get(ax.index)
             v = lim.plimit if CompType == 1 else lim.nlimit
@@ -462,10 +462,8 @@ class IoFunctions(HslBase):
         past ORG by ORGOffset, then ORG is searched again slowly."""
         mod, ax = self._axis(axis)
         cfg = self._home_config(mod, ax, StrVel, MaxVel, Tacc)
-        cfg = HomeConfig(**{**cfg.__dict__, "org_offset": abs(check_finite("ORGOffset",
-                                                                           ORGOffset)),
-                            "auto_search": True})
-        mod.homing[ax.index] = home_move(mod.ctl, ax.index, cfg)
+        off = abs(check_finite("ORGOffset", ORGOffset))
+        mod.homing[ax.index] = home_search(mod.ctl, ax.index, replace(cfg, org_offset=off))
 
     @hsl_call(SHORT)
     def HSL_M_escape_home(self, axis: int, StrVel: float, MaxVel: float, Tacc: float) -> None:
