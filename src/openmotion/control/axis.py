@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative, check_positive
 from ..hw.interface import AxisCommand
+from ..profile.onthefly import final_decel_start
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
 from ..units import MAX_PULSE_RATE, AxisUnits
@@ -31,6 +32,7 @@ from .states import AxisState, MotionDone, transition
 if TYPE_CHECKING:
     from ..config import AxisConfig
     from .controller import Controller
+    from .speed_range import SpeedModel
 
 F = TypeVar("F", bound=Callable[..., Any])
 S = AxisState
@@ -67,6 +69,8 @@ class Axis(AxisEngine):
         self._inp_enabled = False
         self._waiting_inp = False
         self._speed_range: float | None = None
+        #: PCL6045 register grid (control.speed_range.attach_speed_model), None = exact
+        self.speed_model: SpeedModel | None = None
         #: ALM reaction: False = stop at once (default), True = decelerate (HSL set_alm mode)
         self.alarm_decelerate = False
         self._max_speed = min(config.max_speed_pps, MAX_PULSE_RATE)
@@ -109,13 +113,16 @@ class Axis(AxisEngine):
 
     @property
     def motion_done(self) -> int:
-        """HSL motion_done status: 0 stopped, 10..13 moving, 14 waiting for INP."""
+        """HSL motion_done status: 0 stopped, 9 homing between moves, 10..13 moving, 14
+        waiting for INP."""
         m = self._motion
         if m is not None:
             return m.done_code(self._ctl.time)
         if self._waiting_inp:
             return MotionDone.WAITING_INP
-        return self._gate_code() if self._gated else MotionDone.STOPPED
+        if self._gated:
+            return self._gate_code()
+        return MotionDone.HOMING if self._state is S.HOMING else MotionDone.STOPPED
 
     @property
     def motion(self) -> ActiveMotion | None:
@@ -262,7 +269,8 @@ class Axis(AxisEngine):
         va = self.check_speed("vs_acc", vs_acc, units)
         vd = self.check_speed("vs_dec", vs_dec, units)
         td = tacc if tdec is None else tdec
-        return MoveSpec(shape, sv, mv, tacc, td, va, vd)
+        spec = MoveSpec(shape, sv, mv, tacc, td, va, vd)
+        return spec if self.speed_model is None else self.speed_model.move(spec)
 
     def _check_can_start(self) -> None:
         st = self._state
@@ -301,6 +309,8 @@ class Axis(AxisEngine):
         sv = self.check_speed("str_vel", str_vel, units)
         va = self.check_speed("vs_acc", vs_acc, units)
         spec = MoveSpec(shape, sv, abs(v), tacc, tacc, va, va)
+        if self.speed_model is not None:
+            spec = self.speed_model.move(spec)
         self._check_can_start()
         profile = planning.velocity_move(spec, 1.0 if v > 0 else -1.0, self._pos)
         self._start(ActiveMotion(profile, self._ctl.time, "velocity", spec),
@@ -458,7 +468,9 @@ class Axis(AxisEngine):
 
         The new speed may not exceed the fixed speed range (`fix_speed_range`) or, when none
         is fixed, the move's own MaxVel. Refused (InfeasibleError, motion unchanged) when a
-        positioning move has too few pulses left to reach the speed and still stop.
+        positioning move has too few pulses left to reach the speed and still stop. A
+        change to the speed the move already runs or ramps to changes nothing (a legacy loop
+        re-issuing v_change while a sensor stays on keeps its first ramp).
         """
         v = abs(self.check_speed("new_vel", new_vel, units))
         ta = check_positive("tacc", tacc)
@@ -471,7 +483,11 @@ class Axis(AxisEngine):
             raise InfeasibleError(
                 f"new_vel must be <= the speed range {limit:g} pps "
                 f"(fix_speed_range to allow more), got {new_vel!r}")
+        if self.speed_model is not None:
+            v = self.speed_model.change(v, limit)
         t = self._ctl.time
+        if v == m.spec.max_vel and t - m.t_start < final_decel_start(m.profile):
+            return  # already running (or ramping) to this speed: the registers stay as set
         profile, spec = planning.change_speed(m, t, v, ta, limit)
         self._replace(m, profile, spec, m.target)
 

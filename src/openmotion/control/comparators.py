@@ -118,6 +118,11 @@ class Comparators:
             raise MotionError(f"tacc must be > 0, got {tacc!r}")
         self._vchange[i] = (v, ta)
 
+    def error_counter_check(self, axis: int | str) -> int | None:
+        """The step-loss tolerance armed on `axis` (comparator 3), or None when off."""
+        e = self._err[self.ctl.axis(axis).index]
+        return None if e is None else e[0]
+
     def general_comparator(self, axis: int | str) -> tuple[str, str, str, float] | None:
         """(source, method, action, data) of the armed general comparator, or None."""
         g = self._gen[self.ctl.axis(axis).index]

@@ -61,7 +61,8 @@ class Counters:
     """Command, feedback, error and general counters plus the target recorder of one axis."""
 
     __slots__ = ("_pulses", "_encoder", "_time", "_ratio", "_cmd_off", "_fb_off", "_err_off",
-                 "_gen_off", "_gen_src", "_target", "_fresh", "out_offset")
+                 "_gen_off", "_gen_src", "_target", "_fresh", "out_offset", "_fb_internal",
+                 "_raw_out", "_raw_enc")
 
     def __init__(self, move_ratio: float = 1.0,
                  refresh: Callable[[], None] | None = None) -> None:
@@ -79,13 +80,33 @@ class Counters:
         self._gen_src = "manual"
         self._target = 0.0
         self.out_offset = 0
+        self._fb_internal = False   # HSL set_feedback_src: count the output pulses
+        self._raw_out = 0
+        self._raw_enc = 0
 
     # -- fed by the controller (through `refresh`) ---------------------------------------
     def update(self, pulses_out: int, encoder: int, time: float) -> None:
         """Latest raw hardware totals (unwrapped) and controller time."""
         self._pulses = pulses_out - self.out_offset
-        self._encoder = encoder
+        self._raw_out, self._raw_enc = pulses_out, encoder
+        self._encoder = pulses_out if self._fb_internal else encoder
         self._time = time
+
+    @property
+    def feedback_source(self) -> str:
+        """"external" (EA/EB encoder input, default) or "internal" (the output pulses)."""
+        return "internal" if self._fb_internal else "external"
+
+    def set_feedback_source(self, source: str) -> None:
+        """HSL_M_set_feedback_src: what the feedback counter counts; its value carries on
+        from where it was (no jump)."""
+        if source not in ("external", "internal"):
+            raise MotionError(f"source must be 'external' or 'internal', got {source!r}")
+        self._fresh()
+        before = self._encoder + self._fb_off
+        self._fb_internal = source == "internal"
+        self._encoder = self._raw_out if self._fb_internal else self._raw_enc
+        self._fb_off = before - self._encoder
 
     # -- raw (unwrapped) views used for motion planning -----------------------------------
     @property

@@ -111,7 +111,7 @@ class HslTrigger:
         a = self._axis(axis)
         if cmp_src not in (0, 1) or isinstance(cmp_src, bool):
             raise MotionError(f"cmp_src must be 0 (command) or 1 (feedback), got {cmp_src!r}")
-        if method != 0 and method not in METHODS:
+        if method != 0 and not (isinstance(method, (int, str)) and method in METHODS):
             raise MotionError(f"method must be 0..5 or '=', '>', '<', got {method!r}")
         d = check_finite("data", data)
         self._src[a] = cmp_src

@@ -76,6 +76,8 @@ SUSPENDABLE = ("pel", "mel", "sd", "soft")
 LIMIT_REASONS = {"pel": "+EL", "mel": "-EL"}
 #: Faults after which an armed ERC pulse is sent (HSL 3: EL and ALM; also E-stop).
 ERC_REASONS = ("+EL", "-EL", "servo alarm", "emergency stop")
+# controller -> weak reference to its Safety: a strong value would keep its key (the
+# controller, which the Safety references) alive for ever
 _INSTALLED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -150,7 +152,7 @@ class Safety:
         if not isinstance(controller, Controller):
             raise MotionError(f"controller must be a Controller, got "
                               f"{type(controller).__name__}")
-        if controller in _INSTALLED:
+        if Safety.of(controller) is not None:
             raise MotionError("this controller already has a Safety attached")
         self.ctl = controller
         n = len(controller.axes)
@@ -171,7 +173,7 @@ class Safety:
         controller.add_cycle_hook(self._on_cycle, due=self._due)
         controller.add_fault_hook(self._on_fault)
         controller.add_motion_check(self._check_motion)
-        _INSTALLED[controller] = self
+        _INSTALLED[controller] = weakref.ref(self)
         hw = controller.hardware
         self._hw_stop = isinstance(hw, EdgeStopHardware)
         if self._hw_stop:
@@ -182,7 +184,8 @@ class Safety:
     @staticmethod
     def of(controller: Controller) -> Safety | None:
         """The Safety attached to `controller`, or None."""
-        return _INSTALLED.get(controller)
+        ref = _INSTALLED.get(controller)
+        return None if ref is None else ref()
 
     def detach(self) -> None:
         """Remove every hook this object installed (reactions off)."""

@@ -66,6 +66,7 @@ class MotionDone:
     """`motion_done` status codes of the PCL6045 main status (seed-facts 2.5)."""
 
     STOPPED = 0
+    HOMING = 9  # home special-speed motion: between the moves of a home sequence
     AT_STRVEL = 10
     ACCELERATING = 11
     AT_MAXVEL = 12
