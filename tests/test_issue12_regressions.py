@@ -1,0 +1,110 @@
+"""Regression tests for the issue #12 defects (reliability under fault injection).
+
+Each test reproduces one defect as the issue reports it and fails on the code before its
+fix; the number in the test name is the defect's number in the issue.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from helpers import free_axes
+from openmotion.control import Controller
+from openmotion.profile.segments import State
+from openmotion.profile.velocity import ramp_rates, velocity_ramp
+
+
+def _peak_speed(ctl: Controller, ax, seconds: float) -> float:
+    peak = 0.0
+    for _ in range(round(seconds / ctl.period)):
+        ctl.step()
+        peak = max(peak, abs(ax.velocity))
+    return peak
+
+
+# -- 1: S-curve change_speed mid-ramp ---------------------------------------------------
+def test_1_velocity_change_mid_s_ramp_stays_under_the_target_and_axis_max():
+    ctl = Controller()
+    ctl.enable_all()
+    x = ctl["x"]
+    x.move_velocity(200_000, tacc=0.1, shape="S")
+    ctl.advance(0.05)  # mid-ramp: 100 kpps, accelerating at its peak rate
+    x.change_speed(200_000, 0.5)
+    peak = _peak_speed(ctl, x, 1.0)  # ends before +EL at 305000
+    assert x.fault is None
+    assert peak <= 200_000 * (1 + 1e-9)
+    assert peak <= x.max_speed
+
+
+@pytest.mark.parametrize("new_vel", [20_000, 19_000, 10_000])
+def test_1_positioning_change_mid_s_ramp_is_accepted_and_bounded(new_vel):
+    ctl = Controller()
+    ctl.enable_all()
+    x = ctl["x"]
+    x.move_relative(250_000, max_vel=20_000, tacc=0.1, shape="S")
+    ctl.advance(0.05)  # 10 kpps and accelerating: a slow change must not overshoot
+    x.change_speed(new_vel, 1.0)
+    peak = 0.0
+    for _ in range(30_000):
+        ctl.step()
+        peak = max(peak, abs(x.velocity))
+        if not x.is_moving:
+            break
+    assert x.fault is None and x.position == 250_000
+    assert peak <= 20_000 * (1 + 1e-9)  # the running move's own speed, nothing beyond
+
+
+@settings(max_examples=300, deadline=None)
+@given(v=st.floats(0.0, 3e5), a=st.floats(-5e6, 5e6), vt=st.floats(-3e5, 3e5),
+       t=st.floats(0.01, 2.0), jz=st.floats(1e5, 1e9), shape=st.sampled_from("TS"))
+def test_1_property_velocity_ramp_peak_is_bounded(v, a, vt, t, jz, shape):
+    """From any (v, a): the ramp's peak speed is at most the target, the start or the
+    speed at which the acceleration can be brought to zero (at the larger of the ramp's
+    and the available jerk) - no more than the physics requires."""
+    if v == 0.0 and a == 0.0:
+        return
+    if shape == "T":
+        a_ok = 0.0  # T ramps step the acceleration: no overshoot at all
+    else:
+        _, jerk = ramp_rates(abs(vt - v) or 1.0, t, "S")
+        j_hi = max(jerk, jz)
+        a_ok = a * abs(a) / (2.0 * j_hi)
+    prof = velocity_ramp(State(0.0, v, a), vt, t, shape=shape, j_zero=jz)
+    peak = _profile_peak(prof)
+    bound = max(abs(vt), abs(v), abs(v + a_ok))
+    assert peak <= bound * (1 + 1e-9) + 1e-6
+
+
+def _profile_peak(prof) -> float:
+    """Largest |v| over the profile (segment ends and interior extremes)."""
+    peak = 0.0
+    for k in range(prof.n_segments):
+        d = prof.segment_duration(k)
+        v0, a0, j = float(prof.v0[k]), float(prof.a0[k]), float(prof.j[k])
+        cands = [0.0, d]
+        if j != 0.0 and 0.0 < -a0 / j < d:
+            cands.append(-a0 / j)
+        for u in cands:
+            peak = max(peak, abs(v0 + a0 * u + 0.5 * j * u * u))
+    return peak
+
+
+@settings(max_examples=25, deadline=None)
+@given(v1=st.floats(20_000, 400_000), tacc=st.floats(0.02, 0.5), frac=st.floats(0.05, 0.95),
+       v2=st.floats(1_000, 400_000), t2=st.floats(0.01, 3.0))
+def test_1_property_axis_change_speed_never_exceeds_the_axis_max(v1, tacc, frac, v2, t2):
+    ctl = free_axes(1)
+    x = ctl["x"]
+    x.move_velocity(v1, tacc=tacc, shape="S")
+    ctl.advance(frac * tacc)
+    if not x.is_moving or x.speed == 0.0:
+        return
+    x.change_speed(min(v2, v1), t2)
+    peak = _peak_speed(ctl, x, min(t2 + tacc, 1.0) + 0.01)
+    assert peak <= max(v1, v2) * (1 + 1e-9)
+    assert peak <= x.max_speed
+    assert math.isfinite(peak)
