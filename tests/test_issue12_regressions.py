@@ -12,8 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helpers import free_axes
+from helpers import free_axes, table_without_mel
 from openmotion.control import Controller
+from openmotion.control.group import Group, GroupState
 from openmotion.profile.segments import State
 from openmotion.profile.velocity import ramp_rates, velocity_ramp
 
@@ -108,3 +109,54 @@ def test_1_property_axis_change_speed_never_exceeds_the_axis_max(v1, tacc, frac,
     assert peak <= max(v1, v2) * (1 + 1e-9)
     assert peak <= x.max_speed
     assert math.isfinite(peak)
+
+
+# -- 2: a group command issued while abort() is still stopping ------------------------
+def _max_axis_rates(ctl: Controller, axes, seconds: float) -> tuple[float, float]:
+    """Largest per-cycle speed and acceleration (from command positions) over `seconds`."""
+    prev = [a.position for a in axes]
+    pv = [a.velocity for a in axes]
+    vmax = amax = 0.0
+    for _ in range(round(seconds / ctl.period)):
+        ctl.step()
+        for k, a in enumerate(axes):
+            v = (a.position - prev[k]) / ctl.period
+            vmax = max(vmax, abs(v))
+            amax = max(amax, abs(a.velocity - pv[k]) / ctl.period)
+            prev[k], pv[k] = a.position, a.velocity
+    return vmax, amax
+
+
+@pytest.mark.parametrize("relative", [False, True])
+def test_2_line_queued_during_abort_starts_from_the_stop_point(relative):
+    ctl = table_without_mel()
+    g = Group(ctl, ["x", "y"], feed=50_000, acc_time=0.1)
+    g.line([100_000, 0])
+    ctl.advance(0.5)
+    g.abort()
+    assert g.state is GroupState.HOLDING
+    g.line([20_000, 20_000], relative=relative)
+    x = ctl["x"]
+    stops = []  # x where the abort's stop comes to rest (the new line starts there)
+    ctl.add_cycle_hook(lambda c, t: stops.append(x.position) if x.velocity == 0.0
+                       and not stops else None)
+    vmax, amax = _max_axis_rates(ctl, g.axes, 3.0)
+    assert vmax <= 50_000 * (1 + 1e-6)  # the feed; x jumped 1000 pulses in 1 ms before
+    assert amax <= 50_000 / 0.1 * (1 + 1e-6) + 1.0
+    assert g.state is GroupState.IDLE and g.error_code == 0
+    assert 20_000 < stops[0] < 30_000
+    want = [stops[0] + 20_000, 20_000] if relative else [20_000, 20_000]
+    assert list(g.position) == pytest.approx(want, abs=1e-6)
+
+
+def test_2_ptp_queued_during_abort_ends_on_its_target():
+    ctl = table_without_mel()
+    g = Group(ctl, ["x", "y"], feed=50_000, acc_time=0.1)
+    g.line([100_000, 0])
+    ctl.advance(0.3)
+    g.abort()
+    g.ptp([10_000, 5_000])
+    g.line([0, 0])
+    vmax, _ = _max_axis_rates(ctl, g.axes, 5.0)
+    assert vmax <= max(a.max_speed for a in g.axes)
+    assert g.state is GroupState.IDLE and list(g.position) == [0.0, 0.0]
