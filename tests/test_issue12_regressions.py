@@ -160,3 +160,56 @@ def test_2_ptp_queued_during_abort_ends_on_its_target():
     vmax, _ = _max_axis_rates(ctl, g.axes, 5.0)
     assert vmax <= max(a.max_speed for a in g.axes)
     assert g.state is GroupState.IDLE and list(g.position) == [0.0, 0.0]
+
+
+# -- 3: stopping or disabling one axis of a running group directly --------------------
+def _running_group():
+    ctl = table_without_mel()
+    g = Group(ctl, ["x", "y"], feed=50_000, acc_time=0.1)
+    g.line([100_000, 50_000])
+    g.line([0, 0])
+    ctl.advance(0.5)
+    assert g.state is GroupState.MOVING and ctl["y"].velocity > 0.0
+    return ctl, g
+
+
+@pytest.mark.parametrize("how", ["stop_immediately", "disable", "fault", "stop"])
+def test_3_an_axis_stopped_directly_stops_the_whole_group(how):
+    ctl, g = _running_group()
+    x, y = ctl["x"], ctl["y"]
+    if how == "fault":
+        x.fault_stop("test fault")
+    else:
+        getattr(x, how)()
+    if how == "stop":  # a decelerating stop: the others decelerate too
+        assert y.is_moving and y.motion.kind == "stop"
+    else:  # an immediate one: the others stop at the same instant
+        assert not y.is_moving and y.velocity == 0.0
+    assert g.state is GroupState.ERROR and g.queue_length == 0
+    assert g.error_code < 0 and "x" in g.error_message
+    if how == "fault":
+        assert "test fault" in g.error_message
+    assert ctl.run_until(lambda: not x.is_moving and not y.is_moving, 2.0)
+    # the group's own API keeps working
+    g.hold()
+    g.set_override(50)
+    g.abort()
+    g.clear_error()
+    x.reset()
+    x.enable()
+    assert g.state is GroupState.IDLE
+    g.line([0, 0])
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
+                         and not x.is_moving and not y.is_moving, 10.0)
+    assert list(g.position) == [0.0, 0.0]
+
+
+def test_3_a_decelerating_stop_of_one_line_axis_keeps_the_others_on_the_line():
+    ctl, g = _running_group()
+    x, y = ctl["x"], ctl["y"]
+    x.stop()
+    worst = 0.0
+    while x.is_moving or y.is_moving:
+        ctl.step()
+        worst = max(worst, abs(x.position - 2.0 * y.position))  # the line x = 2 y
+    assert worst < 50.0

@@ -46,6 +46,7 @@ PreAdvanceHook = Callable[["Controller", float, float], None]
 SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
+MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
 
 
 class Controller:
@@ -95,6 +96,7 @@ class Controller:
         self._samples = 1  # sub-steps per cycle: lcm of the sample hooks' rates
         self._fault_hooks: list[FaultHook] = []
         self._motion_checks: list[MotionCheck] = []
+        self._motion_hooks: list[MotionHook] = []
         self._estop = False
         self._inputs: list[dict[str, bool]] = [{} for _ in self.axes]
         self._nc = [{s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy")
@@ -249,6 +251,20 @@ class Controller:
         with self._lock:
             if check in self._motion_checks:
                 self._motion_checks.remove(check)
+
+    def add_motion_hook(self, hook: MotionHook) -> None:
+        """Call `hook(axis, motion)` whenever an axis starts, re-plans or kills its motion
+        (motion None: stopped at once, disabled, faulted). Not called when a motion ends by
+        itself. A group engine subscribes to react to its axes being stopped directly."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._motion_hooks.append(hook)
+
+    def remove_motion_hook(self, hook: MotionHook) -> None:
+        with self._lock:
+            if hook in self._motion_hooks:
+                self._motion_hooks.remove(hook)
 
     def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
         for check in tuple(self._motion_checks):
@@ -432,6 +448,8 @@ class Controller:
             self.history.truncate(axis.index, self._time)
         else:
             self.history.append(axis.index, motion.t_start, motion.profile)
+        for hook in tuple(self._motion_hooks):
+            hook(axis, motion)
 
 
 # -- built-in edge hooks -------------------------------------------------------------------

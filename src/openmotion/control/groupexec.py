@@ -24,6 +24,7 @@ import math
 import weakref
 from collections import deque
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import TYPE_CHECKING, Any
@@ -135,6 +136,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     _run: _Run | None
     _held: _Run | None
     _aborting: bool
+    _own: int
+    _foreign: tuple[Axis, float] | None
     _error: int
     _error_msg: str
     _override: float
@@ -201,7 +204,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 if self._aborting:
                     self._aborting = False
                     self._state = GroupState.IDLE
-                    self._tail = None
+                    if not self._queue:  # commands queued during the stop keep their tail
+                        self._tail = None
                     return
                 self._held = r
                 self._state = GroupState.HELD
@@ -468,8 +472,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 profiles.append(planning.position_move(spec, float(start[k]),
                                                        float(target[k])))
             elif target[k] != a.position:
-                a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
-                                shape=spec.shape)
+                with self._commanding():
+                    a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
+                                    shape=spec.shape)
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
 
     def _launch(self, plan: pathrun.PathPlan, cmds: list[_Cmd], t: float) -> None:
@@ -506,8 +511,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             except MotionError as exc:
                 raise GroupError(ERR_LIMIT if "SL" in str(exc) or "limit" in str(exc)
                                  else ERR_AXIS_STATE, f"axis {a.name}: {exc}") from exc
-        for a, p, kw in args:
-            a.run_profile(p, **kw)
+        with self._commanding():
+            for a, p, kw in args:
+                a.run_profile(p, **kw)
 
     def _replan(self, r: _Run, *, hold: bool) -> None:
         """Re-plan the running chain from now: a hold (to rest) or a new override."""
@@ -518,11 +524,61 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         lim = r.plan.limits if hold else self._limits(r.plan.chain, r.plan.limits.str_vel)
         self._launch(pathrun.replan(r.plan, t, limits=lim, hold=hold), r.cmds, t)
 
+    def _stop_point(self) -> np.ndarray:
+        """Where the running motion comes to rest (pulses): each axis's profile end (the
+        group's own profiles in dry run), or its position when it has no motion."""
+        r = self._run
+        if self._dry and r is not None and r.profiles:
+            return np.array([p.end.p for p in r.profiles])
+        out = []
+        for a in self.axes:
+            m = a.motion
+            end = a.position if m is None or m.kind == "velocity" else \
+                m.profile.end.p + (a.position - a.raw_position)
+            out.append(end)
+        return np.array(out, dtype=float)
+
+    @contextmanager
+    def _commanding(self) -> Iterator[None]:
+        """The group itself changes its axes' motions (not a direct stop to react to)."""
+        self._own += 1
+        try:
+            yield
+        finally:
+            self._own -= 1
+
+    def _on_axis_motion(self, axis: Axis, motion: Any) -> None:
+        """Controller motion hook: a group axis was stopped (at once: motion None; or
+        decelerating: a "stop" motion) by someone else - a direct stop_immediately(),
+        stop() or disable(), a fault - while the group runs. Every axis stops the same way
+        at the same instant and the group goes to error, so none drives on off the path."""
+        if self._own or self._dry or axis not in self.axes or self._run is None or \
+                self._state not in (GroupState.MOVING, GroupState.HOLDING):
+            return
+        if motion is not None and motion.kind != "stop":
+            return
+        self._foreign = (axis, self._ctl.time)
+        if motion is None:
+            self._fault(ERR_AXIS_STATE, f"axis {axis.name}: stopped outside the group")
+            return
+        with self._commanding():  # a decelerating stop: the others decelerate too
+            for a in self.axes:
+                if a is not axis and a.motion is not None and a.motion.kind != "stop":
+                    a.stop()
+        self._fault(ERR_AXIS_STATE, f"axis {axis.name}: stopped outside the group",
+                    stop=False)
+
     def _on_axis_fault(self, axis: Axis, reason: str) -> None:
         """Controller fault hook: a group axis went to ErrorStop."""
+        code = ERR_LIMIT if "EL" in reason else ERR_AXIS_FAULT
+        if self._state is GroupState.ERROR and self._foreign == (axis, self._ctl.time):
+            # the motion hook reacted first (the fault stopped the axis): name the fault
+            self._foreign = None
+            self._error, self._error_msg = code, f"axis {axis.name}: {reason}"
+            self._stop_axes()
+            return
         if axis in self.axes and not self._dry and self._state in (
                 GroupState.MOVING, GroupState.HOLDING, GroupState.HELD):
-            code = ERR_LIMIT if "EL" in reason else ERR_AXIS_FAULT
             self._fault(code, f"axis {axis.name}: {reason}")
 
     def _check_faults(self) -> bool:
@@ -537,9 +593,11 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 return True
         return False
 
-    def _fault(self, code: int, message: str) -> None:
-        """Stop every axis of the group at once and drop the queue (MCCL 2.6.3 VI)."""
-        self._stop_axes()
+    def _fault(self, code: int, message: str, *, stop: bool = True) -> None:
+        """Stop every axis of the group at once and drop the queue (MCCL 2.6.3 VI);
+        `stop=False`: the axes are already stopping."""
+        if stop:
+            self._stop_axes()
         self._queue.clear()
         self._drop_join()
         self._run = self._held = None
@@ -550,9 +608,10 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     def _stop_axes(self) -> None:
         if self._dry:
             return
-        for a in self.axes:
-            if a.state is not AxisState.ERROR_STOP:
-                a.stop_immediately()
+        with self._commanding():
+            for a in self.axes:
+                if a.state is not AxisState.ERROR_STOP:
+                    a.stop_immediately()
 
 
 def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> bool:
