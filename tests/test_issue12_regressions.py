@@ -60,7 +60,13 @@ def test_1_positioning_change_mid_s_ramp_is_accepted_and_bounded(new_vel):
 
 
 @settings(max_examples=300, deadline=None)
-@given(v=st.floats(0.0, 3e5), a=st.floats(-5e6, 5e6), vt=st.floats(-3e5, 3e5),
+def _normal(lo: float, hi: float):
+    """Floats in [lo, hi] that are 0 or of a representable size (tiny numbers are the
+    input-validation defect 10, refused elsewhere)."""
+    return st.floats(lo, hi).filter(lambda x: x == 0.0 or abs(x) >= 1e-3)
+
+
+@given(v=_normal(0.0, 3e5), a=_normal(-5e6, 5e6), vt=_normal(-3e5, 3e5),
        t=st.floats(0.01, 2.0), jz=st.floats(1e5, 1e9), shape=st.sampled_from("TS"))
 def test_1_property_velocity_ramp_peak_is_bounded(v, a, vt, t, jz, shape):
     """From any (v, a): the ramp's peak speed is at most the target, the start or the
@@ -213,3 +219,96 @@ def test_3_a_decelerating_stop_of_one_line_axis_keeps_the_others_on_the_line():
         ctl.step()
         worst = max(worst, abs(x.position - 2.0 * y.position))  # the line x = 2 y
     assert worst < 50.0
+
+
+# -- 4: no exception escapes the cycle ------------------------------------------------
+def _reversing_arc_group():
+    """A line, then an arc that starts almost straight back (the blend is a half turn):
+    the cycle raised ValueError (math domain error) in groupexec._blend_pays."""
+    ctl = free_axes(2)
+    g = Group(ctl, ["x", "y"], feed=57957.5, acc_time=0.0431654)
+    g.set_axis_limit_policy("slow")
+    g.set_max_pulse_acc([2e6, 2e6])
+    g.enable_blend(105.95347881126578)
+    g.line([20_000, 0])
+    g.arc([19078.9857633636, 3921.4886617331963], [18840.09393231954, -99.61457509738375],
+          direction="CCW")
+    return ctl, g
+
+
+def test_4_blend_next_to_a_reversing_arc_does_not_raise():
+    ctl, g = _reversing_arc_group()
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
+                         and not any(a.is_moving for a in g.axes), 10.0)
+    assert g.error_code == 0
+    assert list(g.position) == pytest.approx([18840.09393231954, -99.61457509738375],
+                                             abs=1e-6)
+
+
+def test_4_a_planner_failure_becomes_a_fault_of_that_group(monkeypatch):
+    from openmotion.control import groupexec
+
+    ctl = free_axes(3)
+    g = Group(ctl, ["x", "y"], feed=20_000)
+    z = ctl["z"]
+    z.move_velocity(1000)
+    for k in range(1, 40):
+        g.line([1000 * k, 500 * (k % 2)])
+    ctl.advance(0.05)
+    assert g.state is GroupState.MOVING
+
+    def broken(*a, **kw):
+        raise ZeroDivisionError("planner bug")
+
+    monkeypatch.setattr(groupexec.pathrun, "replan", broken)
+    for _ in range(3000):  # the next join fails inside the cycle: nothing escapes
+        ctl.step()
+        if g.state is GroupState.ERROR:
+            break
+    assert g.state is GroupState.ERROR and "planner" in g.error_message
+    assert all(a.state.value == "ErrorStop" for a in g.axes)
+    assert all(not a.is_moving for a in g.axes)
+    assert z.is_moving and z.fault is None  # the other axes carry on
+    assert any("planner" in e.detail for e in ctl.events.events())
+    monkeypatch.undo()
+    g.clear_error()
+    for a in g.axes:
+        a.reset()
+    g.line([0, 0])
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
+                         and not any(a.is_moving for a in g.axes), 10.0)
+
+
+def test_4_an_exception_in_any_hook_never_escapes_the_cycle():
+    ctl = free_axes(2)
+    x = ctl["x"]
+    x.move_velocity(5000)
+    ctl.advance(0.01)
+
+    def bad_hook(c, t):
+        raise RuntimeError("hook bug")
+
+    ctl.add_cycle_hook(bad_hook)
+    ctl.step()  # does not raise
+    assert x.state.value == "ErrorStop" and not x.is_moving
+    assert any(e.kind == "cycle_error" for e in ctl.events.events())
+    n = ctl.cycles
+    ctl.advance(0.01)
+    assert ctl.cycles == n + 10
+
+
+def test_4_the_realtime_cycle_thread_survives_a_failing_hook():
+    import time
+
+    ctl = free_axes(1)
+    fails = []
+
+    def bad_hook(c, t):
+        fails.append(t)
+        raise RuntimeError("hook bug")
+
+    ctl.add_cycle_hook(bad_hook)
+    with ctl.start_realtime():
+        time.sleep(0.05)
+        assert ctl.realtime
+    assert len(fails) > 3

@@ -19,6 +19,7 @@ a thread; `stop_realtime()`; `with controller.start_realtime(): ...`; `cycle_sta
 
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 from collections.abc import Callable, Sequence
@@ -98,6 +99,8 @@ class Controller:
         self._motion_checks: list[MotionCheck] = []
         self._motion_hooks: list[MotionHook] = []
         self._estop = False
+        #: cycles that raised (each one became a fault, see `step`)
+        self.cycle_errors = 0
         self._inputs: list[dict[str, bool]] = [{} for _ in self.axes]
         self._nc = [{s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy")
                      if ax.signal_logic(s) == "nc"} for ax in config.axes]
@@ -292,7 +295,39 @@ class Controller:
 
     # ------------------------------------------------------------------ the cycle
     def step(self) -> None:
-        """Run one cycle (virtual time: the caller paces it)."""
+        """Run one cycle (virtual time: the caller paces it). No exception escapes it: a
+        failure anywhere in the cycle (a hook, an engine, the hardware) becomes a fault -
+        see `_cycle_failed` - and the cycle still ends on time."""
+        n = self._n + 1
+        try:
+            self._step()
+        except Exception as err:  # the cycle must go on: safety reactions run in it
+            self._cycle_failed(n, err)
+
+    def _cycle_failed(self, n: int, err: Exception) -> None:
+        """A cycle raised: every axis still moving stops at once in ErrorStop ("cycle
+        error: ..."), a `cycle_error` event records it, and the cycle's time is completed
+        (the hardware advanced to its end) so virtual and real time stay exact. Engines
+        that can contain their own failures (groups) do so first and never get here."""
+        with self._lock:
+            self.cycle_errors += 1
+            t1 = self._t_origin + n * self.period
+            reason = f"cycle error: {type(err).__name__}: {err}"
+            # each step is guarded on its own: one failing part must not stop the rest
+            for ax in self.axes:
+                if ax.is_moving:
+                    with contextlib.suppress(Exception):
+                        ax.fault_stop(reason)
+            if self._n < n:  # the failure came before the hardware reached the cycle end
+                with contextlib.suppress(Exception):
+                    self.hardware.advance(t1)
+                self._n, self._time = n, t1
+            events = getattr(self, "events", None)
+            if events is not None:
+                with contextlib.suppress(Exception):
+                    events.record("cycle_error", None, self._time, None, reason)
+
+    def _step(self) -> None:
         with self._lock:
             t0 = self._time
             n = self._n + 1

@@ -41,6 +41,7 @@ from .groupexec import (
     ERR_AXIS_STATE,
     ERR_GROUP,
     ERR_LIMIT,
+    ERR_PLANNER,
     ERR_QUEUE_FULL,
     ERR_SPEED,
     ERR_STATE,
@@ -58,8 +59,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ERR_ACCEL", "ERR_ARC", "ERR_ARGUMENT", "ERR_AXIS_BUSY", "ERR_AXIS_FAULT", "ERR_AXIS_STATE",
-    "ERR_GROUP", "ERR_LIMIT", "ERR_QUEUE_FULL", "ERR_SPEED", "ERR_STATE", "Group", "GroupError",
-    "GroupState",
+    "ERR_GROUP", "ERR_LIMIT", "ERR_PLANNER", "ERR_QUEUE_FULL", "ERR_SPEED", "ERR_STATE", "Group",
+    "GroupError", "GroupState",
 ]
 
 

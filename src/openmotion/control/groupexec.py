@@ -68,6 +68,7 @@ ERR_GROUP = -8         # the group is in error: clear_error() first
 ERR_LIMIT = -9         # run time: limit switch reached by a group axis
 ERR_AXIS_FAULT = -10   # run time: a group axis went to ErrorStop
 ERR_STATE = -11        # command not allowed in the group's state (e.g. continue when not held)
+ERR_PLANNER = -12      # run time: the group's planner failed in the cycle (the group stopped)
 
 
 class GroupState(Enum):
@@ -185,6 +186,26 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                          str_vel=str_vel, **self._corner_limits())
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
+        """The group's cycle hook. A failure in it (a planner bug) never escapes the cycle:
+        it becomes a fault of this group alone (`_planner_failed`)."""
+        try:
+            self._cycle_step(t)
+        except Exception as err:
+            self._planner_failed(err)
+
+    def _planner_failed(self, err: Exception) -> None:
+        """Stop the group's path at once, put its axes in ErrorStop (one fault event each
+        in ctl.events) and the group in error ERR_PLANNER; other axes carry on."""
+        msg = f"planner failure: {type(err).__name__}: {err}"
+        self._fault(ERR_PLANNER, msg)
+        if self._dry:
+            return
+        with self._commanding():
+            for a in self.axes:
+                if a.state is not AxisState.ERROR_STOP:
+                    a.fault_stop(f"group {msg}")
+
+    def _cycle_step(self, t: float) -> None:
         if self._state is GroupState.ERROR:
             return
         if self._run is not None and not self._dry and self._check_faults():
@@ -452,7 +473,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                                   axis_amax=amax,
                                   square_corner_velocity=corner["square_corner_velocity"],
                                   axis_vjump=corner["axis_vjump"])[1][1]
-        if not _blend_pays(b, accel, cmd.feed, v_corner):
+        trims = (float(prev.length - b.first.length), float(el.length - b.second.length))
+        if not _blend_pays(b, accel, cmd.feed, v_corner, trims):
             return None
         return b.first, b.arc, b.second
 
@@ -614,7 +636,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                     a.stop_immediately()
 
 
-def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> bool:
+def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0,
+                trims: tuple[float, float] | None = None) -> bool:
     """Whether rounding a corner is faster than taking it unrounded: stopping exactly at it
     or, with a corner velocity, passing it at `v_corner` (an estimate).
 
@@ -625,7 +648,10 @@ def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> boo
     time(D from rest) and the blend time(D - d from v_c); the blend pays when
     L/v_c + 2*time(D - d, v_c) < 2*time(D, 0); F is capped by the centripetal speed of
     an arc next to the corner. A sharp corner with a small tolerance gets an
-    arc so tight that it would crawl: it stops exactly instead.
+    arc so tight that it would crawl: it stops exactly instead. A blend that turns half a
+    circle or more (a line into an arc that starts back along it) has no finite
+    R*tan(phi/2): d is then the mean of what the blend trimmed off the two elements
+    (`trims`), never negative (a negative d made a square root of a negative number).
     """
     length = float(b.arc.length)
     kappa = float(b.arc.max_curvature)
@@ -636,12 +662,16 @@ def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> boo
         if k_el > 0.0:
             feed = min(feed, math.sqrt(math.sqrt(0.75) * accel / k_el))
     radius = 1.0 / kappa
-    d = radius * math.tan(0.5 * length / radius)
+    phi = length / radius
+    d = radius * math.tan(0.5 * phi) if phi < math.pi * (1.0 - 1e-9) else math.nan
+    if not (math.isfinite(d) and d >= 0.0):
+        d = max(0.0, 0.5 * (trims[0] + trims[1])) if trims is not None else 0.0
     v_c = min(feed, math.sqrt(math.sqrt(0.75) * accel * radius))
     reach = min(float(b.first.length), float(b.second.length)) + d
     span = min(d + feed * feed / (2.0 * accel), reach)
 
     def time(dist: float, v0: float) -> float:
+        dist = max(0.0, dist)
         d_acc = (feed * feed - v0 * v0) / (2.0 * accel)
         if dist <= d_acc:
             return (math.sqrt(v0 * v0 + 2.0 * accel * dist) - v0) / accel
