@@ -312,3 +312,44 @@ def test_4_the_realtime_cycle_thread_survives_a_failing_hook():
         time.sleep(0.05)
         assert ctl.realtime
     assert len(fails) > 3
+
+
+# -- 5: a following-error trip keeps the history in step with the counters ------------
+def _servo_and_steppers():
+    from openmotion.config import AxisConfig, DriveConfig, LoopConfig, MachineConfig
+
+    loop = LoopConfig(a=0xD8, b=0x00, k=0x10, samples_per_cycle=2, following_error=200.0)
+    servo = AxisConfig("x", pulses_per_rev=4000, encoder_lines_per_rev=1000, unit="pulse",
+                       lead=4000.0, max_speed=200000.0, drive=DriveConfig(type="dc_servo"),
+                       loop=loop)
+    ctl = Controller(MachineConfig(axes=(servo, AxisConfig("y"), AxisConfig("z"))))
+    ctl.enable_all()
+    return ctl
+
+
+def test_5_following_error_trip_keeps_history_and_counters_in_step():
+    ctl = _servo_and_steppers()
+    g = Group(ctl, ["x", "y", "z"], feed=20_000, acc_time=0.05)
+    g.line([40_000, 30_000, 20_000])
+    ctl.advance(0.3)
+    ctl.hardware.scenario.inject_following_error(0, 1000, at=ctl.time + 0.0004)
+    ctl.advance(0.01)
+    x = ctl["x"]
+    assert x.state.value == "ErrorStop" and x.fault == "following error"
+    assert g.state is GroupState.ERROR
+    ctl.advance(0.05)
+    for ax in ctl.axes:
+        hist = ctl.history.state_at(ax.index, ctl.time).p
+        out = ctl.hardware.read_axis(ax.index).pulses_out - ax.counters.out_offset
+        assert hist == pytest.approx(ax.raw_position, abs=1e-9), ax.name
+        assert abs(out - hist) <= 0.5 + 1e-9, ax.name  # emitted pulses = history (rounded)
+
+
+def test_5_inject_following_error_needs_a_closed_loop_axis():
+    from openmotion.errors import MotionError
+
+    ctl = _servo_and_steppers()
+    with pytest.raises(MotionError, match="closed-loop"):
+        ctl.hardware.scenario.inject_following_error(1, 100)
+    with pytest.raises(MotionError, match="counts must be finite"):
+        ctl.hardware.scenario.inject_following_error(0, math.nan)

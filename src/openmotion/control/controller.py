@@ -99,6 +99,7 @@ class Controller:
         self._motion_checks: list[MotionCheck] = []
         self._motion_hooks: list[MotionHook] = []
         self._estop = False
+        self._committed: float | None = None  # inside a cycle: the end its pulses reach
         #: cycles that raised (each one became a fault, see `step`)
         self.cycle_errors = 0
         self._inputs: list[dict[str, bool]] = [{} for _ in self.axes]
@@ -322,6 +323,7 @@ class Controller:
                 with contextlib.suppress(Exception):
                     self.hardware.advance(t1)
                 self._n, self._time = n, t1
+            self._committed = None
             events = getattr(self, "events", None)
             if events is not None:
                 with contextlib.suppress(Exception):
@@ -337,11 +339,13 @@ class Controller:
                 cmd = ax._command(t0, t1)
                 if cmd is not None:
                     hw.command(ax.index, cmd)
+            self._committed = t1  # the hardware has every axis's pulses up to t1
             for pre in tuple(self._pre_hooks):
                 pre(self, t0, t1)
             edges = hw.advance(t1) if not self._sample_hooks else self._sampled(t0, t1)
             self._n = n
             self._time = t1
+            self._committed = None
             if edges:
                 hooks = self._edge_hooks
                 for e in edges:
@@ -480,7 +484,10 @@ class Controller:
     def _motion_changed(self, axis: Axis, motion: ActiveMotion | None) -> None:
         """An axis started, re-planned or killed its motion: keep the history in step."""
         if motion is None:
-            self.history.truncate(axis.index, self._time)
+            # killed inside a cycle (a pre-advance or sample hook: a following-error trip):
+            # the cycle's pulses are already with the hardware, so the motion ends at t1
+            t = self._time if self._committed is None else self._committed
+            self.history.truncate(axis.index, t)
         else:
             self.history.append(axis.index, motion.t_start, motion.profile)
         for hook in tuple(self._motion_hooks):
