@@ -107,7 +107,7 @@ class Controller:
                      if ax.signal_logic(s) == "nc"} for ax in config.axes]
         self._emg_nc = any(ax.signal_logic("emg") == "nc" for ax in config.axes)
         self.recorder: Any = None
-        self._pacer = RealtimePacer(self.step, self.period)
+        self._pacer = RealtimePacer(self.step, self.period, self._overran)
         self._rb_cycle = [-1] * len(self.axes)
         self._estop = self._emg_level_active(hardware.read_input("emg"))
         from .servoloop import attach_servo_loops  # closed loops of axes with a loop config
@@ -470,8 +470,18 @@ class Controller:
         return self._pacer.running
 
     def cycle_stats(self) -> CycleStats:
-        """Statistics of the real-time cycles (mean, p99, max jitter, overruns)."""
+        """Statistics of the real-time cycles (busy and jitter mean/p99/max, overruns, late
+        cycles run in catch-up, the most slots behind, cycles that raised)."""
         return self._pacer.stats()
+
+    def _overran(self, count: int, behind: int) -> None:
+        """Real-time pacer: a burst of overruns began; record an `overrun` event."""
+        events = getattr(self, "events", None)
+        if events is not None:
+            with contextlib.suppress(Exception):
+                events.record("overrun", None, self._time, None,
+                              f"cycle overran its period (overrun {count}, {behind} slots "
+                              "behind; the late cycles run in catch-up, none is skipped)")
 
     def __enter__(self) -> Controller:
         return self
