@@ -381,3 +381,67 @@ def test_14_overruns_are_counted_reported_and_no_cycle_is_skipped():
     # no slot skipped: the 45 slots the slow cycles overran were run in catch-up (they
     # were dropped before: about 155 cycles in 200 slots)
     assert ctl.cycles >= 0.9 * slots - 5
+
+
+# -- 13: history records: no degenerate records, bounded memory ------------------------
+def _profile(rows, duration, start, end):
+    import numpy as np
+
+    from openmotion.profile.segments import Profile
+
+    t0, p0, v0, a0, j = (np.array(c, dtype=float) for c in zip(*rows, strict=True))
+    return Profile(t0, p0, v0, a0, j, duration, start, end)
+
+
+def test_13_history_drops_zero_length_and_sub_nanosecond_records():
+    from openmotion.history import MotionHistory
+
+    h = MotionHistory(1)
+    # a 0 s segment with a huge acceleration, then a 1e-14 s one at 1.1e9 pps
+    prof = _profile([(0.0, 0.0, 0.0, 1.6e23, 0.0), (0.0, 0.0, 0.0, 1000.0, 0.0),
+                     (0.1, 5.0, 100.0, 0.0, 0.0), (0.1 + 1e-14, 15.0, 1.1e9, 0.0, 0.0),
+                     (0.1 + 2e-14, 15.0, 100.0, 0.0, 0.0)],
+                    0.2, State(0.0), State(25.0, 100.0))
+    h.append(0, 1.0, prof)
+    rec = h.records(0)
+    dur = rec["ts"][1:] - rec["ts"][:-1]
+    assert dur.min() > 1e-9
+    assert abs(rec["a0"]).max() <= 1000.0 and abs(rec["v0"]).max() <= 100.0
+    assert h.state_at(0, 1.15).p == pytest.approx(15.0 + 100.0 * 0.05, abs=1e-9)
+    # a re-plan 1e-14 s after a record start leaves no sliver either
+    h.append(0, 1.1 + 1e-14, _profile([(0.0, 5.0, 100.0, 0.0, 0.0)], 0.1,
+                                      State(5.0, 100.0), State(15.0, 100.0)))
+    rec = h.records(0)
+    assert (rec["ts"][1:] - rec["ts"][:-1]).min() > 1e-9
+
+
+def test_13_history_memory_shrinks_after_a_burst_and_is_capped():
+    from openmotion.history import MotionHistory
+
+    h = MotionHistory(1, window_s=1.0, max_records=5000)
+    n = 20_000
+    rows = [(k * 1e-4, float(k), 1.0, 0.0, 0.0) for k in range(n)]
+    h.append(0, 0.0, _profile(rows, n * 1e-4, State(0.0), State(float(n))))
+    assert h.n_records(0) <= 5000  # capped (the oldest dropped)
+    big = h.capacity(0)
+    for k in range(10):  # quiet motion long after: the burst leaves the window
+        h.append(0, 10.0 + k, _profile([(0.0, 0.0, 0.0, 0.0, 0.0)], 0.5, State(0.0),
+                                       State(0.0)))
+    assert h.n_records(0) < 50
+    assert h.capacity(0) <= max(256, big // 8)
+
+
+def test_13_controller_history_has_no_degenerate_records_after_stops_and_changes():
+    ctl = free_axes(1)
+    x = ctl["x"]
+    for k in range(5):
+        x.move_velocity(50_000 + 1000 * k, tacc=0.05, shape="S")
+        ctl.advance(0.013 * (k + 1))
+        x.change_speed(20_000 + 500 * k, 0.03)
+        ctl.advance(0.011)
+        x.stop()
+        assert ctl.wait_motion_done(timeout=5.0)
+    rec = ctl.history.records(0)
+    dur = rec["ts"][1:] - rec["ts"][:-1]
+    assert dur.min() > 1e-9
+    assert abs(rec["v0"]).max() <= x.max_speed
