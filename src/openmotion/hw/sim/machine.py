@@ -366,6 +366,12 @@ class SimMachine:
             self._di[k] = level
             raw.append((self._t, None, signal, level, None))
 
+    def _set_ready(self, axis: int, ready: bool, raw: list) -> None:
+        ax = self._axes[axis]
+        before = ax.level("rdy")
+        ax.not_ready = not ready
+        self._edge(raw, ax, "rdy", before)
+
     def _knock(self, axis: int, counts: float, raw: list) -> None:
         """Move a dc_servo motor `counts` command pulses back (a following error)."""
         ax = self._axes[axis]

@@ -114,6 +114,15 @@ class Scenario:
         t = self._at(at)
         self._push(t, lambda raw: self._m._step_loss(axis, pulses, raw))
 
+    def set_drive_ready(self, axis: int, ready: bool, at: float | None = None) -> None:
+        """The drive of `axis` drops (False) or restores (True) its RDY output without an
+        alarm (a lost enable chain, an undervoltage): RDY reads inactive meanwhile."""
+        self._m._axis(axis)
+        if not isinstance(ready, bool):
+            raise MotionError(f"ready must be a bool, got {ready!r}")
+        t = self._at(at)
+        self._push(t, lambda raw: self._m._set_ready(axis, ready, raw))
+
     def inject_following_error(self, axis: int, counts: float, at: float | None = None
                                ) -> None:
         """The motor of closed-loop (dc_servo) `axis` is knocked `counts` motor pulses (the
