@@ -12,9 +12,16 @@ PSO, limits). As in Klipper's trapq, any time maps to exactly one record:
 - times before the oldest retained record read that record's start position at rest.
 
 Memory is bounded (architecture.md "Memory is bounded"): records that ended more than
-`window_s` before the newest append are dropped, and each axis stores its records in numpy
-arrays that are compacted or grown in chunks, so appending is amortised O(1) and a 10-hour
-job runs in flat memory.
+`window_s` before the newest append are dropped, and at most `max_records` records per axis
+are kept (the oldest go first). Each axis stores its records in numpy arrays that are
+compacted or grown in chunks, and shrunk again when at most an eighth of them is live, so
+appending is amortised O(1) and memory follows what the window holds, not its high-water
+mark: a 10-hour job runs in flat memory.
+
+No degenerate records: a record shorter than `MIN_RECORD_S` (a zero-length segment with a
+velocity or acceleration step, or a float sliver of 1e-14 s at a splice) covers no time
+worth reading, so it is not stored; the record before it runs on for that instant (an
+error below v * 1 ns, far under a pulse).
 """
 
 from __future__ import annotations
@@ -32,6 +39,10 @@ from .profile.segments import Profile, Samples, State
 Array = NDArray[np.float64]
 
 _MIN_CAPACITY = 32
+#: Shortest record stored (s); shorter segments are dropped (see the module docstring).
+MIN_RECORD_S = 1e-9
+#: Default most records kept per axis (5 float64 columns: 40 bytes a record, 4 MB).
+MAX_RECORDS = 100_000
 
 
 class _Track:
@@ -71,6 +82,19 @@ class _Track:
             old = getattr(self, name)
             new = old if new_cap == cap else np.empty(new_cap)
             new[:live] = old[self.lo:self.hi]
+            setattr(self, name, new)
+        self.lo, self.hi = 0, live
+
+    def shrink(self) -> None:
+        """Give memory back when at most an eighth of the buffer is live."""
+        live = self.hi - self.lo
+        cap = self.capacity
+        if cap <= 4 * _MIN_CAPACITY or 8 * live > cap:
+            return
+        new_cap = max(2 * live, _MIN_CAPACITY)
+        for name in ("ts", "p0", "v0", "a0", "j"):
+            new = np.empty(new_cap)
+            new[:live] = getattr(self, name)[self.lo:self.hi]
             setattr(self, name, new)
         self.lo, self.hi = 0, live
 
@@ -115,10 +139,16 @@ class MotionHistory:
     """
 
     def __init__(self, n_axes: int, window_s: float = 60.0, *,
-                 positions: Sequence[float] | None = None, t_start: float = 0.0) -> None:
+                 positions: Sequence[float] | None = None, t_start: float = 0.0,
+                 max_records: int = MAX_RECORDS) -> None:
         if not isinstance(n_axes, Integral) or isinstance(n_axes, bool) or n_axes < 1:
             raise MotionError(f"n_axes must be an integer >= 1, got {n_axes!r}")
         self.window_s = check_positive("window_s", window_s)
+        if isinstance(max_records, bool) or not isinstance(max_records, Integral) or \
+                not 16 <= max_records <= 10**9:
+            raise MotionError(f"max_records must be an integer in [16, 1e9], "
+                              f"got {max_records!r}")
+        self.max_records = int(max_records)
         t_start = check_finite("t_start", t_start)
         if positions is None:
             pos = [0.0] * int(n_axes)
@@ -156,20 +186,29 @@ class MotionHistory:
         first = float(profile.t0[0]) if n else profile.duration
         self._cut(tr, t_abs)
         tr.reserve(n + 2)
-        if first > 0.0:
+        if first > MIN_RECORD_S:
             # Profile semantics before its first segment: the start state at constant speed.
             tr.push(t_abs, profile.start.p, profile.start.v, 0.0, 0.0)
+        t_end = t_abs + profile.duration
         if n:
-            sl = slice(tr.hi, tr.hi + n)
-            tr.ts[sl] = t_abs + profile.t0
-            tr.p0[sl] = profile.p0
-            tr.v0[sl] = profile.v0
-            tr.a0[sl] = profile.a0
-            tr.j[sl] = profile.j
-            tr.hi += n
+            ts = t_abs + profile.t0
+            keep = np.diff(ts, append=t_end) > MIN_RECORD_S
+            if not keep.all():  # drop zero-length and sub-nanosecond segments
+                idx = np.flatnonzero(keep)
+                ts = ts[idx]
+                cols = (profile.p0[idx], profile.v0[idx], profile.a0[idx], profile.j[idx])
+            else:
+                cols = (profile.p0, profile.v0, profile.a0, profile.j)
+            m = ts.size
+            sl = slice(tr.hi, tr.hi + m)
+            tr.ts[sl] = ts
+            tr.p0[sl], tr.v0[sl], tr.a0[sl], tr.j[sl] = cols
+            tr.hi += m
         end = profile.end
-        tr.push(t_abs + profile.duration, end.p, end.v, 0.0, 0.0)
+        tr.push(t_end, end.p, end.v, 0.0, 0.0)
         self._forget(tr, t_abs - self.window_s)
+        if tr.hi - tr.lo > self.max_records:
+            tr.lo = tr.hi - self.max_records
 
     def truncate(self, axis: int, t_abs: float, hold: float | None = None) -> State:
         """Cut everything after `t_abs`; the axis holds its position there at rest (or
@@ -188,8 +227,12 @@ class MotionHistory:
 
     @staticmethod
     def _cut(tr: _Track, t_abs: float) -> None:
-        """Drop records starting at or after t_abs (the one covering t_abs now ends there)."""
-        k = tr.lo + int(np.searchsorted(tr.ts[tr.lo:tr.hi], t_abs, side="left"))
+        """Drop records starting at or after t_abs (the one covering t_abs now ends there),
+        and one that would be left shorter than MIN_RECORD_S (unless it is the oldest)."""
+        live = tr.ts[tr.lo:tr.hi]
+        k = tr.lo + int(np.searchsorted(live, t_abs - MIN_RECORD_S, side="left"))
+        if k == tr.lo:
+            k = tr.lo + int(np.searchsorted(live, t_abs, side="left"))
         tr.hi = k
 
     def forget_before(self, t: float, axis: int | None = None) -> None:
@@ -211,6 +254,7 @@ class MotionHistory:
         k = tr.index_at(t)
         if k > tr.lo:
             tr.lo = k
+            tr.shrink()
 
     # ------------------------------------------------------------------ reading
     def state_at(self, axis: int, t: float) -> State:

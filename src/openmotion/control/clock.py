@@ -5,6 +5,14 @@ Virtual time is the cycle count times the period (no float accumulation, so cycl
 ends at exactly n * period). Real time runs the same cycle function; it records, per cycle,
 how late the cycle started against its schedule (jitter) and how long it took, in a ring
 buffer of fixed size, so statistics cost flat memory however long it runs.
+
+Falling behind: motion time is never skipped. A cycle that ends after the next one was due
+is an overrun; the cycles whose slot passed meanwhile are not dropped but run back to back
+as soon as possible (catch-up), each counted as late (`CycleStats.late`), until the
+schedule is met again; `behind` is the most slots the pacer was ever behind. So the motion
+keeps its exact time (cycle n is always the motion of [(n-1)T, nT]); only its delivery to
+the hardware is late. `on_overrun(count, behind)` is called at the first overrun of each
+burst (the controller records an `overrun` event).
 """
 
 from __future__ import annotations
@@ -36,7 +44,9 @@ class CycleStats:
     """Real-time cycle statistics over the last (up to 65536) cycles, in seconds.
 
     jitter = start lateness against the schedule; busy = time spent inside the cycle;
-    overruns = cycles that ended after the next cycle was due (counted over the whole run).
+    overruns = cycles that ended after the next cycle was due; late = cycles started after
+    their whole slot had passed (run in catch-up, never skipped); behind = the most slots
+    the pacer was behind at once; errors = cycles that raised (counted over the whole run).
     """
 
     cycles: int
@@ -48,14 +58,22 @@ class CycleStats:
     p99_jitter: float
     max_jitter: float
     overruns: int
+    late: int = 0
+    behind: int = 0
+    errors: int = 0
 
 
 class RealtimePacer:
     """Runs `cycle()` every `period` seconds of wall clock on a daemon thread."""
 
-    def __init__(self, cycle: Callable[[], None], period: float) -> None:
+    def __init__(self, cycle: Callable[[], None], period: float,
+                 on_overrun: Callable[[int, int], None] | None = None) -> None:
         self._cycle = cycle
         self._period = period
+        self._on_overrun = on_overrun
+        self._late_cycles = 0
+        self._behind = 0
+        self._errors = 0
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._busy = np.zeros(_STATS_WINDOW)
@@ -86,6 +104,7 @@ class RealtimePacer:
         clock = _time.perf_counter
         period = self._period
         t_next = clock()
+        in_burst = False
         try:
             while not self._stop.is_set():
                 now = clock()
@@ -95,25 +114,36 @@ class RealtimePacer:
                     _time.sleep(t_next - now)
                     now = clock()
                 start = now
-                self._cycle()
+                if start - t_next >= period:  # this cycle's slot passed: catch-up
+                    self._late_cycles += 1
+                try:
+                    self._cycle()
+                except Exception as exc:  # the cycle guards itself; never let it die
+                    self.error = exc
+                    self._errors += 1
                 end = clock()
                 i = self._n % _STATS_WINDOW
                 self._late[i] = start - t_next
                 self._busy[i] = end - start
                 self._n += 1
-                t_next += period
+                t_next += period  # never skip a slot: motion time stays exact
                 if end > t_next:
                     self._overruns += 1
-                    # Do not try to catch up a backlog in a burst: resume on the grid.
-                    missed = int((end - t_next) // period) + 1
-                    t_next += missed * period
+                    behind = int((end - t_next) // period) + 1
+                    self._behind = max(self._behind, behind)
+                    if not in_burst and self._on_overrun is not None:
+                        self._on_overrun(self._overruns, behind)
+                    in_burst = True
+                else:
+                    in_burst = False
         except BaseException as exc:  # surfaced by stop()/stats, never silently dropped
             self.error = exc
 
     def stats(self) -> CycleStats:
         n = min(self._n, _STATS_WINDOW)
         if n == 0:
-            return CycleStats(0, self._period, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
+            return CycleStats(0, self._period, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0,
+                              0, 0, self._errors)
         busy = self._busy[:n]
         late = self._late[:n]
         return CycleStats(
@@ -126,6 +156,9 @@ class RealtimePacer:
             p99_jitter=float(np.percentile(late, 99)),
             max_jitter=float(late.max()),
             overruns=self._overruns,
+            late=self._late_cycles,
+            behind=self._behind,
+            errors=self._errors,
         )
 
 

@@ -19,6 +19,7 @@ a thread; `stop_realtime()`; `with controller.start_realtime(): ...`; `cycle_sta
 
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 from collections.abc import Callable, Collection, Sequence
@@ -48,6 +49,7 @@ PreAdvanceHook = Callable[["Controller", float, float], None]
 SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
+MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
 
 
 class Controller:
@@ -104,13 +106,17 @@ class Controller:
         self._samples = 1  # sub-steps per cycle: lcm of the sample hooks' rates
         self._fault_hooks: list[FaultHook] = []
         self._motion_checks: list[MotionCheck] = []
+        self._motion_hooks: list[MotionHook] = []
         self._estop = False
+        self._committed: float | None = None  # inside a cycle: the end its pulses reach
+        #: cycles that raised (each one became a fault, see `step`)
+        self.cycle_errors = 0
         self._inputs: list[dict[str, bool]] = [{} for _ in self.axes]
         self._nc = [{s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy")
                      if ax.signal_logic(s) == "nc"} for ax in config.axes]
         self._emg_nc = any(ax.signal_logic("emg") == "nc" for ax in config.axes)
         self.recorder: Any = None
-        self._pacer = RealtimePacer(self.step, self.period)
+        self._pacer = RealtimePacer(self.step, self.period, self._overran)
         self._rb_cycle = [-1] * len(self.axes)
         self._estop = self._emg_level_active(hardware.read_input("emg"))
         from .servoloop import attach_servo_loops  # closed loops of axes with a loop config
@@ -286,6 +292,20 @@ class Controller:
             if check in self._motion_checks:
                 self._motion_checks.remove(check)
 
+    def add_motion_hook(self, hook: MotionHook) -> None:
+        """Call `hook(axis, motion)` whenever an axis starts, re-plans or kills its motion
+        (motion None: stopped at once, disabled, faulted). Not called when a motion ends by
+        itself. A group engine subscribes to react to its axes being stopped directly."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._motion_hooks.append(hook)
+
+    def remove_motion_hook(self, hook: MotionHook) -> None:
+        with self._lock:
+            if hook in self._motion_hooks:
+                self._motion_hooks.remove(hook)
+
     def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
         for check in tuple(self._motion_checks):
             check(axis, motion)
@@ -312,7 +332,40 @@ class Controller:
 
     # ------------------------------------------------------------------ the cycle
     def step(self) -> None:
-        """Run one cycle (virtual time: the caller paces it)."""
+        """Run one cycle (virtual time: the caller paces it). No exception escapes it: a
+        failure anywhere in the cycle (a hook, an engine, the hardware) becomes a fault -
+        see `_cycle_failed` - and the cycle still ends on time."""
+        n = self._n + 1
+        try:
+            self._step()
+        except Exception as err:  # the cycle must go on: safety reactions run in it
+            self._cycle_failed(n, err)
+
+    def _cycle_failed(self, n: int, err: Exception) -> None:
+        """A cycle raised: every axis still moving stops at once in ErrorStop ("cycle
+        error: ..."), a `cycle_error` event records it, and the cycle's time is completed
+        (the hardware advanced to its end) so virtual and real time stay exact. Engines
+        that can contain their own failures (groups) do so first and never get here."""
+        with self._lock:
+            self.cycle_errors += 1
+            t1 = self._t_origin + n * self.period
+            reason = f"cycle error: {type(err).__name__}: {err}"
+            # each step is guarded on its own: one failing part must not stop the rest
+            for ax in self.axes:
+                if ax.is_moving:
+                    with contextlib.suppress(Exception):
+                        ax.fault_stop(reason)
+            if self._n < n:  # the failure came before the hardware reached the cycle end
+                with contextlib.suppress(Exception):
+                    self.hardware.advance(t1)
+                self._n, self._time = n, t1
+            self._committed = None
+            events = getattr(self, "events", None)
+            if events is not None:
+                with contextlib.suppress(Exception):
+                    events.record("cycle_error", None, self._time, None, reason)
+
+    def _step(self) -> None:
         with self._lock:
             t0 = self._time
             n = self._n + 1
@@ -322,6 +375,7 @@ class Controller:
                 cmd = ax._command(t0, t1)
                 if cmd is not None:
                     hw.command(ax.index, cmd)
+            self._committed = t1  # the hardware has every axis's pulses up to t1
             for pre in tuple(self._pre_hooks):
                 pre(self, t0, t1)
             edges = hw.advance(t1) if not self._sample_hooks else self._sampled(t0, t1)
@@ -333,6 +387,7 @@ class Controller:
         t1 = self._t_origin + n * self.period
         self._n = n
         self._time = t1
+        self._committed = None
         if edges:
             hooks = self._edge_hooks
             for e in edges:
@@ -348,11 +403,15 @@ class Controller:
     def _run_cycles(self, n: int) -> None:
         """Run up to n cycles: one jump (control/jump.py) or one step."""
         with self._lock:
-            land = plan_jump(self, n)
-            if land > self._n + 1:
-                jump(self, land)
-            else:
-                self.step()
+            try:
+                land = plan_jump(self, n)
+                if land > self._n + 1:
+                    jump(self, land)
+                    return
+            except Exception as err:  # as in step(): nothing escapes the cycle
+                self._cycle_failed(self._n + 1, err)
+                return
+            self.step()
 
     def _sampled(self, t0: float, t1: float) -> list[InputEdge]:
         """Advance the hardware over [t0, t1] in sub-steps, running the sample hooks."""
@@ -477,8 +536,18 @@ class Controller:
         return self._pacer.running
 
     def cycle_stats(self) -> CycleStats:
-        """Statistics of the real-time cycles (mean, p99, max jitter, overruns)."""
+        """Statistics of the real-time cycles (busy and jitter mean/p99/max, overruns, late
+        cycles run in catch-up, the most slots behind, cycles that raised)."""
         return self._pacer.stats()
+
+    def _overran(self, count: int, behind: int) -> None:
+        """Real-time pacer: a burst of overruns began; record an `overrun` event."""
+        events = getattr(self, "events", None)
+        if events is not None:
+            with contextlib.suppress(Exception):
+                events.record("overrun", None, self._time, None,
+                              f"cycle overran its period (overrun {count}, {behind} slots "
+                              "behind; the late cycles run in catch-up, none is skipped)")
 
     def __enter__(self) -> Controller:
         return self
@@ -491,9 +560,14 @@ class Controller:
     def _motion_changed(self, axis: Axis, motion: ActiveMotion | None) -> None:
         """An axis started, re-planned or killed its motion: keep the history in step."""
         if motion is None:
-            self.history.truncate(axis.index, self._time)
+            # killed inside a cycle (a pre-advance or sample hook: a following-error trip):
+            # the cycle's pulses are already with the hardware, so the motion ends at t1
+            t = self._time if self._committed is None else self._committed
+            self.history.truncate(axis.index, t)
         else:
             self.history.append(axis.index, motion.t_start, motion.profile)
+        for hook in tuple(self._motion_hooks):
+            hook(axis, motion)
 
 
 # -- built-in edge hooks -------------------------------------------------------------------

@@ -43,6 +43,7 @@ from .groupexec import (
     ERR_AXIS_STATE,
     ERR_GROUP,
     ERR_LIMIT,
+    ERR_PLANNER,
     ERR_QUEUE_FULL,
     ERR_SPEED,
     ERR_STATE,
@@ -61,8 +62,8 @@ if TYPE_CHECKING:
 __all__ = [
     "PERIOD_PULSES_DEFAULT", "PERIOD_PULSES_MAX",
     "ERR_ACCEL", "ERR_ARC", "ERR_ARGUMENT", "ERR_AXIS_BUSY", "ERR_AXIS_FAULT", "ERR_AXIS_STATE",
-    "ERR_GROUP", "ERR_LIMIT", "ERR_QUEUE_FULL", "ERR_SPEED", "ERR_STATE", "Group", "GroupError",
-    "GroupState",
+    "ERR_GROUP", "ERR_LIMIT", "ERR_PLANNER", "ERR_QUEUE_FULL", "ERR_SPEED", "ERR_STATE", "Group",
+    "GroupError", "GroupState",
 ]
 
 
@@ -155,6 +156,8 @@ class Group(GroupSettings):
         self._run: _Run | None = None
         self._held: _Run | None = None
         self._aborting = False
+        self._own = 0          # > 0 while the group itself commands its axes
+        self._foreign: tuple[Axis, float] | None = None  # last axis stopped directly
         self._error = 0
         self._error_msg = ""
         self._override = 1.0
@@ -188,6 +191,8 @@ class Group(GroupSettings):
         controller.add_cycle_hook(self._on_cycle)
         if hasattr(controller, "add_fault_hook"):  # immediate reaction to axis faults
             controller.add_fault_hook(self._on_axis_fault)
+        if hasattr(controller, "add_motion_hook"):  # ... and to axes stopped directly
+            controller.add_motion_hook(self._on_axis_motion)
 
     # ------------------------------------------------------------------ status
     @property
@@ -306,6 +311,8 @@ class Group(GroupSettings):
         self._ctl.remove_cycle_hook(self._on_cycle)
         if hasattr(self._ctl, "remove_fault_hook"):
             self._ctl.remove_fault_hook(self._on_axis_fault)
+        if hasattr(self._ctl, "remove_motion_hook"):
+            self._ctl.remove_motion_hook(self._on_axis_motion)
         owners = OWNERS.get(self._ctl, {})
         for a in self.axes:
             if owners.get(a.index) is self:
@@ -422,7 +429,10 @@ class Group(GroupSettings):
     # ------------------------------------------------------------------ hold / continue / abort
     @_locked
     def hold(self) -> None:
-        """MCC_HoldMotion: decelerate along the path and stop; continue() resumes."""
+        """MCC_HoldMotion: decelerate along the path and stop; continue() resumes. In the
+        error state (a fault already stopped every axis) it does nothing."""
+        if self._state is GroupState.ERROR:
+            return
         if self._state is not GroupState.MOVING or self._run is None:
             raise GroupError(ERR_STATE, f"hold needs a moving group (state {self._state.value})")
         r = self._run
@@ -434,8 +444,9 @@ class Group(GroupSettings):
         if r.kind == "path":
             self._replan(r, hold=True)
         elif r.kind == "ptp" and not self._dry:
-            for a in self.axes:
-                a.stop()
+            with self._commanding():
+                for a in self.axes:
+                    a.stop()
         self._state = GroupState.HOLDING
 
     @_locked
@@ -505,6 +516,6 @@ class Group(GroupSettings):
                 if a.motion is not None and a.state is AxisState.DISCRETE_MOTION:
                     a.fix_speed_range(min(a.max_speed, spec.max_vel * 2.0))
                     # too close to the target: the move finishes at its speed
-                    with contextlib.suppress(InfeasibleError):
+                    with contextlib.suppress(InfeasibleError), self._commanding():
                         a.change_speed(min(a.max_speed, spec.max_vel * self._ptp_override),
                                        spec.tacc)

@@ -81,7 +81,9 @@ class GroupChecks(GroupEngine):
         self._check_accepting()
         if self._tail is None or (self._run is None and not self._queue
                                   and self._held is None):
-            self._tail = self.position
+            # while abort() is still stopping, the next command starts where it stops
+            self._tail = self._units_of(self._stop_point()) if self._aborting \
+                and self._run is not None else self.position
         return self._tail.copy()
 
     def _point(self, name: str, value: Sequence[float], base: np.ndarray | None) -> np.ndarray:

@@ -24,6 +24,7 @@ import math
 import weakref
 from collections import deque
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import TYPE_CHECKING, Any
@@ -67,6 +68,7 @@ ERR_GROUP = -8         # the group is in error: clear_error() first
 ERR_LIMIT = -9         # run time: limit switch reached by a group axis
 ERR_AXIS_FAULT = -10   # run time: a group axis went to ErrorStop
 ERR_STATE = -11        # command not allowed in the group's state (e.g. continue when not held)
+ERR_PLANNER = -12      # run time: the group's planner failed in the cycle (the group stopped)
 
 
 class GroupState(Enum):
@@ -146,6 +148,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     _run: _Run | None
     _held: _Run | None
     _aborting: bool
+    _own: int
+    _foreign: tuple[Axis, float] | None
     _error: int
     _error_msg: str
     _override: float
@@ -196,6 +200,26 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                          str_vel=str_vel, **self._corner_limits())
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
+        """The group's cycle hook. A failure in it (a planner bug) never escapes the cycle:
+        it becomes a fault of this group alone (`_planner_failed`)."""
+        try:
+            self._cycle_step(t)
+        except Exception as err:
+            self._planner_failed(err)
+
+    def _planner_failed(self, err: Exception) -> None:
+        """Stop the group's path at once, put its axes in ErrorStop (one fault event each
+        in ctl.events) and the group in error ERR_PLANNER; other axes carry on."""
+        msg = f"planner failure: {type(err).__name__}: {err}"
+        self._fault(ERR_PLANNER, msg)
+        if self._dry:
+            return
+        with self._commanding():
+            for a in self.axes:
+                if a.state is not AxisState.ERROR_STOP:
+                    a.fault_stop(f"group {msg}")
+
+    def _cycle_step(self, t: float) -> None:
         if self._state is GroupState.ERROR:
             return
         if self._run is not None and not self._dry and self._check_faults():
@@ -226,7 +250,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 if self._aborting:
                     self._aborting = False
                     self._state = GroupState.IDLE
-                    self._tail = None
+                    if not self._queue:  # commands queued during the stop keep their tail
+                        self._tail = None
                     return
                 self._held = r
                 self._state = GroupState.HELD
@@ -483,7 +508,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                                   axis_amax=amax,
                                   square_corner_velocity=corner["square_corner_velocity"],
                                   axis_vjump=corner["axis_vjump"])[1][1]
-        if not _blend_pays(b, accel, cmd.feed, v_corner):
+        trims = (float(prev.length - b.first.length), float(el.length - b.second.length))
+        if not _blend_pays(b, accel, cmd.feed, v_corner, trims):
             return None
         return b.first, b.arc, b.second
 
@@ -503,8 +529,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 profiles.append(planning.position_move(spec, float(start[k]),
                                                        float(target[k])))
             elif target[k] != a.position:
-                a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
-                                tdec=spec.tdec, shape=spec.shape)
+                with self._commanding():
+                    a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
+                                    tdec=spec.tdec, shape=spec.shape)
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
 
     def _launch(self, plan: pathrun.PathPlan, cmds: list[_Cmd], t: float) -> None:
@@ -544,8 +571,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             except MotionError as exc:
                 raise GroupError(ERR_LIMIT if "SL" in str(exc) or "limit" in str(exc)
                                  else ERR_AXIS_STATE, f"axis {a.name}: {exc}") from exc
-        for a, p, kw in args:
-            a.run_profile(p, **kw)
+        with self._commanding():
+            for a, p, kw in args:
+                a.run_profile(p, **kw)
 
     def _replan(self, r: _Run, *, hold: bool) -> None:
         """Re-plan the running chain from now: a hold (to rest) or a new override."""
@@ -557,11 +585,61 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         lim = r.plan.limits if hold else self._limits(r.plan.chain, r.plan.limits.str_vel)
         self._launch(pathrun.replan(r.plan, t, limits=lim, hold=hold), r.cmds, now)
 
+    def _stop_point(self) -> np.ndarray:
+        """Where the running motion comes to rest (pulses): each axis's profile end (the
+        group's own profiles in dry run), or its position when it has no motion."""
+        r = self._run
+        if self._dry and r is not None and r.profiles:
+            return np.array([p.end.p for p in r.profiles])
+        out = []
+        for a in self.axes:
+            m = a.motion
+            end = a.position if m is None or m.kind == "velocity" else \
+                m.profile.end.p + (a.position - a.raw_position)
+            out.append(end)
+        return np.array(out, dtype=float)
+
+    @contextmanager
+    def _commanding(self) -> Iterator[None]:
+        """The group itself changes its axes' motions (not a direct stop to react to)."""
+        self._own += 1
+        try:
+            yield
+        finally:
+            self._own -= 1
+
+    def _on_axis_motion(self, axis: Axis, motion: Any) -> None:
+        """Controller motion hook: a group axis was stopped (at once: motion None; or
+        decelerating: a "stop" motion) by someone else - a direct stop_immediately(),
+        stop() or disable(), a fault - while the group runs. Every axis stops the same way
+        at the same instant and the group goes to error, so none drives on off the path."""
+        if self._own or self._dry or axis not in self.axes or self._run is None or \
+                self._state not in (GroupState.MOVING, GroupState.HOLDING):
+            return
+        if motion is not None and motion.kind != "stop":
+            return
+        self._foreign = (axis, self._ctl.time)
+        if motion is None:
+            self._fault(ERR_AXIS_STATE, f"axis {axis.name}: stopped outside the group")
+            return
+        with self._commanding():  # a decelerating stop: the others decelerate too
+            for a in self.axes:
+                if a is not axis and a.motion is not None and a.motion.kind != "stop":
+                    a.stop()
+        self._fault(ERR_AXIS_STATE, f"axis {axis.name}: stopped outside the group",
+                    stop=False)
+
     def _on_axis_fault(self, axis: Axis, reason: str) -> None:
         """Controller fault hook: a group axis went to ErrorStop."""
+        code = ERR_LIMIT if "EL" in reason else ERR_AXIS_FAULT
+        if self._state is GroupState.ERROR and self._foreign == (axis, self._ctl.time):
+            # the motion hook reacted first (the fault stopped the axis): name the fault
+            self._foreign = None
+            self._error, self._error_msg = code, f"axis {axis.name}: {reason}"
+            self._stop_axes()
+            return
         if axis in self.axes and not self._dry and self._state in (
                 GroupState.MOVING, GroupState.HOLDING, GroupState.HELD):
-            code = ERR_LIMIT if "EL" in reason else ERR_AXIS_FAULT
             self._fault(code, f"axis {axis.name}: {reason}")
 
     def _check_faults(self) -> bool:
@@ -578,9 +656,11 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 return True
         return False
 
-    def _fault(self, code: int, message: str) -> None:
-        """Stop every axis of the group at once and drop the queue (MCCL 2.6.3 VI)."""
-        self._stop_axes()
+    def _fault(self, code: int, message: str, *, stop: bool = True) -> None:
+        """Stop every axis of the group at once and drop the queue (MCCL 2.6.3 VI);
+        `stop=False`: the axes are already stopping."""
+        if stop:
+            self._stop_axes()
         self._queue.clear()
         self._drop_join()
         self._run = self._held = None
@@ -591,12 +671,14 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
     def _stop_axes(self) -> None:
         if self._dry:
             return
-        for a in self.axes:
-            if a.state is not AxisState.ERROR_STOP:
-                a.stop_immediately()
+        with self._commanding():
+            for a in self.axes:
+                if a.state is not AxisState.ERROR_STOP:
+                    a.stop_immediately()
 
 
-def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> bool:
+def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0,
+                trims: tuple[float, float] | None = None) -> bool:
     """Whether rounding a corner is faster than taking it unrounded: stopping exactly at it
     or, with a corner velocity, passing it at `v_corner` (an estimate).
 
@@ -607,7 +689,10 @@ def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> boo
     time(D from rest) and the blend time(D - d from v_c); the blend pays when
     L/v_c + 2*time(D - d, v_c) < 2*time(D, 0); F is capped by the centripetal speed of
     an arc next to the corner. A sharp corner with a small tolerance gets an
-    arc so tight that it would crawl: it stops exactly instead.
+    arc so tight that it would crawl: it stops exactly instead. A blend that turns half a
+    circle or more (a line into an arc that starts back along it) has no finite
+    R*tan(phi/2): d is then the mean of what the blend trimmed off the two elements
+    (`trims`), never negative (a negative d made a square root of a negative number).
     """
     length = float(b.arc.length)
     kappa = float(b.arc.max_curvature)
@@ -618,12 +703,16 @@ def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0) -> boo
         if k_el > 0.0:
             feed = min(feed, math.sqrt(math.sqrt(0.75) * accel / k_el))
     radius = 1.0 / kappa
-    d = radius * math.tan(0.5 * length / radius)
+    phi = length / radius
+    d = radius * math.tan(0.5 * phi) if phi < math.pi * (1.0 - 1e-9) else math.nan
+    if not (math.isfinite(d) and d >= 0.0):
+        d = max(0.0, 0.5 * (trims[0] + trims[1])) if trims is not None else 0.0
     v_c = min(feed, math.sqrt(math.sqrt(0.75) * accel * radius))
     reach = min(float(b.first.length), float(b.second.length)) + d
     span = min(d + feed * feed / (2.0 * accel), reach)
 
     def time(dist: float, v0: float) -> float:
+        dist = max(0.0, dist)
         d_acc = (feed * feed - v0 * v0) / (2.0 * accel)
         if dist <= d_acc:
             return (math.sqrt(v0 * v0 + 2.0 * accel * dist) - v0) / accel

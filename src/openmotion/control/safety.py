@@ -34,7 +34,8 @@ Reactions (HSL-4XMO 3, 4.8; MCCL 2.8):
   `pulse_erc(axis)` for home completion. The width is rounded up to whole cycles.
 - INP: `set_inp(axis, True)` (Axis.set_inp): motion done only once INP is active.
 - SVON/RDY: `set_servo(axis, on)` powers the axis (SVON); `set_rdy_check(axis, True)`
-  refuses motion while RDY is inactive.
+  refuses motion while RDY is inactive and stops a moving axis at once when RDY drops
+  (ErrorStop "drive not ready").
 
 Residual of the cycle model: the hardware has already executed the cycle in which an edge
 happened, so an immediate stop ends where that cycle ended (at most one cycle of travel past
@@ -379,6 +380,9 @@ class Safety:
             return
         ax = ctl.axes[e.axis]
         sig = e.signal
+        if sig == "rdy":
+            self._rdy_edge(ax, e)
+            return
         active = e.level != (ax.config.signal_logic(sig) == "nc") if sig in (
             "pel", "mel", "sd") else False
         if sig in ("pel", "mel"):
@@ -399,6 +403,15 @@ class Safety:
         if c.el_direction_sensitive and d != (1 if sig == "pel" else -1):
             return
         self._fault(ax, LIMIT_REASONS[sig], c.el_decelerate, e.time)
+
+    def _rdy_edge(self, ax: Axis, e: InputEdge) -> None:
+        """RDY lost while moving, with the RDY check on: the drive cannot follow, so the
+        axis stops at once (ErrorStop "drive not ready"), as for an alarm."""
+        if not self._cfg[ax.index].rdy_required or not ax.is_moving:
+            return
+        if e.level != (ax.config.signal_logic("rdy") == "nc"):
+            return  # RDY became active
+        self._fault(ax, "drive not ready", False, e.time)
 
     def _fault(self, ax: Axis, reason: str, decelerate: bool, t: float) -> None:
         self._edge_time = t

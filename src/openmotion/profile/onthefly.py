@@ -113,9 +113,10 @@ def change_speed(profile: Profile, t: float, spec: MoveSpec, new_vel: float, tac
     tgt = None if target is None else check_distance("target", target)
     base, st = _state(profile, t)
     sgn = _direction(st, profile)
+    jz = _jerk_now(spec, sgn * st.a)
     if tgt is None:
         tail = velocity_ramp(st, sgn * new, tacc, shape=spec.shape, vs=spec.vs_acc,
-                             str_vel=spec.str_vel)
+                             str_vel=spec.str_vel, j_zero=jz)
         acc, jerk = ramp_rates(abs(new - abs(st.v)), tacc, spec.shape, spec.vs_acc)
         new_spec = _spec_from_rates(spec, new, acc, jerk, tacc) if acc > 0 else spec
         return Change(base.splice(t, tail), new_spec, None)
@@ -128,7 +129,7 @@ def change_speed(profile: Profile, t: float, spec: MoveSpec, new_vel: float, tac
         if acc == 0.0 or st.a != 0.0:
             acc, jerk = ramp_rates(max(new - spec.str_vel, 1e-300), tacc, spec.shape, 0.0)
     b = ProfileBuilder(st.p, sgn * st.v, sgn * st.a, direction=sgn)
-    ramp_from_state(b, new, acc, jerk, "change")
+    ramp_from_state(b, new, acc, jerk, "change", j_zero=jz)
     need_acc = sgn * (b.state.p - st.p)
     need_dec = ramp_distance(spec.str_vel, new, acc, jerk)
     if need_acc + need_dec > remaining * (1 + 1e-12) + 1e-9:
@@ -143,6 +144,15 @@ def change_speed(profile: Profile, t: float, spec: MoveSpec, new_vel: float, tac
     tail = b.build(end_p=tgt, end_v=0.0)
     return Change(base.splice(t, tail), _spec_from_rates(spec, new, acc, jerk, tacc), tgt,
                   need_acc, need_dec, remaining)
+
+
+def _jerk_now(spec: MoveSpec, a_along: float) -> float | None:
+    """The running move's own jerk for its present acceleration (along the motion):
+    what a change may use to remove that acceleration. None for T (no jerk limit)."""
+    if spec.shape != "S" or a_along == 0.0:
+        return None
+    r = spec.rates
+    return r.jerk_acc if a_along > 0.0 else r.jerk_dec
 
 
 def final_decel_start(profile: Profile) -> float:

@@ -50,10 +50,15 @@ def ramp_from_state(b: ProfileBuilder, v1: float, accel: float, jerk: float,
                     label: str, *, j_zero: float | None = None) -> ProfileBuilder:
     """Append a ramp from b's (v, a) to (v1, 0) under limits (accel, jerk); jerk = inf is T.
 
-    S from a != 0: if the acceleration points away from the needed change (or exceeds
-    `accel`), it is first brought to 0 (or to `accel`) at jerk `j_zero` (default `jerk`),
-    then `ramps.ramp_jerk` finishes. Zeroing an opposing acceleration at constant jerk and
-    then ramping is the same trajectory as the minimum-time ramp, so nothing is lost.
+    S from a != 0: `j_zero` (default `jerk`) is the jerk available to remove the present
+    acceleration (the running move's own jerk); the larger of it and `jerk` is used. An
+    acceleration pointing away from v1 (or over `accel`) is first brought to 0 (or to
+    `accel`) at that jerk, then `ramps.ramp_jerk` finishes: zeroing at constant jerk and
+    then ramping is the minimum-time ramp. An
+    acceleration pointing towards v1 that `jerk` cannot remove before v1 is removed at
+    the jerk that lands exactly on v1 (never above max(jerk, j_zero)); only when even
+    that jerk overshoots does the speed pass v1, by the least the physics allows
+    (a**2 / (2 max(jerk, j_zero))), and come back.
     """
     st = b.state
     if accel <= 0.0:  # nothing to ramp over (caller jumps the velocity)
@@ -63,17 +68,32 @@ def ramp_from_state(b: ProfileBuilder, v1: float, accel: float, jerk: float,
         return ramp_accel(b, v1, accel, label=label)
     if st.a == 0.0:
         return append_ramp(b, v1, accel, jerk, label)
-    jz = jerk if j_zero is None else j_zero
-    v_stop = st.v + st.a * abs(st.a) / (2.0 * jz)
-    s = 1.0 if v1 > v_stop else -1.0
-    if st.a * s < 0.0 or v1 == v_stop:
-        b.segment(abs(st.a) / jz, -math.copysign(jz, st.a), label=f"{label} jerk-out")
-        b.set_acceleration(0.0)
-        if b.state.v == v1:
-            return b
-    elif abs(st.a) > accel:
-        b.segment((abs(st.a) - accel) / jz, -math.copysign(jz, st.a), label=f"{label} ease")
+    j_hi = jerk if j_zero is None else max(jerk, j_zero)
+    gap = v1 - st.v
+    if st.a * gap > 0.0:  # accelerating towards v1
+        need = st.a * st.a / 2.0  # gap * jerk needed to remove a before v1
+        if need > abs(gap) * jerk:
+            if need <= abs(gap) * j_hi:  # land on v1 with a = 0: no overshoot
+                _jerk_out(b, st.a, need / abs(gap), label)
+                b.set_velocity(v1)
+                return b
+            _jerk_out(b, st.a, j_hi, label)  # the least overshoot there is
+            return ramp_jerk(b, v1, accel, jerk, label=label)
+        if abs(st.a) > accel:
+            b.segment((abs(st.a) - accel) / j_hi, -math.copysign(j_hi, st.a),
+                      label=f"{label} ease")
+        return ramp_jerk(b, v1, accel, jerk, label=label)
+    _jerk_out(b, st.a, j_hi, label)  # away from v1 (or already on it)
+    if b.state.v == v1:
+        return b
     return ramp_jerk(b, v1, accel, jerk, label=label)
+
+
+def _jerk_out(b: ProfileBuilder, a: float, jerk: float, label: str) -> None:
+    """Bring b's acceleration `a` to 0 at `jerk` (at once for an unbounded jerk)."""
+    if math.isfinite(jerk):
+        b.segment(abs(a) / jerk, -math.copysign(jerk, a), label=f"{label} jerk-out")
+    b.set_acceleration(0.0)
 
 
 def segment_durations(profile: Profile) -> np.ndarray:
@@ -116,12 +136,15 @@ def check_profile_time(profile: Profile, t: float) -> float:
 
 
 def velocity_ramp(state: State, target_v: float, t_ramp: float, *, shape: str = "T",
-                  vs: float = 0.0, str_vel: float = 0.0) -> Profile:
+                  vs: float = 0.0, str_vel: float = 0.0,
+                  j_zero: float | None = None) -> Profile:
     """Ramp from `state` to the signed `target_v` (pps) in `t_ramp` s, then hold it.
 
     HSL tv_move (shape 'T') / sv_move (shape 'S', `vs` = SVacc) from rest, v_change while
     moving. From rest (v = a = 0) the rate jumps to StrVel first and the ramp covers
-    |target| - StrVel. Positions are absolute (`state.p`).
+    |target| - StrVel. Positions are absolute (`state.p`). `j_zero` (S only): the jerk
+    available to remove the present acceleration, normally the running move's own jerk
+    (see `ramp_from_state`); by default the new ramp's.
     """
     if shape not in ("T", "S"):
         raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
@@ -132,6 +155,7 @@ def velocity_ramp(state: State, target_v: float, t_ramp: float, *, shape: str = 
     t = check_positive("t_ramp", t_ramp)
     vs = check_nonnegative("vs", vs)
     sv = check_nonnegative("str_vel", str_vel)
+    jz = None if j_zero is None else check_positive("j_zero", j_zero)
     if abs(vt) < sv and vt != 0.0:
         raise MotionError(f"target_v must be 0 or |target_v| >= str_vel ({sv:g}), got {vt!r}")
     b = ProfileBuilder(p0, v0, a0)
@@ -145,7 +169,7 @@ def velocity_ramp(state: State, target_v: float, t_ramp: float, *, shape: str = 
     if v0 * vt < 0.0:
         v_mid = math.copysign(min(sv, abs(v0)), v0)
         acc, jerk = ramp_rates(abs(v_mid - v0) + abs(vt + v_mid), t, shape, vs)
-        ramp_from_state(b, v_mid, acc, jerk, "ramp down")
+        ramp_from_state(b, v_mid, acc, jerk, "ramp down", j_zero=jz)
         b.set_velocity(-v_mid)
         append_ramp(b, vt, acc, jerk, "ramp")
     else:
@@ -153,7 +177,7 @@ def velocity_ramp(state: State, target_v: float, t_ramp: float, *, shape: str = 
         if b.state.a != 0.0 and (acc == 0.0 or jerk == 0.0):
             # (next to) the right speed, only the acceleration to remove
             acc, jerk = abs(a0), (4.0 * abs(a0) / t if shape == "S" else math.inf)
-        ramp_from_state(b, v_end, acc, jerk, "ramp")
+        ramp_from_state(b, v_end, acc, jerk, "ramp", j_zero=jz)
     b.set_velocity(vt)
     return b.build(end_v=vt)
 

@@ -476,6 +476,20 @@ class SimMachine:
             self._di[k] = level
             raw.append((self._t, None, signal, level, None))
 
+    def _set_ready(self, axis: int, ready: bool, raw: list) -> None:
+        ax = self._axes[axis]
+        before = ax.level("rdy")
+        ax.not_ready = not ready
+        self._edge(raw, ax, "rdy", before)
+
+    def _knock(self, axis: int, counts: float, raw: list) -> None:
+        """Move a dc_servo motor `counts` command pulses back (a following error)."""
+        ax = self._axes[axis]
+        plant = ax.plant
+        m0 = plant.motor(ax.gen)
+        plant.dc.theta -= counts / plant.scale
+        ax.scan([JumpPiece(self._t, m0, plant.motor(ax.gen))], raw)
+
     def _step_loss(self, axis: int, pulses: int, raw: list) -> None:
         ax = self._axes[axis]
         plant = ax.plant

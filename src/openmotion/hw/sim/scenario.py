@@ -114,6 +114,32 @@ class Scenario:
         t = self._at(at)
         self._push(t, lambda raw: self._m._step_loss(axis, pulses, raw))
 
+    def set_drive_ready(self, axis: int, ready: bool, at: float | None = None) -> None:
+        """The drive of `axis` drops (False) or restores (True) its RDY output without an
+        alarm (a lost enable chain, an undervoltage): RDY reads inactive meanwhile."""
+        self._m._axis(axis)
+        if not isinstance(ready, bool):
+            raise MotionError(f"ready must be a bool, got {ready!r}")
+        t = self._at(at)
+        self._push(t, lambda raw: self._m._set_ready(axis, ready, raw))
+
+    def inject_following_error(self, axis: int, counts: float, at: float | None = None
+                               ) -> None:
+        """The motor of closed-loop (dc_servo) `axis` is knocked `counts` motor pulses (the
+        encoder counts at move ratio 1) off its command (signed; positive = behind it), as
+        a crash or a load step would: the
+        controller's loop sees the error and, beyond its following_error limit, trips the
+        axis to ErrorStop "following error". Closed-loop axes only."""
+        ax = self._m._axis(axis)
+        if not ax.is_dc:
+            raise MotionError(f"axis {axis} has no closed loop (drive type dc_servo); "
+                              "a following error applies to closed-loop servo axes")
+        c = check_finite("counts", counts)
+        if abs(c) > 1e9:
+            raise MotionError(f"counts must be within +-1e9, got {counts!r}")
+        t = self._at(at)
+        self._push(t, lambda raw: self._m._knock(axis, c, raw))
+
     def set_input(self, signal: str, level: bool, at: float | None = None) -> None:
         """Drive general input `di<n>` to an electrical level."""
         n = len(self._m._di)

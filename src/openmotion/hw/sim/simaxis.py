@@ -74,6 +74,7 @@ class SimAxis:
         self.switches["ez"] = IndexSwitch(float(cfg.pulses_per_rev), ez_width, self.y)
         self.outputs = {s: False for s in AXIS_OUTPUTS}
         self.alarm = False
+        self.not_ready = False  # the drive drops RDY without an alarm (scenario)
         # armed edge stops: signal -> (electrical level, direction 0/+1/-1); see arm_stop
         self.armed: dict[str, tuple[bool, int]] = {}
         self.stop_time: float | None = None
@@ -90,6 +91,8 @@ class SimAxis:
             return sw.active
         if sig == "alm":
             return self.alarm
+        if sig == "rdy" and self.not_ready:
+            return False
         if sig == "rdy" and self.is_dc:
             return self.outputs["svon"] and not self.alarm
         if sig == "rdy":
