@@ -155,13 +155,19 @@ def _passes(jcap2: list[float], acc: list[float], length: list[float],
             start2: float) -> tuple[list[float], list[float]]:
     """Backward pass from the junction caps (v**2), then forward pass from start2."""
     n = len(length)
+    dv = [2.0 * a * L for a, L in zip(acc, length, strict=True)]
     back = jcap2[:]
-    for k in range(n - 1, -1, -1):
-        back[k] = min(jcap2[k], back[k + 1] + 2.0 * acc[k] * length[k])
+    nxt = back[n]
+    for k in range(n - 1, -1, -1):  # min() spelled out: this loop is the planner's hot spot
+        x = nxt + dv[k]
+        c = jcap2[k]
+        nxt = back[k] = c if c <= x else x
     fwd = [0.0] * (n + 1)
-    fwd[0] = min(start2, back[0])
+    cur = fwd[0] = start2 if start2 <= back[0] else back[0]
     for k in range(n):
-        fwd[k + 1] = min(back[k + 1], fwd[k] + 2.0 * acc[k] * length[k])
+        x = cur + dv[k]
+        c = back[k + 1]
+        cur = fwd[k + 1] = c if c <= x else x
     return back, fwd
 
 
