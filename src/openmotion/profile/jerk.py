@@ -200,10 +200,15 @@ def _build(start: float, distance: float, times: Sequence[float], a_max: float,
         t += dt
     # one array for all columns (each column a contiguous row of its transpose)
     t0, p0, v0, a0, jj, dts = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
-    return Profile(t0=t0, p0=p0, v0=v0, a0=a0, j=jj, duration=t if duration is None else duration,
-                   start=State(float(start), 0.0 * dr, 0.0),
-                   end=State(float(start + distance), 0.0 * dr, 0.0), labels=tuple(labels),
-                   dt=dts)
+    # Profile's own fields set at once (it is a frozen dataclass without __post_init__:
+    # the same object Profile(...) makes, without its per-field frozen setattr)
+    prof = object.__new__(Profile)
+    prof.__dict__.update(t0=t0, p0=p0, v0=v0, a0=a0, j=jj,
+                         duration=t if duration is None else duration,
+                         start=State(float(start), 0.0 * dr, 0.0),
+                         end=State(float(start + distance), 0.0 * dr, 0.0),
+                         labels=tuple(labels), dt=dts)
+    return prof
 
 
 def _build_with_builder(start: float, distance: float, times: Sequence[float],
