@@ -2,7 +2,9 @@
 
 Plans the same N seeded random moves (distances 1e-3..1.3e8 pulses, v 1..1e7, a 1..1e9,
 j 1..1e12, half of them with a separate deceleration limit) with both libraries and prints
-agreement of durations, ruckig's failures, throughputs and the batch planner's peak memory.
+agreement of durations, ruckig's failures, throughputs (CPU time; also with new objects
+per move, and three axes synchronised against ruckig 3-DoF, with the goals of issue 14)
+and the batch planner's peak memory.
 
     python bench/bench_profile.py            # N = 100 000, batch of 1 000 000 (< 60 s)
     python bench/bench_profile.py --quick    # a few seconds
@@ -11,13 +13,14 @@ agreement of durations, ruckig's failures, throughputs and the batch planner's p
 from __future__ import annotations
 
 import argparse
+import contextlib
 import time
 import tracemalloc
 
 import numpy as np
 
 from openmotion.profile.batch import jerk_limited_durations
-from openmotion.profile.jerk import jerk_limited, jerk_limited_duration
+from openmotion.profile.jerk import jerk_limited, jerk_limited_duration, jerk_limited_sync
 
 try:
     import ruckig
@@ -91,39 +94,81 @@ def main(argv: list[str] | None = None) -> None:
 
     # throughput: ruckig on the cases it solves (no exceptions in the timed loop)
     solvable = [inp for inp, good in zip(inputs, ok, strict=True) if good]
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     for inp in solvable:
         otg.calculate(inp, traj)
-    t_ruckig = time.perf_counter() - t0
+    t_ruckig = time.process_time() - t0
 
     # the same with one reused InputParameter whose fields are set per move (a user's loop)
     one = ruckig.InputParameter(1)
     one.current_position = [0.0]
     fields = [(inp.target_position, inp.max_velocity, inp.max_acceleration,
                inp.min_acceleration, inp.max_jerk) for inp in solvable]
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     for tp, mv, ma, mi, mj in fields:
         one.target_position, one.max_velocity, one.max_acceleration = tp, mv, ma
         one.min_acceleration, one.max_jerk = mi, mj
         otg.calculate(one, traj)
-    t_ruckig_set = time.perf_counter() - t0
+    t_ruckig_set = time.process_time() - t0
 
     args_list = list(zip(dist.tolist(), v.tolist(), a.tolist(), j.tolist(), d.tolist(),
                          strict=True))
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     for dd, vv, aa, jj, de in args_list:
         jerk_limited(dd, vv, aa, jj, d_max=de)
-    t_profile = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    t_profile = time.process_time() - t0
+    t0 = time.process_time()
     for dd, vv, aa, jj, de in args_list:
         jerk_limited_duration(dd, vv, aa, jj, d_max=de)
-    t_duration = time.perf_counter() - t0
+    t_duration = time.process_time() - t0
+
+    # new objects per move (what a caller without a planner object pays), ruckig's cases
+    m = min(len(solvable), 20_000)
+    new_args = [(inp.target_position, inp.max_velocity, inp.max_acceleration,
+                 inp.min_acceleration, inp.max_jerk) for inp in solvable[:m]]
+    t0 = time.process_time()
+    for tp, mv, ma, mi, mj in new_args:
+        otg1, inp1, tr1 = ruckig.Ruckig(1), ruckig.InputParameter(1), ruckig.Trajectory(1)
+        inp1.current_position = [0.0]
+        inp1.target_position, inp1.max_velocity, inp1.max_acceleration = tp, mv, ma
+        inp1.min_acceleration, inp1.max_jerk = mi, mj
+        otg1.calculate(inp1, tr1)
+    t_ruckig_new = time.process_time() - t0
+    ok_idx = np.flatnonzero(ok)[:m]
+    ours_args = [args_list[i] for i in ok_idx.tolist()]
+    t0 = time.process_time()
+    for dd, vv, aa, jj, de in ours_args:
+        jerk_limited(dd, vv, aa, jj, d_max=de)
+    t_profile_new = time.process_time() - t0
+
+    # three axes synchronised, new objects per move (moves of 3 consecutive random cases)
+    k3 = (m // 3) * 3
+    tri = [ok_idx[i:i + 3] for i in range(0, k3, 3)]
+    t0 = time.process_time()
+    for idx in tri:
+        otg3, inp3, tr3 = ruckig.Ruckig(3), ruckig.InputParameter(3), ruckig.Trajectory(3)
+        inp3.current_position = [0.0, 0.0, 0.0]
+        inp3.target_position = [abs(float(dist[i])) for i in idx]
+        inp3.max_velocity = [float(v[i]) for i in idx]
+        inp3.max_acceleration = [float(a[i]) for i in idx]
+        inp3.min_acceleration = [-float(d[i]) for i in idx]
+        inp3.max_jerk = [float(j[i]) for i in idx]
+        with contextlib.suppress(ruckig.RuckigError, ValueError):  # its failures
+            otg3.calculate(inp3, tr3)
+    t_ruckig3 = time.process_time() - t0
+    sync_args = [([abs(float(dist[i])) for i in idx], [float(v[i]) for i in idx],
+                  [float(a[i]) for i in idx], [float(j[i]) for i in idx],
+                  [float(d[i]) for i in idx]) for idx in tri]
+    t0 = time.process_time()
+    for dd, vv, aa, jj, de in sync_args:
+        jerk_limited_sync(dd, vv, aa, jj, d_max=de)
+    t_sync = time.process_time() - t0
 
     bd, bv, ba, bj, bdd = random_moves(n_batch, args.seed + 1)
     jerk_limited_durations(bd[:1000], bv[:1000], ba[:1000], bj[:1000], bdd[:1000])  # warm-up
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     jerk_limited_durations(bd, bv, ba, bj, bdd)
-    t_batch = time.perf_counter() - t0
+    t_batch = time.process_time() - t0
     tracemalloc.start()
     jerk_limited_durations(bd, bv, ba, bj, bdd)
     _, peak = tracemalloc.get_traced_memory()
@@ -154,6 +199,17 @@ def main(argv: list[str] | None = None) -> None:
           f"{r_duration / r_ruckig:>12.3f}")
     print(f"{'openmotion jerk_limited_durations (batch)':44s} {r_batch:>12.0f} "
           f"{r_batch / r_ruckig:>12.3f}")
+    r_new, r_prof_new = rate(m, t_ruckig_new), rate(m, t_profile_new)
+    r3, r_sync = rate(len(tri), t_ruckig3), rate(len(tri), t_sync)
+    print(f"{'ruckig new objects per move':44s} {r_new:>12.0f}")
+    print(f"{'openmotion jerk_limited (same moves)':44s} {r_prof_new:>12.0f} "
+          f"{r_prof_new / r_new:>12.3f}  goal >= 0.5: "
+          f"{'met' if r_prof_new >= 0.5 * r_new else 'not met'}")
+    print(f"{'ruckig 3-DoF, new objects per move':44s} {r3:>12.0f}")
+    print(f"{'openmotion jerk_limited_sync, 3 axes':44s} {r_sync:>12.0f} {r_sync / r3:>12.3f}"
+          f"  goal >= 0.5: {'met' if r_sync >= 0.5 * r3 else 'not met'}")
+    print(f"{'batch vs ruckig reused objects':44s} {'':>12s} {r_batch / r_ruckig:>12.3f}"
+          f"  goal >= 3: {'met' if r_batch >= 3 * r_ruckig else 'not met'}")
     print("-" * 78)
     print(f"{'batch peak memory (tracemalloc)':44s} {peak / 2**20:>9.1f} MiB "
           f"({peak / n_batch:.0f} B/move)")

@@ -15,9 +15,10 @@ one controller cycle (`Controller.step`: the simulator, the group's hook with it
 and re-plans, the feeder) in the first FILL cycles (the feeder fills the queue) and after
 them (streaming), the 99th percentile and the mean, the peak number of elements in the
 running chain, the number of cycles the path rested between its start and its end, the
-end error (pulses) and the process's peak RSS. Each case runs in a fresh process so the
-RSS figures do not mix. The last lines give the per-command cost of the largest N over the
-smallest: flat streaming keeps it near 1.
+end error (pulses), the process's peak RSS and, for the group feeder, the join cost: the
+CPU time of the group's cycle hook (joins, blends, re-plans) per command. Each case runs in
+a fresh process so the RSS figures do not mix. The last lines give the per-command cost of
+the largest N over the smallest: flat streaming keeps it near 1.
 
     python bench/bench_stream.py [N ...]          (default 1000 10000 50000)
 """
@@ -111,6 +112,16 @@ def case_group(n: int) -> dict:
     g.enable_blend(TOL)
     g.ptp([30.0, 0.0])
     ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0, 10.0)
+    hook_cpu = [0.0]
+    group_hook = g._on_cycle
+
+    def timed_hook(c: Controller, t: float) -> None:  # the group's joins, blends, re-plans
+        t0 = time.process_time()
+        group_hook(c, t)
+        hook_cpu[0] += time.process_time() - t0
+
+    ctl.remove_cycle_hook(group_hook)
+    ctl.add_cycle_hook(timed_hook)
     pts = points(n)
     last = [None]
 
@@ -134,7 +145,9 @@ def case_group(n: int) -> dict:
     wall = time.perf_counter() - w0
     end = np.array([a.position for a in g.axes])
     err = float(np.max(np.abs(end - np.array(last[0]) * 1000.0)))
-    return _figures("group", n, wall, ctl.time - t_start, probe, err, 0.0)
+    out = _figures("group", n, wall, ctl.time - t_start, probe, err, 0.0)
+    out["join_us_per_cmd"] = 1e6 * hook_cpu[0] / n
+    return out
 
 
 def case_runner(n: int) -> dict:
@@ -178,7 +191,7 @@ def main() -> None:
     ns = [int(a) for a in sys.argv[1:]] or [1000, 10_000, 50_000]
     print(f"{'feeder':7} {'N':>6} {'us/cmd':>7} {'machine s':>9} {'fill ms':>7} "
           f"{'max cycle ms':>12} {'p99 ms':>7} {'mean ms':>7} {'chain':>5} {'rests':>5} "
-          f"{'end err':>7} {'RSS MB':>6} {'compile s':>9}")
+          f"{'end err':>7} {'RSS MB':>6} {'compile s':>9} {'join us/cmd':>11}")
     rows: dict[str, list[dict]] = {"group": [], "runner": []}
     for kind in rows:
         for n in ns:
@@ -186,11 +199,12 @@ def main() -> None:
                                  check=True, capture_output=True, text=True).stdout
             r = json.loads(out.strip().splitlines()[-1])
             rows[kind].append(r)
+            join = f"{r['join_us_per_cmd']:.0f}" if "join_us_per_cmd" in r else "-"
             print(f"{kind:7} {n:6d} {r['us_per_cmd']:7.0f} {r['machine_s']:9.2f} "
                   f"{r['fill_cycle_ms']:7.1f} {r['max_cycle_ms']:12.2f} {r['p99_cycle_ms']:7.2f} "
                   f"{r['mean_cycle_ms']:7.3f} {r['peak_chain']:5d} {r['rests']:5d} "
                   f"{r['end_err_pulses']:7.1g} {r['peak_rss_mb']:6.0f} "
-                  f"{r['compile_s']:9.2f}", flush=True)
+                  f"{r['compile_s']:9.2f} {join:>11}", flush=True)
     for kind, rs in rows.items():
         if len(rs) > 1:
             a, b = rs[0], rs[-1]

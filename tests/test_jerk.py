@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from openmotion.errors import MotionError
@@ -304,3 +304,20 @@ def test_tiny_distances_and_extreme_magnitudes_never_fail():
     for row, tb in zip(e, batch, strict=True):
         t = jerk_limited_duration(*row[:4], d_max=row[4])
         assert math.isfinite(t) and t == pytest.approx(tb, rel=1e-12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(-1e6, 1e6), st.floats(1e-3, 1e5), st.floats(1e-3, 1e5), st.floats(1e-3, 1e5),
+       st.floats(1e-3, 1e5), st.floats(-1e3, 1e3))
+def test_direct_build_equals_profile_builder_bit_for_bit(d, v, a, j, dd, start):
+    from openmotion.profile import jerk as J
+
+    times = J.phase_times(abs(d), v, a, dd, j)
+    assume(all(math.isfinite(x) for x in times))
+    p1 = J._build(start, d, times, a, dd, j)
+    p2 = J._build_with_builder(start, d, times, a, dd, j)
+    for f in ("t0", "p0", "v0", "a0", "j", "dt"):
+        x, y = getattr(p1, f), getattr(p2, f)
+        assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes(), f
+    assert (p1.duration, p1.start, p1.end, p1.labels) == (p2.duration, p2.start, p2.end,
+                                                          p2.labels)

@@ -218,3 +218,37 @@ def test_centripetal_speed():
         centripetal_speed(-1.0, 1.0)
     with pytest.raises(MotionError, match="normal_accel must be finite"):
         centripetal_speed(1.0, math.inf)
+
+
+# -- the fast line-line construction equals the validated one bit for bit -------------------
+def _same_element(a, b):
+    assert type(a) is type(b)
+    assert a.length == b.length
+    # equal_nan: corners of subnormal size give NaN tangents, in both constructions alike
+    for name in ("start", "end", "start_tangent", "end_tangent", "max_abs_tangent",
+                 "axis_accel_weight"):
+        assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=True), name
+    assert a.max_curvature == b.max_curvature or (math.isnan(a.max_curvature)
+                                                  and math.isnan(b.max_curvature))
+    s = np.linspace(0.0, a.length, 7)
+    assert np.array_equal(a.point(s), b.point(s), equal_nan=True)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.floats(-1e3, 1e3), min_size=9, max_size=9),
+       st.floats(1e-6, 10.0), st.sampled_from([2, 3]))
+def test_line_blend_bit_for_bit_with_the_validated_construction(c, tol, dim):
+    from oracle_blend import blend_lines
+
+    p0, p1, p2 = np.array(c[0:dim]), np.array(c[3:3 + dim]), np.array(c[6:6 + dim])
+    first, second = Line(p0, p1), Line(p1, p2)
+    # corners of subnormal size break Arc3D (NaN tangents, a 0 radius**2): not compared
+    assume(first.length > 1e-100 and second.length > 1e-100)
+    b = blend_corner(first, second, tol)
+    if b is None:
+        return
+    f, arc, s, dev = blend_lines(first, second, tol)
+    _same_element(b.first, f)
+    _same_element(b.arc, arc)
+    _same_element(b.second, s)
+    assert b.deviation == dev

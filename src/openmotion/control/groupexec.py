@@ -34,6 +34,7 @@ import numpy as np
 from ..errors import InfeasibleError, MotionError
 from ..path import blend_corner, speed_caps
 from ..path.geometry import PathElement
+from ..path.lookahead import _element_limits as element_limits
 from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
@@ -485,8 +486,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         the join then computes only the junctions and the passes."""
         if el.length > 0.0:
             vmax, amax = self._caps()
-            speed_caps([el], min(cmd.feed * self._override, self._sys_max), cmd.accel,
-                       axis_vmax=vmax, axis_amax=amax)
+            # what speed_caps([el], ...) stores, without validating the group's own values
+            element_limits(el, min(cmd.feed * self._override, self._sys_max), cmd.accel,
+                           vmax, amax, px.ARC_TANGENTIAL_RATIO)
 
     def _blend_new(self, prev: PathElement, el: PathElement,
                    cmd: _Cmd) -> tuple[PathElement, PathElement, PathElement] | None:

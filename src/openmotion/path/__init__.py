@@ -17,6 +17,7 @@ from .lookahead import (
     speed_caps,
     tangential_accels,
 )
+from .polyline import PolylinePlan, plan_polyline
 
 __all__ = [
     "ARC_TOL",
@@ -28,12 +29,14 @@ __all__ = [
     "ElementSpeeds",
     "Line",
     "PathElement",
+    "PolylinePlan",
     "acceleration_reversals",
     "blend_corner",
     "centripetal_speed",
     "contour_error",
     "corner_speed",
     "element_extent",
+    "plan_polyline",
     "plan_speeds",
     "speed_caps",
     "tangential_accels",

@@ -35,6 +35,7 @@ from .geometry import (
     path_positions,
     scalar_or_array,
     snap_ends,
+    vnorm,
 )
 
 TWO_PI = 2.0 * math.pi
@@ -74,7 +75,7 @@ class _Frame:
     t_end: Array = field(init=False)
 
     def __post_init__(self) -> None:
-        h = float(np.linalg.norm(self.helix))
+        h = vnorm(self.helix)
         length = math.hypot(self.radius * self.sweep, h)
         c, sn = math.cos(self.sweep), math.sin(self.sweep)
         last = self.centre + self.radius * (c * self.e1 + sn * self.e2) + self.helix
@@ -120,7 +121,7 @@ class _Frame:
 
     @property
     def kappa(self) -> float:
-        pitch = float(np.linalg.norm(self.helix)) / self.sweep
+        pitch = vnorm(self.helix) / self.sweep
         return self.radius / (self.radius**2 + pitch**2)
 
     def curvature(self, s: ArrayLike) -> Any:
@@ -441,6 +442,23 @@ class Arc3D(_ArcQueries):
         obj = object.__new__(cls)
         frame = _Frame(c, u, v, r, sw, frozen(np.zeros_like(c)), frozen(p0), frozen(p2))
         for name, value in (("start", frozen(p0)), ("via", frozen(mid)), ("end", frozen(p2)),
+                            ("_frame", frame)):
+            object.__setattr__(obj, name, value)
+        return obj
+
+    @classmethod
+    def _planned(cls, centre: Array, e1: Array, e2: Array, radius: float, sweep: float,
+                 start: Array, end: Array) -> Arc3D:
+        """`from_frame` for an arc a planner built itself (path/blend.py): the same arc,
+        without checking again what it made (orthonormal e1/e2, ends on the circle,
+        finite read-only float64 arrays)."""
+        for a in (centre, e1, e2, start, end):
+            a.flags.writeable = False
+        r, sw = float(radius), float(sweep)
+        mid = centre + r * (math.cos(sw / 2) * e1 + math.sin(sw / 2) * e2)
+        obj = object.__new__(cls)
+        frame = _Frame(centre, e1, e2, r, sw, frozen(np.zeros_like(centre)), start, end)
+        for name, value in (("start", start), ("via", frozen(mid)), ("end", end),
                             ("_frame", frame)):
             object.__setattr__(obj, name, value)
         return obj

@@ -34,6 +34,7 @@ from ..errors import MotionError, check_nonnegative, check_positive
 from .arcs import Arc, Arc3D
 from .fillet import fillet
 from .geometry import Line, PathElement, as_point
+from .geometry import vnorm as _norm
 
 #: A blend may use at most this fraction of each line (LinuxCNC BLEND_DIST_FRACTION).
 BLEND_DIST_FRACTION = 0.5
@@ -91,15 +92,17 @@ def blend_corner(first: PathElement, second: PathElement, tolerance: float, *,
     frac = check_positive("fraction", fraction)
     if frac > 0.5:
         raise MotionError(f"fraction must be in (0, 0.5], got {fraction!r}")
-    gap = float(np.linalg.norm(second.start - first.end))
-    scale = max(1.0, float(np.max(np.abs(first.end))))
-    if gap > 1e-9 * scale:
-        raise MotionError(f"second.start must equal first.end, they are {gap:.6g} apart")
+    if second.start is not first.end:
+        g = second.start - first.end
+        gap = _norm(g)
+        scale = max(1.0, float(np.max(np.abs(first.end))))
+        if gap > 1e-9 * scale:
+            raise MotionError(f"second.start must equal first.end, they are {gap:.6g} apart")
     if t == 0.0 or first.length == 0.0 or second.length == 0.0:
         return None
     u1, u2 = first.end_tangent, second.start_tangent
-    cos_t = float(np.linalg.norm(u1 - u2)) / 2.0
-    sin_t = float(np.linalg.norm(u1 + u2)) / 2.0
+    cos_t = _norm(u1 - u2) / 2.0
+    sin_t = _norm(u1 + u2) / 2.0
     turn = 2.0 * math.atan2(cos_t, sin_t)  # angle between u1 and u2
     if turn < TANGENT_ANGLE or math.pi - turn < REVERSAL_ANGLE:
         return None
@@ -110,7 +113,8 @@ def blend_corner(first: PathElement, second: PathElement, tolerance: float, *,
     d_tol = t * (1.0 + sin_t) / cos_t
     d = min(frac * first.length, frac * second.length, d_tol)
     radius = d * sin_t / cos_t
-    normal = (u2 - u1) / np.linalg.norm(u2 - u1)
+    diff = u2 - u1
+    normal = diff / _norm(diff)
     centre = corner + normal * (d / cos_t)
     a_start = corner - u1 * d
     a_end = corner + u2 * d
@@ -118,12 +122,15 @@ def blend_corner(first: PathElement, second: PathElement, tolerance: float, *,
     # differences of (possibly large) coordinates, so tiny blends keep exact tangents.
     e1 = -(u1 * cos_t + normal)
     e1 = e1 - (e1 @ u1) * u1
-    e1 = e1 / np.linalg.norm(e1)
+    e1 = e1 / _norm(e1)
     e2 = u1 - (u1 @ e1) * e1
-    e2 = e2 / np.linalg.norm(e2)
-    arc = Arc3D.from_frame(centre, e1, e2, radius, turn, start=a_start, end=a_end)
+    e2 = e2 / _norm(e2)
+    # everything here is the planner's own, finite and checked by construction
+    arc = Arc3D._planned(centre, e1, e2, radius, turn, a_start, a_end)
     dev = d * (1.0 - sin_t) / cos_t
-    return Blend(Line(first.start, a_start), arc, Line(a_end, second.end), dev)
+    return Blend(Line.between(first.start, a_start), arc, Line.between(a_end, second.end),
+                 dev)
+
 
 
 def corner_speed(u1: ArrayLike, u2: ArrayLike, accel: float, square_corner_velocity: float,

@@ -11,6 +11,7 @@ bit for bit, so a move ends exactly on its target.
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
@@ -74,6 +75,12 @@ def as_point(name: str, value: ArrayLike, dim: int | None = None) -> Array:
     return arr
 
 
+def vnorm(v: Array) -> float:
+    """np.linalg.norm of a 1-D float vector by its own formula, sqrt(v.v), without its
+    dispatch overhead: bit for bit the same."""
+    return math.sqrt(v.dot(v))
+
+
 def frozen(arr: Array) -> Array:
     """Mark an internally computed array read-only and return it."""
     arr.flags.writeable = False
@@ -135,12 +142,33 @@ class Line:
         delta = end - start
         big = float(np.max(np.abs(delta)))
         # scaled so tiny (even subnormal) displacements do not underflow to length 0
-        length = big * float(np.linalg.norm(delta / big)) if big > 0.0 else 0.0
+        length = big * vnorm(delta / big) if big > 0.0 else 0.0
         u = delta / length if length > 0.0 else np.zeros_like(delta)
         object.__setattr__(self, "start", start)
         object.__setattr__(self, "end", end)
         object.__setattr__(self, "length", length)
         object.__setattr__(self, "direction", frozen(u))
+
+    @classmethod
+    def between(cls, start: Array, end: Array) -> Line:
+        """The line between two points a planner computed itself: read-only float64 arrays
+        of the same size, finite (not checked again). The same line as Line(start, end)."""
+        obj = object.__new__(cls)
+        delta = end - start
+        big = float(np.max(np.abs(delta)))
+        if big > 0.0:
+            q = delta / big
+            length = big * vnorm(q)
+            u = delta / length
+        else:
+            length = 0.0
+            u = np.zeros_like(delta)
+        u.flags.writeable = False
+        object.__setattr__(obj, "start", start)
+        object.__setattr__(obj, "end", end)
+        object.__setattr__(obj, "length", length)
+        object.__setattr__(obj, "direction", u)
+        return obj
 
     @property
     def dim(self) -> int:

@@ -49,7 +49,7 @@ from numpy.typing import ArrayLike
 from ..errors import InfeasibleError, MotionError, check_nonnegative, check_positive
 from .arcs import Arc, Arc3D
 from .blend import TANGENT_ANGLE, corner_speed
-from .geometry import Array, Line, PathElement
+from .geometry import Array, Line, PathElement, vnorm
 
 #: Element types checked by a plain isinstance (the Protocol check is slow).
 _KNOWN = (Line, Arc, Arc3D)
@@ -100,11 +100,19 @@ def _limit_along(limit: float, axis: Array | None, weight: Array) -> float:
     """min(limit, axis_i / weight_i) over axes with weight_i > 0."""
     if axis is None:
         return limit
-    mask = weight > 0.0
-    if not np.any(mask):
+    # plain floats: the same IEEE quotients and minimum as the numpy form, without its
+    # per-call overhead (a few axes, asked for every element of every re-plan)
+    best = math.inf
+    found = False
+    for a, w in zip(axis.tolist(), weight.tolist(), strict=True):
+        if w > 0.0:
+            found = True
+            q = a / w  # a denormal weight: inf (no limit), as numpy gives it
+            if q < best:
+                best = q
+    if not found:
         return limit
-    with np.errstate(over="ignore"):  # a denormal weight: no limit (inf)
-        return min(limit, float(np.min(axis[mask] / weight[mask])))
+    return limit if limit <= best else best
 
 
 #: Memo of `_element_limits`: one entry per element, its last parameters and result. The
@@ -145,7 +153,7 @@ def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
                   amax_ax: Array | None, vjump_ax: Array | None) -> float:
     u1, u2 = prev.end_tangent, nxt.start_tangent
     diff = u2 - u1
-    chord = float(np.linalg.norm(diff))
+    chord = vnorm(diff)
     if 2.0 * math.asin(min(1.0, chord / 2.0)) < TANGENT_ANGLE:
         return math.inf
     a_j = _limit_along(accel, amax_ax, np.abs(diff) / chord)
@@ -163,14 +171,20 @@ def _passes(jcap2: list[float], acc: list[float], length: list[float],
     """Backward pass from the junction caps (v**2) at the decelerations `dec` (default
     `acc`), then forward pass from start2 at the accelerations."""
     n = len(length)
+    dv = [2.0 * a * L for a, L in zip(acc, length, strict=True)]
     back = jcap2[:]
-    dec = acc if dec is None else dec
-    for k in range(n - 1, -1, -1):
-        back[k] = min(jcap2[k], back[k + 1] + 2.0 * dec[k] * length[k])
+    dvb = dv if dec is None else [2.0 * d * L for d, L in zip(dec, length, strict=True)]
+    nxt = back[n]
+    for k in range(n - 1, -1, -1):  # min() spelled out: this loop is the planner's hot spot
+        x = nxt + dvb[k]
+        c = jcap2[k]
+        nxt = back[k] = c if c <= x else x
     fwd = [0.0] * (n + 1)
-    fwd[0] = min(start2, back[0])
+    cur = fwd[0] = start2 if start2 <= back[0] else back[0]
     for k in range(n):
-        fwd[k + 1] = min(back[k + 1], fwd[k] + 2.0 * acc[k] * length[k])
+        x = cur + dv[k]
+        c = back[k + 1]
+        cur = fwd[k + 1] = c if c <= x else x
     return back, fwd
 
 

@@ -28,10 +28,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import replace
+
+import numpy as np
 
 from ..errors import MotionError, check_distance, check_finite, check_positive
-from .segments import Profile, ProfileBuilder
+from .segments import Profile, ProfileBuilder, State
 
 NEWTON_STEPS = 10  # from within a factor sqrt(3) of the root, 7 reach full double precision
 
@@ -125,7 +126,18 @@ def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
 
     hi = peak_velocity(length, v_max, a_max, d_max, j_max)
     lo = length / t_target  # T(lo) >= t_target since T(vc) > L/vc
+    # Both limits reached at vc (vc*J >= max(A, D)**2): T*vc = k*vc**2 + c*vc + L, a
+    # quadratic with k = (1/A + 1/D)/2, c = (A + D)/(2J); its larger root (T decreasing
+    # in vc) in one step, polished by the Newton loop below (one or two steps).
+    k = 0.5 * (1.0 / a_max + 1.0 / d_max)
+    c = (a_max + d_max) / (2.0 * j_max)
+    b = t_target - c
+    disc = b * b - 4.0 * k * length
     vc = hi
+    if b > 0.0 and disc >= 0.0:
+        q = (b + math.sqrt(disc)) / (2.0 * k)
+        if lo < q < hi and q * j_max >= max(a_max, d_max) ** 2:
+            vc = q
     for _ in range(200):
         t, dt = dur(vc)
         err = t - t_target
@@ -161,7 +173,47 @@ def _check_times(times: Sequence[float]) -> None:
 
 
 def _build(start: float, distance: float, times: Sequence[float], a_max: float,
-           d_max: float, j_max: float) -> Profile:
+           d_max: float, j_max: float, duration: float | None = None) -> Profile:
+    """The seven-phase profile straight from its phase times: the arithmetic of
+    ProfileBuilder (same operations in the same order, so bit for bit the same profile,
+    tests/test_jerk.py compares them) without its per-segment calls."""
+    dr = 1.0 if distance >= 0.0 else -1.0
+    tj1, ta, _, tv, tj2, td, _ = times
+    a_pk = min(a_max, j_max * tj1)
+    d_pk = min(d_max, j_max * tj2)
+    p, v = float(start), 0.0 * dr
+    t = 0.0
+    rows: list[tuple[float, float, float, float, float, float]] = []
+    labels: list[str] = []
+    for k, (dt, jerk, acc) in enumerate(((tj1, j_max, 0.0), (ta, 0.0, a_pk),
+                                         (tj1, -j_max, a_pk), (tv, 0.0, 0.0),
+                                         (tj2, -j_max, 0.0), (td, 0.0, -d_pk),
+                                         (tj2, j_max, -d_pk))):
+        if dt <= 0.0:
+            continue
+        a = acc * dr
+        j = jerk * dr
+        rows.append((t, p, v, a, j, dt))
+        labels.append(PHASE_LABELS[k])
+        p = p + dt * (v + dt * (a / 2.0 + dt * j / 6.0))
+        v = v + dt * (a + dt * j / 2.0)
+        t += dt
+    # one array for all columns (each column a contiguous row of its transpose)
+    t0, p0, v0, a0, jj, dts = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
+    # Profile's own fields set at once (it is a frozen dataclass without __post_init__:
+    # the same object Profile(...) makes, without its per-field frozen setattr)
+    prof = object.__new__(Profile)
+    prof.__dict__.update(t0=t0, p0=p0, v0=v0, a0=a0, j=jj,
+                         duration=t if duration is None else duration,
+                         start=State(float(start), 0.0 * dr, 0.0),
+                         end=State(float(start + distance), 0.0 * dr, 0.0),
+                         labels=tuple(labels), dt=dts)
+    return prof
+
+
+def _build_with_builder(start: float, distance: float, times: Sequence[float],
+                        a_max: float, d_max: float, j_max: float) -> Profile:
+    """The same profile through ProfileBuilder (the reference `_build` is tested against)."""
     b = ProfileBuilder(start, direction=1.0 if distance >= 0.0 else -1.0)
     tj1, ta, _, tv, tj2, td, _ = times
     a_pk = min(a_max, j_max * tj1)
@@ -265,7 +317,6 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
         if durs[i] < t_sync:
             cap = _synced_cap(abs(dists[i]), t_sync, v, a, d, j)
             tm = phase_times(abs(dists[i]), v, a, d, j, v_cap=cap)
-        prof = _build(st[i], dists[i], tm, a, d, j)
         # Float sums of phase times differ from T in the last ulp; pin every axis to T.
-        out.append(replace(prof, duration=t_sync))
+        out.append(_build(st[i], dists[i], tm, a, d, j, duration=t_sync))
     return out

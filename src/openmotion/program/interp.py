@@ -17,10 +17,11 @@ import os
 from dataclasses import dataclass, field
 
 from . import canon
+from .fastpath import compile_plain
 from .modal import Modal
 from .options import GCodeOptions
 from .params import Parameters
-from .parser import Block, Program, parse_program
+from .parser import MAX_LINES, Block, Program, parse_program
 from .source import GCodeError, decode_program, read_program
 
 _OPENERS = {"SUB": "ENDSUB", "IF": "ENDIF", "WHILE": "ENDWHILE", "DO": "WHILE",
@@ -278,6 +279,14 @@ def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon
     if len(text) > options.max_bytes:
         raise GCodeError(f"program is {len(text)} characters, more than the limit of "
                          f"{options.max_bytes}", file=file)
+    lines = text.splitlines()
+    if len(lines) <= MAX_LINES:  # plain word lines skip the Block (fastpath.py)
+        return compile_plain(lines, options, file, lambda: _compile_full(text, options, file))
+    return _compile_full(text, options, file)
+
+
+def _compile_full(text: str, options: GCodeOptions, file: str) -> list[canon.Command]:
+    """The general path: parse the whole program, then interpret it."""
     program = parse_program(text, file, options.max_line_length)
     return interpret(program, options)
 

@@ -386,8 +386,12 @@ class Program:
     file: str = ""
 
 
+#: Most lines parse_program accepts by default.
+MAX_LINES = 5_000_000
+
+
 def parse_program(text: str, file: str = "", max_line_length: int = MAX_LINE_LENGTH,
-                  max_lines: int = 5_000_000) -> Program:
+                  max_lines: int = MAX_LINES) -> Program:
     """Parse a whole program. A first line '%' opens it; the next '%' line ends it."""
     lines = text.splitlines()
     if len(lines) > max_lines:

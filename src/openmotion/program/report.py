@@ -11,7 +11,6 @@ deviation from the corner, not from one side), the I/O events and faults.
 from __future__ import annotations
 
 import html
-import io
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -19,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import MotionError
+from ..svgplot import path_chart, step_chart, time_charts
 from . import canon
 
 if TYPE_CHECKING:
@@ -120,65 +120,33 @@ def format_summary(s: RunSummary) -> str:
     return "\n".join(out)
 
 
-def _svg(fig) -> str:
-    buf = io.StringIO()
-    fig.savefig(buf, format="svg", bbox_inches="tight")
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
-    text = buf.getvalue()
-    return text[text.index("<svg"):]
-
-
-def _figures(run: ProgramRunner, max_points: int = 20_000) -> list[tuple[str, str]]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import LineCollection
-
+def _figures(run: ProgramRunner) -> list[tuple[str, str]]:
+    """The report's figures as inline SVG, drawn at the resolution they are shown at
+    (svgplot.py: never more points than pixels), so any trace is drawn in milliseconds."""
     t, _, pos = run.trace()
-    step = max(1, len(t) // max_points)
-    t, pos = t[::step], pos[::step]
     figs: list[tuple[str, str]] = []
     if len(t) >= 2:
         v = np.gradient(pos, t, axis=0)
         lin = ~run.scales.rotary
         speed = np.linalg.norm(v[:, lin], axis=1) * 60.0 if lin.any() else np.zeros(len(t))
+        units = run.machine_units
         if pos.shape[1] >= 2:
-            fig, ax = plt.subplots(figsize=(7, 6))
-            seg = np.stack([pos[:-1, :2], pos[1:, :2]], axis=1)
-            lc = LineCollection(seg, cmap="viridis", linewidths=1.5)
-            lc.set_array(speed[:-1])
-            ax.add_collection(lc)
-            ax.autoscale()
-            ax.set_aspect("equal", adjustable="datalim")
-            ax.set_xlabel(f"{run.letters[0]} ({run.machine_units})")
-            ax.set_ylabel(f"{run.letters[1]} ({run.machine_units})")
-            fig.colorbar(lc, ax=ax, label=f"speed ({run.machine_units}/min)")
-            ax.set_title("path coloured by speed")
-            figs.append(("Path", _svg(fig)))
-        fig, axs = plt.subplots(len(run.letters), 1, figsize=(8, 1.8 * len(run.letters)),
-                                sharex=True, squeeze=False)
-        for k, letter in enumerate(run.letters):
-            axs[k, 0].plot(t - run.t_start, v[:, k], lw=1)
-            unit = "deg" if run.scales.rotary[k] else run.machine_units
-            axs[k, 0].set_ylabel(f"{letter} ({unit}/s)")
-        axs[-1, 0].set_xlabel("time (s)")
-        figs.append(("Velocity per axis", _svg(fig)))
+            figs.append(("Path", path_chart(
+                pos[:, :2], speed, f"{run.letters[0]} ({units})",
+                f"{run.letters[1]} ({units})", f"speed ({units}/min)",
+                "path coloured by speed")))
+        series = [(f"{letter} ({'deg' if run.scales.rotary[k] else units}/s)", v[:, k])
+                  for k, letter in enumerate(run.letters)]
+        figs.append(("Velocity per axis", time_charts(t - run.t_start, series, "time (s)")))
     io_ev = [e for e in run.events if e.index is not None]
     if io_ev:
-        fig, ax = plt.subplots(figsize=(8, 2.5))
+        lanes = []
         for n in sorted({e.index for e in io_ev}):
             ev = [e for e in io_ev if e.index == n]
             ts = [run.t_start] + [e.t for e in ev] + [max(run.t_end, ev[-1].t)]
             lv = [0] + [int(bool(e.level)) for e in ev] + [int(bool(ev[-1].level))]
-            ax.step(np.array(ts) - run.t_start, np.array(lv) * 0.8 + n, where="post",
-                    label=f"do{n}")
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("output")
-        ax.legend(loc="upper right", fontsize="small")
-        figs.append(("Outputs", _svg(fig)))
+            lanes.append((f"do{n}", np.array(ts) - run.t_start, np.array(lv, dtype=float)))
+        figs.append(("Outputs", step_chart(lanes, "time (s)")))
     return figs
 
 
