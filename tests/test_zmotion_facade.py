@@ -13,7 +13,6 @@ from openmotion.compat.zmotion_params import (
     ZERR_UNSUPPORTED,
     ZMotionError,
 )
-from openmotion.control.group import Group
 from openmotion.errors import MotionError
 
 
@@ -261,14 +260,11 @@ def test_decel_different_from_accel():
     c = ctl()
     c.BASE(0, 1)
     c.DECEL = 500, 500
-    if hasattr(Group, "set_dec_time"):
-        c.MOVE(10, 10)
-        c.WAIT_IDLE(0)
-        assert c.DPOS[0] == 10
-    else:
-        with pytest.raises(ZMotionError) as e:
-            c.MOVE(10, 10)
-        assert e.value.code == ZERR_UNSUPPORTED and e.value.parameter == "DECEL(0)"
+    c.MOVE(10, 10)
+    g = c._group((0, 1), "MOVE")
+    assert g.dec_time == pytest.approx(2 * g.acc_time)   # DECEL half of ACCEL: twice the time
+    c.WAIT_IDLE(0)
+    assert c.DPOS[0] == 10
     c.BASE(2)                             # a single axis has its own deceleration
     c.DECEL[2] = 500
     c.MOVE(10)

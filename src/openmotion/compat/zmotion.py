@@ -318,15 +318,11 @@ class ZController:
         main = axes[0]
         if len(axes) == 1:
             return self._move_axis(command, main, vals[0], relative)
-        if self._decel[main] != self._accel[main] and not hasattr(Group, "set_dec_time"):
-            raise ZMotionError(command, f"DECEL({main})", "DECEL different from ACCEL needs "
-                               "Group.set_dec_time (not in this build)", ZERR_UNSUPPORTED)
         g = self._group(axes, command)
         feed, acc = self._speed[main], self._accel[main]
         g.set_feed(feed)
         g.set_acc_time(feed / acc)
-        if hasattr(g, "set_dec_time"):
-            g.set_dec_time(feed / self._decel[main])
+        g.set_dec_time(feed / self._decel[main])
         ramp = self._sramp[main] / 1000.0
         g.set_path_shape("S", acc / ramp) if ramp > 0 else g.set_path_shape("T")
         if self._merge[main]:
