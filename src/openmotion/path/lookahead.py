@@ -138,6 +138,26 @@ def _element_limits(el: PathElement, feed: float, accel: float, vmax_ax: Array |
     return out
 
 
+#: Memo of `_tangential_decel` (as `_LIMITS`, for a deceleration set apart).
+_DEC_LIMITS: weakref.WeakKeyDictionary[Any, tuple[tuple, float]] = weakref.WeakKeyDictionary()
+
+
+def _tangential_decel(el: PathElement, decel: float, amax_ax: Array | None,
+                      ratio: float) -> float:
+    """Tangential deceleration of one element (`_element_limits`' first value with the
+    deceleration; memoized separately so both stay cached)."""
+    key = (decel, ratio, None if amax_ax is None else amax_ax.tobytes())
+    try:
+        hit = _DEC_LIMITS.get(el)
+    except TypeError:
+        return _limits_of(el, math.inf, decel, None, amax_ax, ratio)[0]
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    out = _limits_of(el, math.inf, decel, None, amax_ax, ratio)[0]
+    _DEC_LIMITS[el] = (key, out)
+    return out
+
+
 def _limits_of(el: PathElement, feed: float, accel: float, vmax_ax: Array | None,
                amax_ax: Array | None, ratio: float) -> tuple[float, float]:
     vmax = _limit_along(feed, vmax_ax, el.max_abs_tangent)
@@ -342,8 +362,7 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
     # tangential decelerations: the same limits with the deceleration (the speed caps,
     # centripetal included, stay the acceleration's)
     dec = acc if decels is accels else [
-        x if decels[k] == accels[k] else _limits_of(el, feeds[k], decels[k], vmax_ax,
-                                                    amax_ax, ratio)[0]
+        x if decels[k] == accels[k] else _tangential_decel(el, decels[k], amax_ax, ratio)
         for x, el, k in zip(acc, els, live, strict=True)]
 
     # jcap2[k]: v**2 cap at the entry of live element k (k = n: the end of the path).
