@@ -202,3 +202,14 @@ def test_the_ported_example_runs(capsys):
     assert "scan done, next compare value 69000" in out
     assert "arc end (1800, 600)" in out
     assert "feeder restart: " in out and "(refused)" in out
+
+
+def test_config_from_file_and_version():
+    hsl = HslLibrary.simulated(1)
+    hsl.HSL_initial(0)
+    assert hsl.HSL_M_version_info(0)[0] % 10 > 0      # 4th digit > 0: arcs with Tacc (4.6)
+    assert hsl.HSL_M_config_from_file(str(EXAMPLES / "two_modules.toml")) == 0
+    assert hsl.HSL_get_module_count(0) == 2
+    assert hsl.HSL_M_get_axis_location(5) == (1, 1)
+    assert hsl.HSL_M_start_tv_move(4, 0, 1000, 0.1) == 0
+    assert hsl.HSL_M_config_from_file(str(EXAMPLES / "two_modules.toml")) == E.ERR_AxisBusy
