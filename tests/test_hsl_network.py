@@ -4,6 +4,7 @@ scenario helper and the ported example program."""
 
 from __future__ import annotations
 
+import math
 import runpy
 from pathlib import Path
 
@@ -213,3 +214,18 @@ def test_config_from_file_and_version():
     assert hsl.HSL_M_get_axis_location(5) == (1, 1)
     assert hsl.HSL_M_start_tv_move(4, 0, 1000, 0.1) == 0
     assert hsl.HSL_M_config_from_file(str(EXAMPLES / "two_modules.toml")) == E.ERR_AxisBusy
+
+
+def test_latch_through_the_library():
+    hsl = HslLibrary.simulated(1)
+    hsl.HSL_initial(0)
+    sim = HslSim(hsl)
+    assert hsl.HSL_M_set_ltc_logic(0, 0) == 0
+    assert math.isnan(hsl.HSL_M_get_latch_data(0, 0))   # nothing latched
+    sim.place_switch(0, "ltc", 1500, 100)
+    hsl.HSL_M_start_tr_move(0, 3000, 0, 10000, 0.01, 0.01)
+    while hsl.HSL_M_motion_done(0):
+        pass
+    assert hsl.HSL_M_get_latch_data(0, 0) == 1500        # command counter at the edge
+    assert hsl.HSL_M_get_latch_data(0, 1) == 1500        # feedback
+    assert hsl.HSL_M_get_latch_data(0, 7) == E.ERR_InvalidParameter
