@@ -150,3 +150,11 @@ def test_codes_name_the_rule():
     hsl.network.advance(0.01)
     assert hsl.HSL_M_start_tr_move(0, 1000, 0, 1000, 0.1, 0.1) == E.ERR_AxisState
     assert hsl.HSL_M_start_tr_move(4, 1000, 0, 1000, 0.1, 0.1) == 0   # module 1 has its own
+
+
+@pytest.mark.parametrize("arg", [[1], None, "x", 3.5, -99, 0])
+def test_error_message_and_initial_take_anything(arg):
+    hsl = HslLibrary.simulated(1)
+    assert isinstance(hsl.HSL_M_get_error_message(arg), str)
+    r = hsl.HSL_initial(arg)
+    assert r == 0 if arg == 0 else r == E.ERR_InvalidCard

@@ -4,6 +4,7 @@ scenario helper and the ported example program."""
 
 from __future__ import annotations
 
+import math
 import runpy
 from pathlib import Path
 
@@ -202,3 +203,60 @@ def test_the_ported_example_runs(capsys):
     assert "scan done, next compare value 69000" in out
     assert "arc end (1800, 600)" in out
     assert "feeder restart: " in out and "(refused)" in out
+
+
+def test_config_from_file_and_version():
+    hsl = HslLibrary.simulated(1)
+    hsl.HSL_initial(0)
+    assert hsl.HSL_M_version_info(0)[0] % 10 > 0      # 4th digit > 0: arcs with Tacc (4.6)
+    assert hsl.HSL_M_config_from_file(str(EXAMPLES / "two_modules.toml")) == 0
+    assert hsl.HSL_get_module_count(0) == 2
+    assert hsl.HSL_M_get_axis_location(5) == (1, 1)
+    assert hsl.HSL_M_start_tv_move(4, 0, 1000, 0.1) == 0
+    assert hsl.HSL_M_config_from_file(str(EXAMPLES / "two_modules.toml")) == E.ERR_AxisBusy
+
+
+def test_latch_through_the_library():
+    hsl = HslLibrary.simulated(1)
+    hsl.HSL_initial(0)
+    sim = HslSim(hsl)
+    assert hsl.HSL_M_set_ltc_logic(0, 0) == 0
+    assert math.isnan(hsl.HSL_M_get_latch_data(0, 0))   # nothing latched
+    sim.place_switch(0, "ltc", 1500, 100)
+    hsl.HSL_M_start_tr_move(0, 3000, 0, 10000, 0.01, 0.01)
+    while hsl.HSL_M_motion_done(0):
+        pass
+    assert hsl.HSL_M_get_latch_data(0, 0) == 1500        # command counter at the edge
+    assert hsl.HSL_M_get_latch_data(0, 1) == 1500        # feedback
+    assert hsl.HSL_M_get_latch_data(0, 7) == E.ERR_InvalidParameter
+
+
+def test_soft_limits_comparator_speed_change_and_backlash():
+    hsl = HslLibrary.simulated(1)
+    hsl.HSL_initial(0)
+    assert hsl.HSL_M_set_softlimit(0, 8000, -8000) == 0
+    assert hsl.HSL_M_enable_softlimit(0, 0) == 0
+    assert hsl.HSL_M_start_tr_move(0, 10000, 0, 10000, 0.01, 0.01) == E.ERR_Limit
+    assert hsl.HSL_M_check_compare_data(0, 1) == 8000
+    assert hsl.HSL_M_diable_softlimit(0) == 0
+    # comparator 4: past command 5000, change speed to 20000 pps (cmp_v_change)
+    assert hsl.HSL_M_cmp_v_change(0, 20000, 0.05) == 0
+    assert hsl.HSL_M_fix_speed_range(0, 20000) == 0
+    assert hsl.HSL_M_set_general_comparator(0, 0, 4, 3, 5000.0) == 0
+    assert hsl.HSL_M_check_compare_data(0, 4) == 5000
+    assert hsl.HSL_M_start_tr_move(0, 30000, 0, 10000, 0.01, 0.01) == 0
+    top = 0.0
+    while hsl.HSL_M_motion_done(0):
+        top = max(top, hsl.HSL_M_get_current_speed(0))
+    assert top == pytest.approx(20000, abs=1.0)
+    assert hsl.HSL_M_get_command(0) == 30000
+    # backlash: 50 corrective pulses on each direction change, counters unaffected
+    assert hsl.HSL_M_backlash_comp(1, 50, 1) == 0
+    hsl.HSL_M_start_tr_move(1, 1000, 0, 10000, 0.01, 0.01)
+    while hsl.HSL_M_motion_done(1):
+        pass
+    hsl.HSL_M_start_tr_move(1, -500, 0, 10000, 0.01, 0.01)
+    while hsl.HSL_M_motion_done(1):
+        pass
+    assert hsl.HSL_M_get_command(1) == 500
+    assert hsl.controller(0).hardware.command_position(1) == pytest.approx(500 - 50, abs=1)

@@ -102,4 +102,6 @@ def error_message(code: int) -> str:
     """HSL_M_get_error_message: the text of a return code."""
     if isinstance(code, HslError):
         return code.message
-    return MESSAGES.get(code, f"unknown error code {code!r}")
+    if isinstance(code, int) and code in MESSAGES:
+        return MESSAGES[code]
+    return f"unknown error code {code!r}"
