@@ -202,16 +202,24 @@ def test_abort_while_a_join_is_in_flight_drops_its_commands():
 @pytest.mark.parametrize("fault", ["late", "fails"])
 def test_a_late_or_failing_worker_falls_back_to_joins_in_the_cycle(monkeypatch, fault):
     orig = groupjoin.pathaxes.axis_profiles
+    box: dict = {}
 
     def slow(*a):  # noqa: ANN002, ANN202
         if threading.current_thread().name == "openmotion-join":
             if fault == "fails":
                 raise RuntimeError("worker failure (test)")
-            time.sleep(3 * groupjoin.JOIN_LEAD)
+            # late in controller cycles, not wall time: on a loaded machine the pacer can
+            # fall behind by more than any sleep, and a wall-clock "late" came in time
+            ctl = box["ctl"]
+            until = ctl.cycles + 3 * groupjoin.lead_cycles(ctl.period)
+            end = time.monotonic() + 30.0
+            while ctl.cycles < until and time.monotonic() < end:
+                time.sleep(0.0005)
         return orig(*a)
 
     monkeypatch.setattr(groupjoin.pathaxes, "axis_profiles", slow)
     ctl, g, pts, info = _setup()
+    box["ctl"] = ctl
     with ctl.start_realtime():
         assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
     assert g.state is GroupState.IDLE and g.error_code == 0
