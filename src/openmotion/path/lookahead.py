@@ -293,6 +293,26 @@ def _per_element(name: str, value: float | Sequence[float], n: int) -> list[floa
     return [check_positive(f"{name}[{k}]", x) for k, x in enumerate(vals)]
 
 
+def check_planner_limits(dim: int, square_corner_velocity: float, start_speed: float,
+                         end_speed: float, axis_vmax, axis_amax, axis_vjump,
+                         arc_tangential_ratio: float, min_cruise_ratio: float) -> tuple:
+    """The look-ahead's scalar and per-axis limits checked once (shared by `plan_speeds`
+    and `plan_polyline`): (scv, v_start, v_end, vmax_ax, amax_ax, vjump_ax, ratio, mcr)."""
+    scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
+    v_start = check_nonnegative("start_speed", start_speed)
+    v_end = check_nonnegative("end_speed", end_speed)
+    vmax_ax = _axis_limits("axis_vmax", axis_vmax, dim)
+    amax_ax = _axis_limits("axis_amax", axis_amax, dim)
+    vjump_ax = _axis_limits("axis_vjump", axis_vjump, dim)
+    ratio = check_positive("arc_tangential_ratio", arc_tangential_ratio)
+    if ratio >= 1.0:
+        raise MotionError(f"arc_tangential_ratio must be in (0, 1), got {arc_tangential_ratio!r}")
+    mcr = check_nonnegative("min_cruise_ratio", min_cruise_ratio)
+    if mcr >= 1.0:
+        raise MotionError(f"min_cruise_ratio must be in [0, 1), got {min_cruise_ratio!r}")
+    return scv, v_start, v_end, vmax_ax, amax_ax, vjump_ax, ratio, mcr
+
+
 def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
                 accel: float | Sequence[float], *,
                 square_corner_velocity: float = 0.0, start_speed: float = 0.0,
@@ -332,18 +352,9 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
     feeds = _per_element("feed", feed, len(elements))
     accels = _per_element("accel", accel, len(elements))
     decels = accels if decel is None else _per_element("decel", decel, len(elements))
-    scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
-    v_start = check_nonnegative("start_speed", start_speed)
-    v_end = check_nonnegative("end_speed", end_speed)
-    vmax_ax = _axis_limits("axis_vmax", axis_vmax, dim)
-    amax_ax = _axis_limits("axis_amax", axis_amax, dim)
-    vjump_ax = _axis_limits("axis_vjump", axis_vjump, dim)
-    ratio = check_positive("arc_tangential_ratio", arc_tangential_ratio)
-    if ratio >= 1.0:
-        raise MotionError(f"arc_tangential_ratio must be in (0, 1), got {arc_tangential_ratio!r}")
-    mcr = check_nonnegative("min_cruise_ratio", min_cruise_ratio)
-    if mcr >= 1.0:
-        raise MotionError(f"min_cruise_ratio must be in [0, 1), got {min_cruise_ratio!r}")
+    scv, v_start, v_end, vmax_ax, amax_ax, vjump_ax, ratio, mcr = check_planner_limits(
+        dim, square_corner_velocity, start_speed, end_speed, axis_vmax, axis_amax, axis_vjump,
+        arc_tangential_ratio, min_cruise_ratio)
 
     live = [k for k, el in enumerate(elements) if el.length > 0.0]
     n = len(live)

@@ -27,7 +27,7 @@ from ..errors import InfeasibleError, MotionError, check_nonnegative, check_posi
 from .arcs import Arc3D
 from .blend import BLEND_DIST_FRACTION, REVERSAL_ANGLE, TANGENT_ANGLE
 from .geometry import Array, Line, frozen
-from .lookahead import ElementSpeeds, _axis_limits, _cruise_caps, _passes
+from .lookahead import ElementSpeeds, _cruise_caps, _passes, check_planner_limits
 
 _SQRT2_M1 = math.sqrt(2.0) - 1.0
 
@@ -171,18 +171,9 @@ def plan_polyline(points: ArrayLike, feed: float | Sequence[float],
     frac = check_positive("fraction", fraction)
     if frac > 0.5:
         raise MotionError(f"fraction must be in (0, 0.5], got {fraction!r}")
-    scv = check_nonnegative("square_corner_velocity", square_corner_velocity)
-    v_start = check_nonnegative("start_speed", start_speed)
-    v_end = check_nonnegative("end_speed", end_speed)
-    vmax_ax = _axis_limits("axis_vmax", axis_vmax, dim)
-    amax_ax = _axis_limits("axis_amax", axis_amax, dim)
-    vjump_ax = _axis_limits("axis_vjump", axis_vjump, dim)
-    ratio = check_positive("arc_tangential_ratio", arc_tangential_ratio)
-    if ratio >= 1.0:
-        raise MotionError(f"arc_tangential_ratio must be in (0, 1), got {arc_tangential_ratio!r}")
-    mcr = check_nonnegative("min_cruise_ratio", min_cruise_ratio)
-    if mcr >= 1.0:
-        raise MotionError(f"min_cruise_ratio must be in [0, 1), got {min_cruise_ratio!r}")
+    scv, v_start, v_end, vmax_ax, amax_ax, vjump_ax, ratio, mcr = check_planner_limits(
+        dim, square_corner_velocity, start_speed, end_speed, axis_vmax, axis_amax, axis_vjump,
+        arc_tangential_ratio, min_cruise_ratio)
 
     # --- segments: lengths and directions (as Line computes them)
     delta = pts[1:] - pts[:-1]
