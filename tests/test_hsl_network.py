@@ -260,3 +260,28 @@ def test_soft_limits_comparator_speed_change_and_backlash():
         pass
     assert hsl.HSL_M_get_command(1) == 500
     assert hsl.controller(0).hardware.command_position(1) == pytest.approx(500 - 50, abs=1)
+
+
+def test_4_3_slave_id_occupancy():
+    # full duplex: start 1 -> IDs 1, 3, 5, 7; the second module at 2 -> 2, 4, 6, 8
+    two = (ModuleConfig(0, 1, default_module()), ModuleConfig(1, 2, default_module()))
+    assert [m.ids("full") for m in NetworkConfig(two).modules] == [(1, 3, 5, 7), (2, 4, 6, 8)]
+    # half duplex: start 1 -> 1..4; the second module at 5 -> 5..8; at 3 they overlap
+    half = (ModuleConfig(0, 1, default_module()), ModuleConfig(1, 5, default_module()))
+    assert NetworkConfig(half, duplex="half").modules[1].ids("half") == (5, 6, 7, 8)
+    with pytest.raises(MotionError, match="ID 3, already used by module 0"):
+        NetworkConfig((half[0], ModuleConfig(1, 3, default_module())), duplex="half")
+
+
+@pytest.mark.parametrize("method,fires", [(1, True), (2, False), (3, True)])
+def test_general_comparator_counting_down(method, fires):
+    hsl = HslLibrary.simulated(1)
+    hsl.HSL_initial(0)
+    hsl.HSL_M_set_command(0, 3000)
+    assert hsl.HSL_M_set_general_comparator(0, 0, method, 1, 1000.0) == 0  # stop at once
+    hsl.HSL_M_start_tr_move(0, -3000, 0, 10000, 0.01, 0.01)
+    while hsl.HSL_M_motion_done(0):
+        pass
+    stopped = hsl.HSL_M_get_command(0)
+    assert (stopped > 0) == fires
+    assert (abs(stopped - 1000) <= 20) == fires

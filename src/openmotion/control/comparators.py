@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from .controller import Controller
 
 SOURCES = ("command", "feedback", "error", "general")
-METHODS = ("=", ">", "<")
+METHODS = ("=", ">", "<", "=+", "=-")  # "=+" / "=-": equal while counting up / down
 ACTIONS = ("event", "stop", "slow_stop", "change_speed")
 
 
@@ -173,6 +173,10 @@ class Comparators:
         d = g.data
         if g.method == "=":
             hit = (prev < d <= val) or (prev > d >= val) or val == d != prev
+        elif g.method == "=+":
+            hit = prev < d <= val
+        elif g.method == "=-":
+            hit = prev > d >= val
         elif g.method == ">":
             hit = val > d
         else:
@@ -183,7 +187,7 @@ class Comparators:
         t_hit = t
         if g.source == "command" and prev != val:
             off = ax.position - ax.counters.pulses_from_command(ax.position)
-            direction = 0 if g.method == "=" else (1 if g.method == ">" else -1)
+            direction = {"=": 0, ">": 1, "=+": 1}.get(g.method, -1)
             times = self.ctl.history.crossings(i, d - off, t_prev, t, direction)
             if len(times):
                 t_hit = float(times[0])

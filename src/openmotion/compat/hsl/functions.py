@@ -130,7 +130,7 @@ TABLE: tuple[Entry, ...] = (
     _e("HSL_M_disable_soft_limit", "comparators", _H),
     _e("HSL_M_error_counter_check", "comparators", note="Table 4-8 name"),
     _e("HSL_M_set_error_counter_check", "comparators"),
-    _e("HSL_M_set_general_comparator", "comparators", note="method 2/3 refused"),
+    _e("HSL_M_set_general_comparator", "comparators", note="codes of seed-facts 2.5"),
     _e("HSL_M_set_trigger_comparator", "comparators", order=_M, note="axes 0, 1 of a module"),
     _e("HSL_M_set_trigger_type", "comparators"),
     _e("HSL_M_build_compare_function", "comparators", order=_M),

@@ -42,7 +42,7 @@ ERC_WIDTHS = {0: 12e-6, 1: 102e-6, 2: 409e-6, 3: 1.6e-3, 4: 13e-3, 5: 52e-3, 6: 
               7: 1.0}
 #: CmpSrc, CmpMethod, CmpAction codes (seed-facts 2.5, [low]).
 CMP_SOURCES = {0: "command", 1: "feedback", 2: "error", 3: "general"}
-CMP_METHODS = {1: "=", 4: ">", 5: "<"}
+CMP_METHODS = {1: "=", 2: "=+", 3: "=-", 4: ">", 5: "<"}
 CMP_ACTIONS = {0: "event", 1: "stop", 2: "slow_stop", 3: "change_speed"}
 #: CntSrc of the general counter, in the manual's order (4.9).
 GENERAL_SOURCES = {0: "command", 1: "feedback", 2: "manual", 3: "clock"}
@@ -296,7 +296,8 @@ class IoFunctions(HslBase):
     @hsl_call(SET_U32)
     def HSL_M_set_general_comparator(self, axis: int, CmpSrc: int, CmpMethod: int,
                                      CmpAction: int, Data: float) -> None:
-        """Comparator 4: source 0..3, method 0 off / 1 = / 4 > / 5 <, action 0 event,
+        """Comparator 4: source 0..3, method 0 off, 1 =, 2 = counting up, 3 = counting
+        down, 4 >, 5 <; action 0 event,
         1 stop, 2 decelerate and stop, 3 change speed (cmp_v_change)."""
         mod, ax = self._axis(axis)
         cmp = self._safety(mod).cmp
