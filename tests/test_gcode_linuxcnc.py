@@ -1,0 +1,108 @@
+"""Differential oracle: openmotion.program against LinuxCNC's own interpreter (rs274).
+
+Every program in tests/gcode_oracle/ (our own programs, each naming the LinuxCNC test or
+sample it mirrors), examples/gcode/ and /work/shared/gcode-corpus/ (when present) is run
+through both; the motions (end points, arc centres, planes and directions, feeds, rapid or
+feed) must agree within 1e-4 program units. Programs in tests/gcode_oracle/bad/ must be
+refused by both. rs274 comes from Debian's linuxcnc-uspace (tools/setup_rs274.sh); without
+it these tests skip, except under CI (env CI set), where a missing oracle is a failure.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from lcnc_oracle import (
+    Motion,
+    compare,
+    openmotion_motions,
+    parse_listing,
+    rs274_path,
+    run_rs274,
+)
+from openmotion.program import GCodeError
+
+HERE = Path(__file__).parent
+ROOT = HERE.parent
+CORPUS = Path("/work/shared/gcode-corpus")
+GOOD = sorted((HERE / "gcode_oracle").glob("*.ngc")) + sorted(
+    (ROOT / "examples" / "gcode").glob("*.ngc")) + (
+    sorted(CORPUS.glob("*.ngc")) if CORPUS.is_dir() else [])
+BAD = sorted((HERE / "gcode_oracle" / "bad").glob("*.ngc"))
+
+
+@pytest.fixture(scope="module")
+def rs274() -> str:
+    exe = rs274_path()
+    if exe is None:
+        reason = ("LinuxCNC rs274 is not installed: run tools/setup_rs274.sh (Debian "
+                  "package linuxcnc-uspace unpacked to /opt/linuxcnc-rs274) or set "
+                  "OPENMOTION_RS274")
+        if os.environ.get("CI"):
+            pytest.fail(f"CI needs the oracle: {reason}")
+        pytest.skip(reason)
+    return exe
+
+
+def _name(p: Path) -> str:
+    return str(p.relative_to(ROOT)) if p.is_relative_to(ROOT) else p.name
+
+
+@pytest.mark.parametrize("path", GOOD, ids=_name)
+def test_same_motion_as_linuxcnc(rs274: str, path: Path) -> None:
+    text = path.read_text()
+    theirs = run_rs274(text, rs274)
+    assert theirs.error is None, f"rs274 refused {path.name}: {theirs.error}"
+    assert theirs.motions, "rs274 produced no motion"
+    ours = openmotion_motions(text)
+    diffs = compare(ours, theirs.motions)
+    assert not diffs, "\n".join(diffs[:20])
+
+
+@pytest.mark.parametrize("path", BAD, ids=_name)
+def test_refused_by_both(rs274: str, path: Path) -> None:
+    text = path.read_text()
+    theirs = run_rs274(text, rs274)
+    assert theirs.error is not None, "rs274 accepted a program meant to be bad"
+    with pytest.raises(GCodeError):
+        openmotion_motions(text)
+
+
+def test_oracle_sees_a_difference(rs274: str) -> None:
+    """The comparison can fail: a program changed on our side only differs."""
+    text = "G21 G0 X1 Y2\nG1 X5 F100\nG2 X9 Y2 I2 J0\nM2\n"
+    theirs = run_rs274(text, rs274).motions
+    assert not compare(openmotion_motions(text), theirs)
+    assert compare(openmotion_motions(text.replace("X9", "X9.001")), theirs)
+    assert compare(openmotion_motions(text.replace("F100", "F101")), theirs)
+    assert compare(openmotion_motions(text.replace("G2", "G3")), theirs)
+
+
+LISTING = """\
+    1 N..... USE_LENGTH_UNITS(CANON_UNITS_MM)
+    2 N..... SET_G5X_OFFSET(1, 10.0000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)
+    3 N..... SET_G92_OFFSET(1.0000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)
+    4 N..... SET_XY_ROTATION(90.0000)
+    5 N..... SET_FEED_RATE(10.0000)
+    6 N..... USE_LENGTH_UNITS(CANON_UNITS_INCHES)
+    7 N..... STRAIGHT_FEED(1.0000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)
+    8 N..... STRAIGHT_FEED(1.0000, 0.0000, 0.0000, 90.0000, 0.0000, 0.0000)
+    9 N..... SELECT_PLANE(CANON_PLANE_XZ)
+   10 N..... ARC_FEED(0.0000, 2.0000, 0.0000, 1.5000, -2, 0.0000, 90.0000, 0.0000, 0.0000)
+"""
+
+
+def test_listing_replays_the_canon_layer() -> None:
+    """Units at the time of each call, G92 then rotation about the G5x origin, feeds."""
+    ms = parse_listing(LISTING)
+    assert [m.kind for m in ms] == ["feed", "feed", "arc"]
+    # X1 in = 25.4 mm, + G92 1 mm, rotated 90 deg, + G5x 10 mm
+    assert ms[0].end[:2] == pytest.approx((10.0, 26.4))
+    assert ms[0].feed == pytest.approx(10.0)  # F set while in mm: 10 mm/min
+    assert ms[1].feed == pytest.approx(10.0)  # rotary only: angular feed, unscaled
+    arc = ms[2]
+    assert (arc.plane, arc.rotation) == ("XZ", -2)
+    assert isinstance(arc, Motion) and arc.tol == pytest.approx(25.4e-4)
