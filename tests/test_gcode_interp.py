@@ -394,3 +394,24 @@ def test_options_validation():
         GCodeOptions(axes={"X": 2}, n_axes=2)
     with pytest.raises(GCodeError, match="options"):
         compile_text("G0 X1", {"X": 0})  # type: ignore[arg-type]
+
+
+# -- LinuxCNC's feed semantics (silent differences found by the rs274 oracle) ---------------
+def _feeds(text: str, opts: GCodeOptions = XYZA) -> list[float]:
+    return [c.feed_per_s * 60.0 for c in run(text, opts) if isinstance(c, (Feed, ArcMove))]
+
+
+def test_rotary_only_feed_is_degrees_per_minute_in_any_units():
+    # G20 F10 G1 A90 on a mm machine: 10 deg/min, not 254 (LinuxCNC never scales angles)
+    assert _feeds("G20\nF10 G1 A90\nG21 G1 A0\n") == pytest.approx([10.0, 10.0])
+    # a move with a linear axis feeds along it in the linear unit
+    assert _feeds("G20\nF10 G1 X1 A90\n") == pytest.approx([254.0])
+
+
+def test_f_on_the_units_line_is_read_in_the_old_units():
+    # order of execution: F before G20/G21, so F10 here is 10 mm/min
+    assert _feeds("G21\nG20 F10 G1 X1\nG1 X2\n") == pytest.approx([10.0, 10.0])
+    assert _feeds("G20\nG21 F10 G1 X1\n") == pytest.approx([254.0])
+    # a later F is in the new units; the feed survives unit changes unscaled physically
+    assert _feeds("G21 F100 G1 X1\nG20\nG1 X2\nF4 G1 X3\n") == pytest.approx(
+        [100.0, 100.0, 101.6])

@@ -77,6 +77,10 @@ class Modal:
         self.plane = 170
         self.inverse_time = False
         self.feed = 0.0  # the F number: program units per minute (G94) or inverse time (G93)
+        # G94 feed in machine units per minute, fixed when F is set (LinuxCNC's canon
+        # converts F with the units active then); angular feeds are never converted.
+        self.feed_lin = 0.0
+        self.feed_ang = 0.0
         self.motion: int | None = None  # G80: no motion mode until G0..G3
         self.coord = 1
         self.tool_z = 0.0
@@ -237,14 +241,18 @@ class Modal:
             inv = gs[5][0] == 930
             if inv != self.inverse_time:
                 self.inverse_time = inv
-                self.feed = 0.0
+                self.feed = self.feed_lin = self.feed_ang = 0.0
         f = words.get("F")
         if f is not None:
             used.add("F")
             if f.value < 0:
                 raise b.error(f"feed rate must be >= 0, got {f.value:g}", f.pos,
                               fmt("F", f.value))
-            self.feed = f.value  # program units per minute: converted when used
+            # F comes before G20/G21 in the order of execution: a unit change on the
+            # same line does not rescale it (LinuxCNC).
+            self.feed = f.value
+            self.feed_lin = self.lin(f.value)
+            self.feed_ang = f.value
         s = words.get("S")
         if s is not None:
             used.add("S")
@@ -429,9 +437,10 @@ class Modal:
             cam = self.lin(q.value)
         out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
 
-    def feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int
-                   ) -> tuple[float, float | None]:
-        """(feed_per_s, duration) for a feed move; errors when F is missing."""
+    def feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int,
+                  rotary_only: bool = False) -> tuple[float, float | None]:
+        """(feed_per_s, duration) for a feed move; errors when F is missing. A move of
+        rotary axes only runs at the F number in degrees per minute (never unit-scaled)."""
         if self.inverse_time:
             f = words.get("F")
             if f is None or f.value <= 0:
@@ -441,7 +450,12 @@ class Modal:
         if self.feed <= 0.0:
             raise b.error("feed rate is zero or not set: give F before or with "
                           f"{gword}", gpos, gword)
-        return self.lin(self.feed) / 60.0, None
+        return (self.feed_ang if rotary_only else self.feed_lin) / 60.0, None
+
+    def _rotary_only(self, start: list[float], end: list[float]) -> bool:
+        """True when only rotary axes move (LinuxCNC then feeds at the angular rate)."""
+        moved = [L for L, (ax, _k) in self.letters.items() if end[ax] != start[ax]]
+        return bool(moved) and all(L in ROTARY_LETTERS for L in moved)
 
     def _motion(self, b: Block, gs: dict[int, tuple[int, int]], axes: dict[str, Word],
                 words: dict[str, Word], used: set[str], out: list[canon.Command],
@@ -465,7 +479,8 @@ class Modal:
             self.check_limits(b, target, target, gword, gpos)
             out.append(canon.Rapid(tuple(target), b.line, b.file))
         elif mode == 10:
-            feed, duration = self.feed_rate(b, words, gword, gpos)
+            feed, duration = self.feed_rate(b, words, gword, gpos,
+                                            self._rotary_only(self.pos, target))
             if duration is not None:
                 feed = feed_length(self.pos, target, self.letters) / duration
             self.check_limits(b, target, target, gword, gpos)
