@@ -78,7 +78,7 @@ def test_oracle_sees_a_difference(rs274: str) -> None:
     assert not compare(openmotion_motions(text), theirs)
     assert compare(openmotion_motions(text.replace("X9", "X9.001")), theirs)
     assert compare(openmotion_motions(text.replace("F100", "F101")), theirs)
-    assert compare(openmotion_motions(text.replace("G2", "G3")), theirs)
+    assert compare(openmotion_motions(text.replace("G2 ", "G3 ")), theirs)
 
 
 LISTING = """\
@@ -106,3 +106,15 @@ def test_listing_replays_the_canon_layer() -> None:
     arc = ms[2]
     assert (arc.plane, arc.rotation) == ("XZ", -2)
     assert isinstance(arc, Motion) and arc.tol == pytest.approx(25.4e-4)
+
+
+def test_debug_messages_as_linuxcnc_prints_them(rs274: str) -> None:
+    from lcnc_oracle import OPTIONS
+    from openmotion.program import Message, compile_text
+
+    text = ("#1=3.14159\n#2=-2.5\n#<_g>=12\n(DEBUG, a=%d#1 b=%f#1 c=%.2f#1 d=#1 e=%lf#1 "
+            "g=#2 h=#9999 i=#<_nope> j=%.x k=%.3g#1 l=#<_g>)\n(debug,#1%.9f#2)\n"
+            "#5599=0\n(debug, hidden)\n#5599=1\n(msg, m=#1)\nG0 X1\nM2\n")
+    theirs = [t.strip() for t in run_rs274(text, rs274).messages]
+    ours = [c.text for c in compile_text(text, OPTIONS) if isinstance(c, Message)]
+    assert ours == theirs

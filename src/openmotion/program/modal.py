@@ -17,12 +17,12 @@ rewrite them (G10, G28/G30, G92) are in coords.py; G2/G3 in arcmove.py.
 from __future__ import annotations
 
 import math
-import re
 
 from . import canon
 from .arcmove import arc_move
 from .coords import offset_command
 from .expr import EvalError, Node
+from .messages import comment_commands
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
@@ -55,7 +55,6 @@ M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
            62: 5, 63: 5, 64: 5, 65: 5}
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
-_DEBUG_PARAM = re.compile(r"#<([^>]*)>|#(\d+)")
 
 
 class Modal:
@@ -98,6 +97,8 @@ class Modal:
         if any(self.g92):
             params.set_number(5210, 1.0)
         params.set_number(5220, 1.0)
+        if 5599 not in options.parameters:
+            params.set_number(5599, 1.0)  # (DEBUG,...) output on, as LinuxCNC starts
         self.off = [0.0] * 9
         self.update_offsets()
         params.position_hook = self.program_position
@@ -176,22 +177,6 @@ class Modal:
         if not math.isfinite(x):
             raise b.error(f"value is not finite ({x})", v.pos, word)
         return x
-
-    def debug_text(self, text: str) -> str:
-        """(DEBUG,...) text with #n and #<name> replaced by their values."""
-
-        def sub(m: re.Match[str]) -> str:
-            if m.group(1) is not None:
-                name = "".join(m.group(1).split()).upper()
-                table = self.params.globals if name.startswith("_") else \
-                    self.params.locals[-1]
-                return f"{table[name]:.6f}" if name in table else "######"
-            n = int(m.group(2))
-            if 1 <= n < len(self.params.numbers):
-                return f"{self.params.get_number(n, 0):.6f}"
-            return "######"
-
-        return _DEBUG_PARAM.sub(sub, text)
 
     # -- one line --------------------------------------------------------------------
     def execute(self, b: Block, out: list[canon.Command]) -> bool:  # noqa: C901
@@ -380,19 +365,7 @@ class Modal:
         self.update_offsets()
 
     def messages(self, b: Block, out: list[canon.Command]) -> None:
-        for _col, text in b.comments:
-            body = text.lstrip()
-            head = body[:6].upper()
-            if head.startswith("MSG,"):
-                out.append(canon.Message(body[4:].strip(), "msg", b.line, b.file))
-            elif head.startswith("DEBUG,"):
-                out.append(canon.Message(self.debug_text(body[6:].strip()), "debug", b.line,
-                                         b.file))
-            elif head.startswith("PRINT,"):
-                out.append(canon.Message(self.debug_text(body[6:].strip()), "print", b.line,
-                                         b.file))
-            elif self.opt.keep_comments:
-                out.append(canon.Message(text, "comment", b.line, b.file))
+        comment_commands(b, self.params, self.opt.keep_comments, out)
 
     def _set_units(self, units: str) -> None:
         self.units = units
