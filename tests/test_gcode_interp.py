@@ -253,15 +253,19 @@ def test_absolute_arc_centre_g90_1():
 
 
 def test_inconsistent_radius_is_an_error():
-    e = err("G0 X0\nG2 X10 Y0.5 I5 F60")
+    e = err("G0 X0\nG2 X10 Y1 I5 F60")
     assert e.line == 2 and "differs" in str(e) and e.word == "I/J/K"
     # within LinuxCNC's tolerance (0.028 mm, 0.1 %): accepted as a slight spiral
     arc = run("G2 X100.02 Y0 I50 F60")[0]
     assert arc.end_radius - arc.radius == pytest.approx(0.02)
     path = arc.to_path()
     assert close(path.point(path.length), (100.02, 0.0, 0.0))
-    e = err("G2 X10.02 Y0 I5 F60")  # same 0.02 but 0.4 % of the radius
-    assert "differs" in str(e)
+    # LinuxCNC's rule: within the absolute tolerance at any percentage ...
+    assert run("G2 X10.02 Y0 I5 F60")[0].end_radius == pytest.approx(5.02)
+    # ... or within 0.1 % beyond it (0.05 mm on 100 mm), but never beyond 100x it
+    assert run("G2 X200.05 Y0 I100 F60")[0].end_radius == pytest.approx(100.05)
+    assert "differs" in str(err("G2 X200.2 Y0 I100 F60"))
+    assert "differs" in str(err("G2 X10003 Y0 I5000 F60"))
     e = err("G2 X30 R5 F60")
     assert "too small" in str(e) and e.word == "R"
     e = err("G2 X0 Y0 R5 F60")
@@ -415,3 +419,8 @@ def test_f_on_the_units_line_is_read_in_the_old_units():
     # a later F is in the new units; the feed survives unit changes unscaled physically
     assert _feeds("G21 F100 G1 X1\nG20\nG1 X2\nF4 G1 X3\n") == pytest.approx(
         [100.0, 100.0, 101.6])
+
+
+def test_g64_p0_is_plain_g64():
+    blends = [c for c in run("G64 P0\nG64 P0.1\nG64\n") if isinstance(c, SetBlend)]
+    assert [b.tolerance for b in blends] == [None, pytest.approx(0.1), None]

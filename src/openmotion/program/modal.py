@@ -401,7 +401,8 @@ class Modal:
             used.add("P")
             if p.value < 0:
                 raise b.error(f"G64 P must be >= 0, got {p.value:g}", p.pos, fmt("P", p.value))
-            tol = self.lin(p.value)
+            # P0 is plain G64 (best speed), as LinuxCNC reads a zero tolerance
+            tol = self.lin(p.value) if p.value > 0 else None
         q = words.get("Q")
         if q is not None:
             used.add("Q")
