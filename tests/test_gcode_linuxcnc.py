@@ -118,3 +118,15 @@ def test_debug_messages_as_linuxcnc_prints_them(rs274: str) -> None:
     theirs = [t.strip() for t in run_rs274(text, rs274).messages]
     ours = [c.text for c in compile_text(text, OPTIONS) if isinstance(c, Message)]
     assert ours == theirs
+
+
+@pytest.mark.parametrize("name", ["predefined_params.ngc"])
+def test_messages_as_linuxcnc_prints_them(rs274: str, name: str) -> None:
+    """Programs whose DEBUG lines print modal state: the same text from both."""
+    from lcnc_oracle import OPTIONS
+    from openmotion.program import Message, compile_text
+
+    text = (HERE / "gcode_oracle" / name).read_text()
+    theirs = [t.strip() for t in run_rs274(text, rs274).messages]
+    ours = [c.text for c in compile_text(text, OPTIONS) if isinstance(c, Message)]
+    assert ours == theirs

@@ -22,7 +22,7 @@ def test_debug_formats_persist_within_the_comment():
 
 
 def test_default_six_decimals_print_and_named_locals():
-    assert texts("#<_a> = 2\n(print, v=#<_a> #<_ a>)\n") == ["v=2.000000 2.000000"]
+    assert texts("#<_aa> = 2\n(print, v=#<_aa> #<_ a a>)\n") == ["v=2.000000 2.000000"]
 
 
 def test_debug_off_while_5599_is_zero_msg_is_literal():
@@ -40,3 +40,14 @@ def test_abort_stops_with_its_text_and_nothing_runs():
     # an ABORT in a branch that is not taken does nothing
     cmds = compile_text("o1 if [0]\n(abort, no)\no1 endif\nG0 X3\n", XYZ)
     assert [c.end[0] for c in cmds if isinstance(c, Rapid)] == [3.0]
+
+
+def test_predefined_parameters_read_state_and_are_read_only():
+    prog = ("G20 G91 G18 G0 X1\n(debug, #<_imperial> #<_plane> #<_incremental> #<_x> "
+            "#<_abs_x> #<_motion_mode> #<_line> #<_vmajor>)\n")
+    assert texts(prog) == ["1.000000 180.000000 1.000000 1.000000 1.000000 0.000000 "
+                           "2.000000 2.900000"]
+    with pytest.raises(GCodeError, match="predefined"):
+        compile_text("#<_x> = 3\n", XYZ)
+    assert texts("(debug, EXISTS)\no1 if [EXISTS[#<_metric>]]\n(debug, yes)\no1 endif\n"
+                 ) == ["EXISTS", "yes"]

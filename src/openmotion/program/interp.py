@@ -182,6 +182,7 @@ class Interpreter:
                 pc += 1
                 continue
             o = b.oword
+            modal.line = b.line
             if o is None:
                 if not modal.execute(b, out):
                     break

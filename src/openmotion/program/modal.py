@@ -23,6 +23,7 @@ from .arcmove import arc_move
 from .coords import offset_command
 from .expr import EvalError, Node
 from .messages import comment_commands
+from .named import READ_ONLY, predefined
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
@@ -102,6 +103,13 @@ class Modal:
         self.off = [0.0] * 9
         self.update_offsets()
         params.position_hook = self.program_position
+        params.predefined_hook = lambda name: predefined(self, name)
+        self.line = 0  # the line being executed (#<_line>)
+        self.per_rev = False  # G95
+        self.css = False  # G96
+        self.retract_old_z = False  # G98 (True) / G99; LinuxCNC's rs274 starts in G99
+        self.diameter_mode = False  # G7
+        self.tool_offset = [0.0] * 9  # active G43 offset per axis letter (machine units)
 
     # -- coordinates -----------------------------------------------------------------
     def update_offsets(self) -> None:
@@ -110,6 +118,20 @@ class Modal:
         for k in range(9):
             self.off[k] = nums[base + k] + self.g92[k]
         self.off[2] += self.tool_z
+
+    def ccomp_code(self) -> int:
+        """Active cutter compensation as G-code * 10 (400 = off)."""
+        return 400
+
+    def feed_program_units(self) -> float:
+        """The active feed (#<_feed>): units per minute in the program's units (G94)."""
+        if self.inverse_time:
+            return self.feed
+        return self.feed_lin * self.ldiv / self.lscale
+
+    def pocket_of(self, tool: int) -> int:
+        """Pocket of a tool (a tool table without pockets: the tool number, 0 -> -1)."""
+        return tool if tool > 0 else -1
 
     def lin(self, v: float) -> float:
         """A program length in machine units (exact when the units agree or 1 in = 25.4 mm)."""
@@ -181,6 +203,7 @@ class Modal:
     # -- one line --------------------------------------------------------------------
     def execute(self, b: Block, out: list[canon.Command]) -> bool:  # noqa: C901
         line, file = b.line, b.file
+        self.line = line
         gs: dict[int, tuple[int, int]] = {}  # group -> (code, pos)
         ms: dict[int, tuple[int, int]] = {}
         words: dict[str, Word] = {}
@@ -254,6 +277,7 @@ class Modal:
             self.selected_tool = self.int_word(b, "T", t, 0)
         if 6 in ms:
             self.tool = self.selected_tool
+            self.params.set_number(5400, float(self.tool))
             out.append(canon.ToolChange(self.tool, line, file))
         if 7 in ms:
             code = ms[7][0]
@@ -356,6 +380,10 @@ class Modal:
                                   f"#{idx:g}")
                 target = int(n)
             pending.append((target, value))
+        for target, _value in pending:
+            if isinstance(target, str) and target in READ_ONLY:
+                raise b.error(f"#<{target.lower()}> is a predefined parameter and cannot be "
+                              "assigned", -1, f"#<{target.lower()}>")
         for target, value in pending:
             if isinstance(target, int):
                 self.params.set_number(target, value)
