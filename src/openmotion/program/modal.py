@@ -21,6 +21,8 @@ import math
 from . import canon
 from .arcmove import arc_move
 from .coords import offset_command
+from .cycles import CYCLES, CycleState, canned_cycle
+from .cycles import REFUSED as CYCLE_REFUSED
 from .expr import EvalError, Node
 from .messages import comment_commands
 from .named import READ_ONLY, predefined
@@ -32,7 +34,8 @@ from .words import Word, feed_length, fmt
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
 G_GROUP = {
     40: 0, 100: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
-    0: 1, 10: 1, 20: 1, 30: 1, 800: 1,
+    0: 1, 10: 1, 20: 1, 30: 1, 800: 1, 730: 1, 810: 1, 820: 1, 830: 1, 850: 1, 860: 1, 880: 1,
+    890: 1,
     170: 2, 180: 2, 190: 2,
     900: 3, 910: 3,
     901: 4, 911: 4,
@@ -42,6 +45,7 @@ G_GROUP = {
     430: 8, 490: 8,
     540: 12, 550: 12, 560: 12, 570: 12, 580: 12, 590: 12, 591: 12, 592: 12, 593: 12,
     610: 13, 611: 13, 640: 13,
+    980: 10, 990: 10,
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
 G_REFUSED = {
@@ -50,7 +54,7 @@ G_REFUSED = {
     330: "spindle-synchronized motion (G33) is not supported",
     382: "probing (G38.x) is not supported",
     950: "feed per revolution (G95) is not supported",
-    810: "canned cycles (G81) are not supported",
+    **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
            62: 5, 63: 5, 64: 5, 65: 5}
@@ -82,6 +86,9 @@ class Modal:
         self.feed_lin = 0.0
         self.feed_ang = 0.0
         self.motion: int | None = None  # G80: no motion mode until G0..G3
+        self.motion_prev: int | None = None  # the motion mode before this line's G-code
+        self.cycle = CycleState()
+        self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
         self.coord = 1
         self.tool_z = 0.0
         self.selected_tool = 0
@@ -326,6 +333,8 @@ class Modal:
             self.update_offsets()
         if 13 in gs:
             self._path_control(b, gs[13][0], words, used, out)
+        if 10 in gs:
+            self.retract_old_z = gs[10][0] == 980
         if 3 in gs:
             self.incremental = gs[3][0] == 910
         if 4 in gs:
@@ -339,9 +348,13 @@ class Modal:
             offset_command(self, b, g0, axes, words, used, out)
             used.update(axes)
         elif 1 in gs or axes or (g0 is not None and g0[0] == 530):
+            self.motion_prev = self.motion
             if 1 in gs:
                 self.motion = None if gs[1][0] == 800 else gs[1][0]
-            if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")):
+            if self.motion not in CYCLES and (1 in gs or axes):
+                self.cycle.initial = None  # a series of cycles ends at any other motion
+            if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")) or (
+                    1 in gs and self.motion in CYCLES):
                 self._motion(b, gs, axes, words, used, out, machine=g0 is not None)
                 used.update(axes)
         for letter, w in words.items():
@@ -422,6 +435,7 @@ class Modal:
         if code != 640:
             mode = "exact_path" if code == 610 else "exact_stop"
             out.append(canon.SetBlend(mode, None, b.line, b.file))
+            self.blend = (mode, None, None)
             return
         tol = cam = None
         p = words.get("P")
@@ -438,6 +452,12 @@ class Modal:
                 raise b.error(f"G64 Q must be >= 0, got {q.value:g}", q.pos, fmt("Q", q.value))
             cam = self.lin(q.value)
         out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
+        self.blend = ("blend", tol, cam)
+
+    def spindle_record(self, on: bool, b: Block) -> canon.Spindle:
+        """A Spindle record in the current direction and speed (cycles stop/restart)."""
+        return canon.Spindle(on, self.spindle_cw, self.speed, self.opt.spindle_output,
+                             b.line, b.file)
 
     def feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int,
                   rotary_only: bool = False) -> tuple[float, float | None]:
@@ -470,12 +490,15 @@ class Modal:
             w = next(iter(axes.values()))
             raise b.error("axis words without a motion mode (G0, G1, G2 or G3)", w.pos,
                           fmt(next(iter(axes)), w.value))
-        gword = f"G{mode // 10}"
+        gword = f"G{mode / 10:g}"
         if machine:
             if mode not in (0, 10):
                 raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
             if self.incremental:
                 raise b.error("G53 cannot be used in incremental mode (G91)", gs[0][1], "G53")
+        if mode in CYCLES:
+            canned_cycle(self, b, mode, gpos, axes, words, used, out)
+            return
         target = self.target_position(b, axes, machine=machine)
         if mode == 0:
             self.check_limits(b, target, target, gword, gpos)
