@@ -31,7 +31,7 @@ DEFAULT_RS274 = "/opt/linuxcnc-rs274/rs274"
 LETTERS = "XYZABC"
 ROTARY = (3, 4, 5)
 #: Machine for both interpreters: XYZABC in mm, like LinuxCNC's sim configurations.
-OPTIONS = GCodeOptions(axes={L: k for k, L in enumerate(LETTERS)})
+OPTIONS = GCodeOptions(axes={L: k for k, L in enumerate(LETTERS)}, max_blocks=2_000_000)
 
 
 def rs274_path() -> str | None:

@@ -120,7 +120,7 @@ def test_debug_messages_as_linuxcnc_prints_them(rs274: str) -> None:
     assert ours == theirs
 
 
-@pytest.mark.parametrize("name", ["predefined_params.ngc"])
+@pytest.mark.parametrize("name", ["predefined_params.ngc", "fanuc_params.ngc"])
 def test_messages_as_linuxcnc_prints_them(rs274: str, name: str) -> None:
     """Programs whose DEBUG lines print modal state: the same text from both."""
     from lcnc_oracle import OPTIONS
@@ -130,3 +130,34 @@ def test_messages_as_linuxcnc_prints_them(rs274: str, name: str) -> None:
     theirs = [t.strip() for t in run_rs274(text, rs274).messages]
     ours = [c.text for c in compile_text(text, OPTIONS) if isinstance(c, Message)]
     assert ours == theirs
+
+
+SUB_FILES = {
+    "probe_hole.ngc": "o<probe_hole> sub\nG0 X#1 Y#2\nG1 Z-1 F100\n"
+                      "o<probe_hole> endsub [#1 + #2]\n",
+    "100.ngc": "o100 sub\nG0 X100\no100 return [7]\no100 endsub\n",
+}
+SUB_MAIN = ("(external subroutine files on the search path, computed O numbers, return values)\n"
+            "(mirrors LinuxCNC tests/interp/subroutine-path and 14-o-expression-call)\n"
+            "G21\no<probe_hole> call [3] [4]\n(debug, v=#<_value> r=#<_value_returned>)\n"
+            "#5=50\no[#5*2] call\n(debug, v=#<_value>)\nG0 X[#<_value> * 2]\nM2\n")
+
+
+def test_external_subroutine_files_as_linuxcnc(rs274: str, tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from openmotion.program import Message, compile_file
+    from lcnc_oracle import OPTIONS
+
+    theirs = run_rs274(SUB_MAIN, rs274, extra_files=SUB_FILES)
+    assert theirs.error is None
+    for name, body in SUB_FILES.items():
+        (tmp_path / name).write_text(body)
+    (tmp_path / "main.ngc").write_text(SUB_MAIN)
+    # found next to the program ...
+    cmds = compile_file(tmp_path / "main.ngc", OPTIONS)
+    assert [c.text for c in cmds if isinstance(c, Message)] == [
+        t.strip() for t in theirs.messages]
+    # ... or on the search path for a program given as text
+    opts = replace(OPTIONS, subroutine_path=(str(tmp_path),))
+    assert not compare(openmotion_motions(SUB_MAIN, opts), theirs.motions)

@@ -57,7 +57,7 @@ G_REFUSED = {
     **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
-           62: 5, 63: 5, 64: 5, 65: 5}
+           62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11}
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
 
@@ -99,6 +99,9 @@ class Modal:
         self.mist = False
         self.flood = False
         self.ended = False
+        #: M98 (call: P number, L count) or M99 for the interpreter, after the line ran:
+        #: (kind, P, L, column)
+        self.flow_request: tuple[str, float, int, int] | None = None
         # letter -> (machine axis, parameter offset k)
         self.letters = {L: (options.axes[L], AXIS_LETTERS.index(L)) for L in options.axes}
         self.g92 = [params.numbers[5211 + k] for k in range(9)]
@@ -357,10 +360,17 @@ class Modal:
                     1 in gs and self.motion in CYCLES):
                 self._motion(b, gs, axes, words, used, out, machine=g0 is not None)
                 used.update(axes)
+        if 11 in ms and ms[11][0] == 98:
+            used.update(L for L in "PL" if L in words)
         for letter, w in words.items():
             if letter not in used:
                 raise b.error(f"word {letter} is not used by any command on this line",
                               w.pos, fmt(letter, w.value))
+        if 4 in ms and 11 in ms:
+            raise b.error("M98/M99 cannot share a line with M0/M1/M2/M30", ms[11][1],
+                          f"M{ms[11][0]}")
+        if 11 in ms:
+            self._flow_word(b, ms[11], words)
         if 4 in ms:
             code = ms[4][0]
             if code in (0, 1):
@@ -453,6 +463,20 @@ class Modal:
             cam = self.lin(q.value)
         out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
         self.blend = ("blend", tol, cam)
+
+    def _flow_word(self, b: Block, m: tuple[int, int], words: dict[str, Word]) -> None:
+        code, pos = m
+        if code == 99:
+            self.flow_request = ("M99", 0.0, 0, pos)
+            return
+        p = words.get("P")
+        if p is None:
+            raise b.error("M98 needs P (the program number to call)", pos, "M98")
+        count = 1
+        lw = words.get("L")
+        if lw is not None:
+            count = self.int_word(b, "L", lw, 0)
+        self.flow_request = ("M98", p.value, count, pos)
 
     def spindle_record(self, on: bool, b: Block) -> canon.Spindle:
         """A Spindle record in the current direction and speed (cycles stop/restart)."""

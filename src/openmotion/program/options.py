@@ -8,6 +8,7 @@ spindle/coolant and the safety limits of interpretation. Validated on constructi
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -47,6 +48,9 @@ class GCodeOptions:
     block_delete: skip lines starting with '/' (the block-delete switch is on).
     keep_comments: also emit plain comments as Message(kind="comment").
     max_call_depth: subroutine nesting limit; max_blocks: executed-line limit (loops).
+    subroutine_path: folders searched for `O<name> call` subroutines not defined in the
+        program, as <name>.ngc (then the program's own folder), like LinuxCNC's
+        [RS274NGC]SUBROUTINE_PATH.
     """
 
     axes: Mapping[str, int]
@@ -66,6 +70,7 @@ class GCodeOptions:
     max_blocks: int = 10_000_000
     max_line_length: int = MAX_LINE_LENGTH
     max_bytes: int = MAX_PROGRAM_BYTES
+    subroutine_path: Sequence[str | os.PathLike[str]] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.axes, Mapping) or not self.axes:
@@ -138,6 +143,12 @@ class GCodeOptions:
         for name in ("block_delete", "keep_comments"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        if isinstance(self.subroutine_path, (str, bytes)) or not all(
+                isinstance(d, (str, os.PathLike)) for d in self.subroutine_path):
+            raise MotionError(f"subroutine_path must be a sequence of folder names, got "
+                              f"{self.subroutine_path!r}")
+        object.__setattr__(self, "subroutine_path", tuple(os.fspath(d)
+                                                          for d in self.subroutine_path))
         object.__setattr__(self, "axes", axes)
         object.__setattr__(self, "n_axes", n)
         object.__setattr__(self, "start", start)

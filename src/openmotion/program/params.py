@@ -79,16 +79,20 @@ class Parameters:
         (self.globals if name.startswith("_") else self.locals[-1])[name] = value
 
     # -- call scopes -----------------------------------------------------------------
-    def push_call(self, args: list[float]) -> None:
-        """Enter a subroutine: save #1-#30, set them from `args` (rest 0), new local scope."""
+    def push_call(self, args: list[float] | None) -> None:
+        """Enter a subroutine: save #1-#30, set them from `args` (rest 0), new local scope.
+        args=None (an M98 call): #1-#30 are shared with the caller (Fanuc, LinuxCNC)."""
         self._saved.append(self.numbers[1:N_LOCAL + 1])
-        vals = list(args) + [0.0] * (N_LOCAL - len(args))
-        self.numbers[1:N_LOCAL + 1] = vals
+        if args is not None:
+            vals = list(args) + [0.0] * (N_LOCAL - len(args))
+            self.numbers[1:N_LOCAL + 1] = vals
         self.locals.append({})
 
-    def pop_call(self) -> None:
-        """Leave a subroutine: restore the caller's #1-#30 and local names."""
-        self.numbers[1:N_LOCAL + 1] = self._saved.pop()
+    def pop_call(self, keep_numbered: bool = False) -> None:
+        """Leave a subroutine: restore the caller's #1-#30 (unless kept) and local names."""
+        saved = self._saved.pop()
+        if not keep_numbered:
+            self.numbers[1:N_LOCAL + 1] = saved
         self.locals.pop()
 
     @property

@@ -37,6 +37,7 @@ O_KEYWORDS = {
     "SUB": 0, "ENDSUB": 1, "RETURN": 1, "CALL": 9, "DO": 0, "WHILE": 2, "ENDWHILE": 0,
     "IF": 2, "ELSEIF": 2, "ELSE": 0, "ENDIF": 0, "REPEAT": 2, "ENDREPEAT": 0,
     "BREAK": 0, "CONTINUE": 0,
+    "": 0,  # a bare O<n> line: a Fanuc-style program number (called with M98, ends at M99)
 }
 _WORD_OPS = ("MOD", "AND", "XOR", "OR", "EQ", "NE", "GT", "GE", "LT", "LE")
 
@@ -51,12 +52,14 @@ Value = float | Node
 
 @dataclass(slots=True)
 class OWord:
-    """An O-word control line: `O<label> <keyword> [args]`."""
+    """An O-word control line: `O<label> <keyword> [args]`; `computed` is the expression
+    of an `O[expr] call` label (then `label` is its text)."""
 
     label: str
     keyword: str
     args: list[Value]
     pos: int
+    computed: Node | None = None
 
 
 @dataclass(slots=True)
@@ -255,8 +258,15 @@ class _LineParser:
     def oword(self) -> OWord:
         pos = self.i
         self.i += 1  # 'O'
+        computed: Value | None = None
         if self.peek() == "<":
             label = "<" + self.name() + ">"
+        elif self.peek() == "[":
+            start = self.i
+            computed = self.value()
+            label = self.s[start:self.i]
+            if not isinstance(computed, Node):
+                label = str(int(computed)) if computed == int(computed) else label
         else:
             m = _NUMBER.match(self.s, self.i)
             if m is None or "." in m.group():
@@ -288,7 +298,10 @@ class _LineParser:
             self.fail("CALL takes at most 30 arguments", kstart, word)
         if self.i < len(self.s):
             self.fail("unexpected text after the O-word", word=self.s[self.i:self.i + 8])
-        return OWord(label, keyword, args, pos)
+        if computed is not None and keyword != "CALL" and isinstance(computed, Node):
+            self.fail("a computed O-word label is only allowed with call", pos, word)
+        return OWord(label, keyword, args, pos,
+                     computed if isinstance(computed, Node) else None)
 
     def items(self) -> None:
         b = self.block
