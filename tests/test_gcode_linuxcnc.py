@@ -11,11 +11,13 @@ it these tests skip, except under CI (env CI set), where a missing oracle is a f
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from lcnc_oracle import (
+    OPTIONS,
     Motion,
     compare,
     openmotion_motions,
@@ -23,7 +25,7 @@ from lcnc_oracle import (
     rs274_path,
     run_rs274,
 )
-from openmotion.program import GCodeError
+from openmotion.program import GCodeError, Message, compile_file, compile_text
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
@@ -109,8 +111,6 @@ def test_listing_replays_the_canon_layer() -> None:
 
 
 def test_debug_messages_as_linuxcnc_prints_them(rs274: str) -> None:
-    from lcnc_oracle import OPTIONS
-    from openmotion.program import Message, compile_text
 
     text = ("#1=3.14159\n#2=-2.5\n#<_g>=12\n(DEBUG, a=%d#1 b=%f#1 c=%.2f#1 d=#1 e=%lf#1 "
             "g=#2 h=#9999 i=#<_nope> j=%.x k=%.3g#1 l=#<_g>)\n(debug,#1%.9f#2)\n"
@@ -123,8 +123,6 @@ def test_debug_messages_as_linuxcnc_prints_them(rs274: str) -> None:
 @pytest.mark.parametrize("name", ["predefined_params.ngc", "fanuc_params.ngc"])
 def test_messages_as_linuxcnc_prints_them(rs274: str, name: str) -> None:
     """Programs whose DEBUG lines print modal state: the same text from both."""
-    from lcnc_oracle import OPTIONS
-    from openmotion.program import Message, compile_text
 
     text = (HERE / "gcode_oracle" / name).read_text()
     theirs = [t.strip() for t in run_rs274(text, rs274).messages]
@@ -144,10 +142,6 @@ SUB_MAIN = ("(external subroutine files on the search path, computed O numbers, 
 
 
 def test_external_subroutine_files_as_linuxcnc(rs274: str, tmp_path: Path) -> None:
-    from dataclasses import replace
-
-    from openmotion.program import Message, compile_file
-    from lcnc_oracle import OPTIONS
 
     theirs = run_rs274(SUB_MAIN, rs274, extra_files=SUB_FILES)
     assert theirs.error is None
