@@ -30,8 +30,11 @@ from openmotion.program import ArcMove, Feed, GCodeError, GCodeOptions, Rapid, c
 DEFAULT_RS274 = "/opt/linuxcnc-rs274/rs274"
 LETTERS = "XYZABC"
 ROTARY = (3, 4, 5)
+#: The tool table both interpreters use (machine units, mm).
+TOOLS = Path(__file__).parent / "gcode_oracle" / "tools.tbl"
 #: Machine for both interpreters: XYZABC in mm, like LinuxCNC's sim configurations.
-OPTIONS = GCodeOptions(axes={L: k for k, L in enumerate(LETTERS)}, max_blocks=2_000_000)
+OPTIONS = GCodeOptions(axes={L: k for k, L in enumerate(LETTERS)}, max_blocks=2_000_000,
+                       tool_table=TOOLS)
 
 
 def rs274_path() -> str | None:
@@ -67,7 +70,6 @@ class Rs274Result:
 _CALL = re.compile(r"^\s*\d+\s+N\S*\s+([A-Z_0-9.]+)\((.*)\)\s*$")
 _PLANES = {"CANON_PLANE_XY": ("XY", 0, 1, 2), "CANON_PLANE_YZ": ("YZ", 1, 2, 0),
            "CANON_PLANE_XZ": ("XZ", 2, 0, 1)}
-TOOL_TABLE = "T1 P1 D0 Z0 ;\n"
 INI = "[TRAJ]\nLINEAR_UNITS = mm\nANGULAR_UNITS = degree\n"
 
 
@@ -154,9 +156,26 @@ def parse_listing(listing: str) -> list[Motion]:
     return out
 
 
-def run_rs274(text: str, rs274: str | None = None, tool_table: str = TOOL_TABLE,
+def inch_tool_table(path: Path = TOOLS) -> str:
+    """A mm tool table as rs274 reads it: the standalone interpreter takes tool table
+    lengths and diameters in inches whatever the machine units."""
+    out = []
+    for raw in path.read_text().splitlines():
+        body, sep, comment = raw.partition(";")
+        words = []
+        for w in body.split():
+            letter, v = w[0].upper(), w[1:]
+            if letter in "XYZUVWD":
+                v = f"{float(v) / 25.4:.9f}"
+            words.append(letter + v)
+        out.append(" ".join(words) + f" {sep}{comment}")
+    return "\n".join(out) + "\n"
+
+
+def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None,
               extra_files: dict[str, str] | None = None) -> Rs274Result:
     """Run rs274 on program text (in a scratch folder, with `extra_files` next to it)."""
+    tool_table = inch_tool_table() if tool_table is None else tool_table
     exe = rs274 or rs274_path()
     if exe is None:
         raise RuntimeError("rs274 is not installed (tools/setup_rs274.sh)")

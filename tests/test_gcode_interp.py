@@ -351,7 +351,7 @@ def test_soft_limits_caught_before_motion():
         ("X1", "X1", "without a motion mode"),
         ("G80 X1", "G80", "G80"),
         ("G4", "G4", "needs P"),
-        ("G10 L1 P1 X1", "L1", "L2 and L20"),
+        ("G10 L3 P1 X1", "L3", "L1, L2, L10, L11, L20"),
         ("T-1", "T-1", "integer"),
         ("S-5", "S-5", ">= 0"),
     ],
@@ -425,3 +425,27 @@ def test_f_on_the_units_line_is_read_in_the_old_units():
 def test_g64_p0_is_plain_g64():
     blends = [c for c in run("G64 P0\nG64 P0.1\nG64\n") if isinstance(c, SetBlend)]
     assert [b.tolerance for b in blends] == [None, pytest.approx(0.1), None]
+
+
+def test_tool_table_g43_g10_l1_and_m61(tmp_path):
+    from openmotion.program.tooltable import format_tool_table, parse_tool_table
+
+    tbl = tmp_path / "t.tbl"
+    tbl.write_text("T1 P3 Z10 X1 D6 ;drill\n\nT4 P4 Z-2 ;\n")
+    opts = GCodeOptions(axes={"X": 0, "Y": 1, "Z": 2}, tool_table=str(tbl))
+    assert opts.tool_table[1].pocket == 3 and opts.tool_table[1].radius == 3.0
+    # G43 H applies every axis offset; M61 Q sets the tool without a change
+    assert last_end("G43 H1\nG0 X0 Y0 Z0", opts) == (1.0, 0.0, 10.0)
+    assert last_end("M61 Q4\nG43\nG0 X0 Z0", opts) == (0.0, 0.0, -2.0)
+    # G10 L1 edits the table (R = radius), G10 L10 so that the position reads Z5
+    assert last_end("G10 L1 P4 Z3 R1\nG43 H4\nG0 Z0", opts) == (0.0, 0.0, 3.0)
+    assert last_end("G0 Z20\nG10 L10 P4 Z5\nG43 H4\nG0 Z5", opts) == (0.0, 0.0, 20.0)
+    # G43.1 sets, G43.2 adds; G49 clears
+    assert last_end("G43.1 Z2\nG43.2 Z1\nG0 X0 Z0\n", opts) == (0.0, 0.0, 3.0)
+    assert last_end("G43 H1\nG49\nG0 X0 Z0\n", opts) == (0.0, 0.0, 0.0)
+    table = parse_tool_table(format_tool_table(opts.tool_table))
+    assert table == dict(opts.tool_table)
+    with pytest.raises(GCodeError) as info:
+        parse_tool_table("T1 P1 Z1\nT2 P2 K1\n", "x.tbl")
+    assert info.value.line == 2 and info.value.file == "x.tbl"
+    assert "M61 needs Q" in str(err("M61\n", opts))

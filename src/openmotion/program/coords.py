@@ -72,14 +72,17 @@ def offset_command(m: Modal, b: Block, g: tuple[int, int], axes: dict[str, Word]
         _g10(m, b, gpos, axes, words, used)
 
 def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, Word],
-     used: set[str]) -> None:
+         used: set[str]) -> None:
     lw = words.get("L")
     if lw is None:
-        raise b.error("G10 needs L (L2 or L20)", gpos, "G10")
+        raise b.error("G10 needs L (L1, L2, L10, L11 or L20)", gpos, "G10")
     used.add("L")
     L = m.int_word(b, "L", lw, 0)
-    if L not in (2, 20):
-        raise b.error(f"G10 L{L} is not supported (only L2 and L20)", lw.pos, f"L{L}")
+    if L not in (1, 2, 10, 11, 20):
+        raise b.error(f"G10 L{L} is not supported (L1, L2, L10, L11, L20)", lw.pos, f"L{L}")
+    if L in (1, 10, 11):
+        _g10_tool(m, b, L, gpos, axes, words, used)
+        return
     if "R" in words:
         raise b.error("G10 R (coordinate system rotation) is not supported",
                       words["R"].pos, "R")
@@ -99,6 +102,56 @@ def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, 
         if L == 2:
             m.params.set_number(base + k, v)
         else:  # L20: the current position becomes v in that system
-            extra = m.g92[k] + (m.tool_z if k == 2 else 0.0)
+            extra = m.g92[k] + m.tool_offset[k]
             m.params.set_number(base + k, m.pos[ax] - extra - v)
     m.update_offsets()
+
+
+def _g10_tool(m: Modal, b: Block, L: int, gpos: int, axes: dict[str, Word],
+              words: dict[str, Word], used: set[str]) -> None:
+    """G10 L1 (set a tool table entry), L10 / L11 (set a tool's offsets so the current
+    position reads the given values with the current work offsets, or with G59.3's)."""
+    from dataclasses import replace
+
+    from .tooltable import Tool
+
+    word = f"G10 L{L}"
+    pw = words.get("P")
+    if pw is None:
+        raise b.error(f"{word} needs P (the tool number)", gpos, word)
+    used.add("P")
+    n = m.int_word(b, "P", pw, 1)
+    tool = m.tools.get(n) or Tool(n, n)
+    offsets = list(tool.offsets)
+    base9 = 5221 + 20 * 8
+    for letter, w in axes.items():
+        ax = m.axis_index(b, letter, w)
+        k = m.letters[letter][1]
+        v = m.conv(w.value, letter)
+        if L == 1:
+            offsets[k] = v
+        elif L == 10:
+            work = m.off[k] - m.tool_offset[k]  # origin + G92
+            offsets[k] = m.pos[ax] - work - v
+        else:
+            offsets[k] = m.pos[ax] - m.params.numbers[base9 + k] - v
+    changes: dict[str, object] = {"offsets": tuple(offsets)}
+    rw = words.get("R")
+    if rw is not None:
+        used.add("R")
+        if rw.value < 0:
+            raise b.error(f"{word} R (tool radius) must be >= 0, got {rw.value:g}", rw.pos,
+                          fmt("R", rw.value))
+        changes["diameter"] = 2.0 * m.lin(rw.value)
+    for letter, name in (("I", "front_angle"), ("J", "back_angle")):
+        if letter in words:
+            used.add(letter)
+            changes[name] = words[letter].value
+    if "Q" in words:
+        used.add("Q")
+        q = m.int_word(b, "Q", words["Q"], 0)
+        if q > 9:
+            raise b.error(f"{word} Q (orientation) must be 0..9, got {q}", words["Q"].pos,
+                          fmt("Q", q))
+        changes["orientation"] = q
+    m.tools[n] = replace(tool, **changes)  # type: ignore[arg-type]

@@ -42,7 +42,7 @@ G_GROUP = {
     930: 5, 940: 5,
     200: 6, 210: 6,
     400: 7,
-    430: 8, 490: 8,
+    430: 8, 431: 8, 432: 8, 490: 8,
     540: 12, 550: 12, 560: 12, 570: 12, 580: 12, 590: 12, 591: 12, 592: 12, 593: 12,
     610: 13, 611: 13, 640: 13,
     980: 10, 990: 10,
@@ -57,7 +57,7 @@ G_REFUSED = {
     **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
-           62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11}
+           62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11, 61: 6}
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
 
@@ -90,7 +90,7 @@ class Modal:
         self.cycle = CycleState()
         self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
         self.coord = 1
-        self.tool_z = 0.0
+        self.tools = dict(options.tool_table)  # type: ignore[arg-type]  # G10 L1 edits
         self.selected_tool = 0
         self.tool = 0
         self.spindle_on = False
@@ -111,6 +111,7 @@ class Modal:
         if 5599 not in options.parameters:
             params.set_number(5599, 1.0)  # (DEBUG,...) output on, as LinuxCNC starts
         self.off = [0.0] * 9
+        self.tool_offset = [0.0] * 9  # active G43 offset per axis letter (machine units)
         self.update_offsets()
         params.position_hook = self.program_position
         params.predefined_hook = lambda name: predefined(self, name)
@@ -119,7 +120,6 @@ class Modal:
         self.css = False  # G96
         self.retract_old_z = False  # G98 (True) / G99; LinuxCNC's rs274 starts in G99
         self.diameter_mode = False  # G7
-        self.tool_offset = [0.0] * 9  # active G43 offset per axis letter (machine units)
 
     # -- coordinates -----------------------------------------------------------------
     def update_offsets(self) -> None:
@@ -127,7 +127,8 @@ class Modal:
         nums = self.params.numbers
         for k in range(9):
             self.off[k] = nums[base + k] + self.g92[k]
-        self.off[2] += self.tool_z
+        for k in range(9):
+            self.off[k] += self.tool_offset[k]
 
     def ccomp_code(self) -> int:
         """Active cutter compensation as G-code * 10 (400 = off)."""
@@ -285,7 +286,14 @@ class Modal:
         if t is not None:
             used.add("T")
             self.selected_tool = self.int_word(b, "T", t, 0)
-        if 6 in ms:
+        if 6 in ms and ms[6][0] == 61:  # M61 Q: the tool in the spindle, no change
+            q = words.get("Q")
+            if q is None:
+                raise b.error("M61 needs Q (the tool now in the spindle)", ms[6][1], "M61")
+            used.add("Q")
+            self.tool = self.int_word(b, "Q", q, 0)
+            self.params.set_number(5400, float(self.tool))
+        elif 6 in ms:
             self.tool = self.selected_tool
             self.params.set_number(5400, float(self.tool))
             out.append(canon.ToolChange(self.tool, line, file))
@@ -330,6 +338,9 @@ class Modal:
             self._set_units("inch" if gs[6][0] == 200 else "mm")
         if 8 in gs:
             self._tool_length(b, gs[8], words, used)
+            if gs[8][0] in (431, 432):  # their axis words are offsets, not a move
+                for L in [L for L in words if L in AXIS_SET and L in used]:
+                    del words[L]
         if 12 in gs:
             self.coord = COORD_SYSTEMS[gs[12][0]]
             self.params.set_number(5220, float(self.coord))
@@ -429,15 +440,42 @@ class Modal:
 
     def _tool_length(self, b: Block, g: tuple[int, int], words: dict[str, Word],
                      used: set[str]) -> None:
-        if g[0] == 490:
-            self.tool_z = 0.0
+        """G43 [H] (table offsets of a tool), G43.1 (offsets given on the line), G43.2
+        (add a tool's or the line's offsets), G49 (none)."""
+        code, pos = g
+        axes = {L: w for L, w in words.items() if L in AXIS_SET}
+        if code == 490:
+            self.tool_offset = [0.0] * 9
+        elif code == 431:
+            if not axes:
+                raise b.error("G43.1 needs axis words (the offsets)", pos, "G43.1")
+            self.tool_offset = [0.0] * 9
+            for L, w in axes.items():
+                self.axis_index(b, L, w)
+                self.tool_offset[self.letters[L][1]] = self.conv(w.value, L)
+            used.update(axes)
         else:
             h = words.get("H")
             tool = self.tool
             if h is not None:
                 used.add("H")
                 tool = self.int_word(b, "H", h, 0)
-            self.tool_z = float(self.opt.tool_lengths.get(tool, 0.0))
+            if code == 432 and h is None and axes:
+                extra = [0.0] * 9
+                for L, w in axes.items():
+                    self.axis_index(b, L, w)
+                    extra[self.letters[L][1]] = self.conv(w.value, L)
+                used.update(axes)
+            elif code == 432 and h is None:
+                raise b.error("G43.2 needs H (a tool) or axis words", pos, "G43.2")
+            else:
+                t = self.tools.get(tool)
+                extra = list(t.offsets) if t is not None else [0.0] * 9
+            if code == 430:
+                self.tool_offset = extra
+            else:
+                self.tool_offset = [a + e for a, e in zip(self.tool_offset, extra,
+                                                          strict=True)]
         self.update_offsets()
 
     def _path_control(self, b: Block, code: int, words: dict[str, Word], used: set[str],

@@ -60,7 +60,7 @@ _TABLE: dict[str, Callable[[Modal], float]] = {
     "_UNITS_PER_MINUTE": lambda m: _flag(not m.inverse_time and not m.per_rev),
     "_UNITS_PER_REV": lambda m: _flag(m.per_rev),
     "_COORD_SYSTEM": _coord,
-    "_TOOL_OFFSET": lambda m: _flag(m.tool_z != 0.0 or any(m.tool_offset)),
+    "_TOOL_OFFSET": lambda m: _flag(any(m.tool_offset)),
     "_RETRACT_R_PLANE": lambda m: _flag(not m.retract_old_z),
     "_RETRACT_OLD_Z": lambda m: _flag(m.retract_old_z),
     "_SPINDLE_RPM_MODE": lambda m: _flag(not m.css),
