@@ -18,9 +18,11 @@ from __future__ import annotations
 
 import math
 
+from ..path import Direction
 from . import canon
 from .arcmove import arc_move
 from .coords import offset_command
+from .cuttercomp import CutterComp, comp_arc, comp_off, comp_on, comp_straight
 from .cycles import CYCLES, CycleState, canned_cycle
 from .cycles import REFUSED as CYCLE_REFUSED
 from .expr import EvalError, Node
@@ -41,7 +43,7 @@ G_GROUP = {
     901: 4, 911: 4,
     930: 5, 940: 5,
     200: 6, 210: 6,
-    400: 7,
+    400: 7, 410: 7, 420: 7, 411: 7, 421: 7,
     430: 8, 431: 8, 432: 8, 490: 8,
     540: 12, 550: 12, 560: 12, 570: 12, 580: 12, 590: 12, 591: 12, 592: 12, 593: 12,
     610: 13, 611: 13, 640: 13,
@@ -49,8 +51,6 @@ G_GROUP = {
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
 G_REFUSED = {
-    410: "cutter radius compensation (G41) is not supported",
-    420: "cutter radius compensation (G42) is not supported",
     330: "spindle-synchronized motion (G33) is not supported",
     382: "probing (G38.x) is not supported",
     950: "feed per revolution (G95) is not supported",
@@ -88,6 +88,7 @@ class Modal:
         self.motion: int | None = None  # G80: no motion mode until G0..G3
         self.motion_prev: int | None = None  # the motion mode before this line's G-code
         self.cycle = CycleState()
+        self.comp = CutterComp()
         self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
         self.coord = 1
         self.tools = dict(options.tool_table)  # type: ignore[arg-type]  # G10 L1 edits
@@ -132,7 +133,7 @@ class Modal:
 
     def ccomp_code(self) -> int:
         """Active cutter compensation as G-code * 10 (400 = off)."""
-        return 400
+        return self.comp.code()
 
     def feed_program_units(self) -> float:
         """The active feed (#<_feed>): units per minute in the program's units (G94)."""
@@ -294,6 +295,9 @@ class Modal:
             self.tool = self.int_word(b, "Q", q, 0)
             self.params.set_number(5400, float(self.tool))
         elif 6 in ms:
+            if self.comp.side:
+                raise b.error("cannot change tools with cutter compensation on (G40 first)",
+                              ms[6][1], "M6")
             self.tool = self.selected_tool
             self.params.set_number(5400, float(self.tool))
             out.append(canon.ToolChange(self.tool, line, file))
@@ -333,9 +337,17 @@ class Modal:
                               fmt("P", p.value))
             out.append(canon.Dwell(p.value, line, file))
         if 2 in gs:
+            if self.comp.side and gs[2][0] != self.plane:
+                raise b.error("cannot change planes with cutter compensation on", gs[2][1],
+                              f"G{gs[2][0] / 10:g}")
             self.plane = gs[2][0]
         if 6 in gs:
             self._set_units("inch" if gs[6][0] == 200 else "mm")
+        if 7 in gs:
+            if gs[7][0] == 400:
+                comp_off(self)
+            else:
+                comp_on(self, b, gs[7][0], gs[7][1], words, used)
         if 8 in gs:
             self._tool_length(b, gs[8], words, used)
             if gs[8][0] in (431, 432):  # their axis words are offsets, not a move
@@ -359,6 +371,9 @@ class Modal:
                 raise b.error("axis words are used by two commands on this line "
                               f"(G{g0[0] / 10:g} and G{gs[1][0] / 10:g})", gs[1][1],
                               f"G{gs[1][0] / 10:g}")
+            if self.comp.side and g0[0] in (280, 300):
+                raise b.error("G28/G30 cannot be used with cutter compensation on", g0[1],
+                              f"G{g0[0] / 10:g}")
             offset_command(self, b, g0, axes, words, used, out)
             used.update(axes)
         elif 1 in gs or axes or (g0 is not None and g0[0] == 530):
@@ -387,6 +402,7 @@ class Modal:
             if code in (0, 1):
                 out.append(canon.Pause(code == 1, line, file))
             else:
+                comp_off(self)
                 out.append(canon.End(code == 30, line, file))
                 self.ended = True
                 return False
@@ -536,6 +552,39 @@ class Modal:
                           f"{gword}", gpos, gword)
         return (self.feed_ang if rotary_only else self.feed_lin) / 60.0, None
 
+    def _comp_motion(self, b: Block, mode: int, gpos: int, gword: str,
+                     axes: dict[str, Word], words: dict[str, Word], used: set[str],
+                     out: list[canon.Command], machine: bool) -> None:
+        """A move under cutter compensation: words read against the programmed point."""
+        if machine:
+            raise b.error("G53 cannot be used with cutter compensation on", gpos, "G53")
+        ax, ay = self.letters["X"][0], self.letters["Y"][0]
+        tool_pos = self.pos
+        prog = tool_pos[:]
+        if not self.comp.first_move:
+            prog[ax], prog[ay] = self.comp.prog
+        self.pos = prog
+        try:
+            target = self.target_position(b, axes)
+            if mode in (20, 30):
+                arc = arc_move(self, b, mode, gpos, target, words, used)
+        finally:
+            self.pos = tool_pos
+        if mode == 0:
+            feed = 0.0
+        elif mode == 10:
+            feed, duration = self.feed_rate(b, words, gword, gpos)
+            if duration is not None:  # G93: the programmed length in that time (LinuxCNC)
+                feed = feed_length(prog, target, self.letters) / duration
+        else:
+            feed = arc.feed_per_s
+        if mode in (0, 10):
+            comp_straight(self, b, mode, target, feed, out, gword, gpos)
+        else:
+            sign = 1 if arc.direction == Direction.CCW else -1
+            comp_arc(self, b, mode, target, arc.centre[ax], arc.centre[ay],
+                     sign * (arc.turns + 1), feed, out, gword, gpos)
+
     def _rotary_only(self, start: list[float], end: list[float]) -> bool:
         """True when only rotary axes move (LinuxCNC then feeds at the angular rate)."""
         moved = [L for L, (ax, _k) in self.letters.items() if end[ax] != start[ax]]
@@ -559,8 +608,19 @@ class Modal:
             if self.incremental:
                 raise b.error("G53 cannot be used in incremental mode (G91)", gs[0][1], "G53")
         if mode in CYCLES:
+            if self.comp.side:
+                raise b.error("canned cycles cannot be used with cutter compensation on",
+                              gpos, gword)
             canned_cycle(self, b, mode, gpos, axes, words, used, out)
             return
+        if mode in (20, 30) and self.comp.arc_not_allowed:
+            raise b.error("the move just after cutter compensation ends (G40) must be a "
+                          "straight line", gpos, gword)
+        if self.comp.active:
+            self._comp_motion(b, mode, gpos, gword, axes, words, used, out, machine)
+            return
+        if mode in (0, 10) and any(L in axes for L in "XY"):
+            self.comp.arc_not_allowed = False
         target = self.target_position(b, axes, machine=machine)
         if mode == 0:
             self.check_limits(b, target, target, gword, gpos)
