@@ -120,7 +120,8 @@ def test_debug_messages_as_linuxcnc_prints_them(rs274: str) -> None:
     assert ours == theirs
 
 
-@pytest.mark.parametrize("name", ["predefined_params.ngc", "fanuc_params.ngc", "tool_offsets.ngc"])
+@pytest.mark.parametrize("name", ["predefined_params.ngc", "fanuc_params.ngc", "tool_offsets.ngc",
+                                  "modal_state.ngc"])
 def test_messages_as_linuxcnc_prints_them(rs274: str, name: str) -> None:
     """Programs whose DEBUG lines print modal state: the same text from both."""
 

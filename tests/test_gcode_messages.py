@@ -51,3 +51,15 @@ def test_predefined_parameters_read_state_and_are_read_only():
         compile_text("#<_x> = 3\n", XYZ)
     assert texts("(debug, EXISTS)\no1 if [EXISTS[#<_metric>]]\n(debug, yes)\no1 endif\n"
                  ) == ["EXISTS", "yes"]
+
+
+def test_m70_m72_restore_spindle_and_coolant_records():
+    from openmotion.program import Coolant, Spindle
+
+    cmds = compile_text("S100 M3\nM70\nM5 M8\nM72\nG0 X1\n", XYZ)
+    sp = [c for c in cmds if isinstance(c, Spindle)]
+    co = [c for c in cmds if isinstance(c, Coolant)]
+    assert [s.on for s in sp] == [True, False, True] and sp[-1].speed == 100
+    assert [(c.mist, c.flood) for c in co] == [(False, True), (False, False)]
+    with pytest.raises(GCodeError, match="M72"):
+        compile_text("M72\n", XYZ)

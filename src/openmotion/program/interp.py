@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 from . import canon
 from .modal import Modal
+from .modalstate import on_return
 from .options import GCodeOptions
 from .params import Parameters
 from .parser import Block, Program, parse_program
@@ -210,6 +211,7 @@ class Interpreter:
         modal = self.modal
         skip_deleted = self.opt.block_delete
         out: list[canon.Command] = []
+        self._out = out
         frames: list[_Frame] = [_Frame("", -1)]
         steps = 0
         limit = self.opt.max_blocks
@@ -257,6 +259,7 @@ class Interpreter:
                 frame = frames.pop()
                 if len(frames) == 0:  # pragma: no cover - _analyse forbids this
                     raise b.error("return outside a subroutine", o.pos, f"O{o.label}")
+                on_return(modal, self.params.depth, b, out)
                 self.params.pop_call()
                 pc = frame.return_to
             elif kw == "CALL":
@@ -354,6 +357,7 @@ class Interpreter:
                 top.repeats.clear()
                 return top.start
             frames.pop()
+            on_return(self.modal, self.params.depth, b, self._out)
             self.params.pop_call(keep_numbered=True)
             return top.return_to
         label = self._label(b, p, pos)

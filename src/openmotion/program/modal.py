@@ -27,6 +27,7 @@ from .cycles import CYCLES, CycleState, canned_cycle
 from .cycles import REFUSED as CYCLE_REFUSED
 from .expr import EvalError, Node
 from .messages import comment_commands
+from .modalstate import SavedState, state_word
 from .named import READ_ONLY, predefined
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
@@ -57,7 +58,8 @@ G_REFUSED = {
     **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
-           62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11, 61: 6}
+           62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11, 61: 6,
+           70: 12, 71: 12, 72: 12, 73: 12}
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
 
@@ -89,6 +91,7 @@ class Modal:
         self.motion_prev: int | None = None  # the motion mode before this line's G-code
         self.cycle = CycleState()
         self.comp = CutterComp()
+        self.saved_states: dict[int, SavedState] = {}  # call level -> M70/M73 snapshot
         self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
         self.coord = 1
         self.tools = dict(options.tool_table)  # type: ignore[arg-type]  # G10 L1 edits
@@ -308,6 +311,8 @@ class Modal:
                 self.spindle_cw = code == 3
             out.append(canon.Spindle(self.spindle_on, self.spindle_cw, self.speed,
                                      self.opt.spindle_output, line, file))
+        if 12 in ms:
+            state_word(self, b, ms[12][0], ms[12][1], out)
         if coolant:
             if 9 in coolant:
                 self.mist = self.flood = False
