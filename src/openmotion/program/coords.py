@@ -1,5 +1,5 @@
-"""Coordinate systems and offsets: G10 L2/L20, G28/G30 and their .1 forms, G92 and
-G92.1/.2/.3 (RS-274/NGC group 0, LinuxCNC semantics).
+"""Coordinate systems and offsets: G10 L1/L2/L10/L11/L20, G28/G30 and their .1 forms, G52,
+G92 and G92.1/.2/.3 (RS-274/NGC group 0, LinuxCNC semantics).
 
 They change no modal state of their own: they move through a stored position or rewrite
 the parameters that hold the offsets (G54.. origins #5221.. (+20 per system), G92
@@ -56,6 +56,14 @@ def offset_command(m: Modal, b: Block, g: tuple[int, int], axes: dict[str, Word]
             m.g92[k] = m.pos[ax] - base - m.conv(w.value, L)
             m.params.set_number(5211 + k, m.g92[k])
         m.params.set_number(5210, 1.0)
+        m.update_offsets()
+    elif code == 520:  # G52: a local offset held in the G92 registers (LinuxCNC)
+        for L, w in axes.items():
+            m.axis_index(b, L, w)
+            k = m.letters[L][1]
+            m.g92[k] = m.conv(w.value, L)
+            m.params.set_number(5211 + k, m.g92[k])
+        m.params.set_number(5210, 1.0 if any(m.g92) else 0.0)
         m.update_offsets()
     elif code in (921, 922):
         m.g92 = [0.0] * 9

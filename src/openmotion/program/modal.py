@@ -32,11 +32,12 @@ from .named import READ_ONLY, predefined
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
+from .polar import polar_words
 from .words import Word, feed_length, fmt
 
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
 G_GROUP = {
-    40: 0, 100: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
+    40: 0, 100: 0, 520: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
     0: 1, 10: 1, 20: 1, 30: 1, 800: 1, 730: 1, 810: 1, 820: 1, 830: 1, 850: 1, 860: 1, 880: 1,
     890: 1,
     170: 2, 180: 2, 190: 2,
@@ -49,6 +50,7 @@ G_GROUP = {
     540: 12, 550: 12, 560: 12, 570: 12, 580: 12, 590: 12, 591: 12, 592: 12, 593: 12,
     610: 13, 611: 13, 640: 13,
     980: 10, 990: 10,
+    70: 15, 80: 15,
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
 G_REFUSED = {
@@ -179,6 +181,8 @@ class Modal:
         for letter, w in axes.items():
             ax = self.axis_index(b, letter, w)
             v = self.conv(w.value, letter)
+            if letter == "X" and self.diameter_mode and not machine:
+                v *= 0.5  # G7: X words are diameters
             if machine:
                 target[ax] = v
             elif inc:
@@ -364,14 +368,18 @@ class Modal:
             self.update_offsets()
         if 13 in gs:
             self._path_control(b, gs[13][0], words, used, out)
+        if 15 in gs:
+            self.diameter_mode = gs[15][0] == 70
         if 10 in gs:
             self.retract_old_z = gs[10][0] == 980
         if 3 in gs:
             self.incremental = gs[3][0] == 910
         if 4 in gs:
             self.arc_incremental = gs[4][0] == 911
+        if "@" in words or "^" in words:
+            polar_words(self, b, words)
         axes = {L: w for L, w in words.items() if L in AXIS_SET}
-        if g0 is not None and g0[0] in (100, 280, 281, 300, 301, 920, 921, 922, 923):
+        if g0 is not None and g0[0] in (100, 520, 280, 281, 300, 301, 920, 921, 922, 923):
             if axes and 1 in gs and gs[1][0] != 800:
                 raise b.error("axis words are used by two commands on this line "
                               f"(G{g0[0] / 10:g} and G{gs[1][0] / 10:g})", gs[1][1],
