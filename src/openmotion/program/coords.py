@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from . import canon
+from .frame import frame_position
 from .parser import Block
 from .words import Word, fmt
 
@@ -52,8 +53,7 @@ def offset_command(m: Modal, b: Block, g: tuple[int, int], axes: dict[str, Word]
         for L, w in axes.items():
             ax = m.axis_index(b, L, w)
             k = m.letters[L][1]
-            base = m.off[k] - m.g92[k]
-            m.g92[k] = m.pos[ax] - base - m.conv(w.value, L)
+            m.g92[k] = frame_position(m, k, ax) - m.conv(w.value, L)
             m.params.set_number(5211 + k, m.g92[k])
         m.params.set_number(5210, 1.0)
         m.update_offsets()
@@ -91,9 +91,6 @@ def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, 
     if L in (1, 10, 11):
         _g10_tool(m, b, L, gpos, axes, words, used)
         return
-    if "R" in words:
-        raise b.error("G10 R (coordinate system rotation) is not supported",
-                      words["R"].pos, "R")
     pw = words.get("P")
     if pw is None:
         raise b.error("G10 needs P (coordinate system 1..9, 0 = current)", gpos, "G10")
@@ -103,6 +100,9 @@ def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, 
         raise b.error(f"G10 P must be in [0, 9], got {p}", pw.pos, fmt("P", pw.value))
     system = p or m.coord
     base = 5221 + 20 * (system - 1)
+    if m.params.numbers[base + 9] != 0.0 and L == 20 and any(x in axes for x in "XY"):
+        raise b.error("G10 L20 X/Y on a rotated coordinate system is not supported", gpos,
+                      "G10 L20")
     for letter, w in axes.items():
         ax = m.axis_index(b, letter, w)
         k = m.letters[letter][1]
@@ -112,6 +112,10 @@ def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, 
         else:  # L20: the current position becomes v in that system
             extra = m.g92[k] + m.tool_offset[k]
             m.params.set_number(base + k, m.pos[ax] - extra - v)
+    rw = words.get("R")
+    if rw is not None:  # rotation of the system about its origin, degrees (#5230 + ..)
+        used.add("R")
+        m.params.set_number(base + 9, rw.value)
     m.update_offsets()
 
 
@@ -139,6 +143,9 @@ def _g10_tool(m: Modal, b: Block, L: int, gpos: int, axes: dict[str, Word],
         if L == 1:
             offsets[k] = v
         elif L == 10:
+            if m.rotated and k < 2:
+                raise b.error("G10 L10 X/Y on a rotated coordinate system is not supported",
+                              gpos, word)
             work = m.off[k] - m.tool_offset[k]  # origin + G92
             offsets[k] = m.pos[ax] - work - v
         else:

@@ -64,11 +64,8 @@ class _Cycle:
         return self.m.program_position(self.idx[n][1])
 
     def _target(self, a: float, b: float, c: float) -> list[float]:
-        m = self.m
-        t = m.pos[:]
-        for (ax, k), L, v in zip(self.idx, self.letters, (a, b, c), strict=True):
-            t[ax] = m.conv(v, L) + m.off[k]
-        return t
+        words = {L: Word(v, self.gpos) for L, v in zip(self.letters, (a, b, c), strict=True)}
+        return self.m.target_position(self.b, words, incremental=False, diameter=False)
 
     def traverse(self, a: float, b: float, c: float) -> None:
         t = self._target(a, b, c)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 
 from ..path import Direction
-from . import canon
+from . import canon, frame
 from .arcmove import arc_move
 from .coords import offset_command
 from .cuttercomp import CutterComp, comp_arc, comp_off, comp_on, comp_straight
@@ -117,6 +117,9 @@ class Modal:
         if 5599 not in options.parameters:
             params.set_number(5599, 1.0)  # (DEBUG,...) output on, as LinuxCNC starts
         self.off = [0.0] * 9
+        self.work = [0.0] * 9  # G5x origin per axis letter
+        self.rot = 0.0  # rotation of the active system about its origin, degrees
+        self.rotated = False
         self.tool_offset = [0.0] * 9  # active G43 offset per axis letter (machine units)
         self.update_offsets()
         params.position_hook = self.program_position
@@ -129,12 +132,7 @@ class Modal:
 
     # -- coordinates -----------------------------------------------------------------
     def update_offsets(self) -> None:
-        base = 5221 + 20 * (self.coord - 1)
-        nums = self.params.numbers
-        for k in range(9):
-            self.off[k] = nums[base + k] + self.g92[k]
-        for k in range(9):
-            self.off[k] += self.tool_offset[k]
+        frame.update(self)
 
     def ccomp_code(self) -> int:
         """Active cutter compensation as G-code * 10 (400 = off)."""
@@ -164,6 +162,10 @@ class Modal:
         info = self.letters.get(letter)
         if info is None:
             return 0.0
+        if self.rotated and k in (0, 1):
+            xy = frame.machine_to_xy(self, self.pos[self.letters["X"][0]],
+                                     self.pos[self.letters["Y"][0]])
+            return xy[k] * self.ldiv / self.lscale
         d = self.pos[info[0]] - self.off[k]
         return d if letter in ROTARY_LETTERS else d * self.ldiv / self.lscale
 
@@ -175,20 +177,32 @@ class Modal:
         return info[0]
 
     def target_position(self, b: Block, axes: dict[str, Word], machine: bool = False,
-                incremental: bool | None = None) -> list[float]:
+                        incremental: bool | None = None, diameter: bool = True
+                        ) -> list[float]:
+        """Machine end point of axis words (program units; G90/G91, G7 on X, rotation)."""
         inc = self.incremental if incremental is None else incremental
         target = self.pos[:]
+        xy: list[float] | None = None
         for letter, w in axes.items():
             ax = self.axis_index(b, letter, w)
             v = self.conv(w.value, letter)
-            if letter == "X" and self.diameter_mode and not machine:
+            if letter == "X" and self.diameter_mode and diameter and not machine:
                 v *= 0.5  # G7: X words are diameters
+            k = self.letters[letter][1]
             if machine:
                 target[ax] = v
+            elif self.rotated and k < 2:
+                if xy is None:
+                    xy = list(frame.machine_to_xy(self, self.pos[self.letters["X"][0]],
+                                                  self.pos[self.letters["Y"][0]]))
+                xy[k] = xy[k] + v if inc else v
             elif inc:
                 target[ax] = self.pos[ax] + v
             else:
-                target[ax] = v + self.off[self.letters[letter][1]]
+                target[ax] = v + self.off[k]
+        if xy is not None:
+            mx, my = frame.xy_to_machine(self, xy[0], xy[1])
+            target[self.letters["X"][0]], target[self.letters["Y"][0]] = mx, my
         return target
 
     def check_limits(self, b: Block, lo: list[float], hi: list[float], word: str,
