@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import math
 
-from ..path import Direction
 from . import canon, frame
 from .arcmove import arc_move
+from .compmove import comp_motion
 from .coords import offset_command
-from .cuttercomp import CutterComp, comp_arc, comp_off, comp_on, comp_straight
+from .cuttercomp import CutterComp, comp_off, comp_on
 from .cycles import CYCLES, CycleState, canned_cycle
 from .cycles import REFUSED as CYCLE_REFUSED
 from .expr import EvalError, Node
@@ -33,6 +33,7 @@ from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
+from .tooloffsets import tool_length
 from .words import Word, feed_length, fmt
 
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
@@ -372,7 +373,7 @@ class Modal:
             else:
                 comp_on(self, b, gs[7][0], gs[7][1], words, used)
         if 8 in gs:
-            self._tool_length(b, gs[8], words, used)
+            tool_length(self, b, gs[8], words, used)
             if gs[8][0] in (431, 432):  # their axis words are offsets, not a move
                 for L in [L for L in words if L in AXIS_SET and L in used]:
                     del words[L]
@@ -481,46 +482,6 @@ class Modal:
             else:
                 self.ldiv = MM_PER_INCH
 
-    def _tool_length(self, b: Block, g: tuple[int, int], words: dict[str, Word],
-                     used: set[str]) -> None:
-        """G43 [H] (table offsets of a tool), G43.1 (offsets given on the line), G43.2
-        (add a tool's or the line's offsets), G49 (none)."""
-        code, pos = g
-        axes = {L: w for L, w in words.items() if L in AXIS_SET}
-        if code == 490:
-            self.tool_offset = [0.0] * 9
-        elif code == 431:
-            if not axes:
-                raise b.error("G43.1 needs axis words (the offsets)", pos, "G43.1")
-            self.tool_offset = [0.0] * 9
-            for L, w in axes.items():
-                self.axis_index(b, L, w)
-                self.tool_offset[self.letters[L][1]] = self.conv(w.value, L)
-            used.update(axes)
-        else:
-            h = words.get("H")
-            tool = self.tool
-            if h is not None:
-                used.add("H")
-                tool = self.int_word(b, "H", h, 0)
-            if code == 432 and h is None and axes:
-                extra = [0.0] * 9
-                for L, w in axes.items():
-                    self.axis_index(b, L, w)
-                    extra[self.letters[L][1]] = self.conv(w.value, L)
-                used.update(axes)
-            elif code == 432 and h is None:
-                raise b.error("G43.2 needs H (a tool) or axis words", pos, "G43.2")
-            else:
-                t = self.tools.get(tool)
-                extra = list(t.offsets) if t is not None else [0.0] * 9
-            if code == 430:
-                self.tool_offset = extra
-            else:
-                self.tool_offset = [a + e for a, e in zip(self.tool_offset, extra,
-                                                          strict=True)]
-        self.update_offsets()
-
     def _path_control(self, b: Block, code: int, words: dict[str, Word], used: set[str],
                       out: list[canon.Command]) -> None:
         if code != 640:
@@ -579,39 +540,6 @@ class Modal:
                           f"{gword}", gpos, gword)
         return (self.feed_ang if rotary_only else self.feed_lin) / 60.0, None
 
-    def _comp_motion(self, b: Block, mode: int, gpos: int, gword: str,
-                     axes: dict[str, Word], words: dict[str, Word], used: set[str],
-                     out: list[canon.Command], machine: bool) -> None:
-        """A move under cutter compensation: words read against the programmed point."""
-        if machine:
-            raise b.error("G53 cannot be used with cutter compensation on", gpos, "G53")
-        ax, ay = self.letters["X"][0], self.letters["Y"][0]
-        tool_pos = self.pos
-        prog = tool_pos[:]
-        if not self.comp.first_move:
-            prog[ax], prog[ay] = self.comp.prog
-        self.pos = prog
-        try:
-            target = self.target_position(b, axes)
-            if mode in (20, 30):
-                arc = arc_move(self, b, mode, gpos, target, words, used)
-        finally:
-            self.pos = tool_pos
-        if mode == 0:
-            feed = 0.0
-        elif mode == 10:
-            feed, duration = self.feed_rate(b, words, gword, gpos)
-            if duration is not None:  # G93: the programmed length in that time (LinuxCNC)
-                feed = feed_length(prog, target, self.letters) / duration
-        else:
-            feed = arc.feed_per_s
-        if mode in (0, 10):
-            comp_straight(self, b, mode, target, feed, out, gword, gpos)
-        else:
-            sign = 1 if arc.direction == Direction.CCW else -1
-            comp_arc(self, b, mode, target, arc.centre[ax], arc.centre[ay],
-                     sign * (arc.turns + 1), feed, out, gword, gpos)
-
     def _rotary_only(self, start: list[float], end: list[float]) -> bool:
         """True when only rotary axes move (LinuxCNC then feeds at the angular rate)."""
         moved = [L for L, (ax, _k) in self.letters.items() if end[ax] != start[ax]]
@@ -644,7 +572,7 @@ class Modal:
             raise b.error("the move just after cutter compensation ends (G40) must be a "
                           "straight line", gpos, gword)
         if self.comp.active:
-            self._comp_motion(b, mode, gpos, gword, axes, words, used, out, machine)
+            comp_motion(self, b, mode, gpos, gword, axes, words, used, out, machine)
             return
         if mode in (0, 10) and any(L in axes for L in "XY"):
             self.comp.arc_not_allowed = False
