@@ -152,8 +152,11 @@ def test_inch_units_and_work_offset():
 
 def test_inch_feed_is_converted():
     ctl = iso_ctl()
-    run = ProgramRunner(ctl, "G20 G90 G1 X1 F60\nM2")
+    run = ProgramRunner(ctl, "G20\nG90 G1 X1 F60\nM2")
     assert run.ops[0].feed == pytest.approx(25.4)  # F60 inch/min = 25.4 mm/s
+    # F on the G20 line is read before the unit change (LinuxCNC): 60 mm/min
+    run = ProgramRunner(ctl, "G20 G90 G1 X1 F60\nM2")
+    assert run.ops[0].feed == pytest.approx(1.0)
 
 
 def test_synced_output_fires_with_next_motion_and_immediate_at_once():
