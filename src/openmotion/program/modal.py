@@ -55,10 +55,31 @@ G_GROUP = {
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
 G_REFUSED = {
+    50: "cubic spline G5 is not supported", 51: "quadratic B-spline G5.1 is not supported",
+    52: "NURBS G5.2 is not supported", 53: "NURBS G5.3 is not supported",
     330: "spindle-synchronized motion (G33) is not supported",
-    382: "probing (G38.x) is not supported",
+    331: "rigid tapping (G33.1) is not supported",
+    760: "threading cycle (G76) is not supported",
+    **{c: f"probing (G38.{c - 380}) is not supported" for c in (382, 383, 384, 385)},
+    700: "lathe finishing cycle (G70) is not supported",
+    710: "lathe roughing cycle (G71) is not supported",
+    720: "lathe roughing cycle (G72) is not supported",
     950: "feed per revolution (G95) is not supported",
+    960: "constant surface speed (G96) is not supported",
+    970: "spindle RPM mode (G97) is not supported",
     **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
+}
+#: Why some well-known M-codes are refused.
+M_REFUSED = {
+    19: "spindle orientation (M19) is not supported",
+    48: "override switches (M48) are not supported", 49: "override switches (M49)"
+    " are not supported", 50: "feed override control (M50) is not supported",
+    51: "spindle override control (M51) is not supported",
+    52: "adaptive feed (M52) is not supported", 53: "feed stop control (M53) is not supported",
+    60: "pallet change (M60) is not supported",
+    66: "waiting for an input (M66) is not supported",
+    67: "synchronized analog output (M67) is not supported",
+    68: "analog output (M68) is not supported",
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
            62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11, 61: 6,
@@ -257,7 +278,11 @@ class Modal:
             elif letter == "M":
                 code = round(x)
                 if abs(x - code) > 1e-6 or code not in M_GROUP:
-                    raise b.error(f"unsupported M-code M{x:g}", pos, fmt("M", x))
+                    msg = M_REFUSED.get(code, f"unsupported M-code M{x:g}")
+                    if 100 <= code <= 199:
+                        msg = f"user M-code M{code} (a program in M{code} files) is not " \
+                              "supported"
+                    raise b.error(msg, pos, fmt("M", x))
                 grp = M_GROUP[code]
                 if grp == 8 and code != 9 and grp in ms and ms[grp][0] != 9:
                     coolant.add(code)  # M7 and M8 may share a line
