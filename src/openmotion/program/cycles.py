@@ -129,6 +129,9 @@ def canned_cycle(m: Modal, b: Block, code: int, gpos: int, axes: dict[str, Word]
         repeats = m.int_word(b, "L", lw, 0)
         if repeats == 0:
             raise b.error("L0: a canned cycle cannot be done zero times", lw.pos, "L0")
+        if repeats > m.opt.max_blocks:
+            raise b.error(f"L{repeats}: more repeats than max_blocks ({m.opt.max_blocks})",
+                          lw.pos, f"L{repeats}")
     dwell = peck = 0.0
     if code in (820, 860, 880, 890):
         dwell = _need(m, b, code, words, "P", st.p, used, gword, gpos, "dwell seconds")
@@ -143,6 +146,10 @@ def canned_cycle(m: Modal, b: Block, code: int, gpos: int, axes: dict[str, Word]
         st.q = peck
     if code in (860, 880) and not m.spindle_on:
         raise b.error(f"{gword} needs the spindle turning (M3 or M4)", gpos, gword)
+    if peck > 0 and (r_word - c_word if not m.incremental else -c_word) / peck * repeats \
+            > m.opt.max_blocks:
+        raise b.error(f"{gword}: Q{peck:g} makes more pecks than max_blocks "
+                      f"({m.opt.max_blocks})", gpos, gword)
     cyc = _Cycle(m, b, gword, gpos, out)
     current_c = cyc.prog(2)
     if st.initial is None:
