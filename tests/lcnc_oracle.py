@@ -25,7 +25,15 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from openmotion.program import ArcMove, Feed, GCodeError, GCodeOptions, Rapid, compile_text
+from openmotion.program import (
+    ArcMove,
+    Feed,
+    GCodeError,
+    GCodeOptions,
+    Rapid,
+    SyncedFeed,
+    compile_text,
+)
 
 DEFAULT_RS274 = "/opt/linuxcnc-rs274/rs274"
 LETTERS = "XYZABC"
@@ -51,7 +59,7 @@ class Motion:
 
     kind: str
     end: tuple[float, ...]
-    feed: float | None = None  # mm/min or deg/min (rapids: None)
+    feed: float | None = None  # mm/min or deg/min (rapids: None); "sync": mm/revolution
     plane: str = ""  # arcs: "XY", "YZ" or "XZ" (LinuxCNC's first/second axis order)
     centre: tuple[float, float] = (0.0, 0.0)  # arcs: first, second axis of the plane
     rotation: int = 0  # arcs: +turns CCW, -turns CW (LinuxCNC's ARC_FEED rotation)
@@ -90,6 +98,7 @@ class _Canon:
         self.angular_feed = 0.0
         self.plane = _PLANES["CANON_PLANE_XY"]
         self.pos = [0.0] * 6
+        self.sync: float | None = None  # START_SPEED_FEED_SYNC pitch, mm per revolution
 
     def mm(self, vals: list[float]) -> list[float]:
         return [v if k in ROTARY else v * self.scale for k, v in enumerate(vals)]
@@ -132,12 +141,18 @@ def parse_listing(listing: str) -> list[Motion]:
         elif name == "SET_FEED_RATE":
             f = _nums(args)[0]
             c.linear_feed, c.angular_feed = f * c.scale, f
+        elif name == "START_SPEED_FEED_SYNC":
+            c.sync = _nums(args)[0] * c.scale
+        elif name == "STOP_SPEED_FEED_SYNCH":
+            c.sync = None
         elif name == "SELECT_PLANE":
             c.plane = _PLANES[args.strip()]
         elif name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "STRAIGHT_PROBE"):
             end = c.machine(_nums(args)[:6])
             kind = {"STRAIGHT_TRAVERSE": "rapid", "STRAIGHT_FEED": "feed"}.get(name, "probe")
             feed = None if kind == "rapid" else c.feed_for(end)
+            if kind == "feed" and c.sync is not None:
+                kind, feed = "sync", c.sync
             out.append(Motion(kind, tuple(end), feed, tol=tol, line=raw.strip()))
             c.pos = end
         elif name == "ARC_FEED":
@@ -208,6 +223,8 @@ def openmotion_motions(text: str, options: GCodeOptions = OPTIONS) -> list[Motio
             out.append(Motion("rapid", tuple(cmd.end[:6]), tol=tol))
         elif isinstance(cmd, Feed):
             out.append(Motion("feed", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0, tol=tol))
+        elif isinstance(cmd, SyncedFeed):
+            out.append(Motion("sync", tuple(cmd.end[:6]), cmd.pitch, tol=tol))
         elif isinstance(cmd, ArcMove):
             i, j = cmd.plane
             name = LETTERS[i] + LETTERS[j]

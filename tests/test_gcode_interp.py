@@ -452,8 +452,8 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 
 
 @pytest.mark.parametrize("code, feature", [
-    ("G5 X1 I1 J1 P1 Q1", "spline"), ("G5.2 X1", "NURBS"), ("G33 Z-1 K1", "G33"),
-    ("G76 P1 Z-1", "threading"), ("G38.3 Z-1", "probing (G38.3)"),
+    ("G5 X1 I1 J1 P1 Q1", "spline"), ("G5.2 X1", "NURBS"), ("G33.1 Z-1 K1", "G33.1"),
+    ("G38.3 Z-1", "probing (G38.3)"),
     ("G71 Q1", "roughing"), ("G96 S100", "surface speed"), ("G95", "per revolution"),
     ("G84 Z-1 R1", "tapping"), ("M19", "orientation"), ("M66 P0 L0", "waiting"),
     ("M67", "analog"), ("M101", "user M-code"), ("M60", "pallet")])

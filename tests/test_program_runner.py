@@ -433,3 +433,12 @@ def test_m62_fires_at_the_exact_position_the_next_move_starts(blend, early_mm):
     assert t4 <= t11 + 1e-12
     assert ctl.history.state_at(0, t4).p >= 11000.0 - slack
     assert abs(ctl.history.state_at(1, t4).p) <= slack
+
+
+def test_g33_runs_at_pitch_times_the_commanded_speed():
+    ctl = iso_ctl()
+    run = ProgramRunner(ctl, "G21 S120 M3\nG33 X3 K0.5\nM5 M2")
+    line = [op for op in run.ops if op.kind == "line"][0]
+    assert line.feed == pytest.approx(0.5 * 120 / 60)  # 0.5 mm/rev at 2 rev/s
+    with pytest.raises(MotionError, match="spindle"):
+        ProgramRunner(ctl, "G21 M3\nG33 X3 K0.5\nM2")

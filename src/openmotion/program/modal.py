@@ -33,14 +33,15 @@ from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
+from .threading import g33, g76
 from .tooloffsets import tool_length
 from .words import Word, feed_length, fmt
 
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
 G_GROUP = {
     40: 0, 100: 0, 520: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
-    0: 1, 10: 1, 20: 1, 30: 1, 800: 1, 730: 1, 810: 1, 820: 1, 830: 1, 850: 1, 860: 1, 880: 1,
-    890: 1,
+    0: 1, 10: 1, 20: 1, 30: 1, 330: 1, 760: 1, 800: 1, 730: 1, 810: 1, 820: 1, 830: 1,
+    850: 1, 860: 1, 880: 1, 890: 1,
     170: 2, 180: 2, 190: 2,
     900: 3, 910: 3,
     901: 4, 911: 4,
@@ -57,9 +58,7 @@ G_GROUP = {
 G_REFUSED = {
     50: "cubic spline G5 is not supported", 51: "quadratic B-spline G5.1 is not supported",
     52: "NURBS G5.2 is not supported", 53: "NURBS G5.3 is not supported",
-    330: "spindle-synchronized motion (G33) is not supported",
     331: "rigid tapping (G33.1) is not supported",
-    760: "threading cycle (G76) is not supported",
     **{c: f"probing (G38.{c - 380}) is not supported" for c in (382, 383, 384, 385)},
     700: "lathe finishing cycle (G70) is not supported",
     710: "lathe roughing cycle (G71) is not supported",
@@ -592,6 +591,15 @@ class Modal:
                 raise b.error("canned cycles cannot be used with cutter compensation on",
                               gpos, gword)
             canned_cycle(self, b, mode, gpos, axes, words, used, out)
+            return
+        if mode in (330, 760):
+            if self.comp.side:
+                raise b.error(f"{gword} cannot be used with cutter compensation on", gpos,
+                              gword)
+            if mode == 760:
+                g76(self, b, gpos, axes, words, used, out)
+            else:
+                g33(self, b, gpos, self.target_position(b, axes), words, used, out)
             return
         if mode in (20, 30) and self.comp.arc_not_allowed:
             raise b.error("the move just after cutter compensation ends (G40) must be a "

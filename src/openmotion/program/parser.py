@@ -30,9 +30,9 @@ from .expr import (
 )
 from .source import MAX_LINE_LENGTH, GCodeError, column_of
 
-#: Letters that may start a word. E is not an RS-274/NGC word; @ and ^ are the polar
-#: radius and angle (LinuxCNC).
-WORD_LETTERS = frozenset("ABCDFGHIJKLMNPQRSTUVWXYZ@^")
+#: Letters that may start a word; @ and ^ are the polar radius and angle, E the G76 taper
+#: (LinuxCNC).
+WORD_LETTERS = frozenset("ABCDEFGHIJKLMNPQRSTUVWXYZ@^")
 #: O-word keywords and whether they take expressions: 0 none, 1 optional one, 2 one, 9 any.
 O_KEYWORDS = {
     "SUB": 0, "ENDSUB": 1, "RETURN": 1, "CALL": 9, "DO": 0, "WHILE": 2, "ENDWHILE": 0,
