@@ -442,3 +442,22 @@ def test_g33_runs_at_pitch_times_the_commanded_speed():
     assert line.feed == pytest.approx(0.5 * 120 / 60)  # 0.5 mm/rev at 2 rev/s
     with pytest.raises(MotionError, match="spindle"):
         ProgramRunner(ctl, "G21 M3\nG33 X3 K0.5\nM2")
+
+
+def test_lathe_example_on_the_xz_machine():
+    """examples/lathe_xz.toml + lathe_turn_thread.ngc: G18, G7 diameters, G76 passes."""
+    from pathlib import Path
+
+    from openmotion.config import load_machine
+    from openmotion.program import SyncedFeed
+
+    root = Path(__file__).parent.parent
+    ctl = Controller(load_machine(root / "examples" / "lathe_xz.toml"))
+    ctl.enable_all()
+    run = ProgramRunner(ctl, root / "examples" / "gcode" / "lathe_turn_thread.ngc")
+    synced = [op for op in run.ops if isinstance(op.source, SyncedFeed)]
+    # G7 halves I/J/K: depth 1 + 0.2 n^(1/1.5) reaches 1 + 1.535 after 22 cuts, + 1 spring
+    # pass; each pass is the synchronised cut and its exit taper
+    assert len(synced) == 2 * 23
+    # along Z at pitch 2.5 mm x 800 rpm = 33.3 mm/s
+    assert max(op.feed for op in synced) == pytest.approx(2.5 * 800 / 60)
