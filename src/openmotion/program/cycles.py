@@ -16,6 +16,7 @@ Planes: G17 (hole at X/Y, depth along Z), G18 (Z/X, depth along Y), G19 (Y/Z, al
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -178,9 +179,17 @@ def canned_cycle(m: Modal, b: Block, code: int, gpos: int, axes: dict[str, Word]
     if restore is None or restore[0] != "exact_path":
         out.append(canon.SetBlend("exact_path", None, b.line, b.file))
     delta = PECK_CLEARANCE[m.units]
+    polar, m.polar_inc = m.polar_inc, None
     for n in range(repeats):
         a += da
         bb += db
+        if polar is not None:  # G91 @/^: radius and angle about the origin, per repeat
+            if a == 0.0 and bb == 0.0:
+                raise b.error("incremental polar motion is undefined at the origin", gpos,
+                              gword)
+            rad = math.hypot(a, bb) + polar[0]
+            ang = math.atan2(bb, a) + polar[1]
+            a, bb = rad * math.cos(ang), rad * math.sin(ang)
         if n == 0 and current_c > r:
             cyc.traverse(a, bb, current_c)
             cyc.traverse(a, bb, r)

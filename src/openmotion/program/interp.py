@@ -115,9 +115,9 @@ def _analyse(blocks: list[Block], block_delete: bool) -> _Flow:
             else:
                 raise err(f"{kw.lower()} outside an O{label} loop")
             continue
-        if kw == "RETURN":
-            if not any(f[1] == "SUB" and f[0] == label for f in stack):
-                raise err(f"return outside subroutine O{label}")
+        if kw == "RETURN":  # LinuxCNC: any label returns from the enclosing sub
+            if not any(f[1] == "SUB" for f in stack):
+                raise err(f"return outside a subroutine (O{label} return)")
             continue
     if stack:
         label, kw, i, _ = stack[-1]
@@ -167,6 +167,7 @@ class Interpreter:
         self.params = Parameters(options.parameters)
         self.modal = Modal(options, self.params)
         self.blocks = list(program.blocks)
+        self.main_end = len(self.blocks)  # blocks after this come from subroutine files
         self.search = subroutine_dirs(options, program.file)
         self.flow = _analyse(self.blocks, options.block_delete)
         while self.flow.missing:
@@ -188,17 +189,10 @@ class Interpreter:
         if label not in own.subs:
             raise b.error(f"{path} does not define O{label} sub ... O{label} endsub", pos,
                           word)
-        for sb in sub.blocks:
-            if sb.oword is None and (sb.words or sb.assigns) and not self._inside(
-                    own, sub.blocks.index(sb)):
-                raise sb.error("a subroutine file holds only its subroutine "
-                               "(code outside O.. sub/endsub)", 0, "")
+        # code outside the sub (a test harness, M2 ...) is never run, as in LinuxCNC
         self.blocks.extend(sub.blocks)
         self.flow = _analyse(self.blocks, self.opt.block_delete)
 
-    @staticmethod
-    def _inside(flow: _Flow, i: int) -> bool:
-        return any(a <= i <= e for a, e in flow.subs.values())
 
     def _truth(self, b: Block) -> bool:
         o = b.oword
@@ -219,6 +213,8 @@ class Interpreter:
         test_branch = -1  # the ELSEIF whose condition is to be tested next
         n = len(blocks)
         while pc < n:
+            if pc == self.main_end and len(frames) == 1:
+                break  # the main program ran off its end: loaded files are not run
             b = blocks[pc]
             steps += 1
             if steps > limit:

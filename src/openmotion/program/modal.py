@@ -113,6 +113,7 @@ class Modal:
         self.motion: int | None = None  # G80: no motion mode until G0..G3
         self.motion_prev: int | None = None  # the motion mode before this line's G-code
         self.cycle = CycleState()
+        self.polar_inc: tuple[float, float] | None = None  # G91 polar cycle increments
         self.comp = CutterComp()
         self.saved_states: dict[int, SavedState] = {}  # call level -> M70/M73 snapshot
         self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
@@ -270,6 +271,11 @@ class Modal:
                     msg = G_REFUSED.get(code, f"unsupported G-code G{x:g}")
                     raise b.error(msg, pos, fmt("G", x))
                 grp = G_GROUP[code]
+                if grp == 1 and grp in gs and 800 in (code, gs[1][0]):
+                    # LinuxCNC: G80 with another motion code on the line gives way to it
+                    if code != 800:
+                        gs[1] = (code, pos)
+                    continue
                 if grp in gs:
                     raise b.error(f"two G-codes of the same modal group on one line "
                                   f"(G{gs[grp][0] / 10:g} and G{x:g})", pos, fmt("G", x))
@@ -416,7 +422,8 @@ class Modal:
         if 4 in gs:
             self.arc_incremental = gs[4][0] == 911
         if "@" in words or "^" in words:
-            polar_words(self, b, words)
+            mode = (None if gs[1][0] == 800 else gs[1][0]) if 1 in gs else self.motion
+            polar_words(self, b, words, cycle=mode in CYCLES)
         axes = {L: w for L, w in words.items() if L in AXIS_SET}
         if g0 is not None and g0[0] in (100, 520, 280, 281, 300, 301, 920, 921, 922, 923):
             if axes and 1 in gs and gs[1][0] != 800:
@@ -435,7 +442,7 @@ class Modal:
             if self.motion not in CYCLES and (1 in gs or axes):
                 self.cycle.initial = None  # a series of cycles ends at any other motion
             if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")) or (
-                    1 in gs and self.motion in CYCLES):
+                    (1 in gs or self.polar_inc is not None) and self.motion in CYCLES):
                 self._motion(b, gs, axes, words, used, out, machine=g0 is not None)
                 used.update(axes)
         if 11 in ms and ms[11][0] == 98:

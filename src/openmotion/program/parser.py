@@ -161,9 +161,8 @@ class _LineParser:
         if end < 0:
             self.fail("named parameter is not closed with '>'", start)
         name = self.s[self.i:end]
-        if not name or not all(c.isalnum() or c == "_" for c in name):
-            self.fail("parameter name must be letters, digits and '_'", start,
-                      self.s[start:end + 1])
+        if not name:  # LinuxCNC takes any character but '>' (e.g. <_move:x>, <tap-d>)
+            self.fail("parameter name must not be empty", start, self.s[start:end + 1])
         self.i = end + 1
         return name
 

@@ -18,8 +18,10 @@ if TYPE_CHECKING:
     from .modal import Modal
 
 
-def polar_words(m: Modal, b: Block, words: dict[str, Word]) -> None:
-    """Turn the line's @/^ words into X/Y words (program units, the distance mode's)."""
+def polar_words(m: Modal, b: Block, words: dict[str, Word], cycle: bool = False) -> None:
+    """Turn the line's @/^ words into X/Y words (program units, the distance mode's).
+    For a canned cycle in G91 the increments apply before every repeat: they are left in
+    `m.polar_inc` (radius, angle in rad) for cycles.py instead."""
     r_w, a_w = words.pop("@", None), words.pop("^", None)
     first = r_w or a_w
     assert first is not None
@@ -33,6 +35,10 @@ def polar_words(m: Modal, b: Block, words: dict[str, Word]) -> None:
                           words[L].pos, fmt(L, words[L].value))
     x, y = m.program_position(0), m.program_position(1)
     r0, a0 = math.hypot(x, y), math.atan2(y, x)
+    if m.incremental and cycle:
+        m.polar_inc = (r_w.value if r_w is not None else 0.0,
+                       math.radians(a_w.value) if a_w is not None else 0.0)
+        return
     if m.incremental:
         if x == 0.0 and y == 0.0:
             raise b.error("incremental polar motion is undefined at the origin", first.pos,
