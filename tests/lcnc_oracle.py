@@ -255,7 +255,7 @@ def _moving(ms: list[Motion]) -> list[Motion]:
     """Drop straight moves that end where the last motion ended (LinuxCNC emits some,
     e.g. G28's intermediate leg without axis words; the planner discards them)."""
     out: list[Motion] = []
-    last: tuple[float, ...] | None = None
+    last: tuple[float, ...] | None = (0.0,) * 6  # both start at the machine origin
     for m in ms:
         if m.kind != "arc" and last is not None and all(
                 abs(x - y) <= 1e-9 for x, y in zip(m.end, last, strict=True)):

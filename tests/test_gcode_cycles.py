@@ -68,7 +68,7 @@ def test_cycle_errors_name_the_word_and_nothing_runs():
         run("G83 X1 Z-1 R1 F60\n")
     with pytest.raises(GCodeError, match="below the bottom"):
         run("G81 X1 Z2 R1 F60\n")
-    with pytest.raises(GCodeError, match="rigid tapping G84"):
+    with pytest.raises(GCodeError, match="G84 needs the spindle turning"):
         run("G84 X1 Z-1 R1 F60\n")
     # sticky R and Z only within the same cycle
     with pytest.raises(GCodeError, match="needs R"):

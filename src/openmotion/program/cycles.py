@@ -1,4 +1,4 @@
-"""Canned cycles G73, G81-G83, G85, G86, G88, G89 with G98/G99 and L repeats, expanded
+"""Canned cycles G73, G74, G81-G86, G88, G89 with G98/G99 and L repeats, expanded
 into canonical motion exactly as LinuxCNC's interp_cycles.cc does.
 
 Per repeat (CYCLE_MACRO): rapid parallel to the plane to the hole (on the first repeat
@@ -11,6 +11,9 @@ R is sticky while the same cycle continues, Z (third-axis bottom), P (dwell) and
 are sticky likewise; L (default 1) repeats. If the start is below R, the tool first rapids
 up to R. The cycle runs in exact-path mode and restores the blend mode after.
 
+G74/G84 are floating-chuck tapping (LinuxCNC 2.9): feed in, spindle reversed, dwell P
+(optional, sticky across cycles, 0 at start), feed out to the clearance, spindle restored;
+G84 needs M3, G74 M4.
 Planes: G17 (hole at X/Y, depth along Z), G18 (Z/X, depth along Y), G19 (Y/Z, along X).
 """
 
@@ -28,11 +31,9 @@ if TYPE_CHECKING:
     from .modal import Modal
 
 #: Motion codes (G * 10) of the cycles built here.
-CYCLES = frozenset({730, 810, 820, 830, 850, 860, 880, 890})
+CYCLES = frozenset({730, 740, 810, 820, 830, 840, 850, 860, 880, 890})
 #: Cycles refused, with the feature named.
-REFUSED = {740: "left-hand rigid tapping G74 (needs spindle-synchronised motion)",
-           840: "rigid tapping G84 (needs spindle-synchronised motion)",
-           870: "back boring G87 (needs spindle orientation)"}
+REFUSED = {870: "back boring G87 (needs spindle orientation)"}
 #: Plane -> (first, second, depth) axis letters.
 CYCLE_AXES = {170: ("X", "Y", "Z"), 180: ("Z", "X", "Y"), 190: ("Y", "Z", "X")}
 #: LinuxCNC's peck retract for G73 (chip break) and G83 (rapid back down), program units.
@@ -145,6 +146,18 @@ def canned_cycle(m: Modal, b: Block, code: int, gpos: int, axes: dict[str, Word]
             raise b.error(f"{gword} Q (peck depth) must be > 0, got {peck:g}",
                           words["Q"].pos if "Q" in words else gpos, "Q")
         st.q = peck
+    if code in (740, 840):  # floating-chuck tapping: P optional, sticky across cycles
+        pw = words.get("P")
+        if pw is not None:
+            used.add("P")
+            st.p = pw.value
+        dwell = st.p if st.p is not None else 0.0
+        if not m.spindle_on:
+            raise b.error(f"{gword} needs the spindle turning", gpos, gword)
+        if m.spindle_cw != (code == 840):
+            raise b.error(f"{gword} needs the spindle turning "
+                          f"{'clockwise (M3)' if code == 840 else 'counterclockwise (M4)'}",
+                          gpos, gword)
     if code in (860, 880) and not m.spindle_on:
         raise b.error(f"{gword} needs the spindle turning (M3 or M4)", gpos, gword)
     if peck > 0 and (r_word - c_word if not m.incremental else -c_word) / peck * repeats \
@@ -227,6 +240,17 @@ def _body(m: Modal, cyc: _Cycle, code: int, a: float, b: float, r: float, clear:
         cyc.feed_to(a, b, bottom)
         out.append(canon.Dwell(dwell, blk.line, blk.file))
         cyc.traverse(a, b, clear)
+    elif code in (740, 840):  # feed in, reverse the spindle, dwell, feed out, restore
+        cyc.feed_to(a, b, bottom)
+        cw = m.spindle_cw
+        out.append(m.spindle_record(False, blk))
+        out.append(canon.Spindle(True, not cw, m.speed, m.opt.spindle_output, blk.line,
+                                 blk.file))
+        out.append(canon.Dwell(dwell, blk.line, blk.file))
+        cyc.feed_to(a, b, clear)
+        out.append(canon.Spindle(False, not cw, m.speed, m.opt.spindle_output, blk.line,
+                                 blk.file))
+        out.append(m.spindle_record(True, blk))
     elif code == 850:
         cyc.feed_to(a, b, bottom)
         cyc.feed_to(a, b, r)
