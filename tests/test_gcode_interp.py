@@ -460,3 +460,15 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 def test_unsupported_features_are_named_before_any_motion(code, feature):
     e = err(f"G0 X5 Y5\nG1 X6 F100\n{code}\n")
     assert e.line == 3 and e.column == 1 and feature in str(e)
+
+
+def test_tool_parameters_5400_5413():
+    from openmotion.program import Message
+    from openmotion.program.tooltable import Tool
+
+    opts = GCodeOptions(axes={"X": 0, "Y": 1, "Z": 2},
+                        tool_table={2: Tool(2, 2, (1.0, 0, 7.5) + (0,) * 6, 4.0)})
+    cmds = run("T2 M6\n(debug, #5400 #5401 #5403 #5410)\nG10 L1 P2 Z3\n(debug, #5403)\n",
+               opts)
+    assert [c.text for c in cmds if isinstance(c, Message)] == [
+        "2.000000 1.000000 7.500000 4.000000", "3.000000"]

@@ -9,6 +9,7 @@ modal state re-reads them (`Modal.update_offsets`).
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from . import canon
@@ -100,9 +101,13 @@ def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, 
         raise b.error(f"G10 P must be in [0, 9], got {p}", pw.pos, fmt("P", pw.value))
     system = p or m.coord
     base = 5221 + 20 * (system - 1)
-    if m.params.numbers[base + 9] != 0.0 and L == 20 and any(x in axes for x in "XY"):
-        raise b.error("G10 L20 X/Y on a rotated coordinate system is not supported", gpos,
-                      "G10 L20")
+    rot = m.params.numbers[base + 9]
+    if L == 20 and "R" in words:
+        raise b.error("R is not allowed in G10 L20", words["R"].pos, "R")
+    if L == 20 and rot != 0.0 and any(x in axes for x in "XY") and "X" in m.letters \
+            and "Y" in m.letters:
+        _l20_rotated(m, b, base, rot, axes)
+        axes = {k: v for k, v in axes.items() if k not in "XY"}
     for letter, w in axes.items():
         ax = m.axis_index(b, letter, w)
         k = m.letters[letter][1]
@@ -117,6 +122,24 @@ def _g10(m: Modal, b: Block, gpos: int, axes: dict[str, Word], words: dict[str, 
         used.add("R")
         m.params.set_number(base + 9, rw.value)
     m.update_offsets()
+
+
+def _l20_rotated(m: Modal, b: Block, base: int, rot: float, axes: dict[str, Word]) -> None:
+    """G10 L20 X/Y on a rotated system: the origin moves so the current point reads the
+    given X/Y in that system's rotated frame (LinuxCNC convert_setup)."""
+    nums = m.params.numbers
+    ax, ay = m.letters["X"][0], m.letters["Y"][0]
+    t = math.radians(rot)
+    c, s = math.cos(t), math.sin(t)
+    # current point in system `base`, rotated frame, G92 included (machine units)
+    dx = m.pos[ax] - m.tool_offset[0] - nums[base]
+    dy = m.pos[ay] - m.tool_offset[1] - nums[base + 1]
+    cx, cy = c * dx + s * dy - m.g92[0], -s * dx + c * dy - m.g92[1]
+    x = m.conv(axes["X"].value, "X") if "X" in axes else cx
+    y = m.conv(axes["Y"].value, "Y") if "Y" in axes else cy
+    ddx, ddy = cx - x, cy - y
+    m.params.set_number(base, nums[base] + c * ddx - s * ddy)
+    m.params.set_number(base + 1, nums[base + 1] + s * ddx + c * ddy)
 
 
 def _g10_tool(m: Modal, b: Block, L: int, gpos: int, axes: dict[str, Word],
@@ -170,3 +193,5 @@ def _g10_tool(m: Modal, b: Block, L: int, gpos: int, axes: dict[str, Word],
                           fmt("Q", q))
         changes["orientation"] = q
     m.tools[n] = replace(tool, **changes)  # type: ignore[arg-type]
+    if n == m.tool:
+        m.set_tool_parameters()

@@ -55,3 +55,18 @@ def tool_length(m: Modal, b: Block, g: tuple[int, int], words: dict[str, Word],
                                                       strict=True)]
     m.update_offsets()
 
+
+def set_tool_parameters(m: Modal) -> None:
+    """#5400 tool in the spindle, #5401-#5409 its offsets X..W (machine units), #5410
+    diameter, #5411/#5412 front/back angle, #5413 orientation (LinuxCNC)."""
+    nums = m.params
+    nums.set_number(5400, float(m.tool))
+    t = m.tools.get(m.tool)
+    offs = t.offsets if t is not None else (0.0,) * 9
+    for k in range(9):
+        nums.set_number(5401 + k, offs[k])
+    nums.set_number(5410, t.diameter if t is not None else 0.0)
+    nums.set_number(5411, t.front_angle if t is not None else 0.0)
+    nums.set_number(5412, t.back_angle if t is not None else 0.0)
+    nums.set_number(5413, float(t.orientation) if t is not None else 0.0)
+
