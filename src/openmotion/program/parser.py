@@ -20,6 +20,7 @@ from .expr import (
     Atan,
     Binary,
     Exists,
+    ExistsNumber,
     Func,
     NamedParam,
     Neg,
@@ -216,6 +217,10 @@ class _LineParser:
             self.i = j
             self.expect("[")
             self.expect("#")
+            if self.peek() != "<":  # EXISTS[#n], EXISTS[##n]: is the number in range
+                idx = self.primary()
+                self.expect("]")
+                return ExistsNumber(idx, pos)
             nm = self.name()
             self.expect("]")
             return Exists(nm, pos)
@@ -261,7 +266,7 @@ class _LineParser:
         computed: Value | None = None
         if self.peek() == "<":
             label = "<" + self.name() + ">"
-        elif self.peek() == "[":
+        elif self.peek() and self.peek() in "[#":  # O[expr] / O#<name> call: computed label
             start = self.i
             computed = self.value()
             label = self.s[start:self.i]
