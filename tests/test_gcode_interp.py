@@ -342,7 +342,7 @@ def test_soft_limits_caught_before_motion():
         ("G0 X1 X2", "X2", "twice"),
         ("G1 X1 F10 I5", "I5", "not used"),
         ("G0 X1 R2", "R2", "not used"),
-        ("G41 G18", "G41", "XY plane"),
+        ("G41 G19", "G41", "XY (G17) or XZ (G18)"),
         ("G95", "G95", "feed per revolution"),
         ("G1.5 X1", "G1.5", "unsupported"),
         ("M99", "M99", "restarts it forever"),

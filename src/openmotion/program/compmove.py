@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from ..path import Direction
 from . import canon
 from .arcmove import arc_move
-from .cuttercomp import comp_arc, comp_straight
+from .cuttercomp import comp_arc, comp_straight, plane_axes
 from .parser import Block
 from .words import Word, feed_length
 
@@ -22,7 +22,7 @@ def comp_motion(m: Modal, b: Block, mode: int, gpos: int, gword: str,
     """A move under cutter compensation: words read against the programmed point."""
     if machine:
         raise b.error("G53 cannot be used with cutter compensation on", gpos, "G53")
-    ax, ay = m.letters["X"][0], m.letters["Y"][0]
+    ax, ay = plane_axes(m)
     tool_pos = m.pos
     prog = tool_pos[:]
     if not m.comp.first_move:

@@ -12,7 +12,9 @@ The tool centre runs at the tool radius left (G41) or right (G42) of the program
 - Arcs are offset by the radius (inside arcs must be larger than the tool).
 - G40: the queue is flushed where the tool is; the next move (the exit) is a straight
   line from the compensated point to the programmed one; an arc right after G40 is refused.
-Work in machine XY (offsets are translations, units scale uniformly). G17 only here.
+Work in machine coordinates of the plane: X/Y in G17, Z/X in G18 (lathes; the tool table's
+X/Z offsets place the nose, its orientation only matters for LinuxCNC's arc entry, which is
+refused here). Offsets are translations and units scale uniformly, so distances hold.
 """
 
 from __future__ import annotations
@@ -70,6 +72,7 @@ class CutterComp:
 
     side: str = ""  # "left", "right" or "" (off)
     radius: float = 0.0  # machine units, > 0 when active
+    orientation: int = 0  # lathe tool orientation (G18): where the tip is from the nose
     first_move: bool = True
     arc_not_allowed: bool = False
     prog: tuple[float, float] = (0.0, 0.0)  # programmed XY where the tool is (machine)
@@ -88,9 +91,12 @@ def comp_on(m: Modal, b: Block, code: int, gpos: int, words: dict, used: set[str
     """G41/G42 [D tool] or G41.1/G42.1 D diameter [L orientation]."""
     cc = m.comp
     gword = f"G{code / 10:g}"
-    if m.plane != 170:
-        raise b.error(f"{gword}: cutter compensation is supported in the XY plane (G17) "
-                      "only here", gpos, gword)
+    if m.plane not in (170, 180):
+        raise b.error(f"{gword}: cutter compensation needs the XY (G17) or XZ (G18) plane",
+                      gpos, gword)
+    for L in ("X", "Y") if m.plane == 170 else ("Z", "X"):
+        if L not in m.letters:
+            raise b.error(f"{gword} needs a machine axis for {L}", gpos, gword)
     if cc.side:
         raise b.error(f"{gword}: cutter compensation is already on (G40 first)", gpos, gword)
     side = "left" if code in (410, 411) else "right"
@@ -100,8 +106,16 @@ def comp_on(m: Modal, b: Block, code: int, gpos: int, words: dict, used: set[str
             raise b.error(f"{gword} needs D (the tool diameter)", gpos, gword)
         used.add("D")
         radius = m.lin(d.value) / 2.0
+        orientation = 0
         if "L" in words:
-            raise b.error(f"{gword} L (lathe orientation) needs G18", words["L"].pos, "L")
+            if m.plane != 180:
+                raise b.error(f"{gword} L (lathe orientation) needs G18", words["L"].pos,
+                              "L")
+            used.add("L")
+            orientation = m.int_word(b, "L", words["L"], 0)
+            if orientation > 9:
+                raise b.error(f"{gword} L (orientation) must be 0..9, got {orientation}",
+                              words["L"].pos, f"L{orientation}")
     else:
         tool = m.tool
         if d is not None:
@@ -112,13 +126,15 @@ def comp_on(m: Modal, b: Block, code: int, gpos: int, words: dict, used: set[str
             raise b.error(f"{gword}: tool {tool} is not in the tool table", d.pos if d else
                           gpos, f"D{tool}" if d else gword)
         radius = t.radius if t is not None else 0.0
-        if t is not None and t.orientation not in (0, 9):
+        orientation = t.orientation if t is not None else 0
+        if t is not None and t.orientation not in (0, 9) and m.plane != 180:
             raise b.error(f"{gword} with a lathe tool (orientation {t.orientation}) needs "
                           "G18", gpos, gword)
     if radius < 0:
         radius = -radius
         side = "left" if side == "right" else "right"
     cc.side, cc.radius, cc.first_move = side, radius, True
+    cc.orientation = orientation if m.plane == 180 else 0
     cc.queue.clear()
     cc.endpoint = None
 
@@ -129,6 +145,12 @@ def comp_off(m: Modal) -> None:
     if cc.active and not cc.first_move:
         cc.queue.clear()
         cc.arc_not_allowed = True
+        # LinuxCNC: the programmed point becomes the current point (the exit move runs
+        # from where the tool is to the next programmed point)
+        ax, ay = plane_axes(m)
+        p = list(m.pos)
+        p[ax], p[ay] = cc.prog
+        m.pos = p
     cc.side = ""
     cc.first_move = True
     cc.endpoint = None
@@ -140,7 +162,7 @@ class _Emit:
     def __init__(self, m: Modal, b: Block, out: list[canon.Command], gword: str, gpos: int,
                  feed: float) -> None:
         self.m, self.b, self.out, self.gword, self.gpos, self.feed = m, b, out, gword, gpos, feed
-        self.ax, self.ay = m.letters["X"][0], m.letters["Y"][0]
+        self.ax, self.ay = plane_axes(m)
 
     def point(self, x: float, y: float, rest: list[float] | None = None) -> list[float]:
         p = list(self.m.pos if rest is None else rest)
@@ -148,26 +170,29 @@ class _Emit:
         return p
 
     def straight(self, rapid: bool, end: list[float]) -> int:
-        self.m.check_limits(self.b, end, end, self.gword, self.gpos)
+        shown = shifted(self.m, end)
+        self.m.check_limits(self.b, shown, shown, self.gword, self.gpos)
         rec: canon.Command
         if rapid:
-            rec = canon.Rapid(tuple(end), self.b.line, self.b.file)
+            rec = canon.Rapid(tuple(shown), self.b.line, self.b.file)
         else:
-            rec = canon.Feed(tuple(end), self.feed, self.b.line, self.b.file)
+            rec = canon.Feed(tuple(shown), self.feed, self.b.line, self.b.file)
         self.out.append(rec)
         self.m.pos = end
         return len(self.out) - 1
 
     def arc(self, end: list[float], cx: float, cy: float, turn: int) -> int:
-        self.out.append(make_arc(self.m, self.b, tuple(self.m.pos), end, cx, cy, turn,
-                                 self.feed, self.gword, self.gpos))
+        d1, d2 = lathe_shift(self.m)
+        self.out.append(make_arc(self.m, self.b, tuple(shifted(self.m, self.m.pos)),
+                                 shifted(self.m, end), cx + d1, cy + d2, turn, self.feed,
+                                 self.gword, self.gpos))
         self.m.pos = end
         return len(self.out) - 1
 
 
 def make_arc(m: Modal, b: Block, start: tuple[float, ...], end: list[float], cx: float,
              cy: float, turn: int, feed: float, gword: str, gpos: int) -> canon.ArcMove:
-    ax, ay = m.letters["X"][0], m.letters["Y"][0]
+    ax, ay = plane_axes(m)
     sx, sy, ex, ey = start[ax], start[ay], end[ax], end[ay]
     ccw = turn > 0
     turns = abs(turn) - 1
@@ -191,6 +216,39 @@ def make_arc(m: Modal, b: Block, start: tuple[float, ...], end: list[float], cx:
                          b.line, b.file)
 
 
+def plane_axes(m: Modal) -> tuple[int, int]:
+    """Machine axes of the compensation plane, first then second: X, Y in G17; Z, X in G18
+    (the lathe plane, as LinuxCNC's XZ compensation)."""
+    if m.plane == 180:
+        return m.letters["Z"][0], m.letters["X"][0]
+    return m.letters["X"][0], m.letters["Y"][0]
+
+
+def lathe_shift(m: Modal) -> tuple[float, float]:
+    """Offset (first, second plane axis) from the nose centre that compensation steers to
+    the lathe tool's control point, by orientation (LinuxCNC latheorigin_x/_z); 0 for
+    mills, orientation 0 and 9."""
+    cc = m.comp
+    o, r = cc.orientation, cc.radius
+    if m.plane != 180 or o in (0, 9):
+        return 0.0, 0.0
+    dx = -r if o in (1, 2, 6) else r if o in (3, 4, 8) else 0.0
+    dz = -r if o in (2, 3, 7) else r if o in (1, 4, 5) else 0.0
+    return dz, dx
+
+
+def shifted(m: Modal, p: list[float]) -> list[float]:
+    """A compensated point as output: nose centre -> control point (lathe tools)."""
+    d1, d2 = lathe_shift(m)
+    if d1 == 0.0 and d2 == 0.0:
+        return list(p)
+    ax, ay = plane_axes(m)
+    q = list(p)
+    q[ax] += d1
+    q[ay] += d2
+    return q
+
+
 def _tool_inside(side: str, turn: int) -> bool:
     return (side == "left" and turn > 0) or (side == "right" and turn < 0)
 
@@ -199,13 +257,14 @@ def _move_endpoint_and_flush(m: Modal, b: Block, out: list[canon.Command], x: fl
                              y: float, gword: str, gpos: int) -> None:
     """Move the XY end of every queued motion to (x, y), checking for gouges; flush."""
     cc = m.comp
-    ax, ay = m.letters["X"][0], m.letters["Y"][0]
+    ax, ay = plane_axes(m)
     tol = 0.0254 if m.units == "mm" else 0.001
     ep = cc.endpoint
+    d1, d2 = lathe_shift(m)
     for q in cc.queue:
         rec = out[q.index]
         end = list(rec.end)  # type: ignore[union-attr]
-        end[ax], end[ay] = x, y
+        end[ax], end[ay] = x + d1, y + d2
         if isinstance(rec, canon.ArcMove):
             cx, cy = q.centre
             if ep is not None and q.sweep != 0.0:
@@ -213,8 +272,8 @@ def _move_endpoint_and_flush(m: Modal, b: Block, out: list[canon.Command], x: fl
                 if abs(new) > abs(q.sweep) + tol:
                     raise b.error("arc move in a concave corner cannot be reached by the tool "
                                   "without gouging", gpos, gword)
-            out[q.index] = make_arc(m, b, rec.start, end, cx, cy, q.turn, rec.feed_per_s,
-                                    gword, gpos)
+            out[q.index] = make_arc(m, b, rec.start, end, cx + d1, cy + d2, q.turn,
+                                    rec.feed_per_s, gword, gpos)
         else:
             if ep is not None and q.dx * (x - ep[0]) + q.dy * (y - ep[1]) < 0:
                 kind = "traverse" if isinstance(rec, canon.Rapid) else "feed"
@@ -227,7 +286,7 @@ def _move_endpoint_and_flush(m: Modal, b: Block, out: list[canon.Command], x: fl
             nxt = out[q.index + 1]
             if isinstance(nxt, canon.ArcMove):
                 s = list(nxt.start)
-                s[ax], s[ay] = x, y
+                s[ax], s[ay] = x + d1, y + d2
                 out[q.index + 1] = replace(nxt, start=tuple(s))
     cc.queue.clear()
     p = list(m.pos)
@@ -323,7 +382,7 @@ def _arc_to_line_corner(m: Modal, b: Block, out: list[canon.Command], prev: _Que
     cc = m.comp
     r = cc.radius
     arc = out[prev.index]
-    ax, ay = m.letters["X"][0], m.letters["Y"][0]
+    ax, ay = plane_axes(m)
     c1, c2 = prev.centre
     oldrad = math.hypot(c2 - arc.end[ay], c1 - arc.end[ax])
     base = math.atan2(py - opy, px - opx)
