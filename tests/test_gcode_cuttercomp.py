@@ -55,7 +55,7 @@ def test_refusals():
         compile_text("G41 D3\nG1 X5 F60\nG28\n", OPTS)
     with pytest.raises(GCodeError, match="canned cycles"):
         compile_text("G41 D3\nG1 X5 F60\nG81 X1 Z-1 R1\n", OPTS)
-    with pytest.raises(GCodeError, match="arc entry"):
-        compile_text("G41 D3\nG2 X5 I2.5 F60\n", OPTS)
+    with pytest.raises(GCodeError, match="entry arc"):
+        compile_text("G41 D3\nG2 X0.5 I0.25 F60\n", OPTS)
     with pytest.raises(GCodeError, match="change planes"):
         compile_text("G41 D3\nG18\n", OPTS)

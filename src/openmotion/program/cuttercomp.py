@@ -402,6 +402,40 @@ def _arc_to_line_corner(m: Modal, b: Block, out: list[canon.Command], prev: _Que
     return c1 + oldrad * math.cos(ang), c2 + oldrad * math.sin(ang)
 
 
+def _entry_arc(m: Modal, b: Block, e: _Emit, target: list[float], pcx: float, pcy: float,
+               turn: int, gword: str, gpos: int) -> None:
+    """The first move after G41/G42 is an arc (LinuxCNC convert_arc_comp1): it ends at the
+    radius from the programmed end, on a circle through the current point."""
+    cc = m.comp
+    r = cc.radius
+    ax, ay = e.ax, e.ay
+    cx, cy = m.pos[ax], m.pos[ay]
+    ex, ey = target[ax], target[ay]
+    if math.hypot(ex - cx, ey - cy) <= r:
+        raise b.error("the cutter compensation entry arc is not longer than the tool radius",
+                      gpos, gword)
+    inside = _tool_inside(cc.side, turn)
+    if inside and math.hypot(pcx - cx, pcy - cy) <= r:
+        raise b.error(f"{gword}: the tool radius is not less than the arc radius", gpos,
+                      gword)
+    gamma = math.atan2(pcy - ey, pcx - ex) if inside else math.atan2(ey - pcy, ex - pcx)
+    nex, ney = ex + r * math.cos(gamma), ey + r * math.sin(gamma)
+    half = math.hypot(cy - ney, cx - nex) / 2.0
+    ab = math.atan2(pcy - ney, pcx - nex)
+    a_ang = math.atan2(cy - ney, cx - nex) - ab
+    if abs(math.cos(a_ang)) < 1e-6:
+        raise b.error(f"{gword}: the tool radius is not less than the arc radius", gpos,
+                      gword)
+    c_len = half / math.cos(a_ang)
+    ncx, ncy = nex + c_len * math.cos(ab), ney + c_len * math.sin(ab)
+    cc.first_move = False
+    cc.prog = (ex, ey)
+    cc.endpoint = (cx, cy)
+    idx = e.arc(e.point(nex, ney, target), ncx, ncy, turn)
+    cc.queue.append(_Queued(idx, turn=turn, sweep=signed_sweep(cx, cy, ncx, ncy, turn, nex,
+                                                                ney), centre=(ncx, ncy)))
+
+
 def comp_arc(m: Modal, b: Block, mode: int, target: list[float], pcx: float, pcy: float,
              turn: int, feed: float, out: list[canon.Command], gword: str,
              gpos: int) -> None:
@@ -411,8 +445,8 @@ def comp_arc(m: Modal, b: Block, mode: int, target: list[float], pcx: float, pcy
     e = _Emit(m, b, out, gword, gpos, feed)
     ax, ay = e.ax, e.ay
     if cc.first_move:
-        raise b.error(f"{gword}: the first move after G41/G42 must be a straight line "
-                      "(an arc entry is not supported)", gpos, gword)
+        _entry_arc(m, b, e, target, pcx, pcy, turn, gword, gpos)
+        return
     r = cc.radius
     opx, opy = cc.prog
     cx, cy = m.pos[ax], m.pos[ay]
