@@ -99,6 +99,8 @@ class _Canon:
         self.plane = _PLANES["CANON_PLANE_XY"]
         self.pos = [0.0] * 6
         self.sync: float | None = None  # START_SPEED_FEED_SYNC pitch, mm per revolution
+        self.per_rev = False  # SET_FEED_MODE(0, 1): G95, feeds per spindle revolution
+        self.rpm = 0.0
 
     def mm(self, vals: list[float]) -> list[float]:
         return [v if k in ROTARY else v * self.scale for k, v in enumerate(vals)]
@@ -112,6 +114,11 @@ class _Canon:
         return [v + g + o for v, g, o in zip(p, self.g5x, self.tool, strict=True)]
 
     def feed_for(self, end: list[float]) -> float:
+        """Feed of a move to `end` per minute (G95: per revolution x the commanded S)."""
+        k = self.rpm if self.per_rev else 1.0
+        return k * self._feed_for(end)
+
+    def _feed_for(self, end: list[float]) -> float:
         linear = any(abs(e - s) > 1e-12 for k, (s, e) in enumerate(zip(self.pos, end,
                                                                        strict=True))
                      if k not in ROTARY)
@@ -141,6 +148,10 @@ def parse_listing(listing: str) -> list[Motion]:
         elif name == "SET_FEED_RATE":
             f = _nums(args)[0]
             c.linear_feed, c.angular_feed = f * c.scale, f
+        elif name == "SET_FEED_MODE":
+            c.per_rev = _nums(args)[1] == 1
+        elif name == "SET_SPINDLE_SPEED":
+            c.rpm = _nums(args)[1]
         elif name == "START_SPEED_FEED_SYNC":
             c.sync = _nums(args)[0] * c.scale
         elif name == "STOP_SPEED_FEED_SYNCH":
@@ -165,7 +176,8 @@ def parse_listing(listing: str) -> list[Motion]:
             cen = list(prog)
             cen[i1], cen[i2] = v[2], v[3]
             cm = c.machine(cen)
-            out.append(Motion("arc", tuple(end), c.linear_feed, pname, (cm[i1], cm[i2]),
+            out.append(Motion("arc", tuple(end), c.linear_feed * (c.rpm if c.per_rev else 1.0),
+                              pname, (cm[i1], cm[i2]),
                               int(v[4]), tol=tol, line=raw.strip()))
             c.pos = end
     return out

@@ -343,7 +343,7 @@ def test_soft_limits_caught_before_motion():
         ("G1 X1 F10 I5", "I5", "not used"),
         ("G0 X1 R2", "R2", "not used"),
         ("G41 G19", "G41", "XY (G17) or XZ (G18)"),
-        ("G95", "G95", "feed per revolution"),
+        ("G96 S100", "G96", "constant surface speed"),
         ("G1.5 X1", "G1.5", "unsupported"),
         ("M99", "M99", "restarts it forever"),
         ("M97", "M97", "unsupported M-code"),
@@ -454,7 +454,7 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 @pytest.mark.parametrize("code, feature", [
     ("G5 X1 I1 J1 P1 Q1", "spline"), ("G5.2 X1", "NURBS"), ("G33.1 Z-1 K1", "G33.1"),
     ("G38.3 Z-1", "probing (G38.3)"),
-    ("G71 Q1", "roughing"), ("G96 S100", "surface speed"), ("G95", "per revolution"),
+    ("G71 Q1", "roughing"), ("G96 S100", "surface speed"),
     ("G87 Z-1 R1 I1 J1 K1", "back boring"), ("M19", "orientation"), ("M66 P0 L0", "waiting"),
     ("M67", "analog"), ("M101", "user M-code"), ("M60", "pallet")])
 def test_unsupported_features_are_named_before_any_motion(code, feature):
@@ -472,3 +472,9 @@ def test_tool_parameters_5400_5413():
                opts)
     assert [c.text for c in cmds if isinstance(c, Message)] == [
         "2.000000 1.000000 7.500000 4.000000", "3.000000"]
+
+
+def test_g95_feed_per_revolution_at_the_commanded_speed_and_g94_clears_f():
+    assert _feeds("S600 M3\nG95 F0.2\nG1 X1\nS300\nG1 X2\n") == pytest.approx([120.0, 60.0])
+    assert "S > 0" in str(err("G95 F0.2\nG1 X1\n"))
+    assert "feed rate is zero" in str(err("G94 F100\nG1 X1\nG94\nG1 X2\n"))

@@ -60,7 +60,7 @@ class _Cycle:
         la, lb, lc = CYCLE_AXES[m.plane]
         self.idx = [m.letters[L] for L in (la, lb, lc)]  # (machine axis, param k)
         self.letters = (la, lb, lc)
-        self.feed = m.feed_lin / 60.0
+        self.feed = m.per_second(m.feed_lin, b, gword, gpos)
 
     def prog(self, n: int) -> float:
         return self.m.program_position(self.idx[n][1])

@@ -263,10 +263,11 @@ class Modal:
         if b.comments:
             self.messages(b, out)
         # feed mode, F, S, T
-        if 5 in gs:
-            inv = gs[5][0] == 930
-            if inv != self.inverse_time:
-                self.inverse_time = inv
+        if 5 in gs:  # LinuxCNC: G94 and G95 always clear F; G93 needs F on each line
+            code = gs[5][0]
+            self.inverse_time = code == 930
+            self.per_rev = code == 950
+            if code != 930:
                 self.feed = self.feed_lin = self.feed_ang = 0.0
         f = words.get("F")
         if f is not None:
@@ -527,7 +528,18 @@ class Modal:
         if self.feed <= 0.0:
             raise b.error("feed rate is zero or not set: give F before or with "
                           f"{gword}", gpos, gword)
-        return (self.feed_ang if rotary_only else self.feed_lin) / 60.0, None
+        return self.per_second(self.feed_ang if rotary_only else self.feed_lin, b, gword,
+                               gpos), None
+
+    def per_second(self, f: float, b: Block, gword: str, gpos: int) -> float:
+        """A feed F (per minute, or per revolution in G95) in units per second; G95 uses the
+        commanded spindle speed S (no spindle feedback on this path)."""
+        if not self.per_rev:
+            return f / 60.0
+        if not self.spindle_on or self.speed <= 0.0:
+            raise b.error(f"{gword} in G95 (feed per revolution) needs the spindle turning "
+                          "at S > 0", gpos, gword)
+        return f * self.speed / 60.0
 
     def _rotary_only(self, start: list[float], end: list[float]) -> bool:
         """True when only rotary axes move (LinuxCNC then feeds at the angular rate)."""
