@@ -269,8 +269,8 @@ def _moving(ms: list[Motion]) -> list[Motion]:
     out: list[Motion] = []
     last: tuple[float, ...] | None = (0.0,) * 6  # both start at the machine origin
     for m in ms:
-        if m.kind != "arc" and last is not None and all(
-                abs(x - y) <= 1e-9 for x, y in zip(m.end, last, strict=True)):
+        if m.kind != "arc" and last is not None and all(  # rs274 rounds to 4 decimals
+                abs(x - y) <= m.tol for x, y in zip(m.end, last, strict=True)):
             continue
         out.append(m)
         last = m.end

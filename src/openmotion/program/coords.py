@@ -142,6 +142,34 @@ def _l20_rotated(m: Modal, b: Block, base: int, rot: float, axes: dict[str, Word
     m.params.set_number(base + 1, nums[base + 1] + s * ddx + c * ddy)
 
 
+def _rotation(m: Modal, L: int) -> float:
+    """Rotation of the system G10 L10 (the current one) or L11 (G59.3) measures in."""
+    system = 9 if L == 11 else m.coord
+    return m.params.numbers[5221 + 20 * (system - 1) + 9]
+
+
+def _tool_xy_rotated(m: Modal, L: int, axes: dict[str, Word], offsets: list[float]) -> None:
+    """G10 L10/L11 X/Y in a rotated system (LinuxCNC convert_setup_tool): the tool's X/Y
+    offset so the current point reads the values in the rotated frame; with only one of
+    X/Y the offset's component along the other rotated axis is kept."""
+    nums = m.params.numbers
+    system = 9 if L == 11 else m.coord
+    base = 5221 + 20 * (system - 1)
+    t = math.radians(nums[base + 9])
+    c, s = math.cos(t), math.sin(t)
+    ax, ay = m.letters["X"][0], m.letters["Y"][0]
+    dx, dy = m.pos[ax] - nums[base], m.pos[ay] - nums[base + 1]
+    tx, ty = c * dx + s * dy, -s * dx + c * dy  # current point in the rotated frame
+    if L == 10:
+        tx, ty = tx - m.g92[0], ty - m.g92[1]
+    ox, oy = c * offsets[0] + s * offsets[1], -s * offsets[0] + c * offsets[1]
+    if "X" in axes:
+        ox = tx - m.conv(axes["X"].value, "X")
+    if "Y" in axes:
+        oy = ty - m.conv(axes["Y"].value, "Y")
+    offsets[0], offsets[1] = c * ox - s * oy, s * ox + c * oy
+
+
 def _g10_tool(m: Modal, b: Block, L: int, gpos: int, axes: dict[str, Word],
               words: dict[str, Word], used: set[str]) -> None:
     """G10 L1 (set a tool table entry), L10 / L11 (set a tool's offsets so the current
@@ -165,14 +193,16 @@ def _g10_tool(m: Modal, b: Block, L: int, gpos: int, axes: dict[str, Word],
         v = m.conv(w.value, letter)
         if L == 1:
             offsets[k] = v
+        elif k < 2 and _rotation(m, L) != 0.0 and "X" in m.letters and "Y" in m.letters:
+            continue  # X/Y of a rotated system: below, together
         elif L == 10:
-            if m.rotated and k < 2:
-                raise b.error("G10 L10 X/Y on a rotated coordinate system is not supported",
-                              gpos, word)
             work = m.off[k] - m.tool_offset[k]  # origin + G92
             offsets[k] = m.pos[ax] - work - v
         else:
             offsets[k] = m.pos[ax] - m.params.numbers[base9 + k] - v
+    if L in (10, 11) and _rotation(m, L) != 0.0 and any(x in axes for x in "XY") \
+            and "X" in m.letters and "Y" in m.letters:
+        _tool_xy_rotated(m, L, axes, offsets)
     changes: dict[str, object] = {"offsets": tuple(offsets)}
     rw = words.get("R")
     if rw is not None:
