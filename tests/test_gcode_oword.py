@@ -147,7 +147,7 @@ def test_endless_loop_is_an_error_not_a_hang():
         ("o1 if [1]\no2 endif", 2, "without a matching"),
         ("o1 endwhile", 1, "without a matching"),
         ("o1 while [1]\no2 break\no1 endwhile", 2, "outside an O2 loop"),
-        ("o1 return", 1, "outside subroutine"),
+        ("o1 return", 1, "outside a subroutine"),
         ("o1 sub\no2 sub\no2 endsub\no1 endsub", 2, "inside another"),
         ("o1 sub\no1 endsub\no1 sub\no1 endsub", 3, "defined twice"),
         ("G0 X1\no9 call [1]", 2, "not defined"),
@@ -272,3 +272,46 @@ def test_shipped_examples_compile(name):
     cmds = compile_file(path, opts)
     assert isinstance(cmds[-1], End)
     assert all(c.file == str(path) for c in cmds)
+
+
+# -- Fanuc-style programs, computed labels, subroutine files ---------------------------------
+def test_m98_repeats_shares_numbered_parameters_and_m99_returns():
+    prog = "#1=0\nM98 P7 L3\nG0 X#1\nM98 P7 L0\nM30\nO7\n#1=[#1+1]\nG0 X[#1*10]\nM99\n"
+    assert xs(prog) == [10.0, 20.0, 30.0, 3.0]
+    assert "restarts it forever" in str(err("G0 X1\nM99\n"))
+    e = err("M98 P[2.5]\nM30\n")
+    assert "integer" in str(e) and e.line == 1
+
+
+def test_bare_o_line_is_a_label_when_reached():
+    assert xs("O42 (program title)\nG0 X1\nM30\n") == [1.0]
+
+
+def test_computed_call_labels():
+    prog = "o10 sub\nG0 X#1\no10 endsub\n#2=5\no[#2*2] call [4]\nM2\n"
+    assert xs(prog) == [4.0]
+    e = err("o[#2+1] sub\no1 endsub\n")
+    assert "only allowed with call" in str(e)
+    e = err("o[7] call\nM2\n")
+    assert "O7" in str(e) and "7.ngc" in str(e)
+
+
+def test_subroutine_files_on_the_path(tmp_path):
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    (lib / "Square.ngc").write_text("o<square> sub\nG1 X#1 F100\nG1 X0\no<square> endsub\n")
+    (lib / "junk.ngc").write_text("G0 X9\no<junk> sub\no<junk> endsub\n")
+    (lib / "other.ngc").write_text("o<something> sub\no<something> endsub\n")
+    opts = GCodeOptions(axes={"X": 0}, subroutine_path=[lib])
+    assert xs("o<square> call [5]\nM2\n", opts) == [5.0, 0.0]
+    e = err("o<nosuch> call\nM2\n", opts)
+    assert "nosuch.ngc" in str(e) and str(lib) in str(e)
+    e = err("o<other> call\nM2\n", opts)
+    assert "does not define" in str(e)
+    # code outside the sub in its file is never run (LinuxCNC), even when the main
+    # program has no M2
+    assert xs("o<junk> call\n", opts) == []
+    from openmotion.errors import MotionError
+
+    with pytest.raises(MotionError, match="subroutine_path"):
+        GCodeOptions(axes={"X": 0}, subroutine_path=str(lib))

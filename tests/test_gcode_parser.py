@@ -220,7 +220,7 @@ def test_exists_and_initial_parameters():
 
 
 def test_debug_and_print_substitute_parameters():
-    cmds = compile_text("#<_v> = 7\n#3 = 2\n(DEBUG, v=#<_ v> p=#3 u=#<_zz>)\n(print,x)\n"
+    cmds = compile_text("#<_vv> = 7\n#3 = 2\n(DEBUG, v=#<_ v v> p=#3 u=#<_zz>)\n(print,x)\n"
                         "(MSG, Hello World)", OPTS)
     assert [c.text for c in cmds] == ["v=7.000000 p=2.000000 u=######", "x", "Hello World"]
     assert [c.kind for c in cmds] == ["debug", "print", "msg"]

@@ -152,8 +152,11 @@ def test_inch_units_and_work_offset():
 
 def test_inch_feed_is_converted():
     ctl = iso_ctl()
-    run = ProgramRunner(ctl, "G20 G90 G1 X1 F60\nM2")
+    run = ProgramRunner(ctl, "G20\nG90 G1 X1 F60\nM2")
     assert run.ops[0].feed == pytest.approx(25.4)  # F60 inch/min = 25.4 mm/s
+    # F on the G20 line is read before the unit change (LinuxCNC): 60 mm/min
+    run = ProgramRunner(ctl, "G20 G90 G1 X1 F60\nM2")
+    assert run.ops[0].feed == pytest.approx(1.0)
 
 
 def test_synced_output_fires_with_next_motion_and_immediate_at_once():
@@ -430,3 +433,33 @@ def test_m62_fires_at_the_exact_position_the_next_move_starts(blend, early_mm):
     assert t4 <= t11 + 1e-12
     assert ctl.history.state_at(0, t4).p >= 11000.0 - slack
     assert abs(ctl.history.state_at(1, t4).p) <= slack
+
+
+def test_g33_runs_at_pitch_times_the_commanded_speed():
+    ctl = iso_ctl()
+    run = ProgramRunner(ctl, "G21 S120 M3\nG33 X3 K0.5\nM5 M2")
+    line = [op for op in run.ops if op.kind == "line"][0]
+    assert line.feed == pytest.approx(0.5 * 120 / 60)  # 0.5 mm/rev at 2 rev/s
+    with pytest.raises(MotionError, match="spindle"):
+        ProgramRunner(ctl, "G21 M3\nG33 X3 K0.5\nM2")
+
+
+def test_lathe_example_on_the_xz_machine():
+    """examples/lathe_xz.toml + lathe_turn_thread.ngc: G18, G7 diameters, G76 passes."""
+    from pathlib import Path
+
+    from openmotion.config import load_machine
+    from openmotion.program import SyncedFeed
+
+    root = Path(__file__).parent.parent
+    ctl = Controller(load_machine(root / "examples" / "lathe_xz.toml"))
+    ctl.enable_all()
+    run = ProgramRunner(ctl, root / "examples" / "gcode" / "lathe_turn_thread.ngc")
+    synced = [op for op in run.ops if isinstance(op.source, SyncedFeed)]
+    # G7 halves I/J/K: depth 1 + 0.2 n^(1/1.5) reaches 1 + 1.535 after 22 cuts, + 1 spring
+    # pass; each pass is the synchronised cut and its exit taper
+    assert len(synced) == 2 * 23
+    # the cut along Z at pitch 2.5 mm x 800 rpm = 33.3 mm/s; the exit taper faster, at
+    # the taper pitch 2.5 * hypot(2, 1.535) / 2
+    feeds = sorted({round(op.feed, 9) for op in synced})
+    assert feeds == pytest.approx([2.5 * 800 / 60, 2.5 * math.hypot(2, 1.535) / 2 * 800 / 60])

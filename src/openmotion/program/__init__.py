@@ -22,6 +22,7 @@ from .canon import (
     SetBlend,
     SetOutput,
     Spindle,
+    SyncedFeed,
     ToolChange,
 )
 from .interp import Interpreter, compile_file, compile_text, interpret
@@ -42,6 +43,7 @@ __all__ = [
     "Dwell",
     "End",
     "Feed",
+    "SyncedFeed",
     "GCodeError",
     "GCodeOptions",
     "Interpreter",

@@ -3,9 +3,10 @@
 All in machine coordinates of the two plane axes (a, b), with CCW turning from a to b.
 Tolerances follow LinuxCNC (interp_arc.cc constants), in the program's length unit and
 converted to machine units by the caller:
-- centre form: the end radius may differ from the start radius by at most
-  CENTRE_TOL (0.0028284 in / 0.028284 mm, = 2*sqrt(2) * 0.001 in / 0.01 mm) and by at most
-  0.1 % of the larger radius; beyond that the arc is inconsistent.
+- centre form: the end radius may differ from the start radius by up to CENTRE_TOL
+  (0.0028284 in / 0.028284 mm, = 2*sqrt(2) * 0.001 in / 0.01 mm), or by more as long as
+  it is within 0.1 % of the larger radius, but never by more than 100 * CENTRE_TOL; beyond
+  that the arc is inconsistent.
 - radius form: |R| may be short of half the chord by at most RADIUS_TOL (0.00005 in /
   0.00127 mm); it is then stretched to half the chord. Start == end is an error.
 - a start or end radius below RADIUS_TOL is a zero-radius arc (error).
@@ -72,10 +73,12 @@ def check_radii(sa: float, sb: float, ea: float, eb: float, ca: float, cb: float
         raise ArcGeometryError(f"zero-radius arc (start radius {r1:.6g}, end radius "
                                f"{r2:.6g})", "I/J/K")
     err = abs(r1 - r2)
-    if err > centre_tol or err > CENTRE_REL_TOL * max(r1, r2):
+    rel = err / max(r1, r2)
+    if err > 100.0 * centre_tol or (rel > CENTRE_REL_TOL and err > centre_tol):
         raise ArcGeometryError(
             f"radius to end of arc ({r2:.6g}) differs from radius to start ({r1:.6g}) by "
-            f"{err:.6g} (limit {centre_tol:.6g} and {CENTRE_REL_TOL:.1%} of the radius)",
+            f"{err:.6g} ({rel:.3%}); allowed: up to {centre_tol:.6g}, or up to "
+            f"{CENTRE_REL_TOL:.1%} of the radius but at most {100 * centre_tol:.6g}",
             "I/J/K")
     return r1, r2
 

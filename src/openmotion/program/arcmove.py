@@ -21,6 +21,7 @@ from .arcgeom import (
     check_radii,
     sweep_angle,
 )
+from .frame import rotate_vector, xy_to_machine
 from .parser import Block
 from .words import Word, feed_length, fmt
 
@@ -46,6 +47,9 @@ def arc_move(m: Modal, b: Block, mode: int, gpos: int, target: list[float],
         w = words[oh]
         raise b.error(f"{oh} is not allowed for an arc in the {la}{lb} plane", w.pos,
                       fmt(oh, w.value))
+    if m.rotated and m.plane != 170:
+        raise b.error(f"{gword} in G18/G19 on a rotated coordinate system (G10 R) is not "
+                      "supported", gpos, gword)
     feed, duration = m.feed_rate(b, words, gword, gpos)
     ax_a, ka = m.letters[la]
     ax_b, kb = m.letters[lb]
@@ -76,7 +80,18 @@ def arc_move(m: Modal, b: Block, mode: int, gpos: int, target: list[float],
             if wa is None and wb is None:
                 raise b.error(f"{gword} needs R or a centre ({oa}/{ob})", gpos, gword)
             used.update(L for L in (oa, ob) if L in words)
-            if m.arc_incremental:
+            if m.rotated and m.plane == 170:  # centre given in the rotated frame
+                da = s(wa.value) if wa is not None else 0.0
+                db = s(wb.value) if wb is not None else 0.0
+                if m.arc_incremental:
+                    ra, rb = rotate_vector(m, da, db)
+                    ca, cb = sa + ra, sb + rb
+                elif wa is None or wb is None:
+                    raise b.error(f"absolute arc centre (G90.1) needs both {oa} and {ob}",
+                                  gpos, oa if wa is None else ob)
+                else:
+                    ca, cb = xy_to_machine(m, da, db)
+            elif m.arc_incremental:
                 ca = sa + (s(wa.value) if wa is not None else 0.0)
                 cb = sb + (s(wb.value) if wb is not None else 0.0)
             else:

@@ -42,6 +42,17 @@ class Feed:
 
 
 @dataclass(frozen=True, slots=True)
+class SyncedFeed:
+    """G33 / G76 passes: a straight move synchronised to the spindle, advancing `pitch`
+    machine units along the move per spindle revolution."""
+
+    end: Point
+    pitch: float
+    line: int
+    file: str = ""
+
+
+@dataclass(frozen=True, slots=True)
 class ArcMove:
     """G2/G3: circular arc in the plane of axes `plane` = (i, j); other axes move linearly.
 
@@ -182,6 +193,6 @@ class Message:
     file: str = ""
 
 
-Command = (Rapid | Feed | ArcMove | Dwell | SetBlend | Pause | End | SetOutput | Spindle
-           | Coolant | ToolChange | Message)
-MOTIONS = (Rapid, Feed, ArcMove)
+Command = (Rapid | Feed | SyncedFeed | ArcMove | Dwell | SetBlend | Pause | End | SetOutput
+           | Spindle | Coolant | ToolChange | Message)
+MOTIONS = (Rapid, Feed, SyncedFeed, ArcMove)

@@ -163,8 +163,22 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             raise _fail(cmd, f"feed {cmd.feed_per_s:g} units/s gives no usable speed")
         return min(f, sys_max)  # F above the machine maxima is clamped (as LinuxCNC)
 
+    rpm = 0.0  # commanded spindle speed, for synchronised moves
     for cmd in cmds:
-        if isinstance(cmd, canon.Rapid | canon.Feed):
+        if isinstance(cmd, canon.SyncedFeed):
+            end = np.asarray(cmd.end, dtype=float)
+            length = float(np.linalg.norm(end - pos))
+            if length == 0.0:
+                continue
+            if rpm <= 0.0:
+                raise _fail(cmd, "a synchronised move (G33/G76) needs the spindle turning "
+                                 "at S > 0")
+            # no spindle feedback on this path: the nominal speed pitch x S
+            f = cmd.pitch * rpm / 60.0
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), min(f, sys_max),
+                          end=end, source=cmd))
+            pos = end
+        elif isinstance(cmd, canon.Rapid | canon.Feed):
             end = np.asarray(cmd.end, dtype=float)
             d = end - pos
             length = float(np.linalg.norm(d))
@@ -198,6 +212,7 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             ops.append(Op("output", cmd.line, cmd.file, index=cmd.index, level=cmd.level,
                           synced=cmd.synced, source=cmd))
         elif isinstance(cmd, canon.Spindle):
+            rpm = cmd.speed if cmd.on else 0.0
             outs = () if cmd.output is None else ((cmd.output, cmd.on),)
             txt = f"spindle {'on' if cmd.on else 'off'} S{cmd.speed:g}"
             ops.append(Op("action", cmd.line, cmd.file, text=txt, outputs=outs, barrier=True,

@@ -106,6 +106,22 @@ class Exists(Node):
         return 1.0 if store.has_named(self.name) else 0.0
 
 
+class ExistsNumber(Node):
+    """EXISTS[#expr]: 1.0 if the numbered parameter the index names exists (an integer in
+    1..5601), without reading it (LinuxCNC)."""
+
+    __slots__ = ("index",)
+
+    def __init__(self, index: Node, pos: int) -> None:
+        self.index = index
+        self.pos = pos
+
+    def ev(self, store: Store) -> float:
+        v = self.index.ev(store)
+        n = round(v)
+        return 1.0 if abs(v - n) <= 1e-4 and 1 <= n <= 5601 else 0.0
+
+
 def _need(cond: bool, message: str, node: Node, word: str) -> None:
     if not cond:
         raise EvalError(message, node.pos, word)

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from . import canon
 from .fastpath import compile_plain
 from .modal import Modal
+from .modalstate import on_return
 from .options import GCodeOptions
 from .params import Parameters
 from .parser import MAX_LINES, Block, Program, parse_program
@@ -39,6 +40,8 @@ class _Flow:
     end: dict[int, int] = field(default_factory=dict)  # loop head/break -> loop end
     endif: dict[int, int] = field(default_factory=dict)  # if/elseif/else -> endif
     do_end: set[int] = field(default_factory=set)  # 'WHILE' lines that close a DO
+    fanuc: dict[str, int] = field(default_factory=dict)  # bare O<n> line (M98 target)
+    missing: dict[str, int] = field(default_factory=dict)  # called, not defined: -> line
 
 
 def _analyse(blocks: list[Block], block_delete: bool) -> _Flow:
@@ -56,6 +59,9 @@ def _analyse(blocks: list[Block], block_delete: bool) -> _Flow:
             return b.error(msg, pos, word)
 
         top = stack[-1] if stack else None
+        if kw == "":
+            flow.fanuc.setdefault(label, i)
+            continue
         if kw == "WHILE" and top is not None and top[1] == "DO" and top[0] == label:
             stack.pop()
             flow.do_end.add(i)
@@ -110,20 +116,23 @@ def _analyse(blocks: list[Block], block_delete: bool) -> _Flow:
             else:
                 raise err(f"{kw.lower()} outside an O{label} loop")
             continue
-        if kw == "RETURN":
-            if not any(f[1] == "SUB" and f[0] == label for f in stack):
-                raise err(f"return outside subroutine O{label}")
+        if kw == "RETURN":  # LinuxCNC: any label returns from the enclosing sub
+            if not any(f[1] == "SUB" for f in stack):
+                raise err(f"return outside a subroutine (O{label} return)")
             continue
     if stack:
         label, kw, i, _ = stack[-1]
         b = blocks[i]
         raise b.error(f"O{label} {kw.lower()} is never closed", b.oword.pos,  # type: ignore
                       f"O{label} {kw.lower()}")
-    for b in blocks:
-        if b.oword is not None and b.oword.keyword == "CALL" \
-                and b.oword.label not in flow.subs and not (b.delete and block_delete):
-            raise b.error(f"subroutine O{b.oword.label} is not defined in this program",
-                          b.oword.pos, f"O{b.oword.label} call")
+    for i, b in enumerate(blocks):
+        o = b.oword
+        if o is not None and o.keyword == "CALL" and o.computed is None \
+                and o.label not in flow.subs and not (b.delete and block_delete):
+            if o.label in flow.fanuc:
+                raise b.error(f"O{o.label} is a Fanuc-style program: call it with M98 "
+                              f"P{o.label}", o.pos, f"O{o.label} call")
+            flow.missing.setdefault(o.label, i)
     return flow
 
 
@@ -137,11 +146,15 @@ def _bind(flow: _Flow, blocks: list[Block], j: int, head: int, end: int) -> None
 
 @dataclass
 class _Frame:
-    """One active subroutine call."""
+    """One active subroutine call (`fanuc`: an M98 call, repeated `loops` more times from
+    block `start`)."""
 
     label: str
     return_to: int
     repeats: dict[int, int] = field(default_factory=dict)
+    fanuc: bool = False
+    loops: int = 0
+    start: int = 0
 
 
 class Interpreter:
@@ -154,7 +167,33 @@ class Interpreter:
         self.opt = options
         self.params = Parameters(options.parameters)
         self.modal = Modal(options, self.params)
-        self.flow = _analyse(program.blocks, options.block_delete)
+        self.blocks = list(program.blocks)
+        self.main_end = len(self.blocks)  # blocks after this come from subroutine files
+        self.search = subroutine_dirs(options, program.file)
+        self.flow = _analyse(self.blocks, options.block_delete)
+        while self.flow.missing:
+            label, i = next(iter(self.flow.missing.items()))
+            self._load(label, self.blocks[i])
+
+    def _load(self, label: str, b: Block) -> None:
+        """Append subroutine file <label>.ngc (found on the search path) and re-analyse."""
+        o = b.oword
+        pos, word = (o.pos, f"O{label} call") if o is not None else (0, f"M98 P{label}")
+        path = find_subroutine(label, self.search)
+        if path is None:
+            where = ", ".join(self.search) or "(no search path)"
+            raise b.error(f"subroutine O{label} is not defined in this program and no file "
+                          f"{sub_file_name(label)} is in {where}", pos, word)
+        sub = parse_program(read_program(path, self.opt.max_bytes), path,
+                            self.opt.max_line_length)
+        own = _analyse(sub.blocks, self.opt.block_delete)
+        if label not in own.subs:
+            raise b.error(f"{path} does not define O{label} sub ... O{label} endsub", pos,
+                          word)
+        # code outside the sub (a test harness, M2 ...) is never run, as in LinuxCNC
+        self.blocks.extend(sub.blocks)
+        self.flow = _analyse(self.blocks, self.opt.block_delete)
+
 
     def _truth(self, b: Block) -> bool:
         o = b.oword
@@ -162,11 +201,12 @@ class Interpreter:
         return self.modal.evaluate(b, o.args[0], f"O{o.label}") != 0.0
 
     def run(self) -> list[canon.Command]:  # noqa: C901
-        blocks = self.program.blocks
+        blocks = self.blocks
         flow = self.flow
         modal = self.modal
         skip_deleted = self.opt.block_delete
         out: list[canon.Command] = []
+        self._out = out
         frames: list[_Frame] = [_Frame("", -1)]
         steps = 0
         limit = self.opt.max_blocks
@@ -174,6 +214,8 @@ class Interpreter:
         test_branch = -1  # the ELSEIF whose condition is to be tested next
         n = len(blocks)
         while pc < n:
+            if pc == self.main_end and len(frames) == 1:
+                break  # the main program ran off its end: loaded files are not run
             b = blocks[pc]
             steps += 1
             if steps > limit:
@@ -183,17 +225,30 @@ class Interpreter:
                 pc += 1
                 continue
             o = b.oword
+            modal.line = b.line
             if o is None:
                 if not modal.execute(b, out):
                     break
-                pc += 1
+                req = modal.flow_request
+                if req is None:
+                    pc += 1
+                    continue
+                modal.flow_request = None
+                pc = self._fanuc(b, pc, req, frames)
+                flow = self.flow
+                n = len(blocks)
                 continue
             if b.comments:
                 modal.messages(b, out)
             kw = o.keyword
-            if kw == "SUB":  # reached by falling through: skip the definition
+            if kw == "":  # a Fanuc-style program number: a label, nothing to do
+                pc += 1
+            elif kw == "SUB":  # reached by falling through: skip the definition
                 pc = flow.subs[o.label][1] + 1
             elif kw in ("ENDSUB", "RETURN"):
+                if frames[-1].fanuc:
+                    raise b.error(f"O{frames[-1].label} was called with M98: it must end "
+                                  "with M99", o.pos, f"O{o.label} {kw.lower()}")
                 if o.args:
                     v = modal.evaluate(b, o.args[0], f"O{o.label}")
                     self.params.set_named("_VALUE", v)
@@ -201,17 +256,28 @@ class Interpreter:
                 frame = frames.pop()
                 if len(frames) == 0:  # pragma: no cover - _analyse forbids this
                     raise b.error("return outside a subroutine", o.pos, f"O{o.label}")
+                on_return(modal, self.params.depth, b, out)
                 self.params.pop_call()
                 pc = frame.return_to
             elif kw == "CALL":
                 if len(frames) > self.opt.max_call_depth:
                     raise b.error(f"subroutine calls nested deeper than "
                                   f"{self.opt.max_call_depth}", o.pos, f"O{o.label} call")
-                args = [modal.evaluate(b, a, f"O{o.label}") for a in o.args]
+                label = o.label
+                if o.computed is not None:
+                    label = self._label(b, modal.evaluate(b, o.computed, "O[...]"), o.pos)
+                    if label not in self.flow.subs:
+                        if label in self.flow.fanuc:
+                            raise b.error(f"O{label} is a Fanuc-style program: call it "
+                                          f"with M98 P{label}", o.pos, f"O{label} call")
+                        self._load(label, b)
+                        flow = self.flow
+                        n = len(blocks)
+                args = [modal.evaluate(b, a, f"O{label}") for a in o.args]
                 self.params.set_named("_VALUE_RETURNED", 0.0)
                 self.params.push_call(args)
-                frames.append(_Frame(o.label, pc + 1))
-                pc = flow.subs[o.label][0] + 1
+                frames.append(_Frame(label, pc + 1))
+                pc = flow.subs[label][0] + 1
             elif kw == "ELSEIF" and pc != test_branch:  # reached from a taken branch
                 pc = flow.endif[pc] + 1
             elif kw in ("IF", "ELSEIF"):
@@ -261,6 +327,83 @@ class Interpreter:
             else:  # pragma: no cover - parser admits only the keywords above
                 raise b.error(f"unknown O-word {kw}", o.pos, f"O{o.label}")
         return out
+
+
+    @staticmethod
+    def _label(b: Block, v: float, pos: int) -> str:
+        n = round(v)
+        if abs(v - n) > 1e-6 or n < 0:
+            raise b.error(f"an O-word number must be an integer >= 0, got {v:g}", pos,
+                          f"O{v:g}")
+        return str(int(n))
+
+    def _fanuc(self, b: Block, pc: int, req: tuple[str, float, int, int],
+               frames: list[_Frame]) -> int:
+        """M98 P.. L.. (call a Fanuc-style program) or M99 (return); the next pc."""
+        kind, p, count, pos = req
+        if kind == "M99":
+            top = frames[-1]
+            if len(frames) == 1:
+                raise b.error("M99 in the main program restarts it forever (LinuxCNC's "
+                              "endless loop): end the program with M2 or M30", pos, "M99")
+            if not top.fanuc:
+                raise b.error(f"O{top.label} sub must end with O{top.label} endsub or "
+                              "return, not M99", pos, "M99")
+            if top.loops > 0:
+                top.loops -= 1
+                top.repeats.clear()
+                return top.start
+            frames.pop()
+            on_return(self.modal, self.params.depth, b, self._out)
+            self.params.pop_call(keep_numbered=True)
+            return top.return_to
+        label = self._label(b, p, pos)
+        word = f"M98 P{label}"
+        if label not in self.flow.fanuc:
+            if label in self.flow.subs:
+                raise b.error(f"O{label} sub must be called with O{label} call, not M98",
+                              pos, word)
+            raise b.error(f"M98: program O{label} is not defined in this program", pos,
+                          word)
+        if count == 0:
+            return pc + 1
+        if len(frames) > self.opt.max_call_depth:
+            raise b.error(f"subroutine calls nested deeper than {self.opt.max_call_depth}",
+                          pos, word)
+        start = self.flow.fanuc[label] + 1
+        self.params.push_call(None)
+        frames.append(_Frame(label, pc + 1, fanuc=True, loops=count - 1, start=start))
+        return start
+
+
+def sub_file_name(label: str) -> str:
+    """The file a subroutine is searched in: its name in lower case + '.ngc'."""
+    return label.strip("<>").lower() + ".ngc"
+
+
+def subroutine_dirs(options: GCodeOptions, program_file: str) -> list[str]:
+    """Where external subroutines are searched: options.subroutine_path, then the
+    program's own folder (LinuxCNC: SUBROUTINE_PATH, then the program's directory)."""
+    dirs = [os.fspath(d) for d in options.subroutine_path]
+    if program_file:
+        here = os.path.dirname(os.path.abspath(program_file))
+        if here not in dirs:
+            dirs.append(here)
+    return dirs
+
+
+def find_subroutine(label: str, dirs: list[str]) -> str | None:
+    """Path of <label>.ngc in the first folder holding it (case-insensitive name)."""
+    want = sub_file_name(label)
+    for d in dirs:
+        try:
+            names = os.listdir(d)
+        except OSError:
+            continue
+        for name in names:
+            if name.lower() == want and os.path.isfile(os.path.join(d, name)):
+                return os.path.join(d, name)
+    return None
 
 
 def interpret(program: Program, options: GCodeOptions) -> list[canon.Command]:

@@ -17,45 +17,28 @@ rewrite them (G10, G28/G30, G92) are in coords.py; G2/G3 in arcmove.py.
 from __future__ import annotations
 
 import math
-import re
 
-from . import canon
+from . import canon, frame
 from .arcmove import arc_move
+from .codes import G_GROUP, G_REFUSED, M_GROUP, M_REFUSED
+from .compmove import comp_motion
 from .coords import offset_command
+from .cuttercomp import CutterComp, comp_off, comp_on
+from .cycles import CYCLES, CycleState, canned_cycle
 from .expr import EvalError, Node
+from .messages import comment_commands
+from .modalstate import SavedState, state_word
+from .named import READ_ONLY, predefined
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
+from .polar import polar_words
+from .threading import g33, g76
+from .tooloffsets import set_tool_parameters, tool_length
 from .words import Word, feed_length, fmt
 
-# G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
-G_GROUP = {
-    40: 0, 100: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
-    0: 1, 10: 1, 20: 1, 30: 1, 800: 1,
-    170: 2, 180: 2, 190: 2,
-    900: 3, 910: 3,
-    901: 4, 911: 4,
-    930: 5, 940: 5,
-    200: 6, 210: 6,
-    400: 7,
-    430: 8, 490: 8,
-    540: 12, 550: 12, 560: 12, 570: 12, 580: 12, 590: 12, 591: 12, 592: 12, 593: 12,
-    610: 13, 611: 13, 640: 13,
-}
-#: Why some well-known codes are refused (others get a generic "unsupported").
-G_REFUSED = {
-    410: "cutter radius compensation (G41) is not supported",
-    420: "cutter radius compensation (G42) is not supported",
-    330: "spindle-synchronized motion (G33) is not supported",
-    382: "probing (G38.x) is not supported",
-    950: "feed per revolution (G95) is not supported",
-    810: "canned cycles (G81) are not supported",
-}
-M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
-           62: 5, 63: 5, 64: 5, 65: 5}
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
-_DEBUG_PARAM = re.compile(r"#<([^>]*)>|#(\d+)")
 
 
 class Modal:
@@ -77,9 +60,19 @@ class Modal:
         self.plane = 170
         self.inverse_time = False
         self.feed = 0.0  # the F number: program units per minute (G94) or inverse time (G93)
+        # G94 feed in machine units per minute, fixed when F is set (LinuxCNC's canon
+        # converts F with the units active then); angular feeds are never converted.
+        self.feed_lin = 0.0
+        self.feed_ang = 0.0
         self.motion: int | None = None  # G80: no motion mode until G0..G3
+        self.motion_prev: int | None = None  # the motion mode before this line's G-code
+        self.cycle = CycleState()
+        self.polar_inc: tuple[float, float] | None = None  # G91 polar cycle increments
+        self.comp = CutterComp()
+        self.saved_states: dict[int, SavedState] = {}  # call level -> M70/M73 snapshot
+        self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
         self.coord = 1
-        self.tool_z = 0.0
+        self.tools = dict(options.tool_table)  # type: ignore[arg-type]  # G10 L1 edits
         self.selected_tool = 0
         self.tool = 0
         self.spindle_on = False
@@ -88,23 +81,48 @@ class Modal:
         self.mist = False
         self.flood = False
         self.ended = False
+        #: M98 (call: P number, L count) or M99 for the interpreter, after the line ran:
+        #: (kind, P, L, column)
+        self.flow_request: tuple[str, float, int, int] | None = None
         # letter -> (machine axis, parameter offset k)
         self.letters = {L: (options.axes[L], AXIS_LETTERS.index(L)) for L in options.axes}
         self.g92 = [params.numbers[5211 + k] for k in range(9)]
         if any(self.g92):
             params.set_number(5210, 1.0)
         params.set_number(5220, 1.0)
+        if 5599 not in options.parameters:
+            params.set_number(5599, 1.0)  # (DEBUG,...) output on, as LinuxCNC starts
         self.off = [0.0] * 9
+        self.work = [0.0] * 9  # G5x origin per axis letter
+        self.rot = 0.0  # rotation of the active system about its origin, degrees
+        self.rotated = False
+        self.tool_offset = [0.0] * 9  # active G43 offset per axis letter (machine units)
         self.update_offsets()
         params.position_hook = self.program_position
+        params.predefined_hook = lambda name: predefined(self, name)
+        self.line = 0  # the line being executed (#<_line>)
+        self.per_rev = False  # G95
+        self.css = False  # G96
+        self.retract_old_z = False  # G98 (True) / G99; LinuxCNC's rs274 starts in G99
+        self.diameter_mode = False  # G7
 
     # -- coordinates -----------------------------------------------------------------
     def update_offsets(self) -> None:
-        base = 5221 + 20 * (self.coord - 1)
-        nums = self.params.numbers
-        for k in range(9):
-            self.off[k] = nums[base + k] + self.g92[k]
-        self.off[2] += self.tool_z
+        frame.update(self)
+
+    def ccomp_code(self) -> int:
+        """Active cutter compensation as G-code * 10 (400 = off)."""
+        return self.comp.code()
+
+    def feed_program_units(self) -> float:
+        """The active feed (#<_feed>): units per minute in the program's units (G94)."""
+        if self.inverse_time:
+            return self.feed
+        return self.feed_lin * self.ldiv / self.lscale
+
+    def pocket_of(self, tool: int) -> int:
+        """Pocket of a tool (a tool table without pockets: the tool number, 0 -> -1)."""
+        return tool if tool > 0 else -1
 
     def lin(self, v: float) -> float:
         """A program length in machine units (exact when the units agree or 1 in = 25.4 mm)."""
@@ -120,6 +138,10 @@ class Modal:
         info = self.letters.get(letter)
         if info is None:
             return 0.0
+        if self.rotated and k in (0, 1):
+            xy = frame.machine_to_xy(self, self.pos[self.letters["X"][0]],
+                                     self.pos[self.letters["Y"][0]])
+            return xy[k] * self.ldiv / self.lscale
         d = self.pos[info[0]] - self.off[k]
         return d if letter in ROTARY_LETTERS else d * self.ldiv / self.lscale
 
@@ -131,18 +153,32 @@ class Modal:
         return info[0]
 
     def target_position(self, b: Block, axes: dict[str, Word], machine: bool = False,
-                incremental: bool | None = None) -> list[float]:
+                        incremental: bool | None = None, diameter: bool = True
+                        ) -> list[float]:
+        """Machine end point of axis words (program units; G90/G91, G7 on X, rotation)."""
         inc = self.incremental if incremental is None else incremental
         target = self.pos[:]
+        xy: list[float] | None = None
         for letter, w in axes.items():
             ax = self.axis_index(b, letter, w)
             v = self.conv(w.value, letter)
+            if letter == "X" and self.diameter_mode and diameter and not machine:
+                v *= 0.5  # G7: X words are diameters
+            k = self.letters[letter][1]
             if machine:
                 target[ax] = v
+            elif self.rotated and k < 2:
+                if xy is None:
+                    xy = list(frame.machine_to_xy(self, self.pos[self.letters["X"][0]],
+                                                  self.pos[self.letters["Y"][0]]))
+                xy[k] = xy[k] + v if inc else v
             elif inc:
                 target[ax] = self.pos[ax] + v
             else:
-                target[ax] = v + self.off[self.letters[letter][1]]
+                target[ax] = v + self.off[k]
+        if xy is not None:
+            mx, my = frame.xy_to_machine(self, xy[0], xy[1])
+            target[self.letters["X"][0]], target[self.letters["Y"][0]] = mx, my
         return target
 
     def check_limits(self, b: Block, lo: list[float], hi: list[float], word: str,
@@ -173,25 +209,10 @@ class Modal:
             raise b.error(f"value is not finite ({x})", v.pos, word)
         return x
 
-    def debug_text(self, text: str) -> str:
-        """(DEBUG,...) text with #n and #<name> replaced by their values."""
-
-        def sub(m: re.Match[str]) -> str:
-            if m.group(1) is not None:
-                name = "".join(m.group(1).split()).upper()
-                table = self.params.globals if name.startswith("_") else \
-                    self.params.locals[-1]
-                return f"{table[name]:.6f}" if name in table else "######"
-            n = int(m.group(2))
-            if 1 <= n < len(self.params.numbers):
-                return f"{self.params.get_number(n, 0):.6f}"
-            return "######"
-
-        return _DEBUG_PARAM.sub(sub, text)
-
     # -- one line --------------------------------------------------------------------
     def execute(self, b: Block, out: list[canon.Command]) -> bool:  # noqa: C901
         line, file = b.line, b.file
+        self.line = line
         gs: dict[int, tuple[int, int]] = {}  # group -> (code, pos)
         ms: dict[int, tuple[int, int]] = {}
         words: dict[str, Word] = {}
@@ -204,6 +225,11 @@ class Modal:
                     msg = G_REFUSED.get(code, f"unsupported G-code G{x:g}")
                     raise b.error(msg, pos, fmt("G", x))
                 grp = G_GROUP[code]
+                if grp == 1 and grp in gs and 800 in (code, gs[1][0]):
+                    # LinuxCNC: G80 with another motion code on the line gives way to it
+                    if code != 800:
+                        gs[1] = (code, pos)
+                    continue
                 if grp in gs:
                     raise b.error(f"two G-codes of the same modal group on one line "
                                   f"(G{gs[grp][0] / 10:g} and G{x:g})", pos, fmt("G", x))
@@ -211,7 +237,11 @@ class Modal:
             elif letter == "M":
                 code = round(x)
                 if abs(x - code) > 1e-6 or code not in M_GROUP:
-                    raise b.error(f"unsupported M-code M{x:g}", pos, fmt("M", x))
+                    msg = M_REFUSED.get(code, f"unsupported M-code M{x:g}")
+                    if 100 <= code <= 199:
+                        msg = f"user M-code M{code} (a program in M{code} files) is not " \
+                              "supported"
+                    raise b.error(msg, pos, fmt("M", x))
                 grp = M_GROUP[code]
                 if grp == 8 and code != 9 and grp in ms and ms[grp][0] != 9:
                     coolant.add(code)  # M7 and M8 may share a line
@@ -233,18 +263,23 @@ class Modal:
         if b.comments:
             self.messages(b, out)
         # feed mode, F, S, T
-        if 5 in gs:
-            inv = gs[5][0] == 930
-            if inv != self.inverse_time:
-                self.inverse_time = inv
-                self.feed = 0.0
+        if 5 in gs:  # LinuxCNC: G94 and G95 always clear F; G93 needs F on each line
+            code = gs[5][0]
+            self.inverse_time = code == 930
+            self.per_rev = code == 950
+            if code != 930:
+                self.feed = self.feed_lin = self.feed_ang = 0.0
         f = words.get("F")
         if f is not None:
             used.add("F")
             if f.value < 0:
                 raise b.error(f"feed rate must be >= 0, got {f.value:g}", f.pos,
                               fmt("F", f.value))
-            self.feed = f.value  # program units per minute: converted when used
+            # F comes before G20/G21 in the order of execution: a unit change on the
+            # same line does not rescale it (LinuxCNC).
+            self.feed = f.value
+            self.feed_lin = self.lin(f.value)
+            self.feed_ang = f.value
         s = words.get("S")
         if s is not None:
             used.add("S")
@@ -259,8 +294,19 @@ class Modal:
         if t is not None:
             used.add("T")
             self.selected_tool = self.int_word(b, "T", t, 0)
-        if 6 in ms:
+        if 6 in ms and ms[6][0] == 61:  # M61 Q: the tool in the spindle, no change
+            q = words.get("Q")
+            if q is None:
+                raise b.error("M61 needs Q (the tool now in the spindle)", ms[6][1], "M61")
+            used.add("Q")
+            self.tool = self.int_word(b, "Q", q, 0)
+            self.set_tool_parameters()
+        elif 6 in ms:
+            if self.comp.side:
+                raise b.error("cannot change tools with cutter compensation on (G40 first)",
+                              ms[6][1], "M6")
             self.tool = self.selected_tool
+            self.set_tool_parameters()
             out.append(canon.ToolChange(self.tool, line, file))
         if 7 in ms:
             code = ms[7][0]
@@ -269,6 +315,8 @@ class Modal:
                 self.spindle_cw = code == 3
             out.append(canon.Spindle(self.spindle_on, self.spindle_cw, self.speed,
                                      self.opt.spindle_output, line, file))
+        if 12 in ms:
+            state_word(self, b, ms[12][0], ms[12][1], out)
         if coolant:
             if 9 in coolant:
                 self.mist = self.flood = False
@@ -298,44 +346,77 @@ class Modal:
                               fmt("P", p.value))
             out.append(canon.Dwell(p.value, line, file))
         if 2 in gs:
+            if self.comp.side and gs[2][0] != self.plane:
+                raise b.error("cannot change planes with cutter compensation on", gs[2][1],
+                              f"G{gs[2][0] / 10:g}")
             self.plane = gs[2][0]
         if 6 in gs:
             self._set_units("inch" if gs[6][0] == 200 else "mm")
+        if 7 in gs:
+            if gs[7][0] == 400:
+                comp_off(self)
+            else:
+                comp_on(self, b, gs[7][0], gs[7][1], words, used)
         if 8 in gs:
-            self._tool_length(b, gs[8], words, used)
+            tool_length(self, b, gs[8], words, used)
+            if gs[8][0] in (431, 432):  # their axis words are offsets, not a move
+                for L in [L for L in words if L in AXIS_SET and L in used]:
+                    del words[L]
         if 12 in gs:
             self.coord = COORD_SYSTEMS[gs[12][0]]
             self.params.set_number(5220, float(self.coord))
             self.update_offsets()
         if 13 in gs:
             self._path_control(b, gs[13][0], words, used, out)
+        if 15 in gs:
+            self.diameter_mode = gs[15][0] == 70
+        if 10 in gs:
+            self.retract_old_z = gs[10][0] == 980
         if 3 in gs:
             self.incremental = gs[3][0] == 910
         if 4 in gs:
             self.arc_incremental = gs[4][0] == 911
+        if "@" in words or "^" in words:
+            mode = (None if gs[1][0] == 800 else gs[1][0]) if 1 in gs else self.motion
+            polar_words(self, b, words, cycle=mode in CYCLES)
         axes = {L: w for L, w in words.items() if L in AXIS_SET}
-        if g0 is not None and g0[0] in (100, 280, 281, 300, 301, 920, 921, 922, 923):
+        if g0 is not None and g0[0] in (100, 520, 280, 281, 300, 301, 920, 921, 922, 923):
             if axes and 1 in gs and gs[1][0] != 800:
                 raise b.error("axis words are used by two commands on this line "
                               f"(G{g0[0] / 10:g} and G{gs[1][0] / 10:g})", gs[1][1],
                               f"G{gs[1][0] / 10:g}")
+            if self.comp.side and g0[0] in (280, 300):
+                raise b.error("G28/G30 cannot be used with cutter compensation on", g0[1],
+                              f"G{g0[0] / 10:g}")
             offset_command(self, b, g0, axes, words, used, out)
             used.update(axes)
         elif 1 in gs or axes or (g0 is not None and g0[0] == 530):
+            self.motion_prev = self.motion
             if 1 in gs:
                 self.motion = None if gs[1][0] == 800 else gs[1][0]
-            if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")):
+            if self.motion not in CYCLES and (1 in gs or axes):
+                self.cycle.initial = None  # a series of cycles ends at any other motion
+            if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")) or (
+                    (1 in gs or self.polar_inc is not None) and self.motion in CYCLES):
                 self._motion(b, gs, axes, words, used, out, machine=g0 is not None)
                 used.update(axes)
+        if 11 in ms and ms[11][0] == 98:
+            used.update(L for L in "PL" if L in words)
         for letter, w in words.items():
             if letter not in used:
                 raise b.error(f"word {letter} is not used by any command on this line",
                               w.pos, fmt(letter, w.value))
+        if 4 in ms and 11 in ms:
+            raise b.error("M98/M99 cannot share a line with M0/M1/M2/M30", ms[11][1],
+                          f"M{ms[11][0]}")
+        if 11 in ms:
+            self._flow_word(b, ms[11], words)
         if 4 in ms:
             code = ms[4][0]
             if code in (0, 1):
                 out.append(canon.Pause(code == 1, line, file))
             else:
+                comp_off(self)
                 out.append(canon.End(code == 30, line, file))
                 self.ended = True
                 return False
@@ -363,6 +444,10 @@ class Modal:
                                   f"#{idx:g}")
                 target = int(n)
             pending.append((target, value))
+        for target, _value in pending:
+            if isinstance(target, str) and target in READ_ONLY:
+                raise b.error(f"#<{target.lower()}> is a predefined parameter and cannot be "
+                              "assigned", -1, f"#<{target.lower()}>")
         for target, value in pending:
             if isinstance(target, int):
                 self.params.set_number(target, value)
@@ -372,19 +457,7 @@ class Modal:
         self.update_offsets()
 
     def messages(self, b: Block, out: list[canon.Command]) -> None:
-        for _col, text in b.comments:
-            body = text.lstrip()
-            head = body[:6].upper()
-            if head.startswith("MSG,"):
-                out.append(canon.Message(body[4:].strip(), "msg", b.line, b.file))
-            elif head.startswith("DEBUG,"):
-                out.append(canon.Message(self.debug_text(body[6:].strip()), "debug", b.line,
-                                         b.file))
-            elif head.startswith("PRINT,"):
-                out.append(canon.Message(self.debug_text(body[6:].strip()), "print", b.line,
-                                         b.file))
-            elif self.opt.keep_comments:
-                out.append(canon.Message(text, "comment", b.line, b.file))
+        comment_commands(b, self.params, self.opt.keep_comments, out)
 
     def _set_units(self, units: str) -> None:
         self.units = units
@@ -395,24 +468,12 @@ class Modal:
             else:
                 self.ldiv = MM_PER_INCH
 
-    def _tool_length(self, b: Block, g: tuple[int, int], words: dict[str, Word],
-                     used: set[str]) -> None:
-        if g[0] == 490:
-            self.tool_z = 0.0
-        else:
-            h = words.get("H")
-            tool = self.tool
-            if h is not None:
-                used.add("H")
-                tool = self.int_word(b, "H", h, 0)
-            self.tool_z = float(self.opt.tool_lengths.get(tool, 0.0))
-        self.update_offsets()
-
     def _path_control(self, b: Block, code: int, words: dict[str, Word], used: set[str],
                       out: list[canon.Command]) -> None:
         if code != 640:
             mode = "exact_path" if code == 610 else "exact_stop"
             out.append(canon.SetBlend(mode, None, b.line, b.file))
+            self.blend = (mode, None, None)
             return
         tol = cam = None
         p = words.get("P")
@@ -420,7 +481,8 @@ class Modal:
             used.add("P")
             if p.value < 0:
                 raise b.error(f"G64 P must be >= 0, got {p.value:g}", p.pos, fmt("P", p.value))
-            tol = self.lin(p.value)
+            # P0 is plain G64 (best speed), as LinuxCNC reads a zero tolerance
+            tol = self.lin(p.value) if p.value > 0 else None
         q = words.get("Q")
         if q is not None:
             used.add("Q")
@@ -428,10 +490,35 @@ class Modal:
                 raise b.error(f"G64 Q must be >= 0, got {q.value:g}", q.pos, fmt("Q", q.value))
             cam = self.lin(q.value)
         out.append(canon.SetBlend("blend", tol, b.line, b.file, cam))
+        self.blend = ("blend", tol, cam)
 
-    def feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int
-                   ) -> tuple[float, float | None]:
-        """(feed_per_s, duration) for a feed move; errors when F is missing."""
+    def _flow_word(self, b: Block, m: tuple[int, int], words: dict[str, Word]) -> None:
+        code, pos = m
+        if code == 99:
+            self.flow_request = ("M99", 0.0, 0, pos)
+            return
+        p = words.get("P")
+        if p is None:
+            raise b.error("M98 needs P (the program number to call)", pos, "M98")
+        count = 1
+        lw = words.get("L")
+        if lw is not None:
+            count = self.int_word(b, "L", lw, 0)
+        self.flow_request = ("M98", p.value, count, pos)
+
+    def set_tool_parameters(self) -> None:
+        """#5400-#5413 from the tool in the spindle (tooloffsets.py)."""
+        set_tool_parameters(self)
+
+    def spindle_record(self, on: bool, b: Block) -> canon.Spindle:
+        """A Spindle record in the current direction and speed (cycles stop/restart)."""
+        return canon.Spindle(on, self.spindle_cw, self.speed, self.opt.spindle_output,
+                             b.line, b.file)
+
+    def feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int,
+                  rotary_only: bool = False) -> tuple[float, float | None]:
+        """(feed_per_s, duration) for a feed move; errors when F is missing. A move of
+        rotary axes only runs at the F number in degrees per minute (never unit-scaled)."""
         if self.inverse_time:
             f = words.get("F")
             if f is None or f.value <= 0:
@@ -441,7 +528,23 @@ class Modal:
         if self.feed <= 0.0:
             raise b.error("feed rate is zero or not set: give F before or with "
                           f"{gword}", gpos, gword)
-        return self.lin(self.feed) / 60.0, None
+        return self.per_second(self.feed_ang if rotary_only else self.feed_lin, b, gword,
+                               gpos), None
+
+    def per_second(self, f: float, b: Block, gword: str, gpos: int) -> float:
+        """A feed F (per minute, or per revolution in G95) in units per second; G95 uses the
+        commanded spindle speed S (no spindle feedback on this path)."""
+        if not self.per_rev:
+            return f / 60.0
+        if not self.spindle_on or self.speed <= 0.0:
+            raise b.error(f"{gword} in G95 (feed per revolution) needs the spindle turning "
+                          "at S > 0", gpos, gword)
+        return f * self.speed / 60.0
+
+    def _rotary_only(self, start: list[float], end: list[float]) -> bool:
+        """True when only rotary axes move (LinuxCNC then feeds at the angular rate)."""
+        moved = [L for L, (ax, _k) in self.letters.items() if end[ax] != start[ax]]
+        return bool(moved) and all(L in ROTARY_LETTERS for L in moved)
 
     def _motion(self, b: Block, gs: dict[int, tuple[int, int]], axes: dict[str, Word],
                 words: dict[str, Word], used: set[str], out: list[canon.Command],
@@ -454,18 +557,42 @@ class Modal:
             w = next(iter(axes.values()))
             raise b.error("axis words without a motion mode (G0, G1, G2 or G3)", w.pos,
                           fmt(next(iter(axes)), w.value))
-        gword = f"G{mode // 10}"
+        gword = f"G{mode / 10:g}"
         if machine:
             if mode not in (0, 10):
                 raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
             if self.incremental:
                 raise b.error("G53 cannot be used in incremental mode (G91)", gs[0][1], "G53")
+        if mode in CYCLES:
+            if self.comp.side:
+                raise b.error("canned cycles cannot be used with cutter compensation on",
+                              gpos, gword)
+            canned_cycle(self, b, mode, gpos, axes, words, used, out)
+            return
+        if mode in (330, 760):
+            if self.comp.side:
+                raise b.error(f"{gword} cannot be used with cutter compensation on", gpos,
+                              gword)
+            if mode == 760:
+                g76(self, b, gpos, axes, words, used, out)
+            else:
+                g33(self, b, gpos, self.target_position(b, axes), words, used, out)
+            return
+        if mode in (20, 30) and self.comp.arc_not_allowed:
+            raise b.error("the move just after cutter compensation ends (G40) must be a "
+                          "straight line", gpos, gword)
+        if self.comp.active:
+            comp_motion(self, b, mode, gpos, gword, axes, words, used, out, machine)
+            return
+        if mode in (0, 10) and any(L in axes for L in "XY"):
+            self.comp.arc_not_allowed = False
         target = self.target_position(b, axes, machine=machine)
         if mode == 0:
             self.check_limits(b, target, target, gword, gpos)
             out.append(canon.Rapid(tuple(target), b.line, b.file))
         elif mode == 10:
-            feed, duration = self.feed_rate(b, words, gword, gpos)
+            feed, duration = self.feed_rate(b, words, gword, gpos,
+                                            self._rotary_only(self.pos, target))
             if duration is not None:
                 feed = feed_length(self.pos, target, self.letters) / duration
             self.check_limits(b, target, target, gword, gpos)

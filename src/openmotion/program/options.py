@@ -8,8 +8,10 @@ spindle/coolant and the safety limits of interpretation. Validated on constructi
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from ..errors import MotionError, check_finite, check_int
 from .parser import MAX_PARAMETER
@@ -42,11 +44,17 @@ class GCodeOptions:
     parameters: initial numbered parameters (work offsets #5221.., G28 #5161.., G30 #5181..,
         G92 #5211..), positions in machine units.
     tool_lengths: tool number -> length offset (machine units) applied to Z by G43.
+    tool_table: a LinuxCNC tool table (.tbl path, or {number: Tool} from tooltable.py):
+        offsets per axis for G43 and diameters for cutter compensation; tool_lengths adds
+        Z-only tools not in it.
     n_outputs: M62-M65 P must be in [0, n_outputs).
     spindle_output / mist_output / flood_output: outputs carried by Spindle/Coolant.
     block_delete: skip lines starting with '/' (the block-delete switch is on).
     keep_comments: also emit plain comments as Message(kind="comment").
     max_call_depth: subroutine nesting limit; max_blocks: executed-line limit (loops).
+    subroutine_path: folders searched for `O<name> call` subroutines not defined in the
+        program, as <name>.ngc (then the program's own folder), like LinuxCNC's
+        [RS274NGC]SUBROUTINE_PATH.
     """
 
     axes: Mapping[str, int]
@@ -66,6 +74,8 @@ class GCodeOptions:
     max_blocks: int = 10_000_000
     max_line_length: int = MAX_LINE_LENGTH
     max_bytes: int = MAX_PROGRAM_BYTES
+    subroutine_path: Sequence[str | os.PathLike[str]] = ()
+    tool_table: Mapping[int, Any] | str | os.PathLike[str] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.axes, Mapping) or not self.axes:
@@ -138,7 +148,40 @@ class GCodeOptions:
         for name in ("block_delete", "keep_comments"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        if isinstance(self.subroutine_path, (str, bytes)) or not all(
+                isinstance(d, (str, os.PathLike)) for d in self.subroutine_path):
+            raise MotionError(f"subroutine_path must be a sequence of folder names, got "
+                              f"{self.subroutine_path!r}")
+        object.__setattr__(self, "subroutine_path", tuple(os.fspath(d)
+                                                          for d in self.subroutine_path))
+        object.__setattr__(self, "tool_table", self._tools())
         object.__setattr__(self, "axes", axes)
         object.__setattr__(self, "n_axes", n)
         object.__setattr__(self, "start", start)
         object.__setattr__(self, "soft_limits", limits)
+
+    def _tools(self) -> dict[int, Any]:
+        """The tool table as {number: Tool}, tool_lengths merged in as Z-only tools."""
+        from .tooltable import Tool, read_tool_table
+
+        table = self.tool_table
+        if table is None:
+            tools: dict[int, Tool] = {}
+        elif isinstance(table, (str, os.PathLike)):
+            tools = read_tool_table(table)
+        elif isinstance(table, Mapping):
+            tools = {}
+            for key, t in table.items():
+                if not isinstance(t, Tool) or t.number != key:
+                    raise MotionError(f"tool_table[{key!r}] must be a Tool with number "
+                                      f"{key!r}, got {t!r}")
+                tools[key] = t
+        else:
+            raise MotionError(f"tool_table must be a .tbl path or a mapping number -> Tool,"
+                              f" got {table!r}")
+        for key, length in self.tool_lengths.items():
+            if key in tools:
+                raise MotionError(f"tool {key} is in both tool_table and tool_lengths")
+            if key > 0:
+                tools[key] = Tool(key, key, (0.0, 0.0, float(length)) + (0.0,) * 6)
+        return tools

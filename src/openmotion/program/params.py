@@ -36,6 +36,8 @@ class Parameters:
         self._saved: list[list[float]] = []
         #: Reads #5420-#5428 (current position X..W in program coordinates) when set.
         self.position_hook: Callable[[int], float] | None = None
+        #: Predefined read-only globals (#<_x>, #<_metric>, ...): name -> value or None.
+        self.predefined_hook: Callable[[str], float | None] | None = None
 
     # -- reads (the expr.Store protocol) -------------------------------------------------
     def get_number(self, index: float, pos: int) -> float:
@@ -52,11 +54,22 @@ class Parameters:
         try:
             return table[name]
         except KeyError:
+            v = self.predefined(name)
+            if v is not None:
+                return v
             raise EvalError(f"named parameter #<{name.lower()}> is not defined", pos,
                             f"#<{name.lower()}>") from None
 
+    def predefined(self, name: str) -> float | None:
+        """Value of a predefined global such as _X or _METRIC, None if `name` is not one."""
+        if self.predefined_hook is None or not name.startswith("_"):
+            return None
+        return self.predefined_hook(name)
+
     def has_named(self, name: str) -> bool:
-        return name in (self.globals if name.startswith("_") else self.locals[-1])
+        if name in (self.globals if name.startswith("_") else self.locals[-1]):
+            return True
+        return self.predefined(name) is not None
 
     # -- writes ----------------------------------------------------------------------
     def set_number(self, index: int, value: float) -> None:
@@ -66,16 +79,20 @@ class Parameters:
         (self.globals if name.startswith("_") else self.locals[-1])[name] = value
 
     # -- call scopes -----------------------------------------------------------------
-    def push_call(self, args: list[float]) -> None:
-        """Enter a subroutine: save #1-#30, set them from `args` (rest 0), new local scope."""
+    def push_call(self, args: list[float] | None) -> None:
+        """Enter a subroutine: save #1-#30, set them from `args` (rest 0), new local scope.
+        args=None (an M98 call): #1-#30 are shared with the caller (Fanuc, LinuxCNC)."""
         self._saved.append(self.numbers[1:N_LOCAL + 1])
-        vals = list(args) + [0.0] * (N_LOCAL - len(args))
-        self.numbers[1:N_LOCAL + 1] = vals
+        if args is not None:
+            vals = list(args) + [0.0] * (N_LOCAL - len(args))
+            self.numbers[1:N_LOCAL + 1] = vals
         self.locals.append({})
 
-    def pop_call(self) -> None:
-        """Leave a subroutine: restore the caller's #1-#30 and local names."""
-        self.numbers[1:N_LOCAL + 1] = self._saved.pop()
+    def pop_call(self, keep_numbered: bool = False) -> None:
+        """Leave a subroutine: restore the caller's #1-#30 (unless kept) and local names."""
+        saved = self._saved.pop()
+        if not keep_numbered:
+            self.numbers[1:N_LOCAL + 1] = saved
         self.locals.pop()
 
     @property

@@ -20,6 +20,7 @@ from .expr import (
     Atan,
     Binary,
     Exists,
+    ExistsNumber,
     Func,
     NamedParam,
     Neg,
@@ -30,13 +31,15 @@ from .expr import (
 )
 from .source import MAX_LINE_LENGTH, GCodeError, column_of
 
-#: Letters that may start a word. E is not an RS-274/NGC word.
-WORD_LETTERS = frozenset("ABCDFGHIJKLMNPQRSTUVWXYZ")
+#: Letters that may start a word; @ and ^ are the polar radius and angle, E the G76 taper
+#: (LinuxCNC).
+WORD_LETTERS = frozenset("ABCDEFGHIJKLMNPQRSTUVWXYZ@^")
 #: O-word keywords and whether they take expressions: 0 none, 1 optional one, 2 one, 9 any.
 O_KEYWORDS = {
     "SUB": 0, "ENDSUB": 1, "RETURN": 1, "CALL": 9, "DO": 0, "WHILE": 2, "ENDWHILE": 0,
     "IF": 2, "ELSEIF": 2, "ELSE": 0, "ENDIF": 0, "REPEAT": 2, "ENDREPEAT": 0,
     "BREAK": 0, "CONTINUE": 0,
+    "": 0,  # a bare O<n> line: a Fanuc-style program number (called with M98, ends at M99)
 }
 _WORD_OPS = ("MOD", "AND", "XOR", "OR", "EQ", "NE", "GT", "GE", "LT", "LE")
 
@@ -51,12 +54,14 @@ Value = float | Node
 
 @dataclass(slots=True)
 class OWord:
-    """An O-word control line: `O<label> <keyword> [args]`."""
+    """An O-word control line: `O<label> <keyword> [args]`; `computed` is the expression
+    of an `O[expr] call` label (then `label` is its text)."""
 
     label: str
     keyword: str
     args: list[Value]
     pos: int
+    computed: Node | None = None
 
 
 @dataclass(slots=True)
@@ -157,9 +162,8 @@ class _LineParser:
         if end < 0:
             self.fail("named parameter is not closed with '>'", start)
         name = self.s[self.i:end]
-        if not name or not all(c.isalnum() or c == "_" for c in name):
-            self.fail("parameter name must be letters, digits and '_'", start,
-                      self.s[start:end + 1])
+        if not name:  # LinuxCNC takes any character but '>' (e.g. <_move:x>, <tap-d>)
+            self.fail("parameter name must not be empty", start, self.s[start:end + 1])
         self.i = end + 1
         return name
 
@@ -213,6 +217,10 @@ class _LineParser:
             self.i = j
             self.expect("[")
             self.expect("#")
+            if self.peek() != "<":  # EXISTS[#n], EXISTS[##n]: is the number in range
+                idx = self.primary()
+                self.expect("]")
+                return ExistsNumber(idx, pos)
             nm = self.name()
             self.expect("]")
             return Exists(nm, pos)
@@ -255,8 +263,15 @@ class _LineParser:
     def oword(self) -> OWord:
         pos = self.i
         self.i += 1  # 'O'
+        computed: Value | None = None
         if self.peek() == "<":
             label = "<" + self.name() + ">"
+        elif self.peek() and self.peek() in "[#":  # O[expr] / O#<name> call: computed label
+            start = self.i
+            computed = self.value()
+            label = self.s[start:self.i]
+            if not isinstance(computed, Node):
+                label = str(int(computed)) if computed == int(computed) else label
         else:
             m = _NUMBER.match(self.s, self.i)
             if m is None or "." in m.group():
@@ -288,7 +303,10 @@ class _LineParser:
             self.fail("CALL takes at most 30 arguments", kstart, word)
         if self.i < len(self.s):
             self.fail("unexpected text after the O-word", word=self.s[self.i:self.i + 8])
-        return OWord(label, keyword, args, pos)
+        if computed is not None and keyword != "CALL" and isinstance(computed, Node):
+            self.fail("a computed O-word label is only allowed with call", pos, word)
+        return OWord(label, keyword, args, pos,
+                     computed if isinstance(computed, Node) else None)
 
     def items(self) -> None:
         b = self.block

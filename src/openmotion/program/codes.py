@@ -1,0 +1,52 @@
+"""The G- and M-codes the interpreter knows: their modal groups, and why well-known codes
+it does not implement are refused (the error names the feature)."""
+
+from __future__ import annotations
+
+from .cycles import REFUSED as CYCLE_REFUSED
+
+# G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
+G_GROUP = {
+    40: 0, 100: 0, 520: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
+    0: 1, 10: 1, 20: 1, 30: 1, 330: 1, 760: 1, 800: 1, 730: 1, 740: 1, 810: 1, 820: 1,
+    830: 1, 840: 1, 850: 1, 860: 1, 880: 1, 890: 1,
+    170: 2, 180: 2, 190: 2,
+    900: 3, 910: 3,
+    901: 4, 911: 4,
+    930: 5, 940: 5, 950: 5,
+    970: 14,
+    200: 6, 210: 6,
+    400: 7, 410: 7, 420: 7, 411: 7, 421: 7,
+    430: 8, 431: 8, 432: 8, 490: 8,
+    540: 12, 550: 12, 560: 12, 570: 12, 580: 12, 590: 12, 591: 12, 592: 12, 593: 12,
+    610: 13, 611: 13, 640: 13,
+    980: 10, 990: 10,
+    70: 15, 80: 15,
+}
+#: Why some well-known codes are refused (others get a generic "unsupported").
+G_REFUSED = {
+    50: "cubic spline G5 is not supported", 51: "quadratic B-spline G5.1 is not supported",
+    52: "NURBS G5.2 is not supported", 53: "NURBS G5.3 is not supported",
+    331: "rigid tapping (G33.1) is not supported",
+    **{c: f"probing (G38.{c - 380}) is not supported" for c in (382, 383, 384, 385)},
+    700: "lathe finishing cycle (G70) is not supported",
+    710: "lathe roughing cycle (G71) is not supported",
+    720: "lathe roughing cycle (G72) is not supported",
+    960: "constant surface speed (G96) is not supported",
+    **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
+}
+#: Why some well-known M-codes are refused.
+M_REFUSED = {
+    19: "spindle orientation (M19) is not supported",
+    48: "override switches (M48) are not supported", 49: "override switches (M49)"
+    " are not supported", 50: "feed override control (M50) is not supported",
+    51: "spindle override control (M51) is not supported",
+    52: "adaptive feed (M52) is not supported", 53: "feed stop control (M53) is not supported",
+    60: "pallet change (M60) is not supported",
+    66: "waiting for an input (M66) is not supported",
+    67: "synchronized analog output (M67) is not supported",
+    68: "analog output (M68) is not supported",
+}
+M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
+           62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11, 61: 6,
+           70: 12, 71: 12, 72: 12, 73: 12}
