@@ -58,6 +58,10 @@ def test_random_programs_same_as_general_path(lines, soft, block_delete):
     assert_same("\n".join(lines), opts)
 
 
+@pytest.mark.xfail(strict=True, reason="the fast path is off since the LinuxCNC dialect "
+                   "merge: Modal gained state (feed_lin/feed_ang, work and tool offsets, "
+                   "rotation, cutter comp, cycles) that compile_plain must model before "
+                   "KNOWN_STATE admits it (issue #14)")
 def test_plain_program_takes_the_fast_path(monkeypatch):
     """Catches a Modal that grew state this module does not know (KNOWN_STATE)."""
     assert fastpath.fast_path_available(Modal(OPTS, Parameters(OPTS.parameters)))
