@@ -487,3 +487,21 @@ def test_7_windowed_path_ends_exactly_like_a_whole_one():
         ends.append((ctl.time, tuple(g.position)))
     assert ends[0][0] == pytest.approx(ends[1][0], abs=1e-9)
     assert ends[0][1] == ends[1][1] == (3_000.0, 9_000.0)
+
+
+def test_2_blend_ahead_is_not_prepared_against_a_chain_being_aborted():
+    """Found by the soak: with blending on, a command queued during an abort's stop was
+    pre-blended against the aborted chain's last element (MotionError in the cycle: its
+    start is the stop point, not that element's end) - a planner failure of the group."""
+    ctl = table_without_mel()
+    g = Group(ctl, ["x", "y"], feed=50_000, acc_time=0.1)
+    g.enable_blend(50.0)
+    g.line([100_000, 0])
+    g.line([100_000, 50_000])
+    ctl.advance(0.5)
+    g.abort()
+    g.line([20_000, 20_000])
+    g.line([0, 20_000])
+    assert finish_group(ctl, g, 10.0) > 0.0
+    assert g.error_code == 0 and ctl["x"].fault is None
+    assert list(g.position) == [0.0, 20_000.0]

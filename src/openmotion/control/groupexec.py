@@ -421,7 +421,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         r = self._run
         q = self._queue
         pre = self._pre
-        if r is None or r.plan is None or not q or not (self._blend and self._blend_tol > 0.0):
+        if r is None or r.plan is None or not q or not (self._blend and self._blend_tol > 0.0) \
+                or self._state is not GroupState.MOVING:
+            # (a hold or abort in progress: the queued commands start after it, from rest)
             pre.clear()
             return
         prev = r.plan.chain.elements[-1]
