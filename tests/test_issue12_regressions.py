@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helpers import free_axes, table_without_mel
+from helpers import finish_group, free_axes, table_without_mel
 from openmotion.control import Controller
 from openmotion.control.group import Group, GroupState
 from openmotion.profile.segments import State
@@ -445,3 +445,63 @@ def test_13_controller_history_has_no_degenerate_records_after_stops_and_changes
     dur = rec["ts"][1:] - rec["ts"][:-1]
     assert dur.min() > 1e-9
     assert abs(rec["v0"]).max() <= x.max_speed
+
+
+# -- 7: one long slow element must not stall a cycle -----------------------------------
+def test_7_a_long_slow_circle_is_planned_in_bounded_windows():
+    ctl = free_axes(2)
+    g = Group(ctl, ["x", "y"], feed=500)
+    g.circle([0, 100_000])  # 628 000 pulses at 500 pps: 21 minutes
+    ctl.step()
+    # the axes hold a bounded window of the path, not 1.26 million knots
+    assert all(a.motion.profile.n_segments < 5_000 for a in g.axes)
+    assert all(ctl.history.n_records(i) < 5_000 for i in range(2))
+    # and follow the circle exactly across window ends
+    worst = 0.0
+    for _ in range(6_000):
+        ctl.step()
+        p = g.position
+        worst = max(worst, abs(math.hypot(p[0], p[1] - 100_000) - 100_000))
+    assert worst < 1e-3
+    assert g.state is GroupState.MOVING and g.error_code == 0
+    g.abort()
+    assert ctl.run_until(lambda: g.state is GroupState.IDLE, 5.0)
+
+
+def test_7_windowed_path_ends_exactly_like_a_whole_one():
+    """A path longer than a window ends on its target with the same timing."""
+    from openmotion.control import groupexec
+
+    ends = []
+    for window in (groupexec.PATH_WINDOW_S, 1e9):
+        ctl = free_axes(2)
+        g = Group(ctl, ["x", "y"], feed=2_000, acc_time=0.2)
+        old = groupexec.PATH_WINDOW_S
+        groupexec.PATH_WINDOW_S = window
+        try:
+            g.arc([0, 3_000], [3_000, 3_000], direction="CW")
+            g.line([3_000, 9_000])
+            assert finish_group(ctl, g, 30.0) > 0.0
+        finally:
+            groupexec.PATH_WINDOW_S = old
+        ends.append((ctl.time, tuple(g.position)))
+    assert ends[0][0] == pytest.approx(ends[1][0], abs=1e-9)
+    assert ends[0][1] == ends[1][1] == (3_000.0, 9_000.0)
+
+
+def test_2_blend_ahead_is_not_prepared_against_a_chain_being_aborted():
+    """Found by the soak: with blending on, a command queued during an abort's stop was
+    pre-blended against the aborted chain's last element (MotionError in the cycle: its
+    start is the stop point, not that element's end) - a planner failure of the group."""
+    ctl = table_without_mel()
+    g = Group(ctl, ["x", "y"], feed=50_000, acc_time=0.1)
+    g.enable_blend(50.0)
+    g.line([100_000, 0])
+    g.line([100_000, 50_000])
+    ctl.advance(0.5)
+    g.abort()
+    g.line([20_000, 20_000])
+    g.line([0, 20_000])
+    assert finish_group(ctl, g, 10.0) > 0.0
+    assert g.error_code == 0 and ctl["x"].fault is None
+    assert list(g.position) == [0.0, 20_000.0]

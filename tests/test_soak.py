@@ -18,8 +18,9 @@ pulses to a second difference:
 - counters consistent with history: |c_k - history position(t_k)| <= 1/2 (+ 1e-6);
 - no exception escapes a cycle (`ctl.cycle_errors == 0`), no axis faults;
 - memory bounded: the history holds at most `max_records` records per axis, its arrays
-  never hold more than 8 times the most records it has had live plus a chunk (they shrink
-  when an eighth is live; checked every 100 cycles), and the event log is bounded.
+  never hold more than `cap_bound` rows (8 times the most records seen live, plus what one
+  path window's append can double them by; checked every 100 cycles), and the event log is
+  bounded.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ import numpy as np
 import pytest
 
 from openmotion.config import AxisConfig, MachineConfig
-from openmotion.control import Controller
+from openmotion.control import Controller, groupexec
 from openmotion.control.group import Group, GroupState
 from openmotion.control.jog import jog_conti, stop_jog
 from openmotion.errors import MotionError
@@ -41,6 +42,13 @@ GROUP_ACC = 2e6       # pps^2 cap of each group axis (set_max_pulse_acc, policy 
 Z_ACC = 6e6           # z: T/S moves ramp in >= 20 ms to <= 60 kpps (pure S peaks at 2x)
 U_ACC = 2e6           # u: jogs ramp in 50 ms to <= 50 kpps (T)
 A_MAX = np.array([GROUP_ACC, GROUP_ACC, Z_ACC, U_ACC])
+
+
+def cap_bound(records_high: int) -> int:
+    """Most history rows an axis may hold allocated: its arrays shrink when an eighth is
+    live, and one append (a path window of PATH_WINDOW_S / T knots plus its breaks, or a
+    move) can double them."""
+    return 8 * records_high + 4 * round(groupexec.PATH_WINDOW_S / PERIOD) + 256
 
 
 def _controller() -> tuple[Controller, Group]:
@@ -172,7 +180,7 @@ def soak(seconds: float, seed: int) -> dict[str, float]:
             rec_high = max(rec_high, *(hist.n_records(i) for i in range(n_ax)))
             cap = max(hist.capacity(i) for i in range(n_ax))
             cap_high = max(cap_high, cap)
-            assert cap <= 8 * rec_high + 256, (cap, rec_high)
+            assert cap <= cap_bound(rec_high), (cap, rec_high)
     assert not any(a.fault for a in ctl.axes), [a.fault for a in ctl.axes]
     assert g.error_code == 0, g.error_message
     for i in range(n_ax):

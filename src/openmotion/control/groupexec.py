@@ -37,7 +37,7 @@ from ..path.geometry import PathElement
 from ..path.lookahead import _element_limits as element_limits
 from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
-from ..profile.segments import Profile
+from ..profile.segments import Profile, State
 from . import pathaxes, pathrun, planning
 from . import pathexec as px
 from .group_corners import LookaheadSettings
@@ -119,6 +119,7 @@ class _Run:
     profiles: list[Profile] = field(default_factory=list)
     t_until: float = 0.0
     target: np.ndarray | None = None
+    window_end: float | None = None        # path: the axes' profiles end here (windowed)
 
     @property
     def t_end(self) -> float:
@@ -129,6 +130,10 @@ class _Run:
         return self.t0 + max((p.duration for p in self.profiles), default=0.0)
 
 
+#: The axes of a path get their profiles PATH_WINDOW_S seconds ahead at a time (a knot
+#: every period), renewed when half of it is left: one long slow element (a 21-minute
+#: circle) costs a bounded window per cycle, not its whole length (issue #12 defect 7).
+PATH_WINDOW_S = 2.0
 #: Most commands joined to a running chain in one re-plan (bounds one cycle's work).
 MAX_JOIN = 2000
 #: Queued corners blended ahead of a join per quiet cycle, and how far ahead at most.
@@ -225,6 +230,10 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             return
         if self._run is not None and not self._dry and self._check_faults():
             return
+        r = self._run
+        if r is not None and r.window_end is not None and \
+                t >= r.window_end - 0.5 * PATH_WINDOW_S:
+            self._extend(r, t)
         if self._job is not None and self._poll_join(t):
             return  # a join in flight (real time), or installed this cycle
         r = self._run
@@ -448,7 +457,9 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         r = self._run
         q = self._queue
         pre = self._pre
-        if r is None or r.plan is None or not q or not (self._blend and self._blend_tol > 0.0):
+        if r is None or r.plan is None or not q or not (self._blend and self._blend_tol > 0.0) \
+                or self._state is not GroupState.MOVING:
+            # (a hold or abort in progress: the queued commands start after it, from rest)
             pre.clear()
             return
         prev = r.plan.chain.elements[-1]
@@ -537,13 +548,33 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
 
     def _launch(self, plan: pathrun.PathPlan, cmds: list[_Cmd], t: float) -> None:
-        """Run `plan` from now: per-axis profiles along the chain, started all or none."""
-        profiles = self._pulse_profiles(px.axis_profiles(plan.chain, plan.sprof,
+        """Run `plan` from now: per-axis profiles along the chain, started all or none;
+        a plan longer than 1.5 windows gets its first window only (`_extend` renews it)."""
+        sp = plan.sprof
+        window = not self._dry and sp.duration > 1.5 * PATH_WINDOW_S
+        sp_w = _section(sp, 0.0, PATH_WINDOW_S) if window else sp
+        profiles = self._pulse_profiles(px.axis_profiles(plan.chain, sp_w,
                                                          self._ctl.period, self.position))
         lead = plan.t0 - t
         if lead > 1e-12:  # the plan starts later in this cycle (an exact delay)
             profiles = [pathaxes.delayed(p, lead) for p in profiles]
         self._install(plan, profiles, cmds, t)
+        if window and self._run is not None:
+            self._run.window_end = plan.t0 + sp_w.duration  # t + the lead of a delay
+
+    def _extend(self, r: _Run, t: float) -> None:
+        """The next window of a windowed path, from now (a cycle boundary, so the knots
+        stay on the cycle grid): every axis's profile is replaced by the path's next
+        PATH_WINDOW_S seconds, continuing exactly from where the axes are."""
+        plan = r.plan
+        assert plan is not None
+        u = t - plan.t0
+        sp_w = _section(plan.sprof, u, PATH_WINDOW_S)
+        profiles = self._pulse_profiles(px.axis_profiles(plan.chain, sp_w,
+                                                         self._ctl.period, self.position))
+        self._run_profiles(profiles, plan.limits.str_vel)
+        r.window_end = t + sp_w.duration if u + sp_w.duration < plan.sprof.duration \
+            - 1e-9 else None
 
     def _install(self, plan: pathrun.PathPlan, profiles: list[Profile], cmds: list[_Cmd],
                  t: float) -> None:
@@ -677,6 +708,30 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             for a in self.axes:
                 if a.state is not AxisState.ERROR_STOP:
                     a.stop_immediately()
+
+
+def _section(sp: Profile, u: float, w: float) -> Profile:
+    """s(t) over [u, u + w] (clipped to its end), its time 0 at u."""
+    dur = sp.duration
+    t_end = min(u + w, dur)
+    if u <= 0.0 and t_end >= dur:
+        return sp
+    t0 = sp.t0
+    k0 = max(int(np.searchsorted(t0, u, side="right")) - 1, 0)
+    k1 = max(int(np.searchsorted(t0, t_end, side="left")), k0 + 1)
+    st = sp.state_at(u) if u > 0.0 else None
+    nt0 = t0[k0:k1] - u
+    p0, v0, a0 = sp.p0[k0:k1].copy(), sp.v0[k0:k1].copy(), sp.a0[k0:k1].copy()
+    if st is not None:
+        nt0[0] = 0.0
+        p0[0], v0[0], a0[0] = st.p, st.v, st.a
+    dt = np.diff(np.append(nt0, t_end - u))
+    start = sp.start if st is None else State(st.p, st.v, st.a)
+    end = sp.end if t_end >= dur else sp.state_at(t_end)
+    n = k1 - k0
+    labels = sp.labels[k0:k1] if len(sp.labels) == sp.n_segments else ()
+    return Profile(nt0, p0, v0, a0, sp.j[k0:k1].copy(), t_end - u, start, end,
+                   labels if len(labels) == n else (), dt)
 
 
 def _blend_pays(b: Any, accel: float, feed: float, v_corner: float = 0.0,
