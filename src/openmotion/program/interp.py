@@ -5,7 +5,9 @@ if/while/do/repeat/sub closed with the same label, every call names a defined
 subroutine), then run the program line by line through the modal state machine
 (modal.py), following sub/call/return, if/elseif/else, while, do-while, repeat, break and
 continue as LinuxCNC documents them. Subroutine nesting is limited (`max_call_depth`) and so
-is the number of executed lines (`max_blocks`), so a runaway loop is an error, not a hang.
+is the number of executed lines (`max_blocks`) and of one loop's iterations
+(`max_loop_iterations`); a loop whose iteration changes nothing is refused at its third
+test (loopguard.py), so a runaway loop is an error within a second, not a hang.
 
 The whole program is interpreted before anything is returned: the first problem raises
 GCodeError (line, column, word) and no command list exists, so nothing can move.
@@ -17,6 +19,7 @@ import os
 from dataclasses import dataclass, field
 
 from . import canon
+from .loopguard import LoopGuard
 from .modal import Modal
 from .options import GCodeOptions
 from .params import Parameters
@@ -141,6 +144,7 @@ class _Frame:
     label: str
     return_to: int
     repeats: dict[int, int] = field(default_factory=dict)
+    loops: dict[int, list] = field(default_factory=dict)  # loop head -> LoopGuard record
 
 
 class Interpreter:
@@ -169,6 +173,7 @@ class Interpreter:
         frames: list[_Frame] = [_Frame("", -1)]
         steps = 0
         limit = self.opt.max_blocks
+        guard = LoopGuard(modal, self.opt.max_loop_iterations)
         pc = 0
         test_branch = -1  # the ELSEIF whose condition is to be tested next
         n = len(blocks)
@@ -176,8 +181,13 @@ class Interpreter:
             b = blocks[pc]
             steps += 1
             if steps > limit:
-                raise b.error(f"more than {limit} lines executed (endless loop?)", 0,
-                              f"O{b.oword.label}" if b.oword else "")
+                loops = frames[-1].loops
+                where = ""
+                if loops:  # the innermost active loop
+                    h = blocks[next(reversed(loops))]
+                    where = f" in loop O{h.oword.label} at line {h.line}"  # type: ignore
+                raise b.error(f"more than {limit} lines executed{where} (max_blocks; "
+                              "endless loop?)", 0, f"O{b.oword.label}" if b.oword else "")
             if b.delete and skip_deleted:
                 pc += 1
                 continue
@@ -228,12 +238,24 @@ class Interpreter:
             elif kw == "ENDIF":
                 pc += 1
             elif kw == "WHILE" and pc in flow.do_end:
-                pc = flow.head[pc] + 1 if self._truth(b) else pc + 1
+                head = flow.head[pc]
+                if self._truth(b):
+                    guard.iterate(frames[-1].loops, frames[-1].repeats, head, blocks[head])
+                    pc = head + 1
+                else:
+                    guard.leave(frames[-1].loops, head)
+                    pc += 1
             elif kw == "WHILE":
-                pc = pc + 1 if self._truth(b) else flow.end[pc] + 1
+                if self._truth(b):
+                    guard.iterate(frames[-1].loops, frames[-1].repeats, pc, b)
+                    pc += 1
+                else:
+                    guard.leave(frames[-1].loops, pc)
+                    pc = flow.end[pc] + 1
             elif kw == "ENDWHILE":
                 pc = flow.head[pc]
             elif kw == "DO":
+                guard.leave(frames[-1].loops, pc)  # a fresh entry into the loop
                 pc += 1
             elif kw == "REPEAT":
                 reps = frames[-1].repeats
@@ -242,9 +264,11 @@ class Interpreter:
                     reps[pc] = int(count) if count > 0 else 0
                 if reps[pc] > 0:
                     reps[pc] -= 1
+                    guard.iterate(frames[-1].loops, reps, pc, b)
                     pc += 1
                 else:
                     del reps[pc]
+                    guard.leave(frames[-1].loops, pc)
                     pc = flow.end[pc] + 1
             elif kw == "ENDREPEAT":
                 pc = flow.head[pc]
@@ -252,6 +276,7 @@ class Interpreter:
                 end = flow.end[pc]
                 head = flow.head[end]
                 frames[-1].repeats.pop(head, None)
+                guard.leave(frames[-1].loops, head)
                 pc = end + 1
             elif kw == "CONTINUE":
                 head = flow.head[pc]

@@ -36,6 +36,9 @@ class Parameters:
         self._saved: list[list[float]] = []
         #: Reads #5420-#5428 (current position X..W in program coordinates) when set.
         self.position_hook: Callable[[int], float] | None = None
+        #: Counts writes that changed a value (loop detection). A call and its return are
+        #: not counted: the return restores #1-#30 and drops the callee's locals.
+        self.version = 0
 
     # -- reads (the expr.Store protocol) -------------------------------------------------
     def get_number(self, index: float, pos: int) -> float:
@@ -60,10 +63,15 @@ class Parameters:
 
     # -- writes ----------------------------------------------------------------------
     def set_number(self, index: int, value: float) -> None:
+        if self.numbers[index] != value:
+            self.version += 1
         self.numbers[index] = value
 
     def set_named(self, name: str, value: float) -> None:
-        (self.globals if name.startswith("_") else self.locals[-1])[name] = value
+        table = self.globals if name.startswith("_") else self.locals[-1]
+        if table.get(name) != value:
+            self.version += 1
+        table[name] = value
 
     # -- call scopes -----------------------------------------------------------------
     def push_call(self, args: list[float]) -> None:
