@@ -152,9 +152,10 @@ def _flat_items(value: object) -> list[object] | None:
     return None
 
 
-def as_array(name: str, value: object, kind: str = "pulses", *, zero: bool = True,
+def as_array(name: str, value: object, kind: str | None = "pulses", *, zero: bool = True,
              signed: bool = True) -> NDArray[np.float64]:
-    """`value` (a sequence or array of real numbers) as a float64 array within `kind`.
+    """`value` (a sequence or array of real numbers) as a float64 array within `kind`
+    (None: any finite values).
 
     Refuses bools, strings, Decimals and None as elements (numpy would convert them),
     integers beyond the float range (numpy raises OverflowError) and non-finite values,
@@ -182,5 +183,6 @@ def as_array(name: str, value: object, kind: str = "pulses", *, zero: bool = Tru
         raise MotionError(f"{name} must be a sequence of real numbers of one shape") from None
     if not np.isfinite(x).all():
         raise MotionError(f"{name} must be finite everywhere, got {show(value)}")
-    check_quantity_array(name, x, kind, zero=zero, signed=signed)
+    if kind is not None:
+        check_quantity_array(name, x, kind, zero=zero, signed=signed)
     return x

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import COUNTER28_MAX, MotionError
-from ..limits import check_quantity_array
+from ..limits import as_array
 from .jerk import NEWTON_STEPS
 
 Array = NDArray[np.float64]
@@ -21,15 +21,7 @@ CHUNK = 16384  # moves per vectorized pass
 
 
 def _arr(name: str, value: ArrayLike, *, kind: str = "") -> Array:
-    try:
-        x = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise MotionError(f"{name} must be a real number or an array of them") from None
-    if not np.isfinite(x).all():
-        raise MotionError(f"{name} must be finite everywhere")
-    if kind:
-        check_quantity_array(name, x, kind)
-    return x
+    return as_array(name, value, kind or None, zero=not kind, signed=not kind)
 
 
 def _ramp_distance(v: Array, x: Array, j: Array) -> Array:
@@ -111,6 +103,14 @@ def _phases(distance: ArrayLike, v_max: ArrayLike, a_max: ArrayLike, j_max: Arra
     try:
         length, v, a, d, j = np.broadcast_arrays(np.abs(dist), v, a, d, j)
     except ValueError:
+        shape = dist.shape
+        for name, x in (("v_max", v), ("a_max", a), ("d_max", d), ("j_max", j)):
+            try:
+                shape = np.broadcast_shapes(shape, x.shape)
+            except ValueError:
+                raise MotionError(f"{name} has shape {x.shape}, which does not broadcast "
+                                  f"with distance and the limits before it "
+                                  f"{shape}") from None
         raise MotionError("distance and limits must have broadcastable shapes") from None
     shape = length.shape
     length, v, a, d, j = (x.reshape(-1) for x in (length, v, a, d, j))

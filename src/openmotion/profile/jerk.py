@@ -212,7 +212,8 @@ def _per_axis(name: str, value: float | Sequence[float] | None, n: int) -> list:
     except TypeError:
         raise MotionError(f"{name} must be a number or a sequence of {n} numbers") from None
     if len(vals) != n:
-        raise MotionError(f"{name} must have one value per axis ({n}), got {len(vals)}")
+        raise MotionError(f"{name} must have one value per axis ({n} distances), "
+                          f"got {len(vals)}")
     return vals
 
 

@@ -175,6 +175,10 @@ def velocity_move(spec: MoveSpec, direction: float, *, start: float = 0.0) -> Pr
 
 def stop_distance(spec: MoveSpec, v: float, a: float = 0.0) -> float:
     """Distance (>= 0, along v) a `decel_stop` from (v, a) covers."""
+    if not isinstance(spec, MoveSpec):
+        raise MotionError(f"spec must be a MoveSpec, got {type(spec).__name__}")
+    v = check_quantity("v", v, "pps", zero=True, signed=True)
+    a = check_quantity("a", a, "pps2", zero=True, signed=True)
     b = ProfileBuilder(0.0, v, a)
     append_stop(b, spec)
     return abs(b.state.p)
