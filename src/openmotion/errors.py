@@ -99,3 +99,24 @@ def check_distance(name: str, value: float, limit: float = COUNTER28_MAX) -> flo
             f"{name} must satisfy |{name}| <= {limit} (28-bit counter), got {show(value)}"
         )
     return x
+
+
+#: Keyword arguments that are on/off flags wherever a public call takes them.
+FLAG_ARGS = frozenset({"units", "relative", "absolute", "replace_running", "on", "quantize",
+                       "repeat", "monotonic", "escape_only", "enabled"})
+
+
+def check_flag(name: str, value: object) -> bool:
+    """True or False (numpy's bool too); 1, "yes" or None are typing slips, refused."""
+    if isinstance(value, bool):
+        return value
+    if type(value).__name__ == "bool" and type(value).__module__ == "numpy":
+        return bool(value)
+    raise MotionError(f"{name} must be True or False, got {show(value)}")
+
+
+def check_flags(kwargs: dict[str, object]) -> None:
+    """check_flag for every keyword argument named in FLAG_ARGS (the public call wrappers)."""
+    if kwargs:
+        for k in FLAG_ARGS.intersection(kwargs):
+            check_flag(k, kwargs[k])

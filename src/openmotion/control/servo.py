@@ -26,7 +26,13 @@ import math
 from dataclasses import dataclass
 from typing import Protocol
 
-from openmotion.errors import MotionError, check_finite, check_nonnegative, check_positive
+from openmotion.errors import (
+    MotionError,
+    check_finite,
+    check_flag,
+    check_nonnegative,
+    check_positive,
+)
 
 
 class Compensator(Protocol):
@@ -63,7 +69,7 @@ class LeadFilter:
         if limit is not None:
             limit = check_positive("limit", limit)
         self._limit = limit
-        self._quantize = bool(quantize)
+        self._quantize = check_flag("quantize", quantize)
         self._x1 = 0.0
         self._mc1 = 0.0
 
