@@ -88,6 +88,9 @@ class Entry:
     aliases: dict[str, tuple[str, ...]] = field(default_factory=dict)
     #: arguments that are not fuzzed (objects the entry needs)
     fixed: tuple[str, ...] = ()
+    #: builds the objects the call works on before the snapshot (a lazily built object
+    #: would otherwise count as a state change)
+    prepare: Callable[[World], Any] | None = None
 
 
 @dataclass
@@ -152,6 +155,8 @@ def run_entries(entries: list[Entry], n: int, *, world: World | None = None,
         where = f"{entry.name}({param}={_short(value)})"
         stats.inputs += 1
         try:
+            if entry.prepare is not None:
+                entry.prepare(w)
             before = w.snap()
         except Exception as e:  # noqa: BLE001
             stats.unexpected.append(f"snapshot before {where}: {type(e).__name__}: {e}")

@@ -157,8 +157,10 @@ COMPARE = [
                kind="dpos", name="w")),
     Entry("every_distance", lambda w, **kw: engine(w).add(every_distance(**kw)),
           dict(source=VectorSource((0, 1)), interval=100.0, action=Toggle(2), start=None,
-               end=1000.0)),
-    Entry("CompareEngine.output", lambda w, **kw: engine(w).output(**kw), dict(number=1)),
+               end=1000.0),
+          aliases={k: (k, "table too long") for k in ("start", "end", "interval")}),
+    Entry("CompareEngine.output", lambda w, **kw: engine(w).output(**kw), dict(number=1),
+          aliases={"number": ("output",)}),
     Entry("CompareEngine.remove", lambda w, **kw: engine(w).remove(**kw), dict(job_id=0),
           aliases={"job_id": ("job",)}),
     Entry("CompareEngine.set_vector_moved", lambda w, **kw: engine(w).set_vector_moved(**kw),
@@ -187,9 +189,11 @@ COMP_SERVO = [
     Entry("Compensation.suppress_vibration",
           lambda w, **kw: comp(w).suppress_vibration(**kw), dict(t1=0.01, t2=0.02)),
     Entry("Compensation.set_pitch_table", lambda w, **kw: comp(w).set_pitch_table(**kw),
-          dict(interval=1000, home_index=0, forward=[0, 1, 2], backward=None, stroke=None)),
+          dict(interval=1000, home_index=0, forward=[0, 1, 2], backward=None, stroke=None),
+          aliases={"interval": ("interval", "table covers")}),
     Entry("PitchCompTable.make", lambda w, **kw: PitchCompTable.make(**kw),
-          dict(interval=1000, home_index=1, forward=[0, 1, 2], backward=[0, 1, 1])),
+          dict(interval=1000, home_index=1, forward=[0, 1, 2], backward=[0, 1, 1]),
+          aliases={"interval": ("interval", "home point")}),
     Entry("LeadFilter", lambda w, **kw: LeadFilter(**kw),
           dict(a=229, b=64, k=64, limit=None, quantize=False)),
     Entry("LeadFilter.step", lambda w, **kw: LeadFilter().step(**kw),
@@ -212,7 +216,16 @@ COMP_SERVO = [
 ]
 
 
+_PREP = {"Group.": group, "CompareEngine.": engine, "LevelJob": engine, "WindowJob": engine,
+         "every_distance": engine, "ZPso.": pso, "Compensation.": comp,
+         "InPositionControl.": inpos, "Latch.": latch}
+
+
 def _run(entries, fuzz_long, normal):
+    for e in entries:
+        for prefix, prep in _PREP.items():
+            if e.name.startswith(prefix):
+                e.prepare = prep
     stats = run_entries(entries, examples(fuzz_long, normal))
     print(stats.report())
     assert stats.clean, stats.report()

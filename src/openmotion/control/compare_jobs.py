@@ -284,6 +284,8 @@ class WindowJob(CompareJob):
                 or not all(isinstance(a, int) and not isinstance(a, bool) and a >= 0
                            for a in axes):
             raise MotionError(f"axes must be a sequence of axis indices, got {show(axes)}")
+        if not axes:
+            raise MotionError("axes must name at least one axis")
         self.axes = tuple(axes)
         pts = as_array("points", points)
         if pts.ndim != 2 or pts.shape[1] != len(self.axes) or pts.shape[0] == 0:

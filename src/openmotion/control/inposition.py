@@ -98,7 +98,7 @@ class InPositionControl:
     def _select(self, axes: Sequence[int | str] | None) -> tuple[Axis, ...]:
         if axes is None:
             return self._ctl.axes
-        if isinstance(axes, (str, int)):
+        if isinstance(axes, (str, int)) or not hasattr(axes, "__iter__"):
             raise MotionError(f"axes must be a sequence of names or indices, got {axes!r}")
         return tuple(self._ctl.axis(k) for k in axes)  # validates every key first
 

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import MotionError, check_finite, check_positive
+from ..errors import MotionError, check_finite, check_positive, show
 from .compare import (
     AxisSource,
     CompareEngine,
@@ -41,8 +41,9 @@ MODES = (1, 2, 3, 4, 5, 6, 7, 25, 26, 35, 36)
 
 
 def _int(name: str, value: object, lo: int, hi: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | float) or value != int(value):
-        raise MotionError(f"{name} must be an integer, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, int | float) \
+            or (isinstance(value, float) and not math.isfinite(value)) or value != int(value):
+        raise MotionError(f"{name} must be an integer, got {show(value)}")
     v = int(value)
     if v < lo or (hi is not None and v > hi):
         rng = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
