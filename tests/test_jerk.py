@@ -289,17 +289,24 @@ def test_sync_invalid_arguments():
 
 
 def test_tiny_distances_and_extreme_magnitudes_never_fail():
+    """Every value within the documented ranges (docs/ranges.md) plans a finite move."""
+    from openmotion import limits
     from openmotion.profile.batch import jerk_limited_durations
 
     for dist in (5e-324, 1e-310, 1e-100):
-        prof = jerk_limited(dist, 1e4, 1e-9, 1e-3)
+        prof = jerk_limited(dist, 1e4, 1e-3, 1e-3)
         assert math.isfinite(prof.duration) and prof.duration > 0
         assert prof.end.p == dist
         # the pure jerk triangle: L = 2*J*tj**3, T = 4*tj
         assert prof.duration == pytest.approx(4 * (dist / 2e-3) ** (1 / 3), rel=1e-12)
     rng = np.random.default_rng(5)
-    e = 10 ** rng.uniform(-100, 100, (500, 5))
-    e[:, 0] = np.minimum(e[:, 0], 2**27 - 1)
+    lo = np.log10([1e-100, limits.PPS_MIN, limits.PPS2_MIN, limits.PPS3_MIN, limits.PPS2_MIN])
+    hi = np.log10([2**27 - 1, limits.PPS_MAX, limits.PPS2_MAX, limits.PPS3_MAX,
+                   limits.PPS2_MAX])
+    e = 10 ** rng.uniform(lo, hi, (500, 5))
+    e = np.concatenate([e, np.array([[2**27 - 1, 1e-3, 1e-3, 1e-3, 1e-3],
+                                     [1e-100, 1e9, 1e13, 1e18, 1e13],
+                                     [2**27 - 1, 1e9, 1e-3, 1e18, 1e13]])])
     batch = jerk_limited_durations(*e.T)
     for row, tb in zip(e, batch, strict=True):
         t = jerk_limited_duration(*row[:4], d_max=row[4])
@@ -321,3 +328,20 @@ def test_direct_build_equals_profile_builder_bit_for_bit(d, v, a, j, dd, start):
         assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes(), f
     assert (p1.duration, p1.start, p1.end, p1.labels) == (p2.duration, p2.start, p2.end,
                                                           p2.labels)
+
+
+@pytest.mark.parametrize("args, name", [
+    ((1000, 1000, 1e5, 5e-324), "j_max"), ((1000, 1000, 5e-324, 1e5), "a_max"),
+    ((1000, 1e-300, 1e5, 1e6), "v_max"), ((1000, 1e10, 1e5, 1e6), "v_max"),
+    ((1000, 1000, 1e14, 1e6), "a_max"), ((1000, 1000, 1e5, 1e19), "j_max"),
+])
+def test_values_outside_the_ranges_are_refused_by_name(args, name):
+    """#12 defect 10: jerk_limited(1000, 1000, 1e5, 5e-324) raised ZeroDivisionError."""
+    from openmotion.profile.batch import jerk_limited_durations
+
+    for call in (lambda: jerk_limited(*args), lambda: jerk_limited_duration(*args),
+                 lambda: jerk_limited_sync([args[0], 1.0], *args[1:]),
+                 lambda: jerk_limited_durations(*args)):
+        with pytest.raises(MotionError, match=name) as info:
+            call()
+        assert "pps" in str(info.value)

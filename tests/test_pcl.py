@@ -171,9 +171,11 @@ def test_hctl1100_triangle_trapezoid_rule(dist):
 
 
 # ------------------------------------------------------------------ properties
-speeds = st.tuples(st.floats(0, 5e4), st.floats(1, 1e6)).map(lambda t: (t[0], t[0] + t[1]))
+# speeds are 0 or >= limits.PPS_MIN (docs/ranges.md)
+speeds = st.tuples(st.one_of(st.just(0.0), st.floats(1e-3, 5e4)),
+                   st.floats(1, 1e6)).map(lambda t: (t[0], t[0] + t[1]))
 times = st.floats(1e-3, 5.0)
-fracs = st.floats(0.0, 1.0)
+fracs = st.one_of(st.just(0.0), st.floats(1e-5, 1.0))
 # pulses: sub-micro-pulse moves are not meaningful (a 5e-324 move has no representable time)
 dists = st.one_of(st.just(0.0), st.floats(1e-6, 1e7), st.floats(-1e7, -1e-6))
 

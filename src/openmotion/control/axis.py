@@ -17,7 +17,14 @@ from collections.abc import Callable
 from functools import wraps
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative, check_positive
+from ..errors import (
+    InfeasibleError,
+    MotionError,
+    check_finite,
+    check_flags,
+    check_nonnegative,
+    check_positive,
+)
 from ..hw.interface import AxisCommand
 from ..profile.onthefly import final_decel_start
 from ..profile.pcl import MoveSpec
@@ -43,6 +50,7 @@ def _locked(fn: F) -> F:
 
     @wraps(fn)
     def wrapper(self: Axis, *args: Any, **kwargs: Any) -> Any:
+        check_flags(kwargs)
         with self._ctl._lock:
             return fn(self, *args, **kwargs)
 

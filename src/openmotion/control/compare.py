@@ -124,8 +124,11 @@ class CompareEngine:
         self.buffer_size = buffer_size
         n_do = controller.config.digital_outputs
         caps = range(n_do) if outputs is None else outputs
+        if isinstance(caps, (str, bytes)) or not hasattr(caps, "__iter__"):
+            raise MotionError(f"outputs must be a sequence of output numbers, "
+                              f"got {outputs!r}")
         for o in caps:
-            if not isinstance(o, int) or not 0 <= o < n_do:
+            if not isinstance(o, int) or isinstance(o, bool) or not 0 <= o < n_do:
                 raise MotionError(f"outputs must be output numbers in [0, {n_do - 1}], "
                                   f"got {o!r}")
         self.capable = frozenset(caps)
@@ -168,7 +171,7 @@ class CompareEngine:
 
     def output(self, number: int) -> OutputLine:
         """The exact waveform of output `do<number>` (created at its current level)."""
-        line = self._lines.get(number)
+        line = self._lines.get(number) if isinstance(number, int) else None
         if line is None:
             self.check_output(number)
             line = OutputLine(number, False)
@@ -259,6 +262,8 @@ class CompareEngine:
 
     def set_vector_moved(self, source: VectorSource, value: float = 0.0) -> None:
         """VECTOR_MOVED = value (clear it before a job, as the seed says)."""
+        if not isinstance(source, VectorSource):
+            raise MotionError(f"source must be a VectorSource, got {type(source).__name__}")
         self._vectors[source] = check_finite("value", value)
 
     # ------------------------------------------------------------------ speed-following PWM

@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import MotionError, check_finite, check_positive
+from ..errors import MotionError, check_finite, check_positive, show
+from ..limits import as_array
 from .compare_math import crossings_after, first_crossing, first_inside
 
 if TYPE_CHECKING:
@@ -179,11 +180,9 @@ class LevelJob(CompareJob):
         if isinstance(levels, LevelSeq):
             self.levels: Array | LevelSeq = levels
         else:
-            arr = np.asarray(levels, dtype=np.float64).reshape(-1)
+            arr = as_array("levels", levels).reshape(-1)
             if arr.size == 0:
                 raise MotionError("levels must not be empty")
-            if not np.all(np.isfinite(arr)):
-                raise MotionError("levels must all be finite")
             if monotonic and arr.size > 1:
                 d = np.diff(arr)
                 want = direction if direction else (1 if isinstance(source, VectorSource) else 0)
@@ -281,13 +280,17 @@ class WindowJob(CompareJob):
     def __init__(self, axes: Sequence[int], points: ArrayLike, maxerr: float, action: Action,
                  *, kind: str = "dpos", name: str = "") -> None:
         super().__init__(action, name)
+        if isinstance(axes, (str, bytes)) or not isinstance(axes, Sequence) \
+                or not all(isinstance(a, int) and not isinstance(a, bool) and a >= 0
+                           for a in axes):
+            raise MotionError(f"axes must be a sequence of axis indices, got {show(axes)}")
+        if not axes:
+            raise MotionError("axes must name at least one axis")
         self.axes = tuple(axes)
-        pts = np.asarray(points, dtype=np.float64)
+        pts = as_array("points", points)
         if pts.ndim != 2 or pts.shape[1] != len(self.axes) or pts.shape[0] == 0:
             raise MotionError(f"points must be a non-empty (n, {len(self.axes)}) table, "
                               f"got shape {pts.shape}")
-        if not np.all(np.isfinite(pts)):
-            raise MotionError("points must all be finite")
         self.maxerr = check_positive("maxerr", maxerr)
         if kind not in SOURCE_KINDS:
             raise MotionError(f"kind must be one of {SOURCE_KINDS}, got {kind!r}")

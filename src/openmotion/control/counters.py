@@ -26,6 +26,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..errors import MotionError, check_finite
+from ..limits import check_quantity
 
 COUNTER_BITS = 28
 _HALF = 1 << (COUNTER_BITS - 1)
@@ -117,9 +118,7 @@ class Counters:
     def set_move_ratio(self, ratio: float) -> None:
         """Set the feedback-to-command ratio, keeping the error counter's reading."""
         self._fresh()
-        r = check_finite("move_ratio", ratio)
-        if r <= 0.0:
-            raise MotionError(f"move_ratio must be > 0, got {ratio!r}")
+        r = check_quantity("move_ratio", ratio, "ratio")
         before = self.error
         self._ratio = r
         self._err_off += before - self.error

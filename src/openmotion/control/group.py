@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
-from ..errors import InfeasibleError, MotionError, check_finite
+from ..errors import InfeasibleError, MotionError, check_finite, check_flags
 from ..path import Arc, Arc3D, Line
 from ..profile.pcl import MoveSpec
 from ..units import AxisUnits
@@ -103,6 +103,7 @@ def _locked(fn: F) -> F:
 
     @wraps(fn)
     def wrapper(self: Group, *args: Any, **kwargs: Any) -> Any:
+        check_flags(kwargs)
         with self._ctl._lock:
             return fn(self, *args, **kwargs)
 

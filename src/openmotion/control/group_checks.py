@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import MotionError
+from ..errors import MotionError, show
+from ..limits import PULSES_MAX, as_array
 from ..path.extent import element_extent
 from ..path.geometry import PathElement
 from ..units import AxisUnits
@@ -88,27 +89,38 @@ class GroupChecks(GroupEngine):
 
     def _point(self, name: str, value: Sequence[float], base: np.ndarray | None) -> np.ndarray:
         try:
-            arr = np.array(value, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} numbers") from None
-        if arr.size != len(self.axes) or not np.all(np.isfinite(arr)):
+            arr = as_array(name, value).reshape(-1)
+        except MotionError as e:
+            raise GroupError(ERR_ARGUMENT, str(e)) from None
+        if arr.size != len(self.axes):
             raise GroupError(ERR_ARGUMENT, f"{name} must be {len(self.axes)} finite numbers, "
-                                           f"got {value!r}")
-        return arr + base if base is not None else arr
+                                           f"got {show(value)}")
+        out = arr + base if base is not None else arr
+        if np.any(np.abs(out) > PULSES_MAX):
+            raise GroupError(ERR_ARGUMENT, f"{name} must lie within |x| <= {PULSES_MAX:g} "
+                                           f"pulses, got {show(value)}")
+        return out
 
     def _point2(self, name: str, value: Sequence[float], base: np.ndarray | None,
                 plane: tuple[int, int]) -> np.ndarray:
         try:
-            arr = np.array(value, dtype=float).reshape(-1)
-            i, j = (int(k) for k in plane)
-            if not (0 <= i < len(self.axes) and 0 <= j < len(self.axes)):
-                raise IndexError
-        except (TypeError, ValueError, IndexError):
-            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 numbers and plane two axis "
-                                           f"indices, got {value!r}, {plane!r}") from None
-        if arr.size != 2 or not np.all(np.isfinite(arr)):
-            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 finite numbers, got {value!r}")
-        return arr + base[[i, j]] if base is not None else arr
+            arr = as_array(name, value).reshape(-1)
+        except MotionError as e:
+            raise GroupError(ERR_ARGUMENT, str(e)) from None
+        if not isinstance(plane, (tuple, list)) or len(plane) != 2 \
+                or not all(isinstance(k, int) and not isinstance(k, bool) for k in plane) \
+                or not all(0 <= k < len(self.axes) for k in plane) or plane[0] == plane[1]:
+            raise GroupError(ERR_ARGUMENT, f"plane must be two different axis indices in "
+                                           f"[0, {len(self.axes)}), got {show(plane)}")
+        i, j = plane
+        if arr.size != 2:
+            raise GroupError(ERR_ARGUMENT, f"{name} must be 2 finite numbers, "
+                                           f"got {show(value)}")
+        out = arr + base[[i, j]] if base is not None else arr
+        if np.any(np.abs(out) > PULSES_MAX):
+            raise GroupError(ERR_ARGUMENT, f"{name} must lie within |x| <= {PULSES_MAX:g} "
+                                           f"pulses, got {show(value)}")
+        return out
 
     def _check_soft_limits(self, el: PathElement) -> None:
         """Refuse (ERR_LIMIT) a path element that would take an axis past an enabled soft

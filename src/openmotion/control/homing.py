@@ -126,7 +126,27 @@ class Homing:
                     f"more than max_overrun {c.max_overrun:g}: lower max_vel or tacc")
         if self.running:
             raise MotionError(f"axis {ax.name}: homing already running")
+        saved = (self.status, self._t_begin, self._plan, self._k, self._recovered,
+                 self._suspended, self._stage)
         ax.begin_homing()
+        try:
+            self._start_sequence()
+        except BaseException:
+            # atomic: whatever failed, nothing stays attached and the axis is as it was
+            self.ctl.remove_edge_hook(self._on_edge)
+            self.ctl.remove_cycle_hook(self._on_cycle)
+            if self.safety is not None:
+                for sig in self._suspended:
+                    self.safety.resume(ax.index, sig)
+            (self.status, self._t_begin, self._plan, self._k, self._recovered,
+             self._suspended, self._stage) = saved
+            ax.end_homing()
+            raise
+
+    def _start_sequence(self) -> None:
+        """The part of start() after the axis entered Homing (undone if it raises)."""
+        c = self.config
+        ax = self.axis
         if self.safety is not None:
             el = self._el_name(1)
             uses_el = uses(self._table, "el") or c.auto_search

@@ -25,7 +25,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..errors import MotionError, check_finite, check_int, check_nonnegative, check_positive
+from ..errors import MotionError, check_int, show
+from ..limits import check_pulses, check_quantity
 
 #: ez_count n waits for n + EZ_COUNT_BASE index edges ([low]: PCL6045B counts 1..16 with
 #: a 0..15 register; seed-facts 1.1).
@@ -176,34 +177,43 @@ class HomeConfig:
                 m not in tuple(f"mccl_{k}" for k in MCCL_TYPES):
             raise MotionError(f"mode must be 0..12 or mccl_normal/mccl_home_only/"
                               f"mccl_index_only, got {m!r}")
-        if self.direction not in (1, -1) or isinstance(self.direction, bool):
-            raise MotionError(f"direction must be +1 or -1, got {self.direction!r}")
-        sv = check_nonnegative("str_vel", self.str_vel)
-        mv = check_positive("max_vel", self.max_vel)
+        if not isinstance(self.direction, int) or isinstance(self.direction, bool) \
+                or self.direction not in (1, -1):
+            raise MotionError(f"direction must be +1 or -1, got {show(self.direction)}")
+        # every number is checked and stored as a float, so a str or Decimal that would
+        # break Homing.start() (TypeError, axis left in Homing) is refused here
+        vals: dict[str, float | None] = {
+            "str_vel": check_quantity("str_vel", self.str_vel, "pps"),
+            "max_vel": check_quantity("max_vel", self.max_vel, "pps"),
+            "tacc": check_quantity("tacc", self.tacc, "seconds"),
+            "tdec": None if self.tdec is None else check_quantity("tdec", self.tdec, "seconds"),
+            "jerk": None if self.jerk is None else check_quantity("jerk", self.jerk, "pps3"),
+            "org_offset": check_quantity("org_offset", self.org_offset, "pulses", zero=True),
+            "home_offset": check_pulses("home_offset", self.home_offset),
+            "search_range": check_quantity("search_range", self.search_range, "pulses"),
+            "max_overrun": None if self.max_overrun is None else
+            check_quantity("max_overrun", self.max_overrun, "pulses"),
+            "settle_s": check_quantity("settle_s", self.settle_s, "seconds", zero=True),
+            "timeout_s": check_quantity("timeout_s", self.timeout_s, "seconds"),
+        }
+        sv, mv = vals["str_vel"], vals["max_vel"]
+        assert sv is not None and mv is not None
         if sv > mv:
             raise MotionError(f"str_vel must be <= max_vel ({mv!r}), got {sv!r}")
-        if sv == 0.0:
-            raise MotionError("str_vel must be > 0 (the slow search speed)")
-        check_positive("tacc", self.tacc)
-        if self.tdec is not None:
-            check_positive("tdec", self.tdec)
-        if self.jerk is not None:
-            check_positive("jerk", self.jerk)
-        e = self.ez_count
-        check_int("ez_count", e, 0, EZ_COUNT_MAX)
-        check_nonnegative("org_offset", self.org_offset)
-        if check_finite("home_offset", self.home_offset) != round(self.home_offset):
+        check_int("ez_count", self.ez_count, 0, EZ_COUNT_MAX)
+        if vals["home_offset"] != round(vals["home_offset"] or 0.0):
             raise MotionError(f"home_offset must be a whole number of pulses, got "
                               f"{self.home_offset!r}")
-        if self.final not in FINALS:
-            raise MotionError(f"final must be one of {FINALS}, got {self.final!r}")
-        if self.el_stop not in EL_STOPS:
-            raise MotionError(f"el_stop must be one of {EL_STOPS}, got {self.el_stop!r}")
-        check_positive("search_range", self.search_range)
-        if self.max_overrun is not None:
-            check_positive("max_overrun", self.max_overrun)
-        check_nonnegative("settle_s", self.settle_s)
-        check_positive("timeout_s", self.timeout_s)
+        if not isinstance(self.final, str) or self.final not in FINALS:
+            raise MotionError(f"final must be one of {FINALS}, got {show(self.final)}")
+        if not isinstance(self.el_stop, str) or self.el_stop not in EL_STOPS:
+            raise MotionError(f"el_stop must be one of {EL_STOPS}, got {show(self.el_stop)}")
+        for name in ("auto_search", "phase1_same_direction"):
+            if not isinstance(getattr(self, name), bool):
+                raise MotionError(f"{name} must be True or False, got "
+                                  f"{show(getattr(self, name))}")
+        for name, x in vals.items():
+            object.__setattr__(self, name, x)
 
     @property
     def mccl(self) -> bool:

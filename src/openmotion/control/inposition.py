@@ -19,7 +19,7 @@ from collections import deque
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
-from ..errors import MotionError, check_nonnegative, check_positive
+from ..errors import MotionError, check_flag, check_nonnegative, check_positive
 from .states import MotionDone
 
 if TYPE_CHECKING:
@@ -57,7 +57,7 @@ class InPositionControl:
         units with units=True)."""
         ax = self._ctl.axis(axis)
         tol = check_nonnegative("tolerance", tolerance)
-        if units:
+        if check_flag("units", units):
             tol = abs(float(ax.units.to_pulses(tol)))
         with self._ctl.lock:
             self._tol[ax.index] = tol
@@ -98,7 +98,7 @@ class InPositionControl:
     def _select(self, axes: Sequence[int | str] | None) -> tuple[Axis, ...]:
         if axes is None:
             return self._ctl.axes
-        if isinstance(axes, (str, int)):
+        if isinstance(axes, (str, int)) or not hasattr(axes, "__iter__"):
             raise MotionError(f"axes must be a sequence of names or indices, got {axes!r}")
         return tuple(self._ctl.axis(k) for k in axes)  # validates every key first
 

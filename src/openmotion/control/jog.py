@@ -16,7 +16,8 @@ from __future__ import annotations
 import weakref
 from typing import TYPE_CHECKING
 
-from ..errors import MotionError, check_finite, check_positive
+from ..errors import COUNTER28_MAX, MotionError, check_finite, check_positive
+from ..limits import PPS_MIN
 from .states import AxisState
 
 if TYPE_CHECKING:
@@ -41,9 +42,11 @@ def _axis(ctl: Controller, key: int | str) -> Axis:
 
 def _ratio_speed(ax: Axis, ratio: float) -> float:
     r = check_finite("ratio", ratio)
-    if not 0.0 < r <= 100.0:
-        raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
-    return ax.config.max_speed_pps * r / 100.0  # the config caps it at the pulse rate
+    v = ax.config.max_speed_pps * r / 100.0  # the config caps it at the pulse rate
+    if not 0.0 < r <= 100.0 or v < PPS_MIN:
+        raise MotionError(f"ratio must be in (0, 100] percent and give at least {PPS_MIN:g} "
+                          f"pps, got {ratio!r}")
+    return v
 
 
 def jog_pulse(ctl: Controller, axis: int | str, pulses: int, *, speed: float | None = None,
@@ -81,6 +84,9 @@ def jog_conti(ctl: Controller, axis: int | str, direction: int, ratio: float, *,
     sign = 1.0 if direction == 0 else -1.0
     if border is not None:
         b = float(ax.units.to_pulses(check_finite("border", border)))
+        if abs(b) > COUNTER28_MAX:
+            raise MotionError(f"border must lie within the 28-bit position counter "
+                              f"(|border| <= {COUNTER28_MAX} pulses), got {border!r}")
         if (b - ax.position) * sign <= 0.0:
             raise MotionError(f"border must lie ahead of the axis in the jog direction, "
                               f"got {border!r}")

@@ -23,7 +23,7 @@ from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..errors import MotionError, check_finite, check_int
+from ..errors import MotionError, check_finite, check_int, show
 from ..hw.interface import AXIS_INPUTS, InputEdge
 from .pulserule import half_pulse, pulse_count
 
@@ -131,10 +131,12 @@ class TouchProbe:
                 raise MotionError(f"trigger signal must be one of {AXIS_INPUTS}, "
                                   f"got {trigger[1]!r}")
             self._src = (ctl.axis(trigger[0]).index, trigger[1])
-        if edge not in EDGES:
-            raise MotionError(f"edge must be one of {EDGES}, got {edge!r}")
-        if mode not in ("single", "continuous"):
-            raise MotionError(f"mode must be 'single' or 'continuous', got {mode!r}")
+        if not isinstance(edge, str) or edge not in EDGES:
+            raise MotionError(f"edge must be one of {EDGES}, got {show(edge)}")
+        if not isinstance(mode, str) or mode not in ("single", "continuous"):
+            raise MotionError(f"mode must be 'single' or 'continuous', got {show(mode)}")
+        if window is not None and (not isinstance(window, (tuple, list)) or len(window) != 2):
+            raise MotionError(f"window must be (first, last) or None, got {show(window)}")
         if window is not None:
             lo = check_finite("window[0]", window[0])
             hi = check_finite("window[1]", window[1])

@@ -34,7 +34,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import MotionError, check_finite, check_positive
+from ..errors import MotionError, check_finite, check_positive, show
 from .compare import (
     AxisSource,
     CompareEngine,
@@ -67,8 +67,8 @@ def base_axes(base: Sequence[int], count: int | None, n_axes: int) -> tuple[int,
 
 def _int(name: str, value: object, lo: int, hi: int | None = None) -> int:
     if isinstance(value, bool) or not isinstance(value, int | float) \
-            or not math.isfinite(value) or value != int(value):
-        raise MotionError(f"{name} must be an integer, got {value!r}")
+            or (isinstance(value, float) and not math.isfinite(value)) or value != int(value):
+        raise MotionError(f"{name} must be an integer, got {show(value)}")
     v = int(value)
     if v < lo or (hi is not None and v > hi):
         rng = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"

@@ -26,7 +26,27 @@ import math
 from dataclasses import dataclass
 from typing import Protocol
 
-from openmotion.errors import MotionError, check_finite, check_nonnegative, check_positive
+from openmotion.errors import (
+    MotionError,
+    check_finite,
+    check_flag,
+    check_nonnegative,
+    check_positive,
+    is_real,
+    show,
+)
+
+
+def _sample(name: str, x: float) -> float:
+    """A sample value: floats pass as they are (NaN is a fault the caller handles)."""
+    if type(x) is float:
+        return x
+    if is_real(x):
+        try:
+            return float(x)
+        except OverflowError:
+            raise MotionError(f"{name} must be finite, got {show(x)}") from None
+    raise MotionError(f"{name} must be a real number, got {show(x)}")
 
 
 class Compensator(Protocol):
@@ -63,7 +83,7 @@ class LeadFilter:
         if limit is not None:
             limit = check_positive("limit", limit)
         self._limit = limit
-        self._quantize = bool(quantize)
+        self._quantize = check_flag("quantize", quantize)
         self._x1 = 0.0
         self._mc1 = 0.0
 
@@ -93,7 +113,7 @@ class LeadFilter:
 
     def step(self, command: float, feedback: float) -> float:
         """One sample with error X_n = command - feedback; returns MC_n."""
-        return self.step_error(command - feedback)
+        return self.step_error(_sample("command", command) - _sample("feedback", feedback))
 
     def step_error(self, x: float) -> float:
         """One sample from the position error X_n directly."""
@@ -140,13 +160,16 @@ class PIDFF:
         self.dt = check_positive("dt", dt)
         for name, val in (("output_limit", output_limit), ("integral_limit", integral_limit)):
             try:
+                if not is_real(val):
+                    raise TypeError
                 v = float(val)
+            except OverflowError:
+                v = math.nan  # an int beyond the float range: refused below
             except (TypeError, ValueError):
-                raise MotionError(f"{name} must be a real number > 0, got {val!r}") from None
+                raise MotionError(f"{name} must be a real number > 0, got {show(val)}") from None
             if math.isnan(v) or v <= 0.0:
-                raise MotionError(f"{name} must be > 0 (inf allowed), got {val!r}")
-        self.output_limit = float(output_limit)
-        self.integral_limit = float(integral_limit)
+                raise MotionError(f"{name} must be > 0 (inf allowed), got {show(val)}")
+            setattr(self, name, v)
         self._i = 0.0
         self._c1 = self._v1 = self._f1 = 0.0
         self._primed = False
@@ -159,6 +182,7 @@ class PIDFF:
 
     def step(self, command: float, feedback: float) -> float:
         """One sample: returns the clamped output."""
+        command, feedback = _sample("command", command), _sample("feedback", feedback)
         dt = self.dt
         if not self._primed:  # no history yet: zero derivatives instead of a kick
             self._c1, self._f1, self._v1 = command, feedback, 0.0
@@ -209,7 +233,7 @@ class FollowingErrorMonitor:
 
     def check(self, command: float, feedback: float) -> FollowingErrorResult:
         """Compare one sample; returns the (latched) trip state, the error and its peak."""
-        e = command - feedback
+        e = _sample("command", command) - _sample("feedback", feedback)
         if e != e:  # NaN feedback or command is itself a fault
             self._tripped = True
             self.trip_error = e

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import COUNTER28_MAX, MotionError
+from ..limits import as_array
 from .jerk import NEWTON_STEPS
 
 Array = NDArray[np.float64]
@@ -19,16 +20,8 @@ Array = NDArray[np.float64]
 CHUNK = 16384  # moves per vectorized pass
 
 
-def _arr(name: str, value: ArrayLike, *, positive: bool) -> Array:
-    try:
-        x = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise MotionError(f"{name} must be a real number or an array of them") from None
-    if not np.isfinite(x).all():
-        raise MotionError(f"{name} must be finite everywhere")
-    if positive and not (x > 0.0).all():
-        raise MotionError(f"{name} must be > 0 everywhere")
-    return x
+def _arr(name: str, value: ArrayLike, *, kind: str = "") -> Array:
+    return as_array(name, value, kind or None, zero=not kind, signed=not kind)
 
 
 def _ramp_distance(v: Array, x: Array, j: Array) -> Array:
@@ -100,16 +93,24 @@ def _total(ph: Array) -> Array:
 def _phases(distance: ArrayLike, v_max: ArrayLike, a_max: ArrayLike, j_max: ArrayLike,
             d_max: ArrayLike | None, *, totals: bool = False) -> tuple[Array, tuple[int, ...]]:
     """(N, 7) phase times, or with `totals` only the (N,) durations (8 bytes per move)."""
-    dist = _arr("distance", distance, positive=False)
+    dist = _arr("distance", distance)
     if (np.abs(dist) > COUNTER28_MAX).any():
         raise MotionError(f"distance must satisfy |distance| <= {COUNTER28_MAX} everywhere")
-    v = _arr("v_max", v_max, positive=True)
-    a = _arr("a_max", a_max, positive=True)
-    j = _arr("j_max", j_max, positive=True)
-    d = a if d_max is None else _arr("d_max", d_max, positive=True)
+    v = _arr("v_max", v_max, kind="pps")
+    a = _arr("a_max", a_max, kind="pps2")
+    j = _arr("j_max", j_max, kind="pps3")
+    d = a if d_max is None else _arr("d_max", d_max, kind="pps2")
     try:
         length, v, a, d, j = np.broadcast_arrays(np.abs(dist), v, a, d, j)
     except ValueError:
+        shape = dist.shape
+        for name, x in (("v_max", v), ("a_max", a), ("d_max", d), ("j_max", j)):
+            try:
+                shape = np.broadcast_shapes(shape, x.shape)
+            except ValueError:
+                raise MotionError(f"{name} has shape {x.shape}, which does not broadcast "
+                                  f"with distance and the limits before it "
+                                  f"{shape}") from None
         raise MotionError("distance and limits must have broadcastable shapes") from None
     shape = length.shape
     length, v, a, d, j = (x.reshape(-1) for x in (length, v, a, d, j))

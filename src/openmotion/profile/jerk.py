@@ -31,7 +31,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import MotionError, check_distance, check_finite, check_positive
+from ..errors import MotionError, check_distance
+from ..limits import check_pulses, check_quantity
 from .segments import Profile, ProfileBuilder, State
 
 NEWTON_STEPS = 10  # from within a factor sqrt(3) of the root, 7 reach full double precision
@@ -159,10 +160,10 @@ def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
 # ------------------------------------------------------------------ validation
 def _limits(v_max: float, a_max: float, j_max: float,
             d_max: float | None) -> tuple[float, float, float, float]:
-    v = check_positive("v_max", v_max)
-    a = check_positive("a_max", a_max)
-    j = check_positive("j_max", j_max)
-    d = a if d_max is None else check_positive("d_max", d_max)
+    v = check_quantity("v_max", v_max, "pps")
+    a = check_quantity("a_max", a_max, "pps2")
+    j = check_quantity("j_max", j_max, "pps3")
+    d = a if d_max is None else check_quantity("d_max", d_max, "pps2")
     return v, a, d, j
 
 
@@ -238,7 +239,7 @@ def jerk_limited(distance: float, v_max: float, a_max: float, j_max: float, *,
     backwards; zero gives an empty profile. The profile ends exactly on start + distance.
     """
     dist = check_distance("distance", distance)
-    st = check_finite("start", start)
+    st = check_pulses("start", start)
     v, a, d, j = _limits(v_max, a_max, j_max, d_max)
     times = phase_times(abs(dist), v, a, d, j)
     _check_times(times)
@@ -256,14 +257,15 @@ def jerk_limited_duration(distance: float, v_max: float, a_max: float, j_max: fl
 
 
 def _per_axis(name: str, value: float | Sequence[float] | None, n: int) -> list:
-    if value is None or isinstance(value, (int, float)):
-        return [value] * n
+    if value is None or isinstance(value, (int, float)) or not hasattr(value, "__len__"):
+        return [value] * n  # a scalar (or a non-number, refused by its own check)
     try:
         vals = list(value)
     except TypeError:
         raise MotionError(f"{name} must be a number or a sequence of {n} numbers") from None
     if len(vals) != n:
-        raise MotionError(f"{name} must have one value per axis ({n}), got {len(vals)}")
+        raise MotionError(f"{name} must have one value per axis ({n} distances), "
+                          f"got {len(vals)}")
     return vals
 
 
@@ -286,7 +288,7 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
         raise MotionError("distances must hold at least one axis")
     dists = [check_distance(f"distances[{i}]", x) for i, x in enumerate(dists)]
     st = [0.0] * n if starts is None else [
-        check_finite(f"starts[{i}]", x) for i, x in enumerate(_per_axis("starts", starts, n))
+        check_pulses(f"starts[{i}]", x) for i, x in enumerate(_per_axis("starts", starts, n))
     ]
     vs, as_, js, ds = (_per_axis(nm, val, n) for nm, val in
                        (("v_max", v_max), ("a_max", a_max), ("j_max", j_max),

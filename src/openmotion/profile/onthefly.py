@@ -25,7 +25,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import InfeasibleError, MotionError, check_distance, check_positive
+from ..errors import InfeasibleError, MotionError, check_distance
+from ..limits import check_quantity
 from .pcl import MoveSpec, Rates, append_ramp, ramp_distance, ramp_time
 from .segments import Profile, ProfileBuilder, State
 from .velocity import (
@@ -104,10 +105,10 @@ def change_speed(profile: Profile, t: float, spec: MoveSpec, new_vel: float, tac
     """
     t = check_profile_time(profile, t)
     spec = _check_spec(spec)
-    new = check_positive("new_vel", new_vel)
-    tacc = check_positive("tacc", tacc)
+    new = check_quantity("new_vel", new_vel, "pps")
+    tacc = check_quantity("tacc", tacc, "seconds")
     if v_limit is not None:
-        new = min(new, check_positive("v_limit", v_limit))
+        new = min(new, check_quantity("v_limit", v_limit, "pps"))
     if new < spec.str_vel:
         raise MotionError(f"new_vel must be >= str_vel ({spec.str_vel:g}), got {new_vel!r}")
     tgt = None if target is None else check_distance("target", target)

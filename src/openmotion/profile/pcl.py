@@ -27,10 +27,8 @@ from dataclasses import dataclass, replace
 from ..errors import (
     MotionError,
     check_distance,
-    check_finite,
-    check_nonnegative,
-    check_positive,
 )
+from ..limits import check_pulses, check_quantity
 from .segments import Profile, ProfileBuilder, empty_profile
 
 # S-curve ramp algebra (one ramp covering dv = MaxVel - StrVel in time Tacc):
@@ -68,18 +66,18 @@ class MoveSpec:
     vs_dec: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.shape not in ("T", "S"):
+        if not isinstance(self.shape, str) or self.shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {self.shape!r}")
-        sv = check_nonnegative("str_vel", self.str_vel)
-        mv = check_positive("max_vel", self.max_vel)
+        sv = check_quantity("str_vel", self.str_vel, "pps", zero=True)
+        mv = check_quantity("max_vel", self.max_vel, "pps")
         if mv < sv:
             raise MotionError(f"max_vel must be >= str_vel ({sv!r}), got {self.max_vel!r}")
-        ta = check_positive("tacc", self.tacc)
-        td = check_positive("tdec", self.tdec)
+        ta = check_quantity("tacc", self.tacc, "seconds")
+        td = check_quantity("tdec", self.tdec, "seconds")
         half = (mv - sv) / 2.0
         vals = {"str_vel": sv, "max_vel": mv, "tacc": ta, "tdec": td}
         for name in ("vs_acc", "vs_dec"):
-            vs = check_nonnegative(name, getattr(self, name))
+            vs = check_quantity(name, getattr(self, name), "pps", zero=True)
             if vs > half:
                 raise MotionError(
                     f"{name} must be in [0, (max_vel - str_vel)/2 = {half:g}], "
@@ -102,7 +100,7 @@ class MoveSpec:
     def plan(self, distance: float, start: float = 0.0) -> MovePlan:
         """Plan a relative move of `distance` pulses from position `start` (at rest)."""
         dist = check_distance("distance", distance)
-        p0 = check_finite("start", start)
+        p0 = check_pulses("start", start)
         return _plan(self, dist, p0)
 
 

@@ -13,13 +13,16 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import MotionError, check_positive
+from ..errors import MotionError
+from ..limits import check_quantity
 from .segments import Profile
 
 
 def sample_times(profile: Profile, period: float) -> NDArray[np.float64]:
     """Times 0, period, ... up to the first multiple of period at or after the end."""
-    period = check_positive("period", period)
+    if not isinstance(profile, Profile):
+        raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
+    period = check_quantity("period", period, "period")
     n = max(0, math.ceil(profile.duration / period - 1e-12))
     if n > 50_000_000:
         raise MotionError(
@@ -44,6 +47,8 @@ def check_quantized(counts: NDArray[np.int64], profile: Profile, period: float) 
     caller can re-check any stored or transmitted sequence (the stepcompress idea).
     """
     t = sample_times(profile, period)
+    if not isinstance(counts, np.ndarray):
+        raise MotionError(f"counts must be a numpy array, got {type(counts).__name__}")
     if counts.shape != t.shape:
         raise MotionError(f"counts must have {t.size} entries for this profile, got {counts.size}")
     err = np.abs(counts - profile.sample(t).p)

@@ -32,7 +32,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from ..errors import COUNTER28_MAX, MotionError, check_finite, check_positive
+from ..errors import COUNTER28_MAX, MotionError
+from ..limits import check_pulses, check_quantity
 from .jerk import PHASE_LABELS, phase_times
 from .ramps import ramp_jerk
 from .segments import Profile, ProfileBuilder, State
@@ -215,12 +216,11 @@ def _rest_to_rest(length: float, v_max: float, a_max: float, d_max: float,
 
 # ------------------------------------------------------------------- public API
 def _check_state(state: State) -> tuple[float, float, float]:
-    try:
-        p, v, a = (tuple(state) + (0.0, 0.0))[:3]
-    except TypeError:
-        raise MotionError("state must be a State(p, v, a)") from None
-    return (check_finite("state.p", p), check_finite("state.v", v),
-            check_finite("state.a", a))
+    if not isinstance(state, State):
+        raise MotionError(f"state must be a State(p, v, a), got {type(state).__name__}")
+    return (check_pulses("state.p", state.p),
+            check_quantity("state.v", state.v, "pps", zero=True, signed=True),
+            check_quantity("state.a", state.a, "pps2", zero=True, signed=True))
 
 
 def retarget(state: State, target: float, v_max: float, a_max: float, j_max: float, *,
@@ -233,14 +233,14 @@ def retarget(state: State, target: float, v_max: float, a_max: float, j_max: flo
     through zero velocity only when the target lies behind the stopping point.
     """
     p, v, a = _check_state(state)
-    tgt = check_finite("target", target)
+    tgt = check_pulses("target", target)
     if abs(tgt - p) > COUNTER28_MAX:
         raise MotionError(f"target must satisfy |target - state.p| <= {COUNTER28_MAX} "
                           f"(28-bit counter), got {target!r}")
-    vm = check_positive("v_max", v_max)
-    am = check_positive("a_max", a_max)
-    jm = check_positive("j_max", j_max)
-    dm = am if d_max is None else check_positive("d_max", d_max)
+    vm = check_quantity("v_max", v_max, "pps")
+    am = check_quantity("a_max", a_max, "pps2")
+    jm = check_quantity("j_max", j_max, "pps3")
+    dm = am if d_max is None else check_quantity("d_max", d_max, "pps2")
     if abs(a) > max(am, dm) * (1.0 + 1e-9):
         raise MotionError(f"state.a must satisfy |state.a| <= max(a_max, d_max), got {a!r}")
 
@@ -270,9 +270,9 @@ def retarget(state: State, target: float, v_max: float, a_max: float, j_max: flo
 def retarget_velocity(state: State, v_target: float, a_max: float, j_max: float) -> Profile:
     """Fastest jerk-limited ramp from (p, v, a) to v_target; v_target is held afterwards."""
     p, v, a = _check_state(state)
-    vt = check_finite("v_target", v_target)
-    am = check_positive("a_max", a_max)
-    jm = check_positive("j_max", j_max)
+    vt = check_quantity("v_target", v_target, "pps", zero=True, signed=True)
+    am = check_quantity("a_max", a_max, "pps2")
+    jm = check_quantity("j_max", j_max, "pps3")
     if abs(a) > am * (1.0 + 1e-9):
         raise MotionError(f"state.a must satisfy |state.a| <= a_max, got {a!r}")
     b = ProfileBuilder(p, v, a)

@@ -13,11 +13,15 @@ end it is `end`, whose position is the exact target, not a float sum of segment 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from ..errors import check_finite
+from ..limits import as_array, check_pulses
 
 Array = NDArray[np.float64]
 
@@ -80,7 +84,8 @@ class Profile:
 
     def sample(self, t: ArrayLike) -> Samples:
         """Position, velocity, acceleration and jerk at time(s) `t` (vectorized)."""
-        ts = np.asarray(t, dtype=np.float64)
+        fast = isinstance(t, np.ndarray) and t.dtype == np.float64
+        ts = t if fast else as_array("t", t, None)
         shape = ts.shape
         ts = ts.reshape(-1)
         p = np.empty_like(ts)
@@ -110,6 +115,8 @@ class Profile:
 
     def state_at(self, t: float) -> State:
         """Scalar (p, v, a) at time t, cheaper than `sample` for one instant."""
+        if type(t) is not float or not math.isfinite(t):
+            t = check_finite("t", t)
         if t < 0.0:
             return State(self.start.p + self.start.v * t, self.start.v, 0.0)
         if t >= self.duration or not self.n_segments:
@@ -275,4 +282,5 @@ class ProfileBuilder:
 
 def empty_profile(p: float = 0.0) -> Profile:
     """A profile that stays at `p` (zero-distance move)."""
+    p = check_pulses("p", p)
     return ProfileBuilder(p).build(end_p=p)

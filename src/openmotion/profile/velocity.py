@@ -26,7 +26,8 @@ import math
 
 import numpy as np
 
-from ..errors import MotionError, check_finite, check_nonnegative, check_positive
+from ..errors import MotionError, check_finite
+from ..limits import check_pulses, check_quantity
 from .pcl import MoveSpec, append_ramp
 from .ramps import ramp_accel, ramp_jerk
 from .segments import Profile, ProfileBuilder, State
@@ -126,10 +127,7 @@ def check_profile_time(profile: Profile, t: float) -> float:
     """Validate a (profile, t >= 0) pair for the stop and on-the-fly entry points."""
     if not isinstance(profile, Profile):
         raise MotionError(f"profile must be a Profile, got {type(profile).__name__}")
-    t = check_finite("t", t)
-    if t < 0.0:
-        raise MotionError(f"t must be >= 0, got {t!r}")
-    return t
+    return check_quantity("t", t, "seconds", zero=True)
 
 
 # ------------------------------------------------------------------ velocity mode
@@ -146,16 +144,18 @@ def velocity_ramp(state: State, target_v: float, t_ramp: float, *, shape: str = 
     available to remove the present acceleration, normally the running move's own jerk
     (see `ramp_from_state`); by default the new ramp's.
     """
-    if shape not in ("T", "S"):
+    if not isinstance(state, State):
+        raise MotionError(f"state must be a State(p, v, a), got {type(state).__name__}")
+    if not isinstance(shape, str) or shape not in ("T", "S"):
         raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
-    p0 = check_finite("state.p", state.p)
-    v0 = check_finite("state.v", state.v)
-    a0 = check_finite("state.a", state.a)
-    vt = check_finite("target_v", target_v)
-    t = check_positive("t_ramp", t_ramp)
-    vs = check_nonnegative("vs", vs)
-    sv = check_nonnegative("str_vel", str_vel)
-    jz = None if j_zero is None else check_positive("j_zero", j_zero)
+    p0 = check_pulses("state.p", state.p)
+    v0 = check_quantity("state.v", state.v, "pps", zero=True, signed=True)
+    a0 = check_quantity("state.a", state.a, "pps2", zero=True, signed=True)
+    vt = check_quantity("target_v", target_v, "pps", zero=True, signed=True)
+    t = check_quantity("t_ramp", t_ramp, "seconds")
+    vs = check_quantity("vs", vs, "pps", zero=True)
+    sv = check_quantity("str_vel", str_vel, "pps", zero=True)
+    jz = None if j_zero is None else check_quantity("j_zero", j_zero, "pps3")
     if abs(vt) < sv and vt != 0.0:
         raise MotionError(f"target_v must be 0 or |target_v| >= str_vel ({sv:g}), got {vt!r}")
     b = ProfileBuilder(p0, v0, a0)
@@ -184,10 +184,12 @@ def velocity_ramp(state: State, target_v: float, t_ramp: float, *, shape: str = 
 
 def velocity_move(spec: MoveSpec, direction: float, *, start: float = 0.0) -> Profile:
     """HSL tv_move / sv_move from rest: StrVel, ramp to +-MaxVel in Tacc, hold."""
+    if not isinstance(spec, MoveSpec):
+        raise MotionError(f"spec must be a MoveSpec, got {type(spec).__name__}")
     d = check_finite("direction", direction)
     if d == 0.0:
         raise MotionError("direction must be +1 or -1, got 0")
-    return velocity_ramp(State(check_finite("start", start)),
+    return velocity_ramp(State(check_pulses("start", start)),
                          math.copysign(spec.max_vel, d), spec.tacc, shape=spec.shape,
                          vs=spec.vs_acc, str_vel=spec.str_vel)
 
@@ -197,6 +199,10 @@ def velocity_move(spec: MoveSpec, direction: float, *, start: float = 0.0) -> Pr
 
 def stop_distance(spec: MoveSpec, v: float, a: float = 0.0) -> float:
     """Distance (>= 0, along v) a `decel_stop` from (v, a) covers."""
+    if not isinstance(spec, MoveSpec):
+        raise MotionError(f"spec must be a MoveSpec, got {type(spec).__name__}")
+    v = check_quantity("v", v, "pps", zero=True, signed=True)
+    a = check_quantity("a", a, "pps2", zero=True, signed=True)
     b = ProfileBuilder(0.0, v, a)
     append_stop(b, spec)
     return abs(b.state.p)

@@ -5,7 +5,9 @@ if/while/do/repeat/sub closed with the same label, every call names a defined
 subroutine), then run the program line by line through the modal state machine
 (modal.py), following sub/call/return, if/elseif/else, while, do-while, repeat, break and
 continue as LinuxCNC documents them. Subroutine nesting is limited (`max_call_depth`) and so
-is the number of executed lines (`max_blocks`), so a runaway loop is an error, not a hang.
+is the number of executed lines (`max_blocks`) and of one loop's iterations
+(`max_loop_iterations`); a loop whose iteration changes nothing is refused at its third
+test (loopguard.py), so a runaway loop is an error within a second, not a hang.
 
 The whole program is interpreted before anything is returned: the first problem raises
 GCodeError (line, column, word) and no command list exists, so nothing can move.
@@ -18,6 +20,7 @@ from dataclasses import dataclass, field
 
 from . import canon
 from .fastpath import compile_plain
+from .loopguard import LoopGuard
 from .modal import Modal
 from .modalstate import on_return
 from .options import GCodeOptions
@@ -146,15 +149,16 @@ def _bind(flow: _Flow, blocks: list[Block], j: int, head: int, end: int) -> None
 
 @dataclass
 class _Frame:
-    """One active subroutine call (`fanuc`: an M98 call, repeated `loops` more times from
-    block `start`)."""
+    """One active subroutine call (`fanuc`: an M98 call, repeated `repeat_left` more times
+    from block `start`; `loops`: the loop guard's records)."""
 
     label: str
     return_to: int
     repeats: dict[int, int] = field(default_factory=dict)
     fanuc: bool = False
-    loops: int = 0
+    repeat_left: int = 0
     start: int = 0
+    loops: dict[int, list] = field(default_factory=dict)  # loop head -> LoopGuard record
 
 
 class Interpreter:
@@ -210,6 +214,7 @@ class Interpreter:
         frames: list[_Frame] = [_Frame("", -1)]
         steps = 0
         limit = self.opt.max_blocks
+        guard = LoopGuard(modal, self.opt.max_loop_iterations)
         pc = 0
         test_branch = -1  # the ELSEIF whose condition is to be tested next
         n = len(blocks)
@@ -219,8 +224,13 @@ class Interpreter:
             b = blocks[pc]
             steps += 1
             if steps > limit:
-                raise b.error(f"more than {limit} lines executed (endless loop?)", 0,
-                              f"O{b.oword.label}" if b.oword else "")
+                loops = frames[-1].loops
+                where = ""
+                if loops:  # the innermost active loop
+                    h = blocks[next(reversed(loops))]
+                    where = f" in loop O{h.oword.label} at line {h.line}"  # type: ignore
+                raise b.error(f"more than {limit} lines executed{where} (max_blocks; "
+                              "endless loop?)", 0, f"O{b.oword.label}" if b.oword else "")
             if b.delete and skip_deleted:
                 pc += 1
                 continue
@@ -295,12 +305,24 @@ class Interpreter:
             elif kw == "ENDIF":
                 pc += 1
             elif kw == "WHILE" and pc in flow.do_end:
-                pc = flow.head[pc] + 1 if self._truth(b) else pc + 1
+                head = flow.head[pc]
+                if self._truth(b):
+                    guard.iterate(frames[-1].loops, frames[-1].repeats, head, blocks[head])
+                    pc = head + 1
+                else:
+                    guard.leave(frames[-1].loops, head)
+                    pc += 1
             elif kw == "WHILE":
-                pc = pc + 1 if self._truth(b) else flow.end[pc] + 1
+                if self._truth(b):
+                    guard.iterate(frames[-1].loops, frames[-1].repeats, pc, b)
+                    pc += 1
+                else:
+                    guard.leave(frames[-1].loops, pc)
+                    pc = flow.end[pc] + 1
             elif kw == "ENDWHILE":
                 pc = flow.head[pc]
             elif kw == "DO":
+                guard.leave(frames[-1].loops, pc)  # a fresh entry into the loop
                 pc += 1
             elif kw == "REPEAT":
                 reps = frames[-1].repeats
@@ -309,9 +331,11 @@ class Interpreter:
                     reps[pc] = int(count) if count > 0 else 0
                 if reps[pc] > 0:
                     reps[pc] -= 1
+                    guard.iterate(frames[-1].loops, reps, pc, b)
                     pc += 1
                 else:
                     del reps[pc]
+                    guard.leave(frames[-1].loops, pc)
                     pc = flow.end[pc] + 1
             elif kw == "ENDREPEAT":
                 pc = flow.head[pc]
@@ -319,6 +343,7 @@ class Interpreter:
                 end = flow.end[pc]
                 head = flow.head[end]
                 frames[-1].repeats.pop(head, None)
+                guard.leave(frames[-1].loops, head)
                 pc = end + 1
             elif kw == "CONTINUE":
                 head = flow.head[pc]
@@ -349,9 +374,10 @@ class Interpreter:
             if not top.fanuc:
                 raise b.error(f"O{top.label} sub must end with O{top.label} endsub or "
                               "return, not M99", pos, "M99")
-            if top.loops > 0:
-                top.loops -= 1
+            if top.repeat_left > 0:
+                top.repeat_left -= 1
                 top.repeats.clear()
+                top.loops.clear()
                 return top.start
             frames.pop()
             on_return(self.modal, self.params.depth, b, self._out)
@@ -372,7 +398,8 @@ class Interpreter:
                           pos, word)
         start = self.flow.fanuc[label] + 1
         self.params.push_call(None)
-        frames.append(_Frame(label, pc + 1, fanuc=True, loops=count - 1, start=start))
+        frames.append(_Frame(label, pc + 1, fanuc=True, repeat_left=count - 1,
+                             start=start))
         return start
 
 

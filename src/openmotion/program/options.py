@@ -51,7 +51,8 @@ class GCodeOptions:
     spindle_output / mist_output / flood_output: outputs carried by Spindle/Coolant.
     block_delete: skip lines starting with '/' (the block-delete switch is on).
     keep_comments: also emit plain comments as Message(kind="comment").
-    max_call_depth: subroutine nesting limit; max_blocks: executed-line limit (loops).
+    max_call_depth: subroutine nesting limit; max_blocks: executed-line limit (loops);
+    max_loop_iterations: iterations one while/do/repeat loop may run each time it is entered.
     subroutine_path: folders searched for `O<name> call` subroutines not defined in the
         program, as <name>.ngc (then the program's own folder), like LinuxCNC's
         [RS274NGC]SUBROUTINE_PATH.
@@ -72,6 +73,7 @@ class GCodeOptions:
     keep_comments: bool = False
     max_call_depth: int = 64
     max_blocks: int = 10_000_000
+    max_loop_iterations: int = 1_000_000
     max_line_length: int = MAX_LINE_LENGTH
     max_bytes: int = MAX_PROGRAM_BYTES
     subroutine_path: Sequence[str | os.PathLike[str]] = ()
@@ -142,7 +144,8 @@ class GCodeOptions:
         check_int("n_outputs", self.n_outputs, 0)
         for name in ("spindle_output", "mist_output", "flood_output"):
             _opt_index(name, getattr(self, name))
-        for name, lo in (("max_call_depth", 1), ("max_blocks", 1), ("max_line_length", 16),
+        for name, lo in (("max_call_depth", 1), ("max_blocks", 1),
+                         ("max_loop_iterations", 1), ("max_line_length", 16),
                          ("max_bytes", 1)):
             check_int(name, getattr(self, name), lo)
         for name in ("block_delete", "keep_comments"):

@@ -38,6 +38,9 @@ class Parameters:
         self.position_hook: Callable[[int], float] | None = None
         #: Predefined read-only globals (#<_x>, #<_metric>, ...): name -> value or None.
         self.predefined_hook: Callable[[str], float | None] | None = None
+        #: Counts writes that changed a value (loop detection). A call and its return are
+        #: not counted: the return restores #1-#30 and drops the callee's locals.
+        self.version = 0
 
     # -- reads (the expr.Store protocol) -------------------------------------------------
     def get_number(self, index: float, pos: int) -> float:
@@ -73,10 +76,15 @@ class Parameters:
 
     # -- writes ----------------------------------------------------------------------
     def set_number(self, index: int, value: float) -> None:
+        if self.numbers[index] != value:
+            self.version += 1
         self.numbers[index] = value
 
     def set_named(self, name: str, value: float) -> None:
-        (self.globals if name.startswith("_") else self.locals[-1])[name] = value
+        table = self.globals if name.startswith("_") else self.locals[-1]
+        if table.get(name) != value:
+            self.version += 1
+        table[name] = value
 
     # -- call scopes -----------------------------------------------------------------
     def push_call(self, args: list[float] | None) -> None:

@@ -43,9 +43,10 @@ O_KEYWORDS = {
 }
 _WORD_OPS = ("MOD", "AND", "XOR", "OR", "EQ", "NE", "GT", "GE", "LT", "LE")
 
-_NUMBER = re.compile(r"\d+\.?\d*|\.\d+")
-_SIMPLE_LINE = re.compile(r"(?:[A-DF-NP-Z][-+]?(?:\d+\.?\d*|\.\d+))*\Z")
-_SIMPLE_WORD = re.compile(r"([A-Z])([-+]?(?:\d+\.?\d*|\.\d+))")
+#: One unsigned literal; the alternatives cannot both match a digit run (no backtracking).
+_NUMBER = re.compile(r"\d+(?:\.\d*)?|\.\d+")
+_SIMPLE_LETTERS = frozenset("ABCDFGHIJKLMNPQRSTUVWXYZ")
+_DIGITS = frozenset("0123456789")
 _LINE_NUMBER = re.compile(r"N\d+(?:\.\d+)?")
 
 #: A word value: a literal (float) or an expression evaluated when the line runs.
@@ -354,6 +355,40 @@ def _param_index(p: _LineParser, value: float, pos: int) -> int:
 MAX_PARAMETER = 5601
 
 
+def _simple_words(code: str, i: int) -> list[tuple[str, Value, int]] | None:
+    """Words of a plain line (letters and literal numbers only) from `i`, else None.
+
+    A hand-written scan, one pass over the characters: a regex with a repeated group of
+    optional parts backtracked exponentially on a long plain prefix followed by a '['.
+    """
+    words: list[tuple[str, Value, int]] = []
+    n = len(code)
+    digits = _DIGITS
+    while i < n:
+        letter = code[i]
+        if letter not in _SIMPLE_LETTERS:
+            return None
+        start = i
+        i += 1
+        if i < n and code[i] in "+-":
+            i += 1
+        lead = i
+        while i < n and code[i] in digits:
+            i += 1
+        whole = i > lead
+        if i < n and code[i] == ".":
+            i += 1
+            frac = i
+            while i < n and code[i] in digits:
+                i += 1
+            if not whole and i == frac:
+                return None
+        elif not whole:
+            return None
+        words.append((letter, float(code[start + 1:i]), start))
+    return words
+
+
 def parse_line(text: str, line: int, file: str = "",
                max_line_length: int = MAX_LINE_LENGTH) -> Block | None:
     """Parse one line; None for a line with nothing on it. '%' lines return a marker block."""
@@ -379,13 +414,9 @@ def parse_line(text: str, line: int, file: str = "",
             raise block.error("line number N needs digits", i, "N")
         block.number = float(m.group()[1:])
         i = m.end()
-    rest = code[i:] if i else code
-    if "O" not in rest and _SIMPLE_LINE.match(rest):
-        words = block.words
-        p = i  # fast-path words are contiguous: each starts where the last one ended
-        for letter, num in _SIMPLE_WORD.findall(rest):
-            words.append((letter, float(num), p))
-            p += 1 + len(num)
+    simple = _simple_words(code, i)
+    if simple is not None:
+        block.words = simple
         return block
     p = _LineParser(code, block)
     p.i = i

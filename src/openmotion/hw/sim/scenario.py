@@ -13,6 +13,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from openmotion.errors import MotionError, check_finite, check_nonnegative
+from openmotion.limits import check_quantity
 
 if TYPE_CHECKING:
     from .machine import SimMachine
@@ -109,8 +110,7 @@ class Scenario:
         ax = self._m._axis(axis)
         if ax.is_servo:
             raise MotionError(f"axis {axis} is a servo; step loss applies to stepper axes")
-        if isinstance(pulses, bool) or not isinstance(pulses, int):
-            raise MotionError(f"pulses must be an int, got {pulses!r}")
+        pulses = check_quantity("pulses", pulses, "count", zero=True, signed=True)
         t = self._at(at)
         self._push(t, lambda raw: self._m._step_loss(axis, pulses, raw))
 
