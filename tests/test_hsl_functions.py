@@ -45,3 +45,20 @@ def test_misspellings_are_the_same_functions():
     assert h.HSL_M_diable_softlimit is h.HSL_M_disable_softlimit
     assert h.HSL_M_build_comp_table is h.HSL_M_build_compare_table
     assert h.HSL_M_start_tv_move is h.HSL_M_tv_move
+
+
+def test_set_sd_mode_1_slows_down_and_stops():
+    """HSL_M_set_sd(..., sd_mode=1): SD active makes a decelerating stop (core
+    Safety.set_sd(stop=True)); sd_mode 0 keeps the slow run at StrVel."""
+    from openmotion.compat.hsl import HslLibrary
+
+    hsl = HslLibrary.simulated(1)
+    assert hsl.HSL_initial(0) == 0
+    ctl = hsl.controller(0)
+    logic = 1 if ctl.axes[0].config.signal_logic("sd") == "nc" else 0
+    assert hsl.HSL_M_set_sd(0, 1, logic, 0, 1) == 0
+    assert ctl.safety.settings(0).sd_stop
+    assert hsl.HSL_M_set_sd(0, 1, logic, 0, 0) == 0
+    assert not ctl.safety.settings(0).sd_stop
+    assert hsl.HSL_M_set_sd(0, 1, logic, 0, 2) < 0      # a bad mode: refused, unchanged
+    assert not ctl.safety.settings(0).sd_stop

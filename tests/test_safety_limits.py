@@ -323,6 +323,24 @@ def test_sd_without_strvel_makes_a_decelerating_stop() -> None:
     assert ctl.wait_motion_done(["a"], 1.0) and ax.position < 15_000.0
 
 
+def test_sd_mode_stop_slows_down_and_stops_without_a_fault() -> None:
+    """HSL sd_mode 1: SD active makes a decelerating stop (not a slow run at StrVel)."""
+    ctl, safety = setup()
+    safety.set_sd("a", True, stop=True)
+    assert safety.settings("a").sd_stop
+    ax = ctl.axis("a")
+    ctl.hardware.scenario.place_switch(0, "sd", 5000.0, 30_000.0)
+    ax.move_relative(20_000.0, max_vel=20_000.0, str_vel=2000.0, tacc=0.02)
+    ctl.run_until(lambda: ctl.input_active(0, "sd"), 1.0)
+    ctl.step()
+    assert ax.state is S.STOPPING
+    assert ctl.wait_motion_done(["a"], 1.0)
+    assert 5000.0 < ax.position < 20_000.0 and ax.fault is None and ax.speed == 0.0
+    with pytest.raises(MotionError, match="stop"):
+        safety.set_sd("a", True, stop=1)  # type: ignore[arg-type]
+    assert safety.settings("a").sd_stop  # unchanged by the refusal
+
+
 def test_rdy_check_svon_and_io_status_bits() -> None:
     ctl, safety = setup()
     s = ctl.axis("s")

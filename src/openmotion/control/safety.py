@@ -24,8 +24,10 @@ Reactions (HSL-4XMO 3, 4.8; MCCL 2.8):
   called whenever any axis goes to ErrorStop: limits, alarms, E-stop, step loss, soft limits.
 - SD (when enabled, `set_sd`): while active the axis runs at StrVel (HSL change of speed at
   the move's Tdec); released, it goes back to the speed it had (level mode) or stays slow
-  until the motion ends (latched mode). A motion without StrVel (jerk-limited, external)
-  or with StrVel 0 makes a decelerating stop instead. Cycle resolution (one cycle late).
+  until the motion ends (latched mode). `set_sd(..., stop=True)` (HSL sd_mode 1): SD
+  active makes a decelerating stop instead (the motion ends, no fault). A motion without
+  StrVel (jerk-limited, external) or with StrVel 0 makes a decelerating stop instead.
+  Cycle resolution (one cycle late).
 - ALM: the controller stops the axis (ErrorStop "servo alarm"); `set_alm(axis, "decel")`
   makes it a decelerating stop from the edge time. Motion is refused while ALM is active.
 - EMG: the controller stops every axis at once; motion is refused until released + reset.
@@ -95,6 +97,7 @@ class AxisSafety:
     rdy_required: bool = False
     edge_stop: bool = False      # immediate EL/ALM stops cut the pulses in the hardware
     suspended: set[str] = field(default_factory=set)
+    sd_stop: bool = False        # SD mode 1: slow down and stop (a decelerating stop)
 
 
 @dataclass(frozen=True)
@@ -228,7 +231,7 @@ class Safety:
         c = self._cfg[self._idx(axis)]
         return AxisSafety(c.el_enabled, c.el_decelerate, c.el_direction_sensitive,
                           c.sd_enabled, c.sd_latched, c.erc_width, c.rdy_required,
-                          c.edge_stop, set(c.suspended))
+                          c.edge_stop, set(c.suspended), c.sd_stop)
 
     def set_el(self, axis: int | str, mode: str | int) -> None:
         """HSL_M_set_el: stop mode at an end limit, "immediate" (0) or "decel" (1: to StrVel
@@ -259,14 +262,17 @@ class Safety:
         self._arm(i)
         return self._hw_stop
 
-    def set_sd(self, axis: int | str, enabled: bool, *, latched: bool = False) -> None:
-        """HSL_M_set_sd: slow-down on/off, level (default) or latched mode. The SD logic is
+    def set_sd(self, axis: int | str, enabled: bool, *, latched: bool = False,
+               stop: bool = False) -> None:
+        """HSL_M_set_sd: slow-down on/off, level (default) or latched mode; `stop` (sd_mode
+        1): SD active makes a decelerating stop instead of slowing to StrVel. The SD logic is
         the axis config's (logic["sd"])."""
         i = self._idx(axis)
         _bool("enabled", enabled)
         _bool("latched", latched)
+        _bool("stop", stop)
         c = self._cfg[i]
-        c.sd_enabled, c.sd_latched = enabled, latched
+        c.sd_enabled, c.sd_latched, c.sd_stop = enabled, latched, stop
         if not enabled:
             self._sd_latch[i] = False
 
@@ -503,8 +509,8 @@ class Safety:
         running = ax.state in (S.DISCRETE_MOTION, S.CONTINUOUS_MOTION)
         saved = self._sd_saved[i]
         if active and saved is None and running:
-            if m.spec is None or m.spec.str_vel <= 0.0:
-                ax.stop()
+            if c.sd_stop or m.spec is None or m.spec.str_vel <= 0.0:
+                ax.stop()  # sd_mode 1, or nothing to slow to: a decelerating stop
                 return
             self._sd_saved[i] = m.spec.max_vel
             if ax.speed > m.spec.str_vel:

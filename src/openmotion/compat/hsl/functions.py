@@ -100,7 +100,7 @@ TABLE: tuple[Entry, ...] = (
     _e("HSL_M_set_el_logic", "motion I/O", note="logic as the machine file wires it"),
     _e("HSL_M_set_inp", "motion I/O"),
     _e("HSL_M_set_erc", "motion I/O", note="width codes 0..7 (PCL6045)"),
-    _e("HSL_M_set_sd", "motion I/O", note="sd_mode 1 refused (not modelled)"),
+    _e("HSL_M_set_sd", "motion I/O"),
     _e("HSL_M_set_ltc_logic", "motion I/O"),
     _e("HSL_M_set_pls_outmode", "motion I/O", note="must match the machine file"),
     _e("HSL_M_set_pls_iptmode", "motion I/O", note="must match the machine file"),

@@ -125,14 +125,13 @@ class IoFunctions(HslBase):
     def HSL_M_set_sd(self, axis: int, enable: int, sd_logic: int, sd_latch: int,
                      sd_mode: int) -> None:
         """Slow-down input: enable, logic (as wired), 1 = latched, sd_mode 0 (slow to
-        StrVel; 1, slow down and stop, is not modelled: ERR_NotSupported)."""
+        StrVel) or 1 (slow down and stop)."""
         mod, ax = self._axis(axis)
         on = _flag("enable", enable)
         latch = _flag("sd_latch", sd_latch)
-        if _flag("sd_mode", sd_mode):
-            raise Refusal(ERR_NotSupported, "sd_mode 1 (slow down then stop) is not modelled")
+        stop = _flag("sd_mode", sd_mode)
         self._wired(ax, ("sd",), sd_logic, "set_sd")
-        self._safety(mod).set_sd(ax.index, on, latched=latch)
+        self._safety(mod).set_sd(ax.index, on, latched=latch, stop=stop)
 
     @hsl_call(SET_U16)
     def HSL_M_set_ltc_logic(self, axis: int, ltc_logic: int) -> None:
