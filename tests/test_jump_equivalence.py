@@ -1,6 +1,7 @@
 """Virtual time that jumps gives what cycle-by-cycle execution gives (control/jump.py).
 
-Random scenarios (moves, velocity moves, speed changes, stops, end limits, E-stop, alarms,
+Random scenarios on ideal steppers, stalling steppers with backlash and servo drives
+(moves, velocity moves, speed changes, stops, end limits, E-stop, alarms,
 step losses, soft limits, digital inputs, group lines, homing, G-code, PSO) run twice on
 the same machine: once cycle by cycle (`virtual_jumps = False`, the reference) and once
 jumping. After every operation the two controllers must agree on everything observable:
@@ -34,6 +35,12 @@ def machine(rng: np.random.Generator) -> MachineConfig:
         kw = {}
         if rng.random() < 0.3:
             kw["pel"] = SwitchConfig(position=float(rng.uniform(30_000, 60_000)), width=500.0)
+        k = rng.random()
+        if k < 0.2:  # a stepper that stalls and loses pulses above its pull-out limits
+            kw["drive"] = replace(x.drive, type="stepper", pullout_speed=60_000.0,
+                                  pullout_accel=3e6, backlash=float(rng.choice([0.0, 3.0])))
+        elif k < 0.4:  # a servo drive (plant dynamics, INP and RDY from the drive)
+            kw["drive"] = replace(x.drive, type="servo")
         axes.append(replace(x, name="xyz"[i], **kw))
     return MachineConfig(name="jump", axes=tuple(axes), digital_inputs=2)
 
