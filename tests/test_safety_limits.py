@@ -460,3 +460,22 @@ def test_a_limit_cuts_short_another_faults_deceleration() -> None:
     ctl.run_until(lambda: ax.motion is None, 1.0)
     assert ax.fault == "+EL"
     assert ax.position <= PEL + 50_000.0 * ctl.period + 1e-6
+
+
+@pytest.mark.parametrize("jumps", [False, True])
+def test_rdy_lost_while_moving_stops_the_same_way_cycle_by_cycle_and_jumping(jumps) -> None:
+    """The RDY edge wakes a jump (Safety's edge hook lists "rdy"): with virtual time
+    jumping, the axis stops at the same cycle and position as cycle by cycle."""
+    results = []
+    for jump in (False, jumps):
+        ctl, safety = setup()
+        ctl.virtual_jumps = jump
+        s = ctl.axis("s")
+        safety.set_rdy_check("s", True)
+        ctl.step()
+        s.move_relative(40_000.0, max_vel=20_000.0, tacc=0.05)
+        ctl.hardware.scenario.set_drive_ready(s.index, False, at=ctl.time + 0.3004)
+        ctl.advance(1.0)
+        assert s.fault == "drive not ready"
+        results.append((s.position, [e.time for e in ctl.events.events("fault")]))
+    assert results[0] == results[1]

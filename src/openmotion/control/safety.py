@@ -173,7 +173,7 @@ class Safety:
         self.stops: list[StopRecord] = []
         self.soft = SoftLimits(controller, self._is_suspended)
         self.cmp = Comparators(controller)
-        controller.add_edge_hook(self._on_edge, signals=("pel", "mel", "sd"))
+        controller.add_edge_hook(self._on_edge, signals=("pel", "mel", "sd", "rdy"))
         controller.add_cycle_hook(self._on_cycle, due=self._due)
         controller.add_fault_hook(self._on_fault)
         controller.add_motion_check(self._check_motion)
