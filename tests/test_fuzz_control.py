@@ -70,7 +70,7 @@ AXES = [
     Entry("Axis.move_absolute", axis_call("move_absolute"), dict(position=5000.0, **MOVE)),
     Entry("Axis.move_velocity", axis_call("move_velocity"),
           dict(velocity=5000.0, str_vel=100.0, tacc=0.05, shape="T", vs_acc=0.0,
-               units=False)),
+               units=False), aliases={"units": ("units", "velocity")}),
     Entry("Axis.move_jerk_limited", axis_call("move_jerk_limited"),
           dict(distance=5000.0, v_max=2e4, a_max=2e5, j_max=2e7, d_max=None, absolute=False,
                units=False)),
@@ -81,7 +81,8 @@ AXES = [
     Entry("Axis.stop", axis_call("stop"), dict(tdec=0.1)),
     Entry("Axis.check_speed", axis_call("check_speed"),
           dict(name="v", value=100.0, units=False), aliases={"value": ("v",)}),
-    Entry("Controller.axis", lambda w, key: w.ctl.axis(key), dict(key="x")),
+    Entry("Controller.axis", lambda w, key: w.ctl.axis(key), dict(key="x"),
+          aliases={"key": ("axis",)}),
 ]
 
 GROUPS = [

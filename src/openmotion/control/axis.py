@@ -26,6 +26,7 @@ from ..errors import (
     check_positive,
 )
 from ..hw.interface import AxisCommand
+from ..limits import check_quantity
 from ..profile.onthefly import final_decel_start
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
@@ -314,7 +315,11 @@ class Axis(AxisEngine):
         v = self.check_speed("velocity", v, False)
         if v == 0.0:
             raise MotionError("velocity must be non-zero (its sign gives the direction)")
+        check_quantity("velocity", abs(v), "pps")
         sv = self.check_speed("str_vel", str_vel, units)
+        if abs(v) < sv:
+            raise MotionError(f"velocity must satisfy |velocity| >= str_vel ({sv:g} pps), "
+                              f"got {velocity!r}")
         va = self.check_speed("vs_acc", vs_acc, units)
         spec = MoveSpec(shape, sv, abs(v), tacc, tacc, va, va)
         if self.speed_model is not None:
