@@ -141,3 +141,30 @@ def test_sets_work_offset():
     assert not sets_work_offset("G10 L2 P2 X-60\n")
     assert not sets_work_offset("(G10 L2 P1 X1)\nG1 X1\n")
     assert not sets_work_offset("G110 L2 P1\n")
+
+
+def test_ctrl_c_stops_decelerating_with_partial_report(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    prog = tmp_path / "long.ngc"
+    prog.write_text("G10 L2 P1 X0 Y0 Z0\nG21 G91\nG1 X100 F600\nG1 Y100\nM2\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.Popen([sys.executable, "-m", "openmotion", "run", str(prog), "--out",
+                             str(tmp_path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env=env, text=True)
+    assert proc.stderr is not None
+    assert "commands" in proc.stderr.readline()  # compiled, running now
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    assert "aborted at line 3" in err
+    assert "aborted" in out and "report:" in out
+    assert (tmp_path / "long.html").exists()
+    dist = float(out.split("distance")[1].split()[0])
+    assert 0 < dist < 100  # stopped inside the first move

@@ -12,7 +12,9 @@ import argparse
 import math
 import os
 import re
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -26,7 +28,8 @@ _CHUNK = 1.0
 
 
 def run_job(args: argparse.Namespace) -> int:
-    """The `run` subcommand; returns the exit code (0 done, 1 fault/abort)."""
+    """The `run` subcommand; returns the exit code (0 done, 1 fault/abort, 130 Ctrl-C: the
+    axes decelerate along the path, the summary and report cover what ran)."""
     from ..config import default_machine
     from ..control import Controller
 
@@ -66,20 +69,22 @@ def run_job(args: argparse.Namespace) -> int:
     run.start()
     if override != 100.0 and run.group is not None:
         run.group.set_override(float(override))  # before the first cycle: the whole job
-    if args.realtime:
-        with ctl.start_realtime():
-            while run.state is RunState.RUNNING:
-                time.sleep(0.05)
-                _progress(run)
-    else:
-        while run.state is RunState.RUNNING:
-            ctl.run_until(lambda: run.state is not RunState.RUNNING, _CHUNK)
-            _progress(run)
+    with _CtrlC() as stop:
+        _drive(ctl, run, stop, args.realtime)
+        if stop.pressed and run.state in (RunState.RUNNING, RunState.PAUSED):
+            line = run.current_line
+            run.abort()  # decelerating stop along the path
+            _settle(ctl, run, args.realtime)
+            print(file=sys.stderr)
+            print(f"aborted at line {line} (Ctrl-C) after {ctl.time - run.t_start:.3f} s of "
+                  "machine time; the axes stopped along the path", file=sys.stderr)
     print(file=sys.stderr)
     summary = summarize(run)
     print(format_summary(summary))
     report = write_report(run, args.out, path.stem)
     print(f"report: {report}")
+    if stop.pressed:
+        return 130
     return 0 if run.state is RunState.DONE else 1
 
 
@@ -139,6 +144,58 @@ def work_origin(ctl) -> dict[int, float]:
         mid = 0.5 * (t[0] + t[1])
         out[5221 + AXIS_LETTERS.index(letter)] = mid if unit == "mm" else mid * MM_PER_INCH
     return out
+
+
+class _CtrlC:
+    """While active, the first Ctrl-C (SIGINT) only sets `pressed` so the job can stop
+    cleanly between controller cycles; a second one interrupts at once."""
+
+    def __init__(self) -> None:
+        self.pressed = False
+        self._old: object = None
+
+    def _handler(self, signum: int, frame: object) -> None:
+        if self.pressed:
+            raise KeyboardInterrupt
+        self.pressed = True
+
+    def __enter__(self) -> _CtrlC:
+        if threading.current_thread() is threading.main_thread():
+            self._old = signal.signal(signal.SIGINT, self._handler)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._old is not None:
+            signal.signal(signal.SIGINT, self._old)  # type: ignore[arg-type]
+
+
+def _drive(ctl, run: ProgramRunner, stop: _CtrlC, realtime: bool) -> None:
+    """Run the controller until the program ends or Ctrl-C is pressed."""
+    if realtime:
+        with ctl.start_realtime():
+            while run.state is RunState.RUNNING and not stop.pressed:
+                time.sleep(0.05)
+                _progress(run)
+        return
+    while run.state is RunState.RUNNING and not stop.pressed:
+        ctl.run_until(lambda: run.state is not RunState.RUNNING or stop.pressed, _CHUNK)
+        _progress(run)
+
+
+def _settle(ctl, run: ProgramRunner, realtime: bool, limit: float = 120.0) -> None:
+    """After abort(): let the group decelerate to rest (at most `limit` s machine time)."""
+    from ..control.group import GroupState
+
+    def at_rest() -> bool:
+        return run.group is None or run.group.state in (GroupState.IDLE, GroupState.ERROR)
+
+    if realtime:
+        with ctl.start_realtime():
+            t_end = time.monotonic() + limit
+            while not at_rest() and time.monotonic() < t_end:
+                time.sleep(0.01)
+    else:
+        ctl.run_until(at_rest, limit)
 
 
 def _progress(run: ProgramRunner) -> None:
