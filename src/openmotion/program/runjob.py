@@ -1,7 +1,7 @@
 """`openmotion run PROGRAM`: run a program on the simulated machine, summary + HTML report.
 
-Virtual time by default (as fast as the simulation goes) with a text progress bar on
-stderr for jobs longer than a few seconds of machine time; `--realtime` paces the
+Virtual time by default (as fast as the simulation goes) with a progress line on stderr
+when it is a terminal (progress.py: executed line, machine time, %, ETA); `--realtime` paces the
 controller to the wall clock on its thread. A point table (.toml/.csv) runs its points in
 table order.
 """
@@ -20,11 +20,12 @@ from pathlib import Path
 
 from ..errors import MotionError
 from .points import PointTable
+from .progress import RunProgress
 from .report import format_summary, summarize, write_report
 from .runner import ProgramRunner, RunOptions, RunState
 
 #: Controller time (s) between progress updates in virtual time.
-_CHUNK = 1.0
+_CHUNK = 0.25
 
 
 def run_job(args: argparse.Namespace) -> int:
@@ -69,18 +70,20 @@ def run_job(args: argparse.Namespace) -> int:
     run.start()
     if override != 100.0 and run.group is not None:
         run.group.set_override(float(override))  # before the first cycle: the whole job
+    bar = RunProgress(ctl, run)
     with _CtrlC() as stop:
-        _drive(ctl, run, stop, args.realtime)
+        _drive(ctl, run, stop, args.realtime, bar)
         if stop.pressed and run.state in (RunState.RUNNING, RunState.PAUSED):
             line = run.current_line
             run.abort()  # decelerating stop along the path
             _settle(ctl, run, args.realtime)
-            print(file=sys.stderr)
+            bar.close()
             print(f"aborted at line {line} (Ctrl-C) after {ctl.time - run.t_start:.3f} s of "
                   "machine time; the axes stopped along the path", file=sys.stderr)
-    print(file=sys.stderr)
+    bar.close()
     summary = summarize(run)
     print(format_summary(summary))
+    bar.status("writing the report ...")
     report = write_report(run, args.out, path.stem)
     print(f"report: {report}")
     if stop.pressed:
@@ -169,17 +172,17 @@ class _CtrlC:
             signal.signal(signal.SIGINT, self._old)  # type: ignore[arg-type]
 
 
-def _drive(ctl, run: ProgramRunner, stop: _CtrlC, realtime: bool) -> None:
+def _drive(ctl, run: ProgramRunner, stop: _CtrlC, realtime: bool, bar: RunProgress) -> None:
     """Run the controller until the program ends or Ctrl-C is pressed."""
     if realtime:
         with ctl.start_realtime():
             while run.state is RunState.RUNNING and not stop.pressed:
                 time.sleep(0.05)
-                _progress(run)
+                bar.update()
         return
     while run.state is RunState.RUNNING and not stop.pressed:
         ctl.run_until(lambda: run.state is not RunState.RUNNING or stop.pressed, _CHUNK)
-        _progress(run)
+        bar.update()
 
 
 def _settle(ctl, run: ProgramRunner, realtime: bool, limit: float = 120.0) -> None:
@@ -196,11 +199,3 @@ def _settle(ctl, run: ProgramRunner, realtime: bool, limit: float = 120.0) -> No
                 time.sleep(0.01)
     else:
         ctl.run_until(at_rest, limit)
-
-
-def _progress(run: ProgramRunner) -> None:
-    width = 30
-    done = int(run.progress * width)
-    n = min(run.passes_done + 1, run.options.repeat)
-    print(f"\r[{'#' * done}{'.' * (width - done)}] pass {n}/"
-          f"{run.options.repeat} line {run.current_line}", end="", file=sys.stderr)
