@@ -174,6 +174,21 @@ def cmd_config(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_examples(args: argparse.Namespace) -> int:
+    from .examples_cmd import copy_example, examples_root, list_examples
+
+    if args.name:
+        print(f"wrote {copy_example(args.name, args.to)}")
+        return 0
+    items = list_examples()
+    width = max(len(n) for n, _ in items)
+    for name, what in items:
+        print(f"{name:<{width}}  {what}")
+    print(f"# {len(items)} examples in {examples_root()}; copy one with "
+          "`openmotion examples NAME [--to DIR]`", file=sys.stderr)
+    return 0
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from .program.runjob import run_job
 
@@ -197,6 +212,10 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("config", formatter_class=_FMT,
                        help="validate a machine file and print the resolved machine")
     c.add_argument("file", nargs="?", help="TOML machine file (default: the XYZU table)")
+    e = sub.add_parser("examples", formatter_class=_FMT,
+                       help="list the example programs and machine files, or copy one out")
+    e.add_argument("name", nargs="?", help="example to copy (e.g. gcode/bolt_circle.ngc)")
+    e.add_argument("--to", default=".", help="folder to copy it into")
     r = sub.add_parser("run", formatter_class=_FMT,
                        help="run a G-code program or point table on the simulated machine, "
                        "print a summary and write an HTML report")
@@ -216,7 +235,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     handler = {"profile": cmd_profile, "demo": cmd_demo, "config": cmd_config,
-               "run": cmd_run}[args.command]
+               "run": cmd_run, "examples": cmd_examples}[args.command]
     try:
         return handler(args)
     except (MotionError, OSError) as exc:
