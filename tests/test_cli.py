@@ -168,3 +168,11 @@ def test_ctrl_c_stops_decelerating_with_partial_report(tmp_path):
     assert (tmp_path / "long.html").exists()
     dist = float(out.split("distance")[1].split()[0])
     assert 0 < dist < 100  # stopped inside the first move
+
+
+def test_point_table_without_letters_names_the_file(tmp_path, capsys):
+    t = tmp_path / "pts.toml"
+    t.write_text('[[point]]\nposition = [1, 2]\n')
+    assert main(["run", str(t), "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "pts.toml" in err and "letters" in err
