@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 
@@ -16,6 +18,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    if config.getoption("--long"):
+        os.environ["OPENMOTION_LONG"] = "1"  # read by tests/longrun.py at import time
     config.addinivalue_line("markers", "long: a heavy run, reduced unless --long is given")
 
 

@@ -5,6 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from longrun import size
 from openmotion.control.motion import ActiveMotion
 from openmotion.profile.pcl import MoveSpec
 from openmotion.profile.velocity import velocity_move
@@ -25,7 +26,7 @@ def cubic(piece, s):
     period=st.sampled_from([0.001, 0.002, 0.01]),
     t_start=st.floats(0, 100),
 )
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=size(15, 60), deadline=None)
 def test_pieces_hit_the_profile_at_every_cycle_end(distance, str_vel, max_vel, tacc, tdec,
                                                    shape, period, t_start):
     spec = MoveSpec(shape, str_vel, max_vel, tacc, tdec)

@@ -327,7 +327,7 @@ def test_soft_limits_caught_before_motion():
     # the arc's end points are inside but its bulge is not
     opts2 = GCodeOptions(axes={"X": 0, "Y": 1}, soft_limits=[(-1, 100), (-5, 100)])
     e = err("G0 X10\nG2 X30 I10 F100\nG3 X10 I-10 F100\nG3 X30 I10 F100", opts2)
-    assert e.line == 4 and "machine axis 1" in str(e) and "< min -5" in str(e)
+    assert e.line == 4 and "Y would reach machine" in str(e) and "< min -5" in str(e)
     e = err("G0 X5\nG3 X5 Y0 I10 F100\n", GCodeOptions(axes={"X": 0, "Y": 1},
                                                        soft_limits=[(0, 30), (-9, 9)]))
     assert e.line == 2

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from helpers import finish_group, table_without_mel
+from longrun import size
 from openmotion.control import Controller, pulse_accuracy
 from openmotion.control import pathexec as px
 from openmotion.control.group import Group, GroupState
@@ -310,7 +311,7 @@ def test_command_queued_while_braking_stops_exactly_at_the_corner():
     assert g.position.tolist() == [3000.0, 5000.0]
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=size(3, 10), deadline=None)
 @given(st.lists(st.tuples(st.floats(0.02, 0.6), st.floats(5.0, 200.0)), min_size=1,
                 max_size=3), st.booleans())
 def test_overrides_and_holds_at_random_times_keep_path_limits_and_end(events, with_hold):

@@ -237,8 +237,17 @@ class Interpreter:
             o = b.oword
             modal.line = b.line
             if o is None:
-                if not modal.execute(b, out):
-                    break
+                try:
+                    if not modal.execute(b, out):
+                        break
+                except GCodeError as exc:
+                    if len(frames) == 1:
+                        raise
+                    calls = ", ".join(
+                        f"o{f.label.lower()} called at line {blocks[f.return_to - 1].line}"
+                        for f in reversed(frames[1:]))
+                    raise GCodeError(f"{exc.reason} (in {calls})", exc.line, exc.column,
+                                     exc.word, exc.file) from None
                 req = modal.flow_request
                 if req is None:
                     pc += 1

@@ -190,11 +190,32 @@ class Modal:
             if lim is None:
                 continue
             if lo[ax] < lim[0] - 1e-9 * max(1.0, abs(lim[0])):
-                raise b.error(f"move beyond soft limit: machine axis {ax} would reach "
-                              f"{lo[ax]:.6g} < min {lim[0]:g}", pos, word)
+                raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
+                              f"machine {lo[ax]:.6g} < min {lim[0]:g}"
+                              f"{self._offset_note(ax)}", pos, word)
             if hi[ax] > lim[1] + 1e-9 * max(1.0, abs(lim[1])):
-                raise b.error(f"move beyond soft limit: machine axis {ax} would reach "
-                              f"{hi[ax]:.6g} > max {lim[1]:g}", pos, word)
+                raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
+                              f"machine {hi[ax]:.6g} > max {lim[1]:g}"
+                              f"{self._offset_note(ax)}", pos, word)
+
+    def _limit_axis(self, ax: int) -> str:
+        """The program's letter for machine axis `ax` (soft-limit messages)."""
+        names = [L for L, (a, _) in self.letters.items() if a == ax]
+        return names[0] if names else f"machine axis {ax}"
+
+    def _offset_note(self, ax: int) -> str:
+        """' (active offset G55 X-60, G92 X5)': where the program origin of axis `ax` is."""
+        names = [(L, k) for L, (a, k) in self.letters.items() if a == ax]
+        if not names:
+            return ""
+        letter, k = names[0]
+        system = {v: f"G{c // 10}" + (f".{c % 10}" if c % 10 else "")
+                  for c, v in COORD_SYSTEMS.items()}[self.coord]
+        work = self.params.numbers[5221 + 20 * (self.coord - 1) + k]
+        note = f" (active offset {system} {letter}{work:g}"
+        if self.g92[k]:
+            note += f", G92 {letter}{self.g92[k]:g}"
+        return note + ")"
 
     # -- evaluation ------------------------------------------------------------------
     def evaluate(self, b: Block, v: Value, word: str = "") -> float:

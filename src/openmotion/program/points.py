@@ -168,7 +168,12 @@ class PointTable:
             unknown = set(data) - {"letters", "point"}
             if unknown:
                 raise MotionError(f"{p}: unknown keys {sorted(unknown)}")
-            table = cls(str(data.get("letters", "")))
+            if "letters" not in data:
+                raise MotionError(f'{p}: a point table needs letters = "XY.." (its axes)')
+            try:
+                table = cls(str(data["letters"]))
+            except MotionError as err:
+                raise MotionError(f"{p}: {err}") from None
             for k, q in enumerate(data.get("point", [])):
                 bad = set(q) - {"name", "position", "speed", "kind"}
                 if bad:
@@ -185,7 +190,10 @@ class PointTable:
             if not rows or len(rows[0]) < 4 or rows[0][0] != "name" \
                     or rows[0][-2:] != ["speed", "kind"]:
                 raise MotionError(f"{p}: header must be name,<letters>,speed,kind")
-            table = cls("".join(rows[0][1:-2]))
+            try:
+                table = cls("".join(rows[0][1:-2]))
+            except MotionError as err:
+                raise MotionError(f"{p}: header columns: {err}") from None
             for k, row in enumerate(rows[1:], start=2):
                 try:
                     if len(row) != len(rows[0]):

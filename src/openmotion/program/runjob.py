@@ -1,7 +1,7 @@
 """`openmotion run PROGRAM`: run a program on the simulated machine, summary + HTML report.
 
-Virtual time by default (as fast as the simulation goes) with a text progress bar on
-stderr for jobs longer than a few seconds of machine time; `--realtime` paces the
+Virtual time by default (as fast as the simulation goes) with a progress line on stderr
+when it is a terminal (progress.py: executed line, machine time, %, ETA); `--realtime` paces the
 controller to the wall clock on its thread. A point table (.toml/.csv) runs its points in
 table order.
 """
@@ -10,59 +10,124 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import re
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
 from ..errors import MotionError
 from .points import PointTable
+from .progress import RunProgress
 from .report import format_summary, summarize, write_report
 from .runner import ProgramRunner, RunOptions, RunState
 
 #: Controller time (s) between progress updates in virtual time.
-_CHUNK = 1.0
+_CHUNK = 0.25
 
 
 def run_job(args: argparse.Namespace) -> int:
-    """The `run` subcommand; returns the exit code (0 done, 1 fault/abort)."""
-    from ..config import default_machine, load_machine
+    """The `run` subcommand; returns the exit code (0 done, 1 fault/abort, 130 Ctrl-C: the
+    axes decelerate along the path, the summary and report cover what ran)."""
+    from ..config import default_machine
     from ..control import Controller
 
     if isinstance(args.repeat, bool) or not isinstance(args.repeat, int) or args.repeat < 1:
         raise MotionError(f"--repeat must be an integer >= 1, got {args.repeat!r}")
-    cfg = load_machine(args.machine) if args.machine else default_machine()
+    acc_time = getattr(args, "acc_time", 0.05)
+    if not (isinstance(acc_time, float | int) and 0.0 < acc_time < 1e3):
+        raise MotionError(f"--acc-time must be in (0, 1000) s, got {acc_time!r}")
+    override = getattr(args, "feed_override", 100.0)
+    if not (isinstance(override, float | int) and 1.0 <= override <= 200.0):
+        raise MotionError(f"--feed-override must be in [1, 200] %, got {override!r}")
+    cfg = load_machine_arg(args.machine, "--machine") if args.machine else default_machine()
+    path = Path(args.program)
+    if not path.is_file():
+        raise MotionError(f"program {str(path)!r}: no such file")
     ctl = Controller(cfg)
     ctl.enable_all()
-    path = Path(args.program)
     if path.suffix in (".toml", ".csv"):
         table = PointTable.load(path)
         program: object = table.to_gcode(range(len(table)))
+        sets_g54 = False
     else:
         program = path
-    params = work_origin(ctl)
-    run = ProgramRunner(ctl, program, options=RunOptions(repeat=args.repeat),  # type: ignore[arg-type]
+        sets_g54 = sets_work_offset(path.read_text(encoding="utf-8", errors="replace"))
+    params = {} if sets_g54 else work_origin(ctl)
+    run = ProgramRunner(ctl, program,  # type: ignore[arg-type]
+                        options=RunOptions(repeat=args.repeat, acc_time=float(acc_time)),
                         file=str(path), gcode={"parameters": params})
+    if not run.ops:
+        raise MotionError(f"{path}: the program holds no moves or actions, nothing to run")
     if params:
         print("G54 origin at the middle of the travel: " + ", ".join(
             f"#{k} = {v:g}" for k, v in sorted(params.items())), file=sys.stderr)
     print(f"{path}: {len(run.commands)} commands, {len(run.ops)} moves/actions on "
-          f"{''.join(run.letters)} of machine '{cfg.name}'", file=sys.stderr)
+          f"{''.join(run.letters)} of machine '{cfg.name}', acceleration time "
+          f"{acc_time:g} s, feed override {override:g} %", file=sys.stderr)
     run.start()
-    if args.realtime:
-        with ctl.start_realtime():
-            while run.state is RunState.RUNNING:
-                time.sleep(0.05)
-                _progress(run)
-    else:
-        while run.state is RunState.RUNNING:
-            ctl.run_until(lambda: run.state is not RunState.RUNNING, _CHUNK)
-            _progress(run)
-    print(file=sys.stderr)
+    if override != 100.0 and run.group is not None:
+        run.group.set_override(float(override))  # before the first cycle: the whole job
+    bar = RunProgress(ctl, run)
+    with _CtrlC() as stop:
+        _drive(ctl, run, stop, args.realtime, bar)
+        if stop.pressed and run.state in (RunState.RUNNING, RunState.PAUSED):
+            line = run.current_line
+            run.abort()  # decelerating stop along the path
+            _settle(ctl, run, args.realtime)
+            bar.close()
+            print(f"aborted at line {line} (Ctrl-C) after {ctl.time - run.t_start:.3f} s of "
+                  "machine time; the axes stopped along the path", file=sys.stderr)
+    bar.close()
     summary = summarize(run)
     print(format_summary(summary))
+    bar.status("writing the report ...")
     report = write_report(run, args.out, path.stem)
     print(f"report: {report}")
+    if stop.pressed:
+        return 130
     return 0 if run.state is RunState.DONE else 1
+
+
+def load_machine_arg(path: str, what: str):
+    """load_machine with messages naming the flag or argument `what` (no raw [Errno 2]), and
+    refusing a machine without axes (nothing could run on it)."""
+    from ..config import load_machine
+
+    try:
+        cfg = load_machine(path)
+    except FileNotFoundError:
+        raise MotionError(f"{what} {path!r}: no such file") from None
+    except IsADirectoryError:
+        raise MotionError(f"{what} {path!r} is a folder, not a TOML machine file") from None
+    except OSError as exc:
+        raise MotionError(f"{what} {path!r}: cannot read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError:
+        raise MotionError(f"{what} {path!r} is not a UTF-8 TOML text file") from None
+    if not cfg.axes:
+        raise MotionError(f"{os.fspath(path)}: the machine has no axes (add an [axes.<name>] "
+                          "table per axis)")
+    return cfg
+
+
+_COMMENT = re.compile(r"\([^)]*\)|;.*")
+_G54_WRITE = re.compile(r"#\s*522[1-9]\s*=")
+_G10 = re.compile(r"G0*10(?![\d.])")
+_L = re.compile(r"L0*(2|20)(?![\d.])")
+_P = re.compile(r"P0*([01])(?![\d.])")
+
+
+def sets_work_offset(text: str) -> bool:
+    """True when a G-code program sets the G54 origin itself (G10 L2/L20 P1 or P0, or
+    #5221..#5229 = ...), so the runner must not put its own there."""
+    for raw in text.upper().splitlines():
+        line = _COMMENT.sub("", raw).replace(" ", "")
+        if _G54_WRITE.search(line) or (_G10.search(line) and _L.search(line)
+                                       and _P.search(line)):
+            return True
+    return False
 
 
 def work_origin(ctl) -> dict[int, float]:
@@ -84,9 +149,53 @@ def work_origin(ctl) -> dict[int, float]:
     return out
 
 
-def _progress(run: ProgramRunner) -> None:
-    width = 30
-    done = int(run.progress * width)
-    n = min(run.passes_done + 1, run.options.repeat)
-    print(f"\r[{'#' * done}{'.' * (width - done)}] pass {n}/"
-          f"{run.options.repeat} line {run.current_line}", end="", file=sys.stderr)
+class _CtrlC:
+    """While active, the first Ctrl-C (SIGINT) only sets `pressed` so the job can stop
+    cleanly between controller cycles; a second one interrupts at once."""
+
+    def __init__(self) -> None:
+        self.pressed = False
+        self._old: object = None
+
+    def _handler(self, signum: int, frame: object) -> None:
+        if self.pressed:
+            raise KeyboardInterrupt
+        self.pressed = True
+
+    def __enter__(self) -> _CtrlC:
+        if threading.current_thread() is threading.main_thread():
+            self._old = signal.signal(signal.SIGINT, self._handler)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._old is not None:
+            signal.signal(signal.SIGINT, self._old)  # type: ignore[arg-type]
+
+
+def _drive(ctl, run: ProgramRunner, stop: _CtrlC, realtime: bool, bar: RunProgress) -> None:
+    """Run the controller until the program ends or Ctrl-C is pressed."""
+    if realtime:
+        with ctl.start_realtime():
+            while run.state is RunState.RUNNING and not stop.pressed:
+                time.sleep(0.05)
+                bar.update()
+        return
+    while run.state is RunState.RUNNING and not stop.pressed:
+        ctl.run_until(lambda: run.state is not RunState.RUNNING or stop.pressed, _CHUNK)
+        bar.update()
+
+
+def _settle(ctl, run: ProgramRunner, realtime: bool, limit: float = 120.0) -> None:
+    """After abort(): let the group decelerate to rest (at most `limit` s machine time)."""
+    from ..control.group import GroupState
+
+    def at_rest() -> bool:
+        return run.group is None or run.group.state in (GroupState.IDLE, GroupState.ERROR)
+
+    if realtime:
+        with ctl.start_realtime():
+            t_end = time.monotonic() + limit
+            while not at_rest() and time.monotonic() < t_end:
+                time.sleep(0.01)
+    else:
+        ctl.run_until(at_rest, limit)

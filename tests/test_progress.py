@@ -1,0 +1,56 @@
+"""The `openmotion run` progress line: executed (not queued) work, terminal only."""
+
+import io
+
+from openmotion.control import Controller
+from openmotion.program.progress import RunProgress
+from openmotion.program.runner import ProgramRunner, RunState
+
+PROGRAM = "G21 G91 G1 X4 F600\nG1 Y4\nG4 P0.2\nG1 X-4\nM2\n"
+
+
+def _runner():
+    ctl = Controller()
+    ctl.enable_all()
+    return ctl, ProgramRunner(ctl, PROGRAM)
+
+
+def test_fraction_counts_executed_work_not_the_queue():
+    ctl, run = _runner()
+    bar = RunProgress(ctl, run, io.StringIO(), force_terminal=True)
+    run.start()
+    ctl.run_until(lambda: run.current_line == 2, 30)
+    mid = bar.fraction()
+    assert run.progress >= 0.8  # the moves and the dwell are all in the queue ...
+    assert 0.2 < mid < 0.5  # ... but one of three 4 mm moves has run
+    fractions = []
+    while run.state is RunState.RUNNING:
+        ctl.run_until(lambda: run.state is not RunState.RUNNING, 0.1)
+        fractions.append(bar.fraction())
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    bar.close()
+
+
+def test_terminal_shows_line_machine_time_percent_eta():
+    ctl, run = _runner()
+    out = io.StringIO()
+    bar = RunProgress(ctl, run, out, force_terminal=True)
+    run.start()
+    ctl.run_until(lambda: run.current_line == 4, 30)
+    bar.update()
+    text = out.getvalue()
+    assert "line      4" in text and "machine " in text and "%" in text and "ETA" in text
+    bar.close()
+
+
+def test_silent_when_not_a_terminal():
+    ctl, run = _runner()
+    out = io.StringIO()
+    bar = RunProgress(ctl, run, out)
+    assert not bar.enabled
+    run.start()
+    run.wait(30)
+    bar.update()
+    bar.status("writing the report ...")
+    bar.close()
+    assert out.getvalue() == ""
