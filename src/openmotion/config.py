@@ -88,7 +88,7 @@ def _bool(path: str, value: Any) -> bool:
 
 
 def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
-    if value not in choices:
+    if not isinstance(value, str) or value not in choices:
         raise MotionError(f"{path} must be one of {', '.join(choices)}; got {value!r}")
     return value
 

@@ -63,9 +63,11 @@ class AxisUnits:
 
     def __post_init__(self) -> None:
         check_positive(f"axes.{self.axis}.pulses_per_unit", self.pulses_per_unit)
-        if self.sign not in (1, -1):
+        if isinstance(self.sign, bool) or not isinstance(self.sign, int) \
+                or self.sign not in (1, -1):
             raise MotionError(f"axes.{self.axis}.sign must be 1 or -1, got {self.sign!r}")
-        if not self.max_speed > 0:
+        if not isinstance(self.max_speed, int | float) or isinstance(self.max_speed, bool) \
+                or math.isnan(self.max_speed) or not self.max_speed > 0:
             raise MotionError(f"axes.{self.axis}.max_speed must be > 0, got {self.max_speed!r}")
 
     @classmethod

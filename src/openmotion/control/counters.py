@@ -101,7 +101,7 @@ class Counters:
     def set_feedback_source(self, source: str) -> None:
         """HSL_M_set_feedback_src: what the feedback counter counts; its value carries on
         from where it was (no jump)."""
-        if source not in ("external", "internal"):
+        if not isinstance(source, str) or source not in ("external", "internal"):
             raise MotionError(f"source must be 'external' or 'internal', got {source!r}")
         self._fresh()
         before = self._encoder + self._fb_off

@@ -28,7 +28,7 @@ class GroupSettings(GroupChecks):
         """Which limit switches stop the moving group (MCC_EnableLimitSwitchCheck):
         "direction" (default, mode 0: the switch ahead of an axis) or "any" (mode 1: any
         engaged switch of a moving axis)."""
-        if mode not in ("direction", "any"):
+        if not isinstance(mode, str) or mode not in ("direction", "any"):
             raise MotionError(f"mode must be 'direction' or 'any', got {mode!r}")
         self._limit_any = mode == "any"
 
@@ -133,7 +133,7 @@ class GroupSettings(GroupChecks):
         """"refuse" (default, MCCL): a path command whose feed or acceleration would take an
         axis past its maximum pulse speed/acceleration is refused (ERR_SPEED / ERR_ACCEL);
         "slow": it is accepted and the look-ahead slows the path down to the axis limits."""
-        if policy not in ("refuse", "slow"):
+        if not isinstance(policy, str) or policy not in ("refuse", "slow"):
             raise MotionError(f"policy must be 'refuse' or 'slow', got {policy!r}")
         self._refuse = policy == "refuse"
 
@@ -168,7 +168,7 @@ class GroupSettings(GroupChecks):
         user units/s^3). S paths blend, stream, hold and take overrides like T paths: the
         T plan is smoothed by a moving average of window 2*accel/jerk, its speed caps held
         that much further along the path, exact-stop corners passed at rest."""
-        if shape not in ("T", "S"):
+        if not isinstance(shape, str) or shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
         if shape == "T":
             self._path_jerk = 0.0
@@ -194,14 +194,15 @@ class GroupSettings(GroupChecks):
         r = check_finite("ratio", ratio)
         if not 0.0 < r <= 100.0:
             raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
-        if shape not in ("T", "S"):
+        if not isinstance(shape, str) or shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
         self._ptp_ratio, self._ptp_shapes = r, (shape,) * len(self.axes)
 
     def set_ptp_shapes(self, shapes: Sequence[str]) -> None:
         """MCC_SetPtPAccType per axis: "T" or "S" for each logical axis's PtP profile."""
         if isinstance(shapes, str) or not isinstance(shapes, Sequence) or \
-                len(shapes) != len(self.axes) or any(x not in ("T", "S") for x in shapes):
+                len(shapes) != len(self.axes) or \
+                any(not isinstance(x, str) or x not in ("T", "S") for x in shapes):
             raise MotionError(f"shapes must be {len(self.axes)} of 'T'/'S', got {shapes!r}")
         self._ptp_shapes = tuple(shapes)
 

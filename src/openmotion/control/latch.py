@@ -75,7 +75,7 @@ class Latch:
     def set_edge(self, axis: int | str, edge: str) -> None:
         """Latch on the LTC becoming active ("on", default) or inactive ("off")."""
         i = self.ctl.axis(axis).index
-        if edge not in ("on", "off"):
+        if not isinstance(edge, str) or edge not in ("on", "off"):
             raise MotionError(f"edge must be 'on' or 'off', got {edge!r}")
         self._edge[i] = edge
 

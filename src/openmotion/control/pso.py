@@ -228,7 +228,7 @@ class ZPso:
         self.eng.track_vector(self._vector())
 
     def source(self, axis: int, kind: str) -> None:
-        if kind not in ("dpos", "mpos"):
+        if not isinstance(kind, str) or kind not in ("dpos", "mpos"):
             raise MotionError(f"kind must be 'dpos' or 'mpos', got {kind!r}")
         self._kind[_int("axis", axis, 0, len(self._kind) - 1)] = kind
 

@@ -109,6 +109,10 @@ class GCodeOptions:
                               f"got {len(start)}")
         limits: tuple[tuple[float, float] | None, ...] | None = None
         if self.soft_limits is not None:
+            if isinstance(self.soft_limits, str | bytes) or not hasattr(self.soft_limits,
+                                                                         "__len__"):
+                raise MotionError(f"soft_limits must be a sequence of {n} (lo, hi) or None "
+                                  f"entries, got {self.soft_limits!r}")
             if len(self.soft_limits) != n:
                 raise MotionError(f"soft_limits must have {n} entries (one per machine axis),"
                                   f" got {len(self.soft_limits)}")
