@@ -334,6 +334,8 @@ def every_distance(source: VectorSource, interval: float, action: Action, *,
     if end is not None:
         e = check_finite("end", end)
         if e < s:
-            raise MotionError(f"end must be >= start, got start={s!r}, end={end!r}")
+            what = "start" if start is not None else "start (default: interval)"
+            raise MotionError(f"end must be >= {what}, got start={s!r} (interval={iv!r}), "
+                              f"end={end!r}")
         count = int(math.floor((e - s) / iv * (1 + 1e-12))) + 1
     return LevelJob(source, LevelSeq(s, iv, count), action, direction=1, name="distance")
