@@ -10,6 +10,7 @@ the same test means the program repeats forever, which is refused at once.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from .parser import Block
@@ -31,6 +32,9 @@ def _freeze(v: Any) -> Any:
         return tuple((k, _freeze(x)) for k, x in v.items())
     if isinstance(v, (set, frozenset)):
         return frozenset(v)
+    if dataclasses.is_dataclass(v) and not isinstance(v, type):  # CutterComp, CycleState...
+        return (type(v).__name__,) + tuple(_freeze(getattr(v, f.name))
+                                           for f in dataclasses.fields(v))
     raise _Unfreezable
 
 
