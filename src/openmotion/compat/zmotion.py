@@ -404,13 +404,21 @@ class ZController:
                                ZERR_UNSUPPORTED)
         if mode not in (2, 3):
             raise ZMotionError("RAPIDSTOP", "mode", f"mode must be 2 or 3, got {mode!r}")
+        in_groups: set[int] = set()
         for k, g in list(self._groups.items()):
             if mode == 3:
                 g.close()
                 del self._groups[k]
-            elif g.state is not GroupState.IDLE or g.queue_length:
-                g.abort()
-        self.ctl.stop_all(immediately=mode == 3)
+            else:
+                in_groups.update(k)
+                if g.state is not GroupState.IDLE or g.queue_length:
+                    g.abort()  # the group decelerates its own axes along the path
+        for ax in self.ctl.axes:  # single axes (a direct stop of a group axis would fault it)
+            if ax.index not in in_groups:
+                if mode == 3:
+                    ax.stop_immediately()
+                else:
+                    ax.stop()
 
     @_command("WAIT UNTIL")
     def WAIT_UNTIL(self, condition: Callable[[], bool], timeout: float = 3600.0  # noqa: N802
