@@ -260,3 +260,29 @@ def test_bad_shape_and_max_distance_ok():
         MoveSpec("X", 0, 1, 1, 1)
     prof = trapezoid(-(2**27 - 1), 0, 1e6, 0.1, 0.1)
     assert prof.end.p == -(2**27 - 1)
+
+
+@pytest.mark.parametrize("shape", "TS")
+@pytest.mark.parametrize("dist", [0.001953125, 1e-6, 1e-9, -3e-7])
+def test_sub_pulse_move_plans_with_derived_ramps_under_1ns(shape, dist):
+    """A tiny move's automatic velocity decrease derives Tacc/Tdec far below the 1 ns user
+    minimum; the derived spec is the controller's, so the move plans and ends exactly
+    (CI found sv=391, tacc=5, tdec=1 ms, dist=2^-9 refused with 'tdec must satisfy ...')."""
+    spec = MoveSpec(shape, 391.0, 392.0, 5.0, 0.001)
+    plan = spec.plan(dist)
+    assert plan.reduced
+    assert plan.effective.max_vel >= plan.effective.str_vel
+    assert plan.profile.end.p == dist
+    assert plan.profile.end.v == 0.0
+
+
+def test_derived_spec_keeps_the_structural_rules():
+    spec = MoveSpec("S", 0.0, 1000.0, 0.1, 0.1)
+    with pytest.raises(MotionError, match="derived"):
+        spec.derived(tacc=0.0)
+    with pytest.raises(MotionError, match="derived"):
+        spec.derived(max_vel=-1.0)
+    with pytest.raises(MotionError, match="derived"):
+        spec.derived(vs_acc=600.0)
+    tiny = spec.derived(tacc=1e-12)
+    assert tiny.tacc == 1e-12 and tiny.shape == "S" and tiny.max_vel == 1000.0

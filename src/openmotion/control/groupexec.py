@@ -535,9 +535,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         for k, a in enumerate(self.axes):
             spec = cmd.specs[k]
             if self._ptp_override != 1.0:
-                spec = MoveSpec(spec.shape, spec.str_vel,
-                                min(a.max_speed, spec.max_vel * self._ptp_override),
-                                spec.tacc, spec.tdec, spec.vs_acc, spec.vs_dec)
+                spec = spec.derived(
+                    max_vel=min(a.max_speed, spec.max_vel * self._ptp_override))
             if self._dry:
                 profiles.append(planning.position_move(spec, float(start[k]),
                                                        float(target[k])))

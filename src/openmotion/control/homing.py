@@ -258,7 +258,7 @@ class Homing:
         if c.jerk is None:
             spec = MoveSpec("T", 0.0, v, c.tacc, c.tacc, 0.0, 0.0)
             # the speed reached at the homing acceleration, not in Tacc
-            spec = replace(spec, tacc=v / c.accel, tdec=v / c.decel)
+            spec = spec.derived(tacc=v / c.accel, tdec=v / c.decel)
             prof = planning.position_move(spec, p, target)
         else:
             prof = planning.jerk_move(p, target, v, c.accel, c.jerk,

@@ -34,7 +34,7 @@ nothing changes). Axes without the model stay exact.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import InfeasibleError, MotionError, check_finite, check_nonnegative
@@ -150,8 +150,8 @@ def on_range(spec: MoveSpec, fixed: float | None = None) -> MoveSpec:
     ta = rng.ramp_time("tacc", spec.str_vel, spec.max_vel, spec.tacc)
     td = rng.ramp_time("tdec", spec.str_vel, spec.max_vel, spec.tdec)
     half = (mv - sv) / 2.0
-    return replace(spec, str_vel=sv, max_vel=mv, tacc=ta, tdec=td,
-                   vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
+    return spec.derived(str_vel=sv, max_vel=mv, tacc=ta, tdec=td,
+                        vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
 
 
 class SpeedModel:

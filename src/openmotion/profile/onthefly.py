@@ -85,13 +85,14 @@ def _spec_from_rates(spec: MoveSpec, v: float, accel: float, jerk: float,
     s = spec.str_vel
     x = v - s
     if x <= 0.0 or accel <= 0.0:
-        return MoveSpec(spec.shape, s, max(v, s), t_fallback, t_fallback)
+        return spec.derived(max_vel=max(v, s), tacc=t_fallback, tdec=t_fallback,
+                            vs_acc=0.0, vs_dec=0.0)
     t = ramp_time(x, accel, jerk)
     vs = 0.0
     if spec.shape == "S":
         vs = accel * accel / (2.0 * jerk)
         vs = x / 2.0 if vs > x / 2.0 else vs
-    return MoveSpec(spec.shape, s, v, t, t, vs, vs)
+    return spec.derived(max_vel=v, tacc=t, tdec=t, vs_acc=vs, vs_dec=vs)
 
 
 def change_speed(profile: Profile, t: float, spec: MoveSpec, new_vel: float, tacc: float,

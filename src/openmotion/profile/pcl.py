@@ -22,7 +22,7 @@ points that return only the profile.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields
 
 from ..errors import (
     MotionError,
@@ -86,6 +86,30 @@ class MoveSpec:
             vals[name] = vs
         for name, x in vals.items():
             object.__setattr__(self, name, x)
+
+    def derived(self, **changes: float) -> MoveSpec:
+        """This spec with `changes`, computed by the controller rather than given by a user.
+
+        A derived spec (a lowered MaxVel and its shorter ramps, an on-the-fly remainder, a
+        homing phase) is held to the profile's own rules (finite, times > 0, StrVel <= MaxVel,
+        VS within half the span) but not to the user ranges of docs/ranges.md: the
+        automatic velocity decrease of a 0.002-pulse move derives a Tdec under 1 ns, and
+        refusing it would refuse a valid user move.
+        """
+        vals = {f.name: changes.get(f.name, getattr(self, f.name)) for f in fields(self)}
+        sv, mv, ta, td = (float(vals[k]) for k in ("str_vel", "max_vel", "tacc", "tdec"))
+        va, vd = float(vals["vs_acc"]), float(vals["vs_dec"])
+        numbers = (sv, mv, ta, td, va, vd)
+        if not all(math.isfinite(x) for x in numbers) or ta <= 0.0 or td <= 0.0 \
+                or sv < 0.0 or mv < sv or min(va, vd) < 0.0 \
+                or max(va, vd) > (mv - sv) / 2.0 * (1.0 + 1e-12) + 1e-300:
+            raise MotionError(f"derived move parameters are invalid: {vals!r}")
+        new = object.__new__(MoveSpec)
+        for k, x in zip(("str_vel", "max_vel", "tacc", "tdec", "vs_acc", "vs_dec"), numbers,
+                        strict=True):
+            object.__setattr__(new, k, x)
+        object.__setattr__(new, "shape", self.shape)
+        return new
 
     @property
     def rates(self) -> Rates:
@@ -261,17 +285,17 @@ def _reduced_spec(spec: MoveSpec, r: Rates, v: float) -> MoveSpec:
     s = spec.str_vel
     x = v - s
     if x <= 0.0:  # only by rounding, when StrVel dwarfs the distance
-        return replace(spec, max_vel=s, vs_acc=0.0, vs_dec=0.0)
+        return spec.derived(max_vel=s, vs_acc=0.0, vs_dec=0.0)
     tacc = ramp_time(x, r.accel, r.jerk_acc)
     tdec = ramp_time(x, r.decel, r.jerk_dec)
     half = x / 2.0
     if spec.shape == "T":  # VS is ignored by a T-curve; keep it valid
-        return replace(spec, max_vel=v, tacc=tacc, tdec=tdec,
-                       vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
+        return spec.derived(max_vel=v, tacc=tacc, tdec=tdec,
+                            vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
     vs_a = r.accel * r.accel / (2.0 * r.jerk_acc)
     vs_d = r.decel * r.decel / (2.0 * r.jerk_dec)
-    return replace(
-        spec, max_vel=v, tacc=tacc, tdec=tdec,
+    return spec.derived(
+        max_vel=v, tacc=tacc, tdec=tdec,
         vs_acc=spec.vs_acc if vs_a <= half else half,
         vs_dec=spec.vs_dec if vs_d <= half else half,
     )
