@@ -29,6 +29,7 @@ from openmotion.hw.interface import (
     QueueRun,
 )
 
+from . import kernel
 from .cubic import Cubic
 from .encoder import EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
@@ -77,6 +78,9 @@ class SimMachine:
         self.output_record = OutputRecord()  # every output edge at its exact time
         self.scenario = Scenario(self)
         self._queues = [PieceQueue() for _ in self._axes]  # QueuedHardware
+        #: run quiet cycles of `run_cycles` in the compiled kernel (hw/sim/kernel.py) when
+        #: it is built and models every axis; False: every cycle in Python (the reference)
+        self.native = True
 
     # -- Hardware protocol --------------------------------------------------------------------
     @property
@@ -148,6 +152,11 @@ class SimMachine:
                 if edges or k >= stop:
                     break
             first = False
+            if self.native and not self._pending and kernel.usable(self._axes):
+                k, self._t = kernel.run_quiet(self._axes, queues, origin, period, k, stop,
+                                              self._t, self._next_action(), wake)
+                if k >= stop:
+                    break
             k += 1
             edges = self.advance(origin + k * period)
             if edges and (wake is None or any(e.signal in wake for e in edges)
@@ -156,6 +165,13 @@ class SimMachine:
             edges = []
         drained = tuple(i for i, q in enumerate(queues) if had[i] and not q)
         return QueueRun(k, edges, drained)
+
+    def _next_action(self) -> float:
+        """Time of the next scenario action or timed output (inf: none): the kernel
+        stops before the cycle it falls in."""
+        t = self.scenario._heap[0][0] if self.scenario._heap else math.inf
+        timed = self._timed._heap
+        return min(t, timed[0][0]) if timed else t
 
     def _holding(self) -> bool:
         """Nothing moves by itself: steppers only, each holding its command's end."""

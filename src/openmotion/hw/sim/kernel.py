@@ -1,0 +1,161 @@
+"""The compiled stepper pipeline (`_stepkernel`, C) behind `SimMachine.run_cycles`.
+
+`run_quiet` hands the kernel a chunk of cycles as flat arrays over all axes: each axis's
+command, pulse count, losses, load position, decoder state and switches, and its queued
+pieces. The kernel runs the cycles in C with the GIL released and stops before the first
+cycle that has an edge to report, a scenario action or timed output due, or anything else
+it does not model; `SimMachine` runs that cycle through the Python path (simaxis.py), which
+finds the edge's exact time and counts. The state comes back into the `SimAxis` objects,
+so both paths always share one state.
+
+The kernel takes a machine whose axes are all steppers (ideal or stalling) without an
+armed edge stop or a pitch-error table; for any other machine `usable` is False and every
+cycle runs in Python. It is built by the package's own build (setup.py); when the module is
+missing (a source tree that was never built) `AVAILABLE` is False and the Python path runs.
+Set `SimMachine.native = False` to force the Python path (the equivalence tests do).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .cubic import Cubic
+from .plant import StepperPlant
+from .pulses import Stretch
+from .switches import IndexSwitch
+
+try:
+    from . import _stepkernel as _k
+except ImportError:  # pragma: no cover - depends on the build
+    _k = None
+
+if TYPE_CHECKING:
+    from .piecequeue import PieceQueue
+    from .simaxis import SimAxis
+
+AVAILABLE = _k is not None
+
+# field indices, kept in step with _stepkernel.c (checked against its constants below)
+_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 25, 8, 4, 2, 12
+(D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
+ D_UPP) = range(_ND)
+(I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
+ I_TURNF, I_TURNB) = range(11)
+I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD = 11, 16, 21, 22, 23, 24
+if _k is not None:
+    assert (_k.ND, _k.NI, _k.MAXSW, _k.NSD, _k.NSI, _k.NREC) == (
+        _ND, _NI, _MAXSW, _NSD, _NSI, _NREC), "_stepkernel layout differs from kernel.py"
+
+
+def usable(axes: list[SimAxis]) -> bool:
+    """True when the kernel models every axis (steppers, nothing armed, no pitch table)."""
+    if _k is None:
+        return False
+    for ax in axes:
+        if (type(ax.plant) is not StepperPlant or ax.armed or ax.trans.pitch.e
+                or len(ax.switches) > _MAXSW):
+            return False
+    return True
+
+
+def _wakes(name: str, switches: dict, wake: Collection[str] | None) -> bool:
+    if wake is None or name in wake:
+        return True
+    return name == "sd" and "ltc" not in switches and "ltc" in wake
+
+
+def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, period: float,
+              start: int, stop: int, now: float, limit: float,
+              wake: Collection[str] | None) -> tuple[int, float]:
+    """Run cycles start+1 .. at most stop in the kernel; returns (cycle reached, time).
+
+    Stops before the first cycle ending at or after `limit` or with an edge on a `wake`
+    signal; the state of every axis (and the pieces started) is written back."""
+    n = len(axes)
+    ad = np.zeros((n, _ND))
+    ai = np.zeros((n, _NI), dtype=np.int64)
+    sd = np.zeros((n, _MAXSW, _NSD))
+    si = np.zeros((n, _MAXSW, _NSI), dtype=np.int64)
+    flat: list[float] = []
+    names: list[list[str]] = []
+    recording = False
+    for x, ax in enumerate(axes):
+        g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
+        c = g.cubic
+        ad[x] = (c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
+                 tr.backlash, tr.z, ax.y, dec.upp)
+        row = ai[x]
+        row[:11] = (g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
+                    dec.count, dec.period, len(ax.switches), dec.turn[1], dec.turn[-1])
+        row[I_FWD:I_FWD + dec.period + 1] = dec.fwd_pre
+        row[I_BWD:I_BWD + dec.period + 1] = dec.bwd_pre
+        begin = len(flat) // 6
+        for p in queues[x].pieces:
+            flat += (p.t0, p.dt, p.p0, p.v0, p.a0, p.j)
+        row[I_PBEGIN] = row[I_CURSOR] = begin
+        row[I_PEND] = len(flat) // 6
+        row[I_RECORD] = g.record is not None
+        recording = recording or g.record is not None
+        nm = list(ax.switches)
+        names.append(nm)
+        for s, name in enumerate(nm):
+            sw = ax.switches[name]
+            if type(sw) is IndexSwitch:
+                sd[x, s] = (1.0, sw.period, sw.width, 0.0)
+            else:
+                sd[x, s] = (0.0, sw.lo, sw.hi, sw.hyst)
+            si[x, s] = (sw.active, _wakes(name, ax.switches, wake))
+    pieces = np.array(flat, dtype=float).reshape(-1, 6) if flat else np.zeros((0, 6))
+    popt = np.zeros(len(pieces))
+    cap = (stop - start) * n * 8 + 16 if recording else 0
+    rows = np.zeros((cap, _NREC))
+    k, t, used = _k.run(ad, ai, sd, si, pieces, popt, rows, float(origin), float(period),
+                        int(start), int(stop), float(now), float(limit))
+    if k == start:
+        return k, now
+    _write_back(axes, queues, ad, ai, si, pieces, popt, rows[:used], names)
+    return k, t
+
+
+def _write_back(axes: list[SimAxis], queues: list[PieceQueue], ad: np.ndarray,
+                ai: np.ndarray, si: np.ndarray, pieces: np.ndarray, popt: np.ndarray,
+                rows: np.ndarray, names: list[list[str]]) -> None:
+    adl, ail, sil = ad.tolist(), ai.tolist(), si.tolist()
+    pcl = pieces.tolist()
+    ptl = popt.tolist()
+    per_axis: list[list[list[float]]] = [[] for _ in axes]
+    for r in rows.tolist():
+        per_axis[int(r[0])].append(r)
+    for x, ax in enumerate(axes):
+        d, i = adl[x], ail[x]
+        g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
+        begin, cursor = i[I_PBEGIN], i[I_CURSOR]
+        rec = g.record
+        if cursor > begin:
+            q = queues[x].pieces
+            for m in range(begin, cursor):
+                q.popleft()
+                if rec is not None:
+                    t0, dt, p0, v0, a0, j = pcl[m]
+                    rec.command(ptl[m], Cubic(p0, v0, a0, j), t0, t0 + dt)
+            g.cubic = Cubic(d[D_P0], d[D_V0], d[D_A0], d[D_J])
+            g.tc, g.te = d[D_TC], d[D_TE]
+        g.count = i[I_COUNT]
+        plant.lost = i[I_LOST]
+        tr.z = d[D_Z]
+        ax.y = d[D_Y]
+        dec.q, dec.last_dir, dec.count = i[I_Q], i[I_LASTDIR], i[I_DCOUNT]
+        for s, name in enumerate(names[x]):
+            ax.switches[name].active = bool(sil[x][s][0])
+        if rec is not None:
+            half = g.half
+            for r in per_axis[x]:
+                _, kind, t0, t1, tc, p0, v0, a0, j, dr, c0, c1 = r
+                cub = Cubic(p0, v0, a0, j) if kind else None
+                rec.add(Stretch(t0, t1, cub, tc, int(dr), int(c0), int(c1)), half)
+        ax.stop_time = None
+        ax.record = []
+        ax.run_start = (tr.z, (dec.q, dec.last_dir, dec.count))
