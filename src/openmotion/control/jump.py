@@ -30,7 +30,9 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from ..hw.interface import AxisCommand, QueuedHardware
+import numpy as np
+
+from ..hw.interface import PieceBlock, QueuedHardware
 
 if TYPE_CHECKING:
     from .controller import Controller
@@ -108,26 +110,19 @@ def jump(ctl: Controller, land: int) -> None:
     n = ctl._n
     t0 = ctl._time
     chunk = FIRST_CHUNK
-    ends: list[list[tuple[float, float]]] = []
+    ends: list[np.ndarray] = []
     while True:
         stop = min(land, n + chunk)
         ends = []
+        t1 = origin + np.arange(n + 1, stop + 1) * period  # cycle ends, as `step` has them
         for ax in movers:
             m = ax._motion
             assert m is not None
-            pieces = []
-            p1v1 = []
-            t_end = m.t_end
-            velocity = m.kind == "velocity"
-            ta = t0
-            for k in range(n + 1, stop + 1):
-                t1 = origin + k * period
-                p0, v0, a0, j, p1, v1 = m.piece(ta, t1)
-                pieces.append(AxisCommand(ta, t1 - ta, p0, v0, a0, j))
-                p1v1.append((p1, v1 if t1 < t_end or velocity else 0.0))
-                ta = t1
+            rows, p1v1 = m.pieces(t0, origin, period, n, stop - n)
+            if m.kind != "velocity":  # a move settles at its end: velocity 0 from t_end on
+                p1v1[t1 >= m.t_end, 1] = 0.0
             try:
-                hw.queue_pieces(ax.index, pieces)
+                hw.queue_pieces(ax.index, PieceBlock(rows))
             except BaseException:
                 for other in movers:  # nothing half-queued stays behind
                     hw.clear_queue(other.index)
@@ -141,7 +136,7 @@ def jump(ctl: Controller, land: int) -> None:
         chunk = min(2 * chunk, MAX_CHUNK)
     k = run.cycle
     for ax, p1v1 in zip(movers, ends, strict=True):
-        ax._pos, ax._vel = p1v1[k - n - 1]
+        ax._pos, ax._vel = p1v1[k - n - 1].tolist()
         if k < stop:
             hw.clear_queue(ax.index)
     ctl._finish_cycle(k, run.edges)

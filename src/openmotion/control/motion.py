@@ -21,9 +21,16 @@ from __future__ import annotations
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile
 from .states import MotionDone
+
+try:  # the compiled inner loops (setup.py builds them; absent in an unbuilt source tree)
+    from .. import _kernel
+except ImportError:  # pragma: no cover - depends on the build
+    _kernel = None
 
 #: Motion kinds. velocity: runs until changed or stopped (ContinuousMotion); relative,
 #: absolute, jerk (jerk-limited) and profile (an external Profile, `Axis.run_profile`): end
@@ -49,6 +56,8 @@ class ActiveMotion:
     _a0: list[float] = field(init=False, repr=False)
     _j: list[float] = field(init=False, repr=False)
     _k: int = field(init=False, default=0, repr=False)
+    _seg_array: np.ndarray | None = field(init=False, default=None, repr=False)
+    _left_end: float = field(init=False, default=0.0, repr=False)
 
     def __post_init__(self) -> None:
         if not self.v_range and self.spec is not None:
@@ -142,6 +151,33 @@ class ActiveMotion:
         a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
         j = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
         return p0, v0, a0, j, p1, v1
+
+    def pieces(self, t0: float, origin: float, period: float, n: int, m: int
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """`piece` for the m cycles n+1 .. n+m at once (cycle k ends at origin + k * period,
+        the first starts at t0): rows (t0, dt, p0, v0, a0, j) and ends (p1, v1), the very
+        floats `piece` gives one cycle at a time. The compiled kernel (openmotion._kernel)
+        computes them when it is built; otherwise `piece` runs per cycle."""
+        rows = np.empty((m, 6))
+        ends = np.empty((m, 2))
+        if _kernel is not None:
+            if self._seg_array is None:
+                pr = self.profile
+                self._seg_array = np.ascontiguousarray(
+                    np.stack([pr.t0, pr.p0, pr.v0, pr.a0, pr.j]), dtype=float)
+                self._left_end = self._left(pr.duration)[1] if self._t0 else 0.0
+            end = self.profile.end
+            _kernel.pieces(self._seg_array, self.t_start, self.profile.duration, end.p, end.v,
+                           self._left_end, t0, origin, period, n, rows, ends)
+            return rows, ends
+        ta = t0
+        for i in range(m):
+            t1 = origin + (n + 1 + i) * period
+            p0, v0, a0, j, p1, v1 = self.piece(ta, t1)
+            rows[i] = (ta, t1 - ta, p0, v0, a0, j)
+            ends[i] = (p1, v1)
+            ta = t1
+        return rows, ends
 
     def done_code(self, t: float) -> int:
         """HSL motion_done code while this motion runs (seed-facts 2.5)."""

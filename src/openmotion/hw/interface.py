@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 #: Names of the per-axis motion input signals (HSL-4XMO chapter 3).
 AXIS_INPUTS = ("pel", "mel", "org", "sd", "ltc", "ez", "alm", "inp", "rdy")
@@ -151,6 +151,15 @@ class TimedOutputHardware(Protocol):
         t in the past or a bad signal/level; nothing is scheduled then."""
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class PieceBlock:
+    """Many timed pieces at once: `rows` is an (n, 6) float array (numpy), row k the piece
+    AxisCommand(*rows[k]) = (t0, dt, p0, v0, a0, j). The planner hands a whole chunk of
+    cycles across the boundary this way, without one Python object per piece."""
+
+    rows: Any
+
+
 @dataclass(frozen=True, slots=True)
 class QueueRun:
     """What `QueuedHardware.run_cycles` reports: the cycle it stopped at (its end time is
@@ -177,8 +186,9 @@ class QueuedHardware(Protocol):
     control layer for now (a back end may add it as a further capability).
     """
 
-    def queue_pieces(self, axis: int, pieces: Sequence[AxisCommand]) -> None:
-        """Append pieces to the queue of `axis`: each an AxisCommand with finite fields,
+    def queue_pieces(self, axis: int, pieces: Sequence[AxisCommand] | PieceBlock) -> None:
+        """Append pieces to the queue of `axis` (a sequence of AxisCommand, or a PieceBlock
+        of arrays), each with finite fields,
         dt >= 0, t0 >= the hardware time, t0 >= the end of the piece queued before it.
         MotionError naming the piece and the rule otherwise; the queue is unchanged then."""
 

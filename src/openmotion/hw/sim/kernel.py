@@ -1,4 +1,4 @@
-"""The compiled stepper pipeline (`_stepkernel`, C) behind `SimMachine.run_cycles`.
+"""The compiled stepper pipeline (`openmotion._kernel.run`, C) behind `SimMachine.run_cycles`.
 
 `run_quiet` hands the kernel a chunk of cycles as flat arrays over all axes: each axis's
 command, pulse count, losses, load position, decoder state and switches, and its queued
@@ -28,7 +28,7 @@ from .pulses import Stretch
 from .switches import IndexSwitch
 
 try:
-    from . import _stepkernel as _k
+    from openmotion import _kernel as _k
 except ImportError:  # pragma: no cover - depends on the build
     _k = None
 
@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
 AVAILABLE = _k is not None
 
-# field indices, kept in step with _stepkernel.c (checked against its constants below)
+# field indices, kept in step with _kernel.c (checked against its constants below)
 _ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 25, 8, 4, 2, 12
 (D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
  D_UPP) = range(_ND)
@@ -47,7 +47,7 @@ _ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 25, 8, 4, 2, 12
 I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD = 11, 16, 21, 22, 23, 24
 if _k is not None:
     assert (_k.ND, _k.NI, _k.MAXSW, _k.NSD, _k.NSI, _k.NREC) == (
-        _ND, _NI, _MAXSW, _NSD, _NSI, _NREC), "_stepkernel layout differs from kernel.py"
+        _ND, _NI, _MAXSW, _NSD, _NSI, _NREC), "_kernel.c layout differs from kernel.py"
 
 
 def usable(axes: list[SimAxis]) -> bool:
@@ -79,7 +79,8 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
     ai = np.zeros((n, _NI), dtype=np.int64)
     sd = np.zeros((n, _MAXSW, _NSD))
     si = np.zeros((n, _MAXSW, _NSI), dtype=np.int64)
-    flat: list[float] = []
+    blocks: list[np.ndarray] = []
+    total = 0
     names: list[list[str]] = []
     recording = False
     for x, ax in enumerate(axes):
@@ -92,11 +93,11 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
                     dec.count, dec.period, len(ax.switches), dec.turn[1], dec.turn[-1])
         row[I_FWD:I_FWD + dec.period + 1] = dec.fwd_pre
         row[I_BWD:I_BWD + dec.period + 1] = dec.bwd_pre
-        begin = len(flat) // 6
-        for p in queues[x].pieces:
-            flat += (p.t0, p.dt, p.p0, p.v0, p.a0, p.j)
-        row[I_PBEGIN] = row[I_CURSOR] = begin
-        row[I_PEND] = len(flat) // 6
+        block = queues[x].remaining()
+        row[I_PBEGIN] = row[I_CURSOR] = total
+        total += len(block)
+        row[I_PEND] = total
+        blocks.append(block)
         row[I_RECORD] = g.record is not None
         recording = recording or g.record is not None
         nm = list(ax.switches)
@@ -108,7 +109,7 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
             else:
                 sd[x, s] = (0.0, sw.lo, sw.hi, sw.hyst)
             si[x, s] = (sw.active, _wakes(name, ax.switches, wake))
-    pieces = np.array(flat, dtype=float).reshape(-1, 6) if flat else np.zeros((0, 6))
+    pieces = np.concatenate(blocks) if total else np.zeros((0, 6))
     popt = np.zeros(len(pieces))
     cap = (stop - start) * n * 8 + 16 if recording else 0
     rows = np.zeros((cap, _NREC))
@@ -124,8 +125,9 @@ def _write_back(axes: list[SimAxis], queues: list[PieceQueue], ad: np.ndarray,
                 ai: np.ndarray, si: np.ndarray, pieces: np.ndarray, popt: np.ndarray,
                 rows: np.ndarray, names: list[list[str]]) -> None:
     adl, ail, sil = ad.tolist(), ai.tolist(), si.tolist()
-    pcl = pieces.tolist()
-    ptl = popt.tolist()
+    recording = any(ax.gen.record is not None for ax in axes)
+    pcl = pieces.tolist() if recording else []
+    ptl = popt.tolist() if recording else []
     per_axis: list[list[list[float]]] = [[] for _ in axes]
     for r in rows.tolist():
         per_axis[int(r[0])].append(r)
@@ -135,10 +137,9 @@ def _write_back(axes: list[SimAxis], queues: list[PieceQueue], ad: np.ndarray,
         begin, cursor = i[I_PBEGIN], i[I_CURSOR]
         rec = g.record
         if cursor > begin:
-            q = queues[x].pieces
-            for m in range(begin, cursor):
-                q.popleft()
-                if rec is not None:
+            queues[x].consume(cursor - begin)
+            if rec is not None:
+                for m in range(begin, cursor):
                     t0, dt, p0, v0, a0, j = pcl[m]
                     rec.command(ptl[m], Cubic(p0, v0, a0, j), t0, t0 + dt)
             g.cubic = Cubic(d[D_P0], d[D_V0], d[D_A0], d[D_J])

@@ -26,6 +26,7 @@ from openmotion.hw.interface import (
     AxisCommand,
     AxisReadback,
     InputEdge,
+    PieceBlock,
     QueueRun,
 )
 
@@ -112,9 +113,10 @@ class SimMachine:
                        t0, t0 + float(cmd.dt), self._t)
 
     # -- QueuedHardware -------------------------------------------------------------------------
-    def queue_pieces(self, axis: int, pieces: Sequence[AxisCommand]) -> None:
-        """Append timed pieces to the queue of `axis` (hw.interface.QueuedHardware); each
-        becomes the pulse generator's command at its t0, as `command` would make it."""
+    def queue_pieces(self, axis: int, pieces: Sequence[AxisCommand] | PieceBlock) -> None:
+        """Append timed pieces (AxisCommands or a PieceBlock of arrays) to the queue of
+        `axis` (hw.interface.QueuedHardware); each becomes the pulse generator's command at
+        its t0, as `command` would make it."""
         self._queues[self._axis(axis).index].extend(pieces, self._t)
 
     def clear_queue(self, axis: int) -> None:
@@ -179,7 +181,7 @@ class SimMachine:
             return False
         t = self._t
         for ax, q in zip(self._axes, self._queues, strict=True):
-            if ax.is_servo or ax.is_dc or ax.gen.te > t or q.pieces:
+            if ax.is_servo or ax.is_dc or ax.gen.te > t or len(q):
                 return False
         return True
 
@@ -209,14 +211,14 @@ class SimMachine:
         if t < self._t:
             raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
         queues = self._queues
-        if not any(q.pieces for q in queues):
+        if not any(len(q) for q in queues):
             return self._advance(t)
         edges: list[InputEdge] = []
         while True:
             for ax, q in zip(self._axes, queues, strict=True):
-                pcs = q.pieces
-                while pcs and pcs[0].t0 <= self._t:
-                    self._set_command(ax, pcs.popleft())
+                while len(q) and q.next_start() <= self._t:
+                    t0, dt, p0, v0, a0, j = q.pop()
+                    ax.set_command(Cubic(p0, v0, a0, j), t0, t0 + dt, self._t)
             tn = min(min(q.next_start() for q in queues), t)
             edges += self._advance(tn)
             if tn >= t:

@@ -1,18 +1,22 @@
 """The queue of timed cubic pieces of one simulated axis (hw.interface.QueuedHardware).
 
-A piece is an `AxisCommand`; it becomes the axis's pulse-generator command at its t0. The
-queue checks a batch as a whole before taking any of it, so a malformed piece leaves the
-queue exactly as it was.
+A piece is a row (t0, dt, p0, v0, a0, j) of a float array; it becomes the axis's
+pulse-generator command at its t0. Pieces arrive as a sequence of `AxisCommand` or as a
+`PieceBlock` of arrays (a whole chunk of cycles from the planner) and are kept as blocks,
+so the compiled kernel takes them without one Python object per piece. The queue checks a
+batch as a whole before taking any of it, so a malformed piece leaves the queue exactly as
+it was.
 """
 
 from __future__ import annotations
 
 import math
-from collections import deque
 from collections.abc import Sequence
 
+import numpy as np
+
 from openmotion.errors import MotionError
-from openmotion.hw.interface import AxisCommand
+from openmotion.hw.interface import AxisCommand, PieceBlock
 
 _FIELDS = ("t0", "dt", "p0", "v0", "a0", "j")
 #: Slack on "starts after the piece before ends" (s): t0 + dt of one cycle's piece may be
@@ -23,50 +27,119 @@ TIME_SLACK = 1e-9
 class PieceQueue:
     """Pieces not started yet, in time order, and the end time of the last one queued."""
 
-    __slots__ = ("pieces", "end")
+    __slots__ = ("_blocks", "_head", "_n", "end")
 
     def __init__(self) -> None:
-        self.pieces: deque[AxisCommand] = deque()
+        self._blocks: list[np.ndarray] = []  # (m, 6) float arrays, oldest first
+        self._head = 0  # rows of _blocks[0] already started
+        self._n = 0
         self.end = -math.inf
 
     def __len__(self) -> int:
-        return len(self.pieces)
+        return self._n
 
-    def extend(self, pieces: Sequence[AxisCommand], now: float) -> None:
+    def extend(self, pieces: Sequence[AxisCommand] | PieceBlock, now: float) -> None:
         """Check every piece (MotionError naming it and the rule; nothing queued then),
         then append them all."""
-        if isinstance(pieces, AxisCommand) or not isinstance(pieces, Sequence):
-            raise MotionError(f"pieces must be a sequence of AxisCommand, got "
-                              f"{type(pieces).__name__}")
-        end = max(self.end, now)
-        for k, p in enumerate(pieces):
-            # fast path: a float AxisCommand whose fields sum to a finite number has only
-            # finite fields; anything else gets the field-by-field check and its message
-            try:
-                ok = type(p) is AxisCommand and math.isfinite(
-                    p.t0 + p.dt + p.p0 + p.v0 + p.a0 + p.j)
-            except TypeError:
-                ok = False
-            if not ok:
-                _check_fields(k, p)
-            if p.dt < 0.0:
-                raise MotionError(f"pieces[{k}].dt must be >= 0 s, got {p.dt!r}")
-            if p.t0 < end - TIME_SLACK:
-                what = "the hardware time" if end == now else "the end of the piece before"
-                raise MotionError(f"pieces[{k}].t0 must be >= {what} ({end!r} s), "
-                                  f"got {p.t0!r}")
-            end = p.t0 + p.dt
-        self.pieces.extend(pieces)
-        if pieces:
-            self.end = end
+        start = max(self.end, now)
+        if isinstance(pieces, PieceBlock):
+            rows = _block_rows(pieces, start, now)
+        elif isinstance(pieces, AxisCommand) or not isinstance(pieces, Sequence):
+            raise MotionError(f"pieces must be a sequence of AxisCommand or a PieceBlock, "
+                              f"got {type(pieces).__name__}")
+        else:
+            rows = _command_rows(pieces, start, now)
+        if not len(rows):
+            return
+        self._blocks.append(rows)
+        self._n += len(rows)
+        self.end = float(rows[-1, 0] + rows[-1, 1])
 
     def clear(self) -> None:
-        self.pieces.clear()
+        self._blocks.clear()
+        self._head = 0
+        self._n = 0
         self.end = -math.inf
 
     def next_start(self) -> float:
         """t0 of the next piece, or +inf."""
-        return self.pieces[0].t0 if self.pieces else math.inf
+        return float(self._blocks[0][self._head, 0]) if self._n else math.inf
+
+    def pop(self) -> tuple[float, float, float, float, float, float]:
+        """The next piece (t0, dt, p0, v0, a0, j), removed from the queue."""
+        row = self._blocks[0][self._head].tolist()
+        self.consume(1)
+        return tuple(row)  # type: ignore[return-value]
+
+    def remaining(self) -> np.ndarray:
+        """Every piece not started yet, as one (n, 6) float array (a copy)."""
+        if not self._n:
+            return np.zeros((0, 6))
+        first = self._blocks[0][self._head:]
+        if len(self._blocks) == 1:
+            return np.array(first)
+        return np.concatenate([first, *self._blocks[1:]])
+
+    def consume(self, n: int) -> None:
+        """Drop the next n pieces (they started)."""
+        self._n -= n
+        while n:
+            left = len(self._blocks[0]) - self._head
+            if n < left:
+                self._head += n
+                return
+            n -= left
+            self._blocks.pop(0)
+            self._head = 0
+
+
+def _late(k: int, t0: float, end: float, now: float) -> MotionError:
+    what = "the hardware time" if end == now else "the end of the piece before"
+    return MotionError(f"pieces[{k}].t0 must be >= {what} ({end!r} s), got {t0!r}")
+
+
+def _command_rows(pieces: Sequence[AxisCommand], end: float, now: float) -> np.ndarray:
+    for k, p in enumerate(pieces):
+        # fast path: a float AxisCommand whose fields sum to a finite number has only
+        # finite fields; anything else gets the field-by-field check and its message
+        try:
+            ok = type(p) is AxisCommand and math.isfinite(
+                p.t0 + p.dt + p.p0 + p.v0 + p.a0 + p.j)
+        except TypeError:
+            ok = False
+        if not ok:
+            _check_fields(k, p)
+        if p.dt < 0.0:
+            raise MotionError(f"pieces[{k}].dt must be >= 0 s, got {p.dt!r}")
+        if p.t0 < end - TIME_SLACK:
+            raise _late(k, p.t0, end, now)
+        end = p.t0 + p.dt
+    return np.array([(p.t0, p.dt, p.p0, p.v0, p.a0, p.j) for p in pieces],
+                    dtype=float).reshape(-1, 6)
+
+
+def _block_rows(block: PieceBlock, end: float, now: float) -> np.ndarray:
+    try:
+        rows = np.array(block.rows, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise MotionError(f"pieces.rows must be an (n, 6) array of numbers ({e})") from None
+    if rows.ndim != 2 or rows.shape[1] != 6:
+        raise MotionError(f"pieces.rows must be an (n, 6) array (t0, dt, p0, v0, a0, j), "
+                          f"got shape {rows.shape}")
+    if not len(rows):
+        return rows
+    t0, dt = rows[:, 0], rows[:, 1]
+    before = np.concatenate(([end], (t0 + dt)[:-1]))
+    bad = ~np.isfinite(rows).all(axis=1) | (dt < 0.0) | (t0 < before - TIME_SLACK)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        for f, v in zip(_FIELDS, rows[k].tolist(), strict=True):
+            if not math.isfinite(v):
+                raise MotionError(f"pieces[{k}].{f} must be a finite number, got {v!r}")
+        if dt[k] < 0.0:
+            raise MotionError(f"pieces[{k}].dt must be >= 0 s, got {dt[k].item()!r}")
+        raise _late(k, t0[k].item(), before[k].item() if k else end, now)
+    return rows
 
 
 def _check_fields(k: int, p: object) -> None:
