@@ -533,7 +533,37 @@ static PyObject *pieces(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(check_rows_doc,
+"check_rows(rows, end, slack) -> index of the first bad piece, or -1\n\n"
+"rows: float64[n, 6] (t0, dt, p0, v0, a0, j). A piece is bad when a field is not finite,\n"
+"dt < 0, or t0 < (the end of the piece before, `end` for the first) - slack.");
+
+static PyObject *check_rows(PyObject *self, PyObject *args)
+{
+    PyObject *o;
+    double end, slack;
+    if (!PyArg_ParseTuple(args, "Odd", &o, &end, &slack)) return NULL;
+    Py_buffer b;
+    if (PyObject_GetBuffer(o, &b, PyBUF_C_CONTIGUOUS) < 0) return NULL;
+    if (b.itemsize != 8 || b.len % (8 * 6)) {
+        PyBuffer_Release(&b);
+        PyErr_SetString(PyExc_ValueError, "check_rows: rows must be float64[n, 6]");
+        return NULL;
+    }
+    const double *r = b.buf;
+    Py_ssize_t n = b.len / (8 * 6), bad = -1;
+    for (Py_ssize_t k = 0; k < n && bad < 0; k++, r += 6) {
+        for (int f = 0; f < 6; f++)
+            if (!isfinite(r[f])) { bad = k; break; }
+        if (bad < 0 && (r[1] < 0.0 || r[0] < end - slack)) bad = k;
+        end = r[0] + r[1];
+    }
+    PyBuffer_Release(&b);
+    return PyLong_FromSsize_t(bad);
+}
+
 static PyMethodDef methods[] = {
+    {"check_rows", check_rows, METH_VARARGS, check_rows_doc},
     {"run", run, METH_VARARGS, run_doc},
     {"pieces", pieces, METH_VARARGS, pieces_doc},
     {NULL, NULL, 0, NULL},

@@ -155,7 +155,8 @@ class TimedOutputHardware(Protocol):
 class PieceBlock:
     """Many timed pieces at once: `rows` is an (n, 6) float array (numpy), row k the piece
     AxisCommand(*rows[k]) = (t0, dt, p0, v0, a0, j). The planner hands a whole chunk of
-    cycles across the boundary this way, without one Python object per piece."""
+    cycles across the boundary this way, without one Python object per piece. A float64
+    C-contiguous array is queued as it is (not copied): do not change it afterwards."""
 
     rows: Any
 

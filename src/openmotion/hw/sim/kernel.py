@@ -75,40 +75,49 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
     Stops before the first cycle ending at or after `limit` or with an edge on a `wake`
     signal; the state of every axis (and the pieces started) is written back."""
     n = len(axes)
-    ad = np.zeros((n, _ND))
-    ai = np.zeros((n, _NI), dtype=np.int64)
-    sd = np.zeros((n, _MAXSW, _NSD))
-    si = np.zeros((n, _MAXSW, _NSI), dtype=np.int64)
+    adl: list[tuple] = []
+    ail: list[list] = []
+    sdl: list[list[tuple]] = []
+    sil: list[list[tuple]] = []
     blocks: list[np.ndarray] = []
     total = 0
     names: list[list[str]] = []
     recording = False
+    pad_d = [(0.0, 0.0, 0.0, 0.0)] * _MAXSW
+    pad_i = [(0, 0)] * _MAXSW
     for x, ax in enumerate(axes):
         g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
         c = g.cubic
-        ad[x] = (c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
-                 tr.backlash, tr.z, ax.y, dec.upp)
-        row = ai[x]
-        row[:11] = (g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
-                    dec.count, dec.period, len(ax.switches), dec.turn[1], dec.turn[-1])
-        row[I_FWD:I_FWD + dec.period + 1] = dec.fwd_pre
-        row[I_BWD:I_BWD + dec.period + 1] = dec.bwd_pre
+        adl.append((c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
+                    tr.backlash, tr.z, ax.y, dec.upp))
         block = queues[x].remaining()
-        row[I_PBEGIN] = row[I_CURSOR] = total
+        begin = total
         total += len(block)
-        row[I_PEND] = total
         blocks.append(block)
-        row[I_RECORD] = g.record is not None
-        recording = recording or g.record is not None
-        nm = list(ax.switches)
+        fwd = [*dec.fwd_pre, 0, 0, 0, 0][:5]
+        bwd = [*dec.bwd_pre, 0, 0, 0, 0][:5]
+        rec = g.record is not None
+        recording = recording or rec
+        ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
+                    dec.count, dec.period, len(ax.switches), dec.turn[1], dec.turn[-1],
+                    *fwd, *bwd, begin, total, begin, rec])
+        sws = ax.switches
+        nm = list(sws)
         names.append(nm)
-        for s, name in enumerate(nm):
-            sw = ax.switches[name]
+        rd, ri = [], []
+        for name in nm:
+            sw = sws[name]
             if type(sw) is IndexSwitch:
-                sd[x, s] = (1.0, sw.period, sw.width, 0.0)
+                rd.append((1.0, sw.period, sw.width, 0.0))
             else:
-                sd[x, s] = (0.0, sw.lo, sw.hi, sw.hyst)
-            si[x, s] = (sw.active, _wakes(name, ax.switches, wake))
+                rd.append((0.0, sw.lo, sw.hi, sw.hyst))
+            ri.append((sw.active, _wakes(name, sws, wake)))
+        sdl.append(rd + pad_d[len(rd):])
+        sil.append(ri + pad_i[len(ri):])
+    ad = np.array(adl, dtype=float)
+    ai = np.array(ail, dtype=np.int64)
+    sd = np.array(sdl, dtype=float)
+    si = np.array(sil, dtype=np.int64)
     pieces = np.concatenate(blocks) if total else np.zeros((0, 6))
     popt = np.zeros(len(pieces))
     cap = (stop - start) * n * 8 + 16 if recording else 0

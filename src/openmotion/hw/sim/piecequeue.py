@@ -18,6 +18,11 @@ import numpy as np
 from openmotion.errors import MotionError
 from openmotion.hw.interface import AxisCommand, PieceBlock
 
+try:  # the compiled inner loops (setup.py builds them)
+    from openmotion import _kernel
+except ImportError:  # pragma: no cover - depends on the build
+    _kernel = None
+
 _FIELDS = ("t0", "dt", "p0", "v0", "a0", "j")
 #: Slack on "starts after the piece before ends" (s): t0 + dt of one cycle's piece may be
 #: one rounding step past the next cycle's start.
@@ -72,12 +77,13 @@ class PieceQueue:
         return tuple(row)  # type: ignore[return-value]
 
     def remaining(self) -> np.ndarray:
-        """Every piece not started yet, as one (n, 6) float array (a copy)."""
+        """Every piece not started yet, as one (n, 6) float array (read only: it may be the
+        queue's own block)."""
         if not self._n:
             return np.zeros((0, 6))
         first = self._blocks[0][self._head:]
         if len(self._blocks) == 1:
-            return np.array(first)
+            return first
         return np.concatenate([first, *self._blocks[1:]])
 
     def consume(self, n: int) -> None:
@@ -119,27 +125,39 @@ def _command_rows(pieces: Sequence[AxisCommand], end: float, now: float) -> np.n
 
 
 def _block_rows(block: PieceBlock, end: float, now: float) -> np.ndarray:
-    try:
-        rows = np.array(block.rows, dtype=float)
-    except (TypeError, ValueError) as e:
-        raise MotionError(f"pieces.rows must be an (n, 6) array of numbers ({e})") from None
+    rows = block.rows  # kept as it is when it is float64 and C-contiguous (PieceBlock doc)
+    if type(rows) is not np.ndarray or rows.dtype != np.float64 or not rows.flags.c_contiguous:
+        try:
+            rows = np.array(rows, dtype=float)
+        except (TypeError, ValueError) as e:
+            raise MotionError(f"pieces.rows must be an (n, 6) array of numbers ({e})"
+                              ) from None
     if rows.ndim != 2 or rows.shape[1] != 6:
         raise MotionError(f"pieces.rows must be an (n, 6) array (t0, dt, p0, v0, a0, j), "
                           f"got shape {rows.shape}")
     if not len(rows):
         return rows
-    t0, dt = rows[:, 0], rows[:, 1]
-    before = np.concatenate(([end], (t0 + dt)[:-1]))
-    bad = ~np.isfinite(rows).all(axis=1) | (dt < 0.0) | (t0 < before - TIME_SLACK)
-    if bad.any():
-        k = int(np.flatnonzero(bad)[0])
+    k = _first_bad(rows, end)
+    if k >= 0:
         for f, v in zip(_FIELDS, rows[k].tolist(), strict=True):
             if not math.isfinite(v):
                 raise MotionError(f"pieces[{k}].{f} must be a finite number, got {v!r}")
-        if dt[k] < 0.0:
-            raise MotionError(f"pieces[{k}].dt must be >= 0 s, got {dt[k].item()!r}")
-        raise _late(k, t0[k].item(), before[k].item() if k else end, now)
+        if rows[k, 1] < 0.0:
+            raise MotionError(f"pieces[{k}].dt must be >= 0 s, got {rows[k, 1].item()!r}")
+        before = (rows[k - 1, 0] + rows[k - 1, 1]).item() if k else end
+        raise _late(k, rows[k, 0].item(), before, now)
     return rows
+
+
+def _first_bad(rows: np.ndarray, end: float) -> int:
+    """Index of the first piece with a non-finite field, dt < 0 or a start before the end
+    of the piece before (`end` for the first), or -1."""
+    if _kernel is not None:
+        return _kernel.check_rows(rows, end, TIME_SLACK)
+    t0, dt = rows[:, 0], rows[:, 1]
+    before = np.concatenate(([end], (t0 + dt)[:-1]))
+    bad = ~np.isfinite(rows).all(axis=1) | (dt < 0.0) | (t0 < before - TIME_SLACK)
+    return int(np.flatnonzero(bad)[0]) if bad.any() else -1
 
 
 def _check_fields(k: int, p: object) -> None:
