@@ -1,5 +1,10 @@
 """Controller runtime benchmark: virtual seconds per CPU second, cycle by cycle and jumping.
 
+Three runs per case: cycle by cycle (`virtual_jumps = False`, the reference), jumping with
+the compiled inner loops switched off (the Python path: per-cycle pieces and the Python
+stepper pipeline, as before the kernel) and jumping with them (openmotion._kernel: chunk
+pieces and the stepper pipeline in C).
+
 1, 4, 16 and 63 moving axes (ideal steppers on the default machine's X axis template, 1 ms
 cycle, every axis doing back-to-back T/S moves for the whole run, each restarted as soon
 as it is done) and 4 enabled idle axes; recorder off and on; each cycle by cycle
@@ -14,11 +19,14 @@ issue 13 beside them, and the recorder's extra cost.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import time
+from collections.abc import Iterator
 from dataclasses import replace
 
 from openmotion.config import MachineConfig, default_machine
 from openmotion.control import Controller
+from openmotion.control import motion as _motion
 
 #: issue 13's goals (virtual s per CPU s)
 GOALS = {("moving", 4): 200.0, ("moving", 16): 50.0, ("moving", 63): 10.0,
@@ -56,16 +64,31 @@ def job(c: Controller, seconds: float, moving: bool) -> int:
     return moves
 
 
+@contextlib.contextmanager
+def python_path(on: bool) -> Iterator[None]:
+    """With `on`, the compiled pieces are off (ActiveMotion.pieces runs `piece` per cycle);
+    the machine's own switch (SimMachine.native) is set by `speed`."""
+    saved = _motion._kernel
+    if on:
+        _motion._kernel = None
+    try:
+        yield
+    finally:
+        _motion._kernel = saved
+
+
 def speed(n_axes: int, seconds: float, moving: bool, jumping: bool,
-          recorder: bool) -> tuple[float, float]:
+          recorder: bool, native: bool = True) -> tuple[float, float]:
     """(virtual s per CPU s, CPU us per cycle)."""
     c = Controller(machine(n_axes))
     c.virtual_jumps = jumping
+    c.hardware.native = native
     if recorder:
         c.start_recording(capacity=int(seconds / c.period) + 10)
-    t0 = time.process_time()
-    job(c, seconds, moving)
-    cpu = max(time.process_time() - t0, 1e-9)
+    with python_path(not native):
+        t0 = time.process_time()
+        job(c, seconds, moving)
+        cpu = max(time.process_time() - t0, 1e-9)
     return seconds / cpu, cpu / c.cycles * 1e6
 
 
@@ -75,20 +98,21 @@ def main() -> None:
                     help="virtual seconds per run (63 axes: half, idle: 20x)")
     args = ap.parse_args()
     print(f"virtual time, 1 ms cycle, CPU time; {args.seconds:g} virtual s per run")
-    print(f"{'case':>10} {'recorder':>8} {'cycle by cycle':>15} {'jumping':>12} "
-          f"{'us/cycle c/j':>14} {'goal':>7} {'met':>4}")
+    print(f"{'case':>10} {'recorder':>8} {'cycle by cycle':>15} {'jump, Python':>13} "
+          f"{'jump, C':>9} {'C/Python':>9} {'goal':>7} {'met':>4}")
     cases = [("moving", 1), ("moving", 4), ("moving", 16), ("moving", 63), ("idle", 4)]
     rec_cost: dict[tuple[str, int], float] = {}
     for kind, n in cases:
         secs = args.seconds * (0.5 if n == 63 else 20.0 if kind == "idle" else 1.0)
         for rec in (False, True):
             slow, us_s = speed(n, secs, kind == "moving", False, rec)
-            fast, us_f = speed(n, secs, kind == "moving", True, rec)
+            py, _ = speed(n, secs, kind == "moving", True, rec, native=False)
+            fast, _ = speed(n, secs, kind == "moving", True, rec)
             goal = GOALS.get((kind, n))
             best = max(slow, fast)
             met = "" if goal is None or rec else ("yes" if best >= goal else "no")
             print(f"{kind + ' ' + str(n):>10} {'on' if rec else 'off':>8} {slow:>14.1f}x "
-                  f"{fast:>11.1f}x {us_s:>7.1f}/{us_f:<6.1f} "
+                  f"{py:>12.1f}x {fast:>8.1f}x {fast / py:>8.1f}x "
                   f"{'' if goal is None or rec else f'{goal:.0f}x':>7} {met:>4}")
             rec_cost[(kind, n)] = us_s if not rec else us_s / rec_cost[(kind, n)] - 1.0
     print("recorder on, extra cycle cost (cycle by cycle; goal <= "

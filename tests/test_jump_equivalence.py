@@ -7,7 +7,8 @@ the same machine: once cycle by cycle (`virtual_jumps = False`, the reference) a
 jumping. After every operation the two controllers must agree on everything observable:
 time and cycle count, every axis's state, fault, position, velocity, motion_done and
 counters, the event log with exact times, the safety stop records, the motion history,
-every output edge and every pulse the generators emitted (exact times). 60 seeded
+every output edge, every pulse the generators emitted (exact times) and, in part of the
+scenarios, every row the recorder kept (jumps record the cycles they cross). 60 seeded
 scenarios in the normal run, 600 with --long.
 """
 
@@ -177,7 +178,10 @@ def observe(ctl: Controller) -> tuple:
             pulses.append((tuple(t.tolist()), tuple(c.tolist())))
         except MotionError:
             pulses.append(None)
-    return ctl.time, ctl.cycles, axes, events, stops, hist, outs, tuple(pulses)
+    rec = ctl.recorder
+    trace = None if rec is None else (len(rec), rec.total, tuple(
+        (k, v.tobytes()) for k, v in rec.arrays().items()))
+    return ctl.time, ctl.cycles, axes, events, stops, hist, outs, tuple(pulses), trace
 
 
 def run_both(seed: int) -> tuple[list, list, int]:
@@ -186,10 +190,14 @@ def run_both(seed: int) -> tuple[list, list, int]:
     ops = script(rng)
     got = []
     jumps = 0
+    # the recorder on in half the scenarios, some with a ring shorter than the run
+    capacity = int(rng.choice([0, 0, 40, 700, 100_000]))
     for jumping in (False, True):
         ctl = Controller(cfg)
         ctl.virtual_jumps = jumping
         ctl.enable_all()
+        if capacity:
+            ctl.start_recording(capacity=capacity)
         trace = []
         if jumping:
             real = ctl._run_cycles
@@ -214,7 +222,7 @@ def _check(seed: int) -> int:
     for (op, r0, o0), (_, r1, o1) in zip(ref, fast, strict=True):
         assert r0 == r1, (seed, op)
         for name, a, b in zip(("time", "cycles", "axes", "events", "stops", "history",
-                               "outputs", "pulses"), o0, o1, strict=True):
+                               "outputs", "pulses", "recorder"), o0, o1, strict=True):
             assert a == b, (seed, op, name)
     return jumps
 

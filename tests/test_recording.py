@@ -160,3 +160,40 @@ def test_bad_record_changes_nothing(args, match) -> None:
 def test_bad_construction(kwargs) -> None:
     with pytest.raises(MotionError):
         Recorder(**kwargs)
+
+
+@settings(max_examples=60, deadline=None)
+@given(capacity=st.integers(1, 30), before=st.integers(0, 40), m=st.integers(0, 70),
+       seed=st.integers(0, 2**32 - 1))
+def test_record_block_stores_what_row_by_row_records_store(capacity, before, m, seed):
+    rng = np.random.default_rng(seed)
+    n = 2
+    t = np.cumsum(rng.uniform(0.0, 1.0, before + m))
+    rows = before + m
+    data = {"cmd_pos": rng.normal(size=(rows, n)), "fb_pos": rng.normal(size=(rows, n)),
+            "cmd_vel": rng.normal(size=(rows, n)), "state": rng.integers(0, 5, (rows, n)),
+            "io": rng.integers(0, 9999, (rows, n))}
+    a, b = Recorder(n, capacity), Recorder(n, capacity)
+    for r in range(before + m):
+        a.record(t[r], **{c: v[r] for c, v in data.items()})
+    for r in range(before):
+        b.record(t[r], **{c: v[r] for c, v in data.items()})
+    b.record_block(t[before:], **{c: v[before:] for c, v in data.items()})
+    assert (len(a), a.total, a.dropped) == (len(b), b.total, b.dropped)
+    for k, v in a.arrays().items():
+        assert v.tobytes() == b.arrays()[k].tobytes()
+
+
+def test_record_block_refuses_bad_rows_and_stores_nothing():
+    rec = Recorder(2, 10)
+    rec.record(1.0, cmd_pos=[0, 0], fb_pos=[0, 0], cmd_vel=[0, 0], state=[0, 0], io=[0, 0])
+    ok = {c: np.zeros((3, 2)) for c in ("cmd_pos", "fb_pos", "cmd_vel", "state", "io")}
+    for t, chans, match in (
+            ([0.5, 2.0, 3.0], ok, "non-decreasing"),
+            ([2.0, 1.5, 3.0], ok, "non-decreasing"),
+            ([2.0, 3.0], ok, r"\(m, 2\)"),
+            ([2.0, 3.0, 4.0], {**ok, "cmd_pos": np.full((3, 2), np.nan)}, "finite"),
+            ([2.0, 3.0, 4.0], {c: v for c, v in ok.items() if c != "io"}, "every recorded")):
+        with pytest.raises(MotionError, match=match):
+            rec.record_block(t, **chans)
+        assert (len(rec), rec.total) == (1, 1)

@@ -38,12 +38,12 @@ enum { D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_
 /* per-axis int64 fields */
 enum { I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
        I_TURNF, I_TURNB, I_FWD, I_BWD = I_FWD + 5, I_PBEGIN = I_BWD + 5, I_PEND, I_CURSOR,
-       I_RECORD, NI };
+       I_RECORD, I_LEVELS, NI };
 #define MAXSW 8
 /* per-switch double fields: kind (0 span, 1 index), lo|period, hi|width, hysteresis */
 enum { S_KIND, S_A, S_B, S_H, NSD };
-/* per-switch int64 fields */
-enum { S_ACTIVE, S_WAKE, NSI };
+/* per-switch int64 fields: active, reported, the input-level bits it flips when active */
+enum { S_ACTIVE, S_WAKE, S_LEVELBITS, NSI };
 /* record row: axis, kind (0 jump, 1 cubic), t0, t1, tc, p0, v0, a0, j, d, c0, c1 */
 #define NREC 12
 
@@ -335,31 +335,32 @@ static void release(Buf *bufs, int n)
 }
 
 PyDoc_STRVAR(run_doc,
-"run(ad, ai, sd, si, pieces, popt, rows, origin, period, start, stop, now, limit)\n"
+"run(ad, ai, sd, si, pieces, popt, rows, trace, origin, period, start, stop, now, limit)\n"
 "-> (cycle reached, hardware time, record rows used)\n\n"
 "Run cycles start+1..stop over float64 ad[n, ND], int64 ai[n, NI], float64 sd[n, 8, 4],\n"
 "int64 si[n, 8, 2], float64 pieces[P, 6] (t0, dt, p0, v0, a0, j) with each axis's range\n"
-"and cursor in ai, popt[P] (the time each piece started), rows[R, 12] (pulse record).\n"
+"and cursor in ai, popt[P] (the time each piece started), rows[R, 12] (pulse record),\n"
+"int64 trace[stop - start, n, 3] (per cycle: pulse count, decoded count, input levels;\n"
+"an empty array: no trace).\n"
 "Stops before the first cycle ending at or after `limit`, or with an edge to report.");
 
 static PyObject *run(PyObject *self, PyObject *args)
 {
-    PyObject *o[7];
+    PyObject *o[8];
     double origin, period, now, limit;
     long long start, stop;
-    if (!PyArg_ParseTuple(args, "OOOOOOOddLLdd", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &origin, &period, &start, &stop, &now, &limit))
+    if (!PyArg_ParseTuple(args, "OOOOOOOOddLLdd", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
+                          &o[6], &o[7], &origin, &period, &start, &stop, &now, &limit))
         return NULL;
-    Buf bufs[7];
+    Buf bufs[8];
     memset(bufs, 0, sizeof bufs);
-    static const Py_ssize_t sizes[7] = {8, 8, 8, 8, 8, 8, 8};
-    static const char *names[7] = {"ad", "ai", "sd", "si", "pieces", "popt", "rows"};
-    for (int k = 0; k < 7; k++)
-        if (get_buf(o[k], &bufs[k], sizes[k], names[k]) < 0) { release(bufs, 7); return NULL; }
+    static const char *names[8] = {"ad", "ai", "sd", "si", "pieces", "popt", "rows", "trace"};
+    for (int k = 0; k < 8; k++)
+        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, 8); return NULL; }
     Py_ssize_t n = bufs[0].b.len / (8 * ND);
     if (bufs[1].b.len != n * 8 * NI || bufs[2].b.len != n * 8 * MAXSW * NSD
             || bufs[3].b.len != n * 8 * MAXSW * NSI) {
-        release(bufs, 7);
+        release(bufs, 8);
         PyErr_SetString(PyExc_ValueError, "run: axis arrays disagree in size");
         return NULL;
     }
@@ -371,16 +372,20 @@ static PyObject *run(PyObject *self, PyObject *args)
         if (ai[I_PBEGIN] < 0 || ai[I_PEND] > npieces || ai[I_CURSOR] < ai[I_PBEGIN]
                 || ai[I_CURSOR] > ai[I_PEND] || ai[I_NSW] < 0 || ai[I_NSW] > MAXSW
                 || ai[I_DPERIOD] < 1 || ai[I_DPERIOD] > 4) {
-            release(bufs, 7);
+            release(bufs, 8);
             PyErr_SetString(PyExc_ValueError, "run: bad axis layout");
             return NULL;
         }
     }
     Rec rec = {bufs[6].b.buf, 0, bufs[6].b.len / (8 * NREC), 0};
+    /* trace[cycle - start - 1, axis] = (pulse count, decoded count, input levels: I_LEVELS
+     * with the S_LEVELBITS of every active switch flipped) when the
+     * caller asks for it (a buffer large enough for every cycle), else none */
+    int64_t *TR = bufs[7].b.len >= (stop - start) * n * 3 * 8 ? bufs[7].b.buf : NULL;
     double *save_d = PyMem_Malloc(sizeof(double) * (n * ND + n * MAXSW * NSD + 1));
     int64_t *save_i = PyMem_Malloc(sizeof(int64_t) * (n * NI + n * MAXSW * NSI + 1));
     if (!save_d || !save_i) {
-        PyMem_Free(save_d); PyMem_Free(save_i); release(bufs, 7);
+        PyMem_Free(save_d); PyMem_Free(save_i); release(bufs, 8);
         return PyErr_NoMemory();
     }
     long long k = start;
@@ -426,12 +431,24 @@ static PyObject *run(PyObject *self, PyObject *args)
             now = now0;
             break;
         }
+        if (TR != NULL) {
+            int64_t *tr = TR + (k - start) * n * 3;
+            for (Py_ssize_t x = 0; x < n; x++) {
+                const int64_t *ai = AI + x * NI, *si = SI + x * MAXSW * NSI;
+                int64_t levels = ai[I_LEVELS];
+                for (int sw = 0; sw < ai[I_NSW]; sw++)
+                    if (si[sw * NSI + S_ACTIVE]) levels ^= si[sw * NSI + S_LEVELBITS];
+                tr[x * 3] = ai[I_COUNT];
+                tr[x * 3 + 1] = ai[I_DCOUNT];
+                tr[x * 3 + 2] = levels;
+            }
+        }
         k++;
     }
     Py_END_ALLOW_THREADS
     PyMem_Free(save_d);
     PyMem_Free(save_i);
-    release(bufs, 7);
+    release(bufs, 8);
     return Py_BuildValue("LdN", k, now, PyLong_FromSsize_t(rec.n));
 }
 

@@ -119,6 +119,46 @@ class Recorder:
         self._head = i + 1 if i + 1 <= self.capacity else 0
         self.total += 1
 
+    def record_block(self, t: ArrayLike, **channels: ArrayLike) -> None:
+        """Store m cycles at once: `t` (m,) and each enabled channel (m, n_axes), as m
+        `record` calls would (the same rows, the same checks; MotionError and nothing
+        stored on a bad argument). Virtual-time jumps record the cycles they cross so."""
+        try:
+            tt = np.asarray(t, dtype=float)
+            vals = {c: np.asarray(channels[c]) for c in self.channels}
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MotionError(f"record_block needs t and every recorded channel "
+                              f"{self.channels}: {exc}") from None
+        m = len(tt)
+        if tt.ndim != 1 or any(v.shape != (m, self.n_axes) for v in vals.values()):
+            raise MotionError(f"record_block: t must be (m,) and each channel (m, "
+                              f"{self.n_axes}), got {tt.shape} and "
+                              f"{[v.shape for v in vals.values()]}")
+        if not m:
+            return
+        if not (np.isfinite(tt).all() and tt[0] >= self._last_t
+                and (np.diff(tt) >= 0.0).all()):
+            raise MotionError(f"t must be finite and non-decreasing from the previous time "
+                              f"{self._last_t!r}")
+        if any(not np.isfinite(vals[c]).all() for c in self._fchans):
+            raise MotionError("recorded positions/velocities must be finite")
+        if self._spill is not None:  # spilling works row by row
+            for r in range(m):
+                self.record(tt[r], **{c: v[r] for c, v in vals.items()})
+            return
+        rows = self.capacity + 1
+        keep = min(m, self.capacity)  # older rows of the block would be overwritten anyway
+        idx = (self._head + (m - keep) + np.arange(keep)) % rows
+        self._t[idx] = tt[m - keep:]
+        for c in self._fchans:
+            self._f[idx, self._fslot[c]] = vals[c][m - keep:]
+        for c in self._ichans:
+            self._i[c][idx] = vals[c][m - keep:]
+        self._last_t = float(tt[-1])
+        self._count = min(self.capacity, self._count + m)
+        self._head = (self._head + m) % rows
+        self.total += m
+
     # ------------------------------------------------------------------ reading
     def __len__(self) -> int:
         return self._count

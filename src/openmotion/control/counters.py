@@ -152,7 +152,12 @@ class Counters:
     @property
     def feedback(self) -> int:
         self._fresh()
-        return wrap28(self._encoder + self._fb_off)
+        return self.feedback_from(self._raw_out, self._raw_enc)
+
+    def feedback_from(self, pulses_out, encoder):
+        """The feedback counter for raw hardware totals (ints or int arrays): what
+        `update(pulses_out, encoder, t)` then `feedback` gives (jumps record with it)."""
+        return wrap28((pulses_out if self._fb_internal else encoder) + self._fb_off)
 
     def set_feedback(self, value: int) -> None:
         self._fresh()

@@ -21,8 +21,11 @@ between are the ones that would have been no-ops, so counters, events, histories
 outputs are identical (tests/test_jump_equivalence.py runs both ways).
 
 Jumping is off, and every cycle runs, while anything needs each cycle: a sample hook (a
-servo loop closed in Python), a pre-advance hook, a cycle hook without a due function, the
-recorder, a command transform, an axis waiting for INP or a done gate.
+servo loop closed in Python), a pre-advance hook, a cycle hook without a due function, a
+command transform, an axis waiting for INP or a done gate. The recorder does not stop
+jumps: the back end reports the readback at every cycle end (`run_cycles(trace=True)`)
+and the crossed cycles are recorded from it and the pieces' end states (`record_trace`),
+the very rows `Controller._record` writes cycle by cycle.
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..hw.interface import PieceBlock, QueuedHardware
+from ..hw.interface import AXIS_INPUTS, PieceBlock, QueuedHardware
 
 if TYPE_CHECKING:
     from .controller import Controller
@@ -61,7 +64,7 @@ def plan_jump(ctl: Controller, cycles: int) -> int:
     when the next cycle must run on its own (then `Controller.step` runs it)."""
     n0 = ctl._n
     nxt = n0 + 1
-    if (cycles < 2 or not ctl.virtual_jumps or ctl.recorder is not None
+    if (cycles < 2 or not ctl.virtual_jumps
             or ctl._sample_hooks or ctl._pre_hooks
             or not isinstance(ctl.hardware, QueuedHardware)):
         return nxt
@@ -128,8 +131,12 @@ def jump(ctl: Controller, land: int) -> None:
                     hw.clear_queue(other.index)
                 raise
             ends.append(p1v1)
-        run = hw.run_cycles(origin, period, n, stop, wake)
-        if run.cycle < stop or run.edges or stop >= land:
+        rec = ctl.recorder
+        run = hw.run_cycles(origin, period, n, stop, wake, trace=rec is not None)
+        last = run.cycle < stop or run.edges or stop >= land
+        if rec is not None:  # the landing cycle is recorded by _finish_cycle
+            record_trace(ctl, movers, ends, n, run.trace[:run.cycle - n - (1 if last else 0)])
+        if last:
             break
         n = stop
         t0 = origin + n * period
@@ -140,3 +147,39 @@ def jump(ctl: Controller, land: int) -> None:
         if k < stop:
             hw.clear_queue(ax.index)
     ctl._finish_cycle(k, run.edges)
+
+
+def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
+                 trace: np.ndarray) -> None:
+    """Record cycles n+1 .. n+len(trace) that a jump crossed: the rows `Controller._record`
+    writes cycle by cycle, from the back end's readback at each cycle end (`trace`) and the
+    end states of the movers' pieces (`ends`); nothing else changes in those cycles."""
+    from .controller import IO_BITS, STATE_CODES  # the controller imports this module
+
+    m = len(trace)
+    if not m:
+        return
+    axes = ctl.axes
+    t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
+    pos = np.empty((m, len(axes)))
+    vel = np.empty((m, len(axes)))
+    for ax in axes:
+        pos[:, ax.index] = ax.position
+        vel[:, ax.index] = ax.velocity
+    for ax, p1v1 in zip(movers, ends, strict=True):
+        pos[:, ax.index] = p1v1[:m, 0] + ax.counters._cmd_off
+        vel[:, ax.index] = p1v1[:m, 1]
+    fb = np.empty((m, len(axes)), dtype=np.int64)
+    io = np.zeros((m, len(axes)), dtype=np.int64)
+    for ax in axes:
+        i = ax.index
+        fb[:, i] = ax.counters.feedback_from(trace[:, i, 0], trace[:, i, 1])
+        levels = trace[:, i, 2]
+        nc = ctl._nc[i]
+        for sig, bit in IO_BITS:
+            lv = (levels >> AXIS_INPUTS.index(sig)) & 1
+            io[:, i] |= (lv ^ (sig in nc)) << bit
+    if ctl._estop:
+        io |= 1 << 6
+    state = np.array([[STATE_CODES[ax.state] for ax in axes]] * m, dtype=np.int64)
+    ctl.recorder.record_block(t, cmd_pos=pos, fb_pos=fb, cmd_vel=vel, state=state, io=io)

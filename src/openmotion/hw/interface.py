@@ -171,6 +171,10 @@ class QueueRun:
     cycle: int
     edges: list[InputEdge]
     drained: tuple[int, ...] = ()
+    #: with run_cycles(..., trace=True): int64 array [cycle - start, n_axes, 3], the
+    #: readback at the end of each cycle run (pulses_out, encoder, electrical input levels
+    #: as bits, bit i = AXIS_INPUTS[i]); the recorder reads jumped cycles from it
+    trace: Any = None
 
 
 @runtime_checkable
@@ -200,10 +204,11 @@ class QueuedHardware(Protocol):
         """Number of pieces of `axis` that have not started yet."""
 
     def run_cycles(self, origin: float, period: float, start: int, stop: int,
-                   wake: Collection[str] | None = None) -> QueueRun:
+                   wake: Collection[str] | None = None, trace: bool = False) -> QueueRun:
         """From the end of cycle `start` (= the hardware time) run cycles start+1 .. stop,
         each ending at origin + k * period (as `advance` would), starting queued pieces at
         their t0; return at the end of the first cycle with an input edge on a signal in
         `wake` (None: any signal) or a stop cut by an armed edge (EdgeStopHardware), with
         every edge of that cycle; edges on other signals in earlier cycles are dropped (the
-        control layer declared it ignores them). MotionError for bad arguments."""
+        control layer declared it ignores them). With `trace`, QueueRun.trace holds the
+        readback at the end of every cycle run. MotionError for bad arguments."""

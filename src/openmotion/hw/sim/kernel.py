@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from openmotion.hw.interface import AXIS_INPUTS
+
 from .cubic import Cubic
 from .plant import StepperPlant
 from .pulses import Stretch
@@ -37,14 +39,15 @@ if TYPE_CHECKING:
     from .simaxis import SimAxis
 
 AVAILABLE = _k is not None
+_BIT = {sig: i for i, sig in enumerate(AXIS_INPUTS)}
 
 # field indices, kept in step with _kernel.c (checked against its constants below)
-_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 25, 8, 4, 2, 12
+_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 26, 8, 4, 3, 12
 (D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
  D_UPP) = range(_ND)
 (I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
  I_TURNF, I_TURNB) = range(11)
-I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD = 11, 16, 21, 22, 23, 24
+I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD, I_LEVELS = 11, 16, 21, 22, 23, 24, 25
 if _k is not None:
     assert (_k.ND, _k.NI, _k.MAXSW, _k.NSD, _k.NSI, _k.NREC) == (
         _ND, _NI, _MAXSW, _NSD, _NSI, _NREC), "_kernel.c layout differs from kernel.py"
@@ -67,10 +70,31 @@ def _wakes(name: str, switches: dict, wake: Collection[str] | None) -> bool:
     return name == "sd" and "ltc" not in switches and "ltc" in wake
 
 
+def level_bits(ax: SimAxis) -> int:
+    """The axis's electrical input levels as a bit field, bit i = AXIS_INPUTS[i]."""
+    word = 0
+    for i, sig in enumerate(AXIS_INPUTS):
+        if ax.level(sig):
+            word |= 1 << i
+    return word
+
+
+def _switch_bits(name: str, switches: dict) -> int:
+    """The input-level bits a switch flips when it toggles (SD is also LTC when no LTC
+    switch is placed)."""
+    bits = 1 << _BIT[name] if name in _BIT else 0
+    if name == "sd" and "ltc" not in switches:
+        bits |= 1 << _BIT["ltc"]
+    return bits
+
+
 def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, period: float,
               start: int, stop: int, now: float, limit: float,
-              wake: Collection[str] | None) -> tuple[int, float]:
-    """Run cycles start+1 .. at most stop in the kernel; returns (cycle reached, time).
+              wake: Collection[str] | None, trace: bool = False
+              ) -> tuple[int, float, np.ndarray | None]:
+    """Run cycles start+1 .. at most stop in the kernel; returns (cycle reached, time,
+    trace): with `trace`, an int64 array [cycles run, axis, 3] of the pulse count, decoded
+    count and input levels (`level_bits`) at the end of each cycle.
 
     Stops before the first cycle ending at or after `limit` or with an edge on a `wake`
     signal; the state of every axis (and the pieces started) is written back."""
@@ -84,7 +108,7 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
     names: list[list[str]] = []
     recording = False
     pad_d = [(0.0, 0.0, 0.0, 0.0)] * _MAXSW
-    pad_i = [(0, 0)] * _MAXSW
+    pad_i = [(0, 0, 0)] * _MAXSW
     for x, ax in enumerate(axes):
         g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
         c = g.cubic
@@ -105,13 +129,18 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
         nm = list(sws)
         names.append(nm)
         rd, ri = [], []
+        base = level_bits(ax) if trace else 0
         for name in nm:
             sw = sws[name]
             if type(sw) is IndexSwitch:
                 rd.append((1.0, sw.period, sw.width, 0.0))
             else:
                 rd.append((0.0, sw.lo, sw.hi, sw.hyst))
-            ri.append((sw.active, _wakes(name, sws, wake)))
+            bits = _switch_bits(name, sws)
+            if sw.active:
+                base ^= bits
+            ri.append((sw.active, _wakes(name, sws, wake), bits))
+        ail[-1].append(base)
         sdl.append(rd + pad_d[len(rd):])
         sil.append(ri + pad_i[len(ri):])
     ad = np.array(adl, dtype=float)
@@ -122,12 +151,13 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
     popt = np.zeros(len(pieces))
     cap = (stop - start) * n * 8 + 16 if recording else 0
     rows = np.zeros((cap, _NREC))
-    k, t, used = _k.run(ad, ai, sd, si, pieces, popt, rows, float(origin), float(period),
+    tr = np.zeros((stop - start if trace else 0, n, 3), dtype=np.int64)
+    k, t, used = _k.run(ad, ai, sd, si, pieces, popt, rows, tr, float(origin), float(period),
                         int(start), int(stop), float(now), float(limit))
     if k == start:
-        return k, now
+        return k, now, tr[:0] if trace else None
     _write_back(axes, queues, ad, ai, si, pieces, popt, rows[:used], names)
-    return k, t
+    return k, t, tr[:k - start] if trace else None
 
 
 def _write_back(axes: list[SimAxis], queues: list[PieceQueue], ad: np.ndarray,

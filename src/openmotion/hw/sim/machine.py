@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from collections.abc import Collection, Sequence
 
+import numpy as np
+
 from openmotion.config import MachineConfig
 from openmotion.errors import MotionError, check_finite, check_nonnegative
 from openmotion.hw.interface import (
@@ -128,12 +130,14 @@ class SimMachine:
         return len(self._queues[self._axis(axis).index])
 
     def run_cycles(self, origin: float, period: float, start: int, stop: int,
-                   wake: Collection[str] | None = None) -> QueueRun:
+                   wake: Collection[str] | None = None, trace: bool = False) -> QueueRun:
         """Run cycles start+1 .. stop on the grid origin + k * period (hw.interface.
         QueuedHardware), starting queued pieces at their t0; stop after the first cycle
         with an input edge on a signal in `wake` (None: any) or an armed stop. Stretches
         with nothing to run (every axis a stepper holding its end, no piece and no scenario
-        action due) are crossed in one step."""
+        action due) are crossed in one step. Quiet cycles run in the compiled kernel
+        (hw/sim/kernel.py) when `native` is on and it models every axis. `trace`: the
+        readback at the end of every cycle run, in QueueRun.trace."""
         origin = check_finite("origin", origin)
         period = check_finite("period", period)
         if period <= 0.0:
@@ -147,26 +151,44 @@ class SimMachine:
         had = [len(q) > 0 for q in queues]
         k = start
         edges: list[InputEdge] = []
+        rows: list[np.ndarray] = []
         first = True
         while k < stop:
             if not first and self._holding():
+                k0 = k
                 k, edges = self._skip_idle(origin, period, k, stop)
+                if trace and k > k0:
+                    rows.append(np.repeat(self._trace_row(), k - k0, axis=0))
                 if edges or k >= stop:
                     break
             first = False
             if self.native and not self._pending and kernel.usable(self._axes):
-                k, self._t = kernel.run_quiet(self._axes, queues, origin, period, k, stop,
-                                              self._t, self._next_action(), wake)
+                k, self._t, tr = kernel.run_quiet(self._axes, queues, origin, period, k,
+                                                  stop, self._t, self._next_action(), wake,
+                                                  trace)
+                if tr is not None and len(tr):
+                    rows.append(tr)
                 if k >= stop:
                     break
             k += 1
             edges = self.advance(origin + k * period)
+            if trace:
+                rows.append(self._trace_row())
             if edges and (wake is None or any(e.signal in wake for e in edges)
                           or any(ax.stop_time is not None for ax in self._axes)):
                 break
             edges = []
         drained = tuple(i for i, q in enumerate(queues) if had[i] and not q)
-        return QueueRun(k, edges, drained)
+        tr = None
+        if trace:
+            tr = np.concatenate(rows) if rows else np.zeros((0, len(self._axes), 3),
+                                                            dtype=np.int64)
+        return QueueRun(k, edges, drained, tr)
+
+    def _trace_row(self) -> np.ndarray:
+        """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""
+        return np.array([[(ax.gen.count, ax.decoder.count, kernel.level_bits(ax))
+                          for ax in self._axes]], dtype=np.int64).reshape(1, -1, 3)
 
     def _next_action(self) -> float:
         """Time of the next scenario action or timed output (inf: none): the kernel
