@@ -169,17 +169,17 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     for ax, p1v1 in zip(movers, ends, strict=True):
         pos[:, ax.index] = p1v1[:m, 0] + ax.counters._cmd_off
         vel[:, ax.index] = p1v1[:m, 1]
-    fb = np.empty((m, len(axes)), dtype=np.int64)
+    fb = np.stack([ax.counters.feedback_from(trace[:, ax.index, 0], trace[:, ax.index, 1])
+                   for ax in axes], axis=1)
+    # logical levels: the electrical ones flipped where the contact is normally closed
+    nc = np.array([sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if sig in ctl._nc[i])
+                   for i in range(len(axes))], dtype=np.int64)
+    logical = trace[:, :, 2] ^ nc
     io = np.zeros((m, len(axes)), dtype=np.int64)
-    for ax in axes:
-        i = ax.index
-        fb[:, i] = ax.counters.feedback_from(trace[:, i, 0], trace[:, i, 1])
-        levels = trace[:, i, 2]
-        nc = ctl._nc[i]
-        for sig, bit in IO_BITS:
-            lv = (levels >> AXIS_INPUTS.index(sig)) & 1
-            io[:, i] |= (lv ^ (sig in nc)) << bit
+    for sig, bit in IO_BITS:
+        io |= ((logical >> AXIS_INPUTS.index(sig)) & 1) << bit
     if ctl._estop:
         io |= 1 << 6
-    state = np.array([[STATE_CODES[ax.state] for ax in axes]] * m, dtype=np.int64)
+    state = np.broadcast_to(np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int64),
+                            (m, len(axes)))
     ctl.recorder.record_block(t, cmd_pos=pos, fb_pos=fb, cmd_vel=vel, state=state, io=io)
