@@ -50,6 +50,7 @@ SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
 MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
+JumpObserver = Callable[["Controller", int, int, list[list[float]]], None]
 
 
 class Controller:
@@ -102,6 +103,8 @@ class Controller:
         #: every cycle (the reference the jumps are tested against).
         self.virtual_jumps = True
         self._pre_hooks: list[PreAdvanceHook] = []
+        self._pre_dues: dict[PreAdvanceHook, DueFn] = {}
+        self._jump_observers: list[JumpObserver] = []
         self._sample_hooks: list[tuple[SampleHook, int]] = []
         self._samples = 1  # sub-steps per cycle: lcm of the sample hooks' rates
         self._fault_hooks: list[FaultHook] = []
@@ -235,20 +238,48 @@ class Controller:
                 if hook not in self._cycle_hooks:
                     self._cycle_dues.pop(hook, None)
 
-    def add_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
+    def add_pre_advance_hook(self, hook: PreAdvanceHook, *, due: DueFn | None = None
+                             ) -> None:
         """Call `hook(controller, t0, t1)` every cycle after every axis's command for
         [t0, t1] is set and before `hardware.advance(t1)`: the commanded motion of the
         coming cycle is known then (the history holds it), so a hook can schedule timed
-        outputs for it (hw.interface.TimedOutputHardware)."""
+        outputs for it (hw.interface.TimedOutputHardware).
+
+        `due(controller)`, as for `add_cycle_hook`: the earliest time inside the first
+        cycle in which the hook may act; that cycle then runs on its own (a jump lands
+        before it). Without it, every cycle runs.
+        """
         if not callable(hook):
             raise MotionError(f"hook must be callable, got {hook!r}")
+        if due is not None and not callable(due):
+            raise MotionError(f"due must be callable or None, got {due!r}")
         with self._lock:
             self._pre_hooks.append(hook)
+            if due is not None:
+                self._pre_dues[hook] = due
 
     def remove_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
         with self._lock:
             if hook in self._pre_hooks:
                 self._pre_hooks.remove(hook)
+                if hook not in self._pre_hooks:
+                    self._pre_dues.pop(hook, None)
+
+    def add_jump_observer(self, observer: JumpObserver) -> None:
+        """Call `observer(controller, first, last, positions)` when a jump (control/jump.py)
+        crosses cycles first..last without running their hooks: `positions[i]` holds every
+        axis's command position (pulses) at the end of cycle first + i, exactly as those
+        cycles would have left it. A hook that records something every cycle (a trace)
+        fills the crossed cycles from it and can declare a `due`."""
+        if not callable(observer):
+            raise MotionError(f"observer must be callable, got {observer!r}")
+        with self._lock:
+            self._jump_observers.append(observer)
+
+    def remove_jump_observer(self, observer: JumpObserver) -> None:
+        with self._lock:
+            if observer in self._jump_observers:
+                self._jump_observers.remove(observer)
 
     def add_sample_hook(self, hook: SampleHook, per_cycle: int = 1) -> None:
         """Call `hook(controller, t)` `per_cycle` times per cycle, at t = t0 + k*T/per_cycle

@@ -8,7 +8,8 @@ itself (hw.interface.QueuedHardware) and every cycle hook can say when it must n
 which nothing needs Python:
 
 - the cycle in which an axis's motion reaches its end (it settles there);
-- the first cycle ending at or after the earliest hook's due time;
+- the first cycle ending at or after the earliest cycle hook's due time, and the cycle
+  before the first one containing a pre-advance hook's due time (that one runs on its own);
 - the cycles asked for (`advance`, `run_until`).
 
 `jump` then queues, for every moving axis, the very pieces the cycle-by-cycle path would
@@ -18,10 +19,12 @@ some edge hook acts on (`add_edge_hook(..., signals=...)`; edges no hook acts on
 encoder index pulses with nobody latching them, are dropped), and
 finishes that landing cycle exactly as `Controller.step` finishes a cycle. The cycles in
 between are the ones that would have been no-ops, so counters, events, histories and
-outputs are identical (tests/test_jump_equivalence.py runs both ways).
+outputs are identical (tests/test_jump_equivalence.py runs both ways). Jump observers
+(`Controller.add_jump_observer`) get the command positions of the crossed cycles, so a
+per-cycle record (the program runner's trace) stays complete.
 
 Jumping is off, and every cycle runs, while anything needs each cycle: a sample hook (a
-servo loop closed in Python), a pre-advance hook, a cycle hook without a due function, the
+servo loop closed in Python), a pre-advance or cycle hook without a due function, the
 recorder, a command transform, an axis waiting for INP or a done gate.
 """
 
@@ -60,10 +63,19 @@ def plan_jump(ctl: Controller, cycles: int) -> int:
     n0 = ctl._n
     nxt = n0 + 1
     if (cycles < 2 or not ctl.virtual_jumps or ctl.recorder is not None
-            or ctl._sample_hooks or ctl._pre_hooks
-            or not isinstance(ctl.hardware, QueuedHardware)):
+            or ctl._sample_hooks or not isinstance(ctl.hardware, QueuedHardware)):
         return nxt
     land = n0 + cycles
+    pre_dues = ctl._pre_dues
+    for pre in ctl._pre_hooks:  # a pre-advance hook's cycle must run on its own: land before
+        due = pre_dues.get(pre)
+        if due is None:
+            return nxt
+        t = due(ctl)
+        if t != math.inf:
+            land = min(land, first_cycle_at(ctl, t) - 1)
+            if land <= nxt:
+                return nxt
     for ax in ctl.axes:
         if ax.command_transforms or ax._waiting_inp or ax._gated:
             return nxt
@@ -134,7 +146,10 @@ def jump(ctl: Controller, land: int) -> None:
                 raise
             ends.append(p1v1)
         run = hw.run_cycles(origin, period, n, stop, wake)
-        if run.cycle < stop or run.edges or stop >= land:
+        landed = run.cycle < stop or run.edges or stop >= land
+        if ctl._jump_observers:
+            _observe(ctl, n, run.cycle - 1 if landed else stop, movers, ends)
+        if landed:
             break
         n = stop
         t0 = origin + n * period
@@ -145,3 +160,17 @@ def jump(ctl: Controller, land: int) -> None:
         if k < stop:
             hw.clear_queue(ax.index)
     ctl._finish_cycle(k, run.edges)
+
+
+def _observe(ctl: Controller, n: int, last: int, movers: list,
+             ends: list[list[tuple[float, float]]]) -> None:
+    """Hand the jump observers the command positions of the crossed cycles n+1..last."""
+    if last <= n:
+        return
+    rows = [[ax.position] * (last - n) for ax in ctl.axes]
+    for ax, p1v1 in zip(movers, ends, strict=True):
+        off = ax.counters._cmd_off  # Axis.position = raw position + this offset
+        rows[ax.index] = [p + off for p, _ in p1v1[:last - n]]
+    positions = [list(r) for r in zip(*rows, strict=True)]
+    for obs in tuple(ctl._jump_observers):
+        obs(ctl, n + 1, last, positions)
