@@ -32,6 +32,7 @@ from ..hw.interface import Hardware, InputEdge
 from ..recording import Recorder
 from .axis import Axis
 from .clock import CycleStats, RealtimePacer, check_period
+from .events import EventLog
 from .jump import jump, plan_jump
 from .motion import ActiveMotion
 from .states import AxisState
@@ -41,6 +42,38 @@ STATE_CODES = {st: i for i, st in enumerate(AxisState)}
 #: Recorder io channel bits, after HSL get_io_status (seed-facts 2.4); logical levels.
 IO_BITS = (("rdy", 0), ("alm", 1), ("pel", 2), ("mel", 3), ("org", 4), ("ez", 9),
            ("ltc", 11), ("sd", 12), ("inp", 13))
+
+#: The back end `Controller(hardware=None)` builds, registered one level up
+#: (openmotion/control/__init__.py: the simulator); the core never imports a back end.
+_DEFAULT_HARDWARE: Callable[[MachineConfig], Hardware] | None = None
+#: (attribute, attach(controller, wanted) -> value): capabilities every new controller gets,
+#: in order (servo loops, safety), registered by the packages that provide them.
+_ATTACHMENTS: list[tuple[str, Callable[[Any, bool], Any]]] = []
+
+
+def set_default_hardware(factory: Callable[[MachineConfig], Hardware]) -> None:
+    """Choose the back end a Controller built without `hardware` gets (factory(config))."""
+    global _DEFAULT_HARDWARE  # noqa: PLW0603 - the composition root sets it once
+    if not callable(factory):
+        raise MotionError(f"factory must be callable, got {factory!r}")
+    _DEFAULT_HARDWARE = factory
+
+
+def register_attachment(name: str, attach: Callable[[Any, bool], Any]) -> None:
+    """Attach a capability to every new Controller as attribute `name`:
+    `attach(controller, wanted)` runs at the end of construction (`wanted`: the
+    constructor's flag of that name, True when it has none) and returns the value.
+    Registering a name again replaces its attach function (same place in the order)."""
+    if not isinstance(name, str) or not name.isidentifier():
+        raise MotionError(f"name must be an identifier, got {name!r}")
+    if not callable(attach):
+        raise MotionError(f"attach must be callable, got {attach!r}")
+    for k, (n, _) in enumerate(_ATTACHMENTS):
+        if n == name:
+            _ATTACHMENTS[k] = (name, attach)
+            return
+    _ATTACHMENTS.append((name, attach))
+
 
 EdgeHook = Callable[["Controller", InputEdge], None]
 CycleHook = Callable[["Controller", float], None]
@@ -57,11 +90,13 @@ class Controller:
     """Multi-axis controller over a `Hardware` back end (the simulator by default).
 
     config: the machine (default `default_machine()`); hardware: a back end implementing
-    hw.interface.Hardware (default `SimMachine(config)`); period: interpolation period in
-    seconds (default config.cycle_s, 1 ms .. 1 s); history_window_s: how much motion history
-    to keep (flat memory); safety: attach the motion I/O reactions (`Safety`: end limits,
-    slow-down, alarm, ERC, soft limits, comparators) as `ctl.safety` — on by default, as on
-    a real card; `safety=False` leaves only E-stop and servo alarm handling.
+    hw.interface.Hardware (default: the one registered with `set_default_hardware`, the
+    simulator `SimMachine(config)`, chosen by openmotion.control); period: interpolation
+    period in seconds (default config.cycle_s, 1 ms .. 1 s); history_window_s: how much
+    motion history to keep (flat memory); safety: attach the motion I/O reactions
+    (`Safety`: end limits, slow-down, alarm, ERC, soft limits, comparators) as
+    `ctl.safety` — on by default, as on a real card; `safety=False` leaves only E-stop and
+    servo alarm handling.
     """
 
     def __init__(self, config: MachineConfig | None = None, hardware: Hardware | None = None,
@@ -75,9 +110,10 @@ class Controller:
             raise MotionError("config must describe at least one axis")
         self.period = check_period(config.cycle_s if period is None else period)
         if hardware is None:
-            from ..hw.sim import SimMachine  # the default back end; control never needs it
-
-            hardware = SimMachine(config)
+            if _DEFAULT_HARDWARE is None:
+                raise MotionError("hardware is required: no default back end is registered "
+                                  "(openmotion.control registers the simulator)")
+            hardware = _DEFAULT_HARDWARE(config)
         if not isinstance(hardware, Hardware):
             raise MotionError("hardware must implement openmotion.hw.interface.Hardware")
         if hardware.n_axes != len(config.axes):
@@ -122,15 +158,14 @@ class Controller:
         self._pacer = RealtimePacer(self.step, self.period, self._overran)
         self._rb_cycle = [-1] * len(self.axes)
         self._estop = self._emg_level_active(hardware.read_input("emg"))
-        from .servoloop import attach_servo_loops  # closed loops of axes with a loop config
-
-        self.servo_loops = attach_servo_loops(self)
-        from .events import EventLog  # faults, limits, latches, home completion, compare
-
-        self.events = EventLog(self)
-        from .safety import Safety
-
-        self.safety: Safety | None = Safety(self) if safety else None
+        self.events = EventLog(self)  # faults, limits, latches, home completion, compare
+        #: capabilities attached at construction (register_attachment): the closed servo
+        #: loops (name -> ServoLoop) and the motion I/O reactions (a `Safety`, or None)
+        self.servo_loops: dict[str, Any] = {}
+        self.safety: Any = None
+        wanted = {"safety": safety}
+        for name, attach in _ATTACHMENTS:
+            setattr(self, name, attach(self, wanted.get(name, True)))
 
     # ------------------------------------------------------------------ lookup
     def axis(self, key: int | str) -> Axis:
