@@ -318,8 +318,10 @@ class ProgramRunner:
         self._finish(RunState.ABORTED, "aborted by the operator")
 
     def wait(self, timeout: float) -> bool:
-        """Virtual time: run the controller until the program is no longer running."""
-        return self._ctl.run_until(lambda: self.state is not RunState.RUNNING, timeout)
+        """Virtual time: run the controller until the program is no longer running (the
+        state changes only inside the cycle's hooks, so virtual time may jump)."""
+        return self._ctl.run_until(lambda: self.state is not RunState.RUNNING, timeout,
+                                   event_driven=True)
 
     @property
     def running(self) -> bool:
