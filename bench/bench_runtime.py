@@ -11,7 +11,9 @@ as it is done) and 4 enabled idle axes; recorder off and on; each cycle by cycle
 (`virtual_jumps = False`, the reference) and jumping (control/jump.py). The driver loop is
 the same both ways: `run_until(any axis done, event_driven=True)`, then new moves. Figures
 are CPU time (time.process_time), so they hold on a loaded machine. Prints the goals of
-issue 13 beside them, and the recorder's extra cost.
+issue 13 beside them, and the recorder's extra cost. Then two jobs, cycle by cycle and
+jumping: a G-code job (lines, arcs and a dwell through the program runner and a group) and
+a homing run (mode 0: search ORG, stop, move to home).
 
     python bench/bench_runtime.py [--seconds 2]
 """
@@ -27,6 +29,8 @@ from dataclasses import replace
 from openmotion.config import MachineConfig, default_machine
 from openmotion.control import Controller
 from openmotion.control import motion as _motion
+from openmotion.control.homing import HomeConfig, home_search
+from openmotion.program.runner import ProgramRunner
 
 #: issue 13's goals (virtual s per CPU s)
 GOALS = {("moving", 4): 200.0, ("moving", 16): 50.0, ("moving", 63): 10.0,
@@ -92,6 +96,58 @@ def speed(n_axes: int, seconds: float, moving: bool, jumping: bool,
     return seconds / cpu, cpu / c.cycles * 1e6
 
 
+#: The G-code job row: a square of lines with arcs in the corners and a dwell, repeated.
+GCODE = "G21 G90 G17\nG0 X0 Y0\n" + "".join(
+    f"G1 X{40 + k} Y0 F2400\nG3 X{50 + k} Y10 I0 J10\nG1 Y40\nG3 X{40 + k} Y50 I-10 J0\n"
+    f"G1 X0\nG4 P0.05\nG1 Y0\n" for k in range(3)) + "M2\n"
+
+
+def gcode_job(c: Controller) -> None:
+    c.enable_all()
+    r = ProgramRunner(c, GCODE, axes={"X": 0, "Y": 1})
+    r.start()
+    c.run_until(lambda: not r.running, 600.0, event_driven=True)
+    assert r.state.value == "done", r.error
+
+
+def homing_run(c: Controller) -> None:
+    c.enable_all()
+    c.axes[0].move_relative(200_000, max_vel=100_000, tacc=0.05)
+    c.wait_motion_done()
+    h = home_search(c, 0, HomeConfig(mode=0, str_vel=2_000.0, max_vel=20_000.0, tacc=0.05))
+    c.run_until(lambda: not h.running, 600.0, event_driven=True)
+    assert h.done, h.status
+
+
+def job_speed(run, jumping: bool) -> tuple[float, float, float]:  # noqa: ANN001
+    """(virtual s per CPU s, CPU us per cycle, of which in the control layer) of one job
+    on the default machine (the rest is the simulator's `advance`/`run_cycles`)."""
+    c = Controller()
+    c.virtual_jumps = jumping
+    hw = c.hardware
+    in_hw = [0.0]
+    depth = [0]  # run_cycles calls advance: count the outer call only
+
+    def timed(fn):  # noqa: ANN001, ANN202
+        def call(*a, **k):  # noqa: ANN002, ANN003, ANN202
+            depth[0] += 1
+            t = time.process_time()
+            try:
+                return fn(*a, **k)
+            finally:
+                depth[0] -= 1
+                if not depth[0]:
+                    in_hw[0] += time.process_time() - t
+        return call
+
+    hw.advance = timed(hw.advance)  # type: ignore[method-assign]
+    hw.run_cycles = timed(hw.run_cycles)  # type: ignore[method-assign]
+    t0 = time.process_time()
+    run(c)
+    cpu = max(time.process_time() - t0, 1e-9)
+    return c.time / cpu, cpu / c.cycles * 1e6, (cpu - in_hw[0]) / c.cycles * 1e6
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=2.0,
@@ -121,6 +177,15 @@ def main() -> None:
         f"{k} {n}: {rec_cost[(k, n)]:+.0%}" for k, n in cases))
     print(f"recorder on, extra cost jumping with the kernel (goal <= +{RECORDER_GOAL:.0%}): "
           + ", ".join(f"{k} {n}: {rec_fast[(k, n)]:+.0%}" for k, n in cases))
+    print("jobs (default machine, 4 axes, recorder off); control us/cycle = the part "
+          "outside the simulator")
+    print(f"{'job':>10} {'':>8} {'cycle by cycle':>15} {'jumping':>12} {'us/cycle c/j':>14} "
+          f"{'ratio':>7} {'control us/cycle c/j':>22}")
+    for name, run in (("G-code", gcode_job), ("homing", homing_run)):
+        slow, us_s, ctl_s = job_speed(run, False)
+        fast, us_f, ctl_f = job_speed(run, True)
+        print(f"{name:>10} {'off':>8} {slow:>14.1f}x {fast:>11.1f}x {us_s:>7.1f}/{us_f:<6.1f} "
+              f"{fast / slow:>6.1f}x {ctl_s:>12.1f}/{ctl_f:<9.2f}")
 
 
 if __name__ == "__main__":

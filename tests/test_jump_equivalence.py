@@ -2,13 +2,17 @@
 
 Random scenarios on ideal steppers, stalling steppers with backlash and servo drives
 (moves, velocity moves, speed changes, stops, end limits, E-stop, alarms,
-step losses, soft limits, digital inputs, group lines, homing, G-code, PSO) run twice on
+step losses, soft limits, digital inputs, group lines/arcs/delays, homing in three modes,
+G-code with arcs and dwells, compare tables with pulses and windows) run twice on
 the same machine: once cycle by cycle (`virtual_jumps = False`, the reference) and once
 jumping. After every operation the two controllers must agree on everything observable:
 time and cycle count, every axis's state, fault, position, velocity, motion_done and
 counters, the event log with exact times, the safety stop records, the motion history,
-every output edge, every pulse the generators emitted (exact times) and, in part of the
-scenarios, every row the recorder kept (jumps record the cycles they cross). 60 seeded
+every output edge, every pulse the generators emitted (exact times), in part of the
+scenarios every row the recorder kept (jumps record the cycles they cross), and what each job
+shows (group state and position, homing status, the program's events and per-cycle trace,
+the compare log and output waveforms). The jobs declare when they act (`due`), so the
+fast run must also jump while they are attached. 60 seeded
 scenarios in the normal run, 600 with --long.
 """
 
@@ -87,13 +91,20 @@ def script(rng: np.random.Generator) -> list[tuple]:
                         float(rng.uniform(-10_000, 40_000)), at))
         elif k < 0.95:
             ops.append(("reset",))
-        elif k < 0.96:
+        elif k < 0.962:
             ops.append(("line", float(rng.uniform(-20_000, 20_000)),
-                        float(rng.uniform(-20_000, 20_000))))
-        elif k < 0.97:
-            ops.append(("home", a))
-        elif k < 0.985:
-            ops.append(("gcode", float(rng.uniform(1, 20)), float(rng.uniform(1, 20))))
+                        float(rng.uniform(-20_000, 20_000)), float(rng.uniform(0.0, 0.05)),
+                        bool(rng.random() < 0.5)))
+        elif k < 0.972:
+            ops.append(("home", a, int(rng.choice([0, 1, 2])),
+                        float(rng.choice([0.0, 0.0123]))))
+        elif k < 0.984:
+            ops.append(("gcode", float(rng.uniform(1, 20)), float(rng.uniform(1, 20)),
+                        float(rng.choice([0.0, 0.0137]))))
+        elif k < 0.992:
+            ops.append(("compare", float(rng.uniform(-20_000, 20_000)),
+                        float(rng.uniform(500, 5_000)), float(rng.uniform(-20_000, 20_000)),
+                        float(rng.uniform(-20_000, 20_000)), bool(rng.random() < 0.5)))
         else:
             ops.append(("errcheck", a, int(rng.integers(1, 20))))
     ops.append(("wait", 3.0))
@@ -103,6 +114,7 @@ def script(rng: np.random.Generator) -> list[tuple]:
 def apply(ctl: Controller, op: tuple) -> object:
     """Run one operation; its result or the MotionError message (both must agree)."""
     kind, *args = op
+    jobs = ctl.__dict__.setdefault("test_jobs", [])
     ax = ctl.axes[args[0]] if args and isinstance(args[0], int) else None
     sc = ctl.hardware.scenario
     t = ctl.time
@@ -143,17 +155,46 @@ def apply(ctl: Controller, op: tuple) -> object:
             for a in ctl.axes:
                 if a.state.name == "ERROR_STOP":
                     a.reset()
-        elif kind == "line":
+        elif kind == "line":  # a line, an arc back through the start, maybe a delay
             g = Group(ctl, [0, 1], feed=30_000.0, acc_time=0.05)
+            jobs.append(g)
+            p = g.position
             g.line([args[0], args[1]])
+            if args[3]:
+                g.enable_blend(20.0)
+            if args[2]:
+                g.delay(args[2])
+            g.arc([(args[0] + p[0]) / 2, (args[1] + p[1]) / 2], [float(p[0]), float(p[1])])
         elif kind == "home":
-            home_search(ctl, args[0], HomeConfig(mode=0, str_vel=2000.0, max_vel=20000.0,
-                                                 tacc=0.05, timeout_s=1.0))
+            jobs.append(home_search(ctl, args[0], HomeConfig(
+                mode=args[1], str_vel=2000.0, max_vel=20000.0, tacc=0.05, timeout_s=1.0,
+                settle_s=args[2])))
         elif kind == "gcode":
             from openmotion.program.runner import ProgramRunner
 
-            ProgramRunner(ctl, f"G91 G1 X{args[0]:.3f} Y{args[1]:.3f} F3000\nM2\n",
-                          axes={"X": 0, "Y": 1}).start()
+            dwell = f"G4 P{args[2]}\n" if args[2] else ""
+            run = ProgramRunner(ctl, f"G91 G1 X{args[0]:.3f} Y{args[1]:.3f} F3000\n{dwell}"
+                                f"G2 X{args[0]:.3f} Y0 I{args[0] / 2:.3f} J0\nM2\n",
+                                axes={"X": 0, "Y": 1})
+            jobs.append(run)
+            run.start()
+        elif kind == "compare":
+            from openmotion.control.compare import (
+                AxisSource,
+                CompareEngine,
+                LevelJob,
+                Pulse,
+                Toggle,
+                WindowJob,
+            )
+
+            eng = CompareEngine(ctl)
+            jobs.append(eng)
+            lo, step = args[0], args[1]
+            eng.add(LevelJob(AxisSource(0), lo + step * np.arange(8.0),
+                             Pulse(0, 0.0021) if args[4] else Toggle(0)))
+            eng.add(WindowJob([0, 1], [[args[2], args[3]], [args[3], args[2]]], 300.0,
+                              Toggle(1)))
         elif kind == "errcheck":
             ctl.safety.cmp.set_error_counter_check(args[0], args[1], True)
         return None
@@ -181,7 +222,31 @@ def observe(ctl: Controller) -> tuple:
     rec = ctl.recorder
     trace = None if rec is None else (len(rec), rec.total, tuple(
         (k, v.tobytes()) for k, v in rec.arrays().items()))
-    return ctl.time, ctl.cycles, axes, events, stops, hist, outs, tuple(pulses), trace
+    jobs = tuple(_job_view(j) for j in ctl.__dict__.get("test_jobs", ()))
+    return (ctl.time, ctl.cycles, axes, events, stops, hist, outs, tuple(pulses), trace,
+            jobs)
+
+
+def _job_view(job: object) -> tuple:
+    """What a group, homing, program run or compare engine shows of itself."""
+    from openmotion.control.compare import CompareEngine
+    from openmotion.control.homing import Homing
+    from openmotion.program.runner import ProgramRunner
+
+    if isinstance(job, Group):
+        return (job.state, job.error_code, job.error_message, job.queue_length,
+                job.current_index, tuple(job.position.tolist()))
+    if isinstance(job, Homing):
+        st = job.status
+        return (st.state, st.phase, st.mark, st.mark_time, st.reason, tuple(st.history))
+    if isinstance(job, ProgramRunner):
+        t, idx, p = job.trace()
+        return (job.state, job.error, tuple(job.events), tuple(t.tolist()),
+                tuple(idx.tolist()), tuple(map(tuple, p.tolist())))
+    assert isinstance(job, CompareEngine)
+    return (tuple((k, tuple(v.ravel().tolist())) for k, v in job.log.arrays().items()),
+            tuple(tuple(job.output(n).edges) for n in sorted(job._lines)),
+            tuple((j.index, j.hits, j.active) for j in job.jobs.values()))
 
 
 def run_both(seed: int) -> tuple[list, list, int]:
@@ -201,12 +266,16 @@ def run_both(seed: int) -> tuple[list, list, int]:
         trace = []
         if jumping:
             real = ctl._run_cycles
+            base = len(ctl._cycle_hooks)  # the safety reactions' hook
 
-            def counting(n: int, real=real, ctl=ctl) -> None:
+            def counting(n: int, real=real, ctl=ctl, base=base) -> None:
                 nonlocal jumps
                 n0 = ctl.cycles
+                jobs = len(ctl._cycle_hooks) > base  # a job's hook is attached
                 real(n)
                 jumps += ctl.cycles - n0 - 1
+                if jobs:
+                    JOB_JUMPS[0] += ctl.cycles - n0 - 1
 
             ctl._run_cycles = counting  # type: ignore[method-assign]
         for op in ops:
@@ -222,15 +291,25 @@ def _check(seed: int) -> int:
     for (op, r0, o0), (_, r1, o1) in zip(ref, fast, strict=True):
         assert r0 == r1, (seed, op)
         for name, a, b in zip(("time", "cycles", "axes", "events", "stops", "history",
-                               "outputs", "pulses", "recorder"), o0, o1, strict=True):
+                               "outputs", "pulses", "recorder", "jobs"), o0, o1,
+                              strict=True):
             assert a == b, (seed, op, name)
     return jumps
 
 
+#: Cycles jumped over while a job (group, homing, program, compare engine) was attached.
+JOB_JUMPS = [0]
+
+
 def test_random_scenarios_jump_like_cycle_by_cycle(long_run):
+    global JOB_JUMPS  # noqa: PLW0603
+    JOB_JUMPS = [0]
     n = 600 if long_run else 60
     jumps = sum(_check(seed) for seed in range(n))
     assert jumps > 300 * n  # the fast runs did jump over many cycles
+    assert JOB_JUMPS[0] > 10 * n  # ... also while groups, homings, programs, compares ran
+    print(f"{n} seeds: {jumps} cycles jumped over, {JOB_JUMPS[0]} of them with a job "
+          "attached")
 
 
 def test_idle_controller_jumps_to_the_end_in_one_go():

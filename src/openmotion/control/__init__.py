@@ -19,7 +19,7 @@ from .compare_jobs import (
     every_distance,
 )
 from .compensation import BACKLASH_COMPENSATING, Compensation, PitchCompTable
-from .controller import Controller
+from .controller import Controller, register_attachment, set_default_hardware
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
 from .events import EventLog, MotionEvent
 from .group import Group
@@ -35,8 +35,21 @@ from .motion import ActiveMotion
 from .pso import PulseTimer, ZPso
 from .safety import IO_STATUS_BITS, Safety, StopRecord, io_status
 from .servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
-from .servoloop import ServoLoop
+from .servoloop import ServoLoop, attach_servo_loops
 from .states import AxisState, MotionDone
+
+
+# -- composition: the core (controller) imports no capability and no back end; this
+# package, one level up, chooses the default back end and what every controller gets.
+def _simulator(config):  # noqa: ANN001, ANN202 - the default back end, imported when used
+    from ..hw.sim import SimMachine
+
+    return SimMachine(config)
+
+
+set_default_hardware(_simulator)
+register_attachment("servo_loops", lambda ctl, wanted: attach_servo_loops(ctl))
+register_attachment("safety", lambda ctl, wanted: Safety(ctl) if wanted else None)
 
 __all__ = [
     "COUNTER_MAX", "COUNTER_MIN", "ActiveMotion", "Axis", "AxisState", "Controller",

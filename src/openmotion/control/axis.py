@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from functools import wraps
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from ..errors import (
     InfeasibleError,
@@ -40,10 +40,18 @@ from .states import AxisState, MotionDone, transition
 if TYPE_CHECKING:
     from ..config import AxisConfig
     from .controller import Controller
-    from .speed_range import SpeedModel
 
 F = TypeVar("F", bound=Callable[..., Any])
 S = AxisState
+
+
+class SpeedGrid(Protocol):
+    """What an axis asks of a speed model (control.speed_range.SpeedModel, attached by
+    `attach_speed_model`): the spec and the speed change the card really runs."""
+
+    def move(self, spec: MoveSpec) -> MoveSpec: ...
+
+    def change(self, new_vel: float, current_range: float) -> float: ...
 
 
 def _locked(fn: F) -> F:
@@ -79,7 +87,7 @@ class Axis(AxisEngine):
         self._waiting_inp = False
         self._speed_range: float | None = None
         #: PCL6045 register grid (control.speed_range.attach_speed_model), None = exact
-        self.speed_model: SpeedModel | None = None
+        self.speed_model: SpeedGrid | None = None
         #: ALM reaction: False = stop at once (default), True = decelerate (HSL set_alm mode)
         self.alarm_decelerate = False
         self._max_speed = min(config.max_speed_pps, MAX_PULSE_RATE)

@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import MotionError, check_finite, check_int, check_positive
+from .compare_due import engine_due
 from .compare_io import EventLog, OutputLine
 from .compare_jobs import (
     SOURCE_KINDS,
@@ -153,9 +154,9 @@ class CompareEngine:
         self._pre_rows: list[tuple[float, int, int, float, int, int]] = []
         self._pre_pos: list[Array] = []
         self._plan: list[tuple[float, ...]] | None = None  # records planned (rollback)
-        controller.add_cycle_hook(self._on_cycle)
+        controller.add_cycle_hook(self._on_cycle, due=self._due)
         if self.timed:
-            controller.add_pre_advance_hook(self._pre_advance)
+            controller.add_pre_advance_hook(self._pre_advance, due=self._due)
 
     def detach(self) -> None:
         """Stop running (the jobs stay as they are)."""
@@ -440,9 +441,13 @@ class CompareEngine:
             del p.duties[n_:]
         self._pre_rows, self._pre_pos = [], []
 
+    def _due(self, ctl: Controller) -> float:
+        """When a hook of the engine may next act (control/compare_due.py)."""
+        return engine_due(self)
+
     def _pre_advance(self, ctl: Controller, t0: float, t1: float) -> None:
         """Timed hardware, before it runs (t0, t1]: command-position jobs, exact edges."""
-        ta = self._t_pre
+        ta = max(self._t_pre, t0)  # (after a jump: the cycles crossed had nothing to do)
         self._t_pre = t1
         if t1 <= ta:
             return
@@ -458,11 +463,13 @@ class CompareEngine:
             line.send(hw, ta, t1)
 
     def _on_cycle(self, ctl: Controller, t1: float) -> None:
-        ta = self._t_last
+        # after a jump the window starts at the previous cycle end, as cycle by cycle
+        ta = max(self._t_last, ctl._t_origin + (ctl.cycles - 1) * ctl.period)
         self._t_last = t1
         if t1 <= ta:
             return
-        replan = self.timed and self._moved_off_plan()
+        # (a jump's landing cycle had no pre-advance scan: nothing to redo)
+        replan = self.timed and self._t_pre == t1 and self._moved_off_plan()
         self._begin(ta, t1)
         if replan:  # redo the command-position jobs on the motion as executed
             self._rollback(ta)

@@ -14,6 +14,7 @@ feedback model) and asks three questions, each answered between cycles, not at c
 
 from __future__ import annotations
 
+import bisect
 import math
 from typing import NamedTuple
 
@@ -98,27 +99,40 @@ def first_crossing(tr: Track, level: float, t: float, t1: float,
 def first_inside(tracks: list[Track], centre: Array, maxerr: float, t: float,
                  t1: float, ranges: list[tuple[float, float]] | None = None) -> float | None:
     """The first time in [t, t1] every track is within +-maxerr of its centre, or None.
-    `ranges`: each track's (min, max) over the window, to skip hopeless solver calls."""
-    cands = [np.array([t])]
-    for k, (tr, c) in enumerate(zip(tracks, centre, strict=True)):
+    `ranges`: each track's (min, max) over the window, to skip hopeless solver calls.
+
+    Plain floats (a query touches a few records, where numpy's per-call cost dominated),
+    candidates tested in time order until the first one inside: the same arithmetic as the
+    vectorized version, so the same time (tests/test_compare_roots.py)."""
+    cands = {t}
+    rows = []
+    for k, (tr, c_) in enumerate(zip(tracks, centre, strict=True)):
+        c = float(c_)
         lo_k, hi_k = ranges[k] if ranges is not None else (-math.inf, math.inf)
         slack = 1e-9 * (abs(c) + maxerr + 1.0)
         if c + maxerr < lo_k - slack or c - maxerr > hi_k + slack:
             return None  # this axis never gets near its coordinate in the window
+        rec = (tr.ts.tolist(), tr.p0.tolist(), tr.v0.tolist(), tr.a0.tolist(), tr.j.tolist())
+        rows.append((rec, c, maxerr + 1e-12 * (abs(c) + maxerr + 1.0)))
         for lvl in (c - maxerr, c + maxerr):
             if not lo_k - slack <= lvl <= hi_k + slack:
                 continue
-            cands.append(np.array(level_events(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, float(lvl),
-                                               t, t1)))
-    cand = np.unique(np.concatenate(cands))
-    cand = cand[(cand >= t) & (cand <= t1)]
-    ok = np.ones(cand.size, dtype=bool)
-    for tr, c in zip(tracks, centre, strict=True):
-        x = positions(tr, cand)
-        tol = 1e-12 * (abs(c) + maxerr + 1.0)  # the crossing solver lands on the level
-        ok &= np.abs(x - c) <= maxerr + tol
-    idx = np.flatnonzero(ok)
-    return float(cand[idx[0]]) if idx.size else None
+            cands.update(level_events(*rec, float(lvl), t, t1))
+    for x in sorted(cands):
+        if not t <= x <= t1:
+            continue
+        # the crossing solver lands on the level: tol 1e-12 relative
+        if all(abs(_position(rec, x) - c) <= lim for rec, c, lim in rows):
+            return float(x)
+    return None
+
+
+def _position(rec: tuple[list[float], ...], x: float) -> float:
+    """`positions` at one time, on the records as lists (same arithmetic)."""
+    ts, p0, v0, a0, j = rec
+    k = max(bisect.bisect_right(ts, x) - 1, 0)
+    dt = x - ts[k]
+    return p0[k] + dt * (v0[k] + dt * (a0[k] / 2.0 + dt * j[k] / 6.0))
 
 
 def track_range(tr: Track, ta: float, t1: float) -> tuple[float, float]:

@@ -35,15 +35,21 @@ def _sign(x: float) -> int:
 def _refine(c: float, v: float, a: float, j: float, lo: float, hi: float, s_lo: int,
             t_base: float) -> float:
     """Root of the monotone cubic in (lo, hi), whose sign is s_lo at lo and -s_lo at hi:
-    Newton's method kept inside the sign bracket, to the absolute time resolution."""
+    Newton's method kept inside the sign bracket, to the absolute time resolution.
+    (The arithmetic is written out once per step, in a fixed order: the result is the
+    same float whatever the caller; tests/test_compare_roots.py checks it against the
+    plain version.)"""
     x = 0.5 * (lo + hi)
+    tb = abs(t_base)
+    a2 = a / 2.0
+    up = s_lo > 0
     for _ in range(200):
-        f = c + x * (v + x * (a / 2.0 + x * j / 6.0))
-        if _sign(f) == s_lo:
+        f = c + x * (v + x * (a2 + x * j / 6.0))
+        if (f > 0.0) if up else (f < 0.0):
             lo = x
         else:
             hi = x
-        tol = 2.0 * _EPS * (abs(t_base) + abs(x))
+        tol = 2.0 * _EPS * (tb + abs(x))
         if hi - lo <= tol:
             return hi
         d = v + x * (a + x * j / 2.0)

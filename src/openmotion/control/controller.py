@@ -32,6 +32,7 @@ from ..hw.interface import Hardware, InputEdge
 from ..recording import Recorder
 from .axis import Axis
 from .clock import CycleStats, RealtimePacer, check_period
+from .events import EventLog
 from .jump import jump, plan_jump
 from .motion import ActiveMotion
 from .states import AxisState
@@ -42,6 +43,38 @@ STATE_CODES = {st: i for i, st in enumerate(AxisState)}
 IO_BITS = (("rdy", 0), ("alm", 1), ("pel", 2), ("mel", 3), ("org", 4), ("ez", 9),
            ("ltc", 11), ("sd", 12), ("inp", 13))
 
+#: The back end `Controller(hardware=None)` builds, registered one level up
+#: (openmotion/control/__init__.py: the simulator); the core never imports a back end.
+_DEFAULT_HARDWARE: Callable[[MachineConfig], Hardware] | None = None
+#: (attribute, attach(controller, wanted) -> value): capabilities every new controller gets,
+#: in order (servo loops, safety), registered by the packages that provide them.
+_ATTACHMENTS: list[tuple[str, Callable[[Any, bool], Any]]] = []
+
+
+def set_default_hardware(factory: Callable[[MachineConfig], Hardware]) -> None:
+    """Choose the back end a Controller built without `hardware` gets (factory(config))."""
+    global _DEFAULT_HARDWARE  # noqa: PLW0603 - the composition root sets it once
+    if not callable(factory):
+        raise MotionError(f"factory must be callable, got {factory!r}")
+    _DEFAULT_HARDWARE = factory
+
+
+def register_attachment(name: str, attach: Callable[[Any, bool], Any]) -> None:
+    """Attach a capability to every new Controller as attribute `name`:
+    `attach(controller, wanted)` runs at the end of construction (`wanted`: the
+    constructor's flag of that name, True when it has none) and returns the value.
+    Registering a name again replaces its attach function (same place in the order)."""
+    if not isinstance(name, str) or not name.isidentifier():
+        raise MotionError(f"name must be an identifier, got {name!r}")
+    if not callable(attach):
+        raise MotionError(f"attach must be callable, got {attach!r}")
+    for k, (n, _) in enumerate(_ATTACHMENTS):
+        if n == name:
+            _ATTACHMENTS[k] = (name, attach)
+            return
+    _ATTACHMENTS.append((name, attach))
+
+
 EdgeHook = Callable[["Controller", InputEdge], None]
 CycleHook = Callable[["Controller", float], None]
 DueFn = Callable[["Controller"], float]
@@ -50,17 +83,20 @@ SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
 MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
+JumpObserver = Callable[["Controller", int, int, list[list[float]]], None]
 
 
 class Controller:
     """Multi-axis controller over a `Hardware` back end (the simulator by default).
 
     config: the machine (default `default_machine()`); hardware: a back end implementing
-    hw.interface.Hardware (default `SimMachine(config)`); period: interpolation period in
-    seconds (default config.cycle_s, 1 ms .. 1 s); history_window_s: how much motion history
-    to keep (flat memory); safety: attach the motion I/O reactions (`Safety`: end limits,
-    slow-down, alarm, ERC, soft limits, comparators) as `ctl.safety` — on by default, as on
-    a real card; `safety=False` leaves only E-stop and servo alarm handling.
+    hw.interface.Hardware (default: the one registered with `set_default_hardware`, the
+    simulator `SimMachine(config)`, chosen by openmotion.control); period: interpolation
+    period in seconds (default config.cycle_s, 1 ms .. 1 s); history_window_s: how much
+    motion history to keep (flat memory); safety: attach the motion I/O reactions
+    (`Safety`: end limits, slow-down, alarm, ERC, soft limits, comparators) as
+    `ctl.safety` — on by default, as on a real card; `safety=False` leaves only E-stop and
+    servo alarm handling.
     """
 
     def __init__(self, config: MachineConfig | None = None, hardware: Hardware | None = None,
@@ -74,9 +110,10 @@ class Controller:
             raise MotionError("config must describe at least one axis")
         self.period = check_period(config.cycle_s if period is None else period)
         if hardware is None:
-            from ..hw.sim import SimMachine  # the default back end; control never needs it
-
-            hardware = SimMachine(config)
+            if _DEFAULT_HARDWARE is None:
+                raise MotionError("hardware is required: no default back end is registered "
+                                  "(openmotion.control registers the simulator)")
+            hardware = _DEFAULT_HARDWARE(config)
         if not isinstance(hardware, Hardware):
             raise MotionError("hardware must implement openmotion.hw.interface.Hardware")
         if hardware.n_axes != len(config.axes):
@@ -102,6 +139,8 @@ class Controller:
         #: every cycle (the reference the jumps are tested against).
         self.virtual_jumps = True
         self._pre_hooks: list[PreAdvanceHook] = []
+        self._pre_dues: dict[PreAdvanceHook, DueFn] = {}
+        self._jump_observers: list[JumpObserver] = []
         self._sample_hooks: list[tuple[SampleHook, int]] = []
         self._samples = 1  # sub-steps per cycle: lcm of the sample hooks' rates
         self._fault_hooks: list[FaultHook] = []
@@ -119,15 +158,14 @@ class Controller:
         self._pacer = RealtimePacer(self.step, self.period, self._overran)
         self._rb_cycle = [-1] * len(self.axes)
         self._estop = self._emg_level_active(hardware.read_input("emg"))
-        from .servoloop import attach_servo_loops  # closed loops of axes with a loop config
-
-        self.servo_loops = attach_servo_loops(self)
-        from .events import EventLog  # faults, limits, latches, home completion, compare
-
-        self.events = EventLog(self)
-        from .safety import Safety
-
-        self.safety: Safety | None = Safety(self) if safety else None
+        self.events = EventLog(self)  # faults, limits, latches, home completion, compare
+        #: capabilities attached at construction (register_attachment): the closed servo
+        #: loops (name -> ServoLoop) and the motion I/O reactions (a `Safety`, or None)
+        self.servo_loops: dict[str, Any] = {}
+        self.safety: Any = None
+        wanted = {"safety": safety}
+        for name, attach in _ATTACHMENTS:
+            setattr(self, name, attach(self, wanted.get(name, True)))
 
     # ------------------------------------------------------------------ lookup
     def axis(self, key: int | str) -> Axis:
@@ -235,20 +273,48 @@ class Controller:
                 if hook not in self._cycle_hooks:
                     self._cycle_dues.pop(hook, None)
 
-    def add_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
+    def add_pre_advance_hook(self, hook: PreAdvanceHook, *, due: DueFn | None = None
+                             ) -> None:
         """Call `hook(controller, t0, t1)` every cycle after every axis's command for
         [t0, t1] is set and before `hardware.advance(t1)`: the commanded motion of the
         coming cycle is known then (the history holds it), so a hook can schedule timed
-        outputs for it (hw.interface.TimedOutputHardware)."""
+        outputs for it (hw.interface.TimedOutputHardware).
+
+        `due(controller)`, as for `add_cycle_hook`: the earliest time inside the first
+        cycle in which the hook may act; that cycle then runs on its own (a jump lands
+        before it). Without it, every cycle runs.
+        """
         if not callable(hook):
             raise MotionError(f"hook must be callable, got {hook!r}")
+        if due is not None and not callable(due):
+            raise MotionError(f"due must be callable or None, got {due!r}")
         with self._lock:
             self._pre_hooks.append(hook)
+            if due is not None:
+                self._pre_dues[hook] = due
 
     def remove_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
         with self._lock:
             if hook in self._pre_hooks:
                 self._pre_hooks.remove(hook)
+                if hook not in self._pre_hooks:
+                    self._pre_dues.pop(hook, None)
+
+    def add_jump_observer(self, observer: JumpObserver) -> None:
+        """Call `observer(controller, first, last, positions)` when a jump (control/jump.py)
+        crosses cycles first..last without running their hooks: `positions[i]` holds every
+        axis's command position (pulses) at the end of cycle first + i, exactly as those
+        cycles would have left it. A hook that records something every cycle (a trace)
+        fills the crossed cycles from it and can declare a `due`."""
+        if not callable(observer):
+            raise MotionError(f"observer must be callable, got {observer!r}")
+        with self._lock:
+            self._jump_observers.append(observer)
+
+    def remove_jump_observer(self, observer: JumpObserver) -> None:
+        with self._lock:
+            if observer in self._jump_observers:
+                self._jump_observers.remove(observer)
 
     def add_sample_hook(self, hook: SampleHook, per_cycle: int = 1) -> None:
         """Call `hook(controller, t)` `per_cycle` times per cycle, at t = t0 + k*T/per_cycle

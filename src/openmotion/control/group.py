@@ -34,6 +34,7 @@ from ..units import AxisUnits
 from . import pathrun
 from .group_checks import unit_scales
 from .group_settings import PERIOD_PULSES_DEFAULT, PERIOD_PULSES_MAX, GroupSettings
+from .groupdue import group_due
 from .groupexec import (
     ERR_ACCEL,
     ERR_ARC,
@@ -189,7 +190,7 @@ class Group(GroupSettings):
         self._ptp_dec_time: float | None = None
         for a in ax:
             owners[a.index] = self
-        controller.add_cycle_hook(self._on_cycle)
+        controller.add_cycle_hook(self._on_cycle, due=self._due)
         if hasattr(controller, "add_fault_hook"):  # immediate reaction to axis faults
             controller.add_fault_hook(self._on_axis_fault)
         if hasattr(controller, "add_motion_hook"):  # ... and to axes stopped directly
@@ -216,13 +217,22 @@ class Group(GroupSettings):
     @property
     def current_index(self) -> int:
         """Index of the command being executed (-1 when none)."""
+        return self.index_at(self._ctl.time)
+
+    def index_at(self, t: float) -> int:
+        """Index of the command the running (or held) chain executes at time t (-1 when
+        none); for times the present run covers."""
         r = self._run or self._held
         if r is None:
             return -1
         if r.plan is not None:
             chain = r.plan.chain
-            return chain.owners[chain.locate(r.plan.s_at(self._ctl.time))]
+            return chain.owners[chain.locate(r.plan.s_at(t))]
         return r.cmds[0].index
+
+    def _due(self, ctl: Controller) -> float:
+        """When the cycle hook may next act (control/groupdue.py)."""
+        return group_due(self, ctl)
 
     @property
     def position(self) -> np.ndarray:

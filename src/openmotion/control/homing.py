@@ -52,6 +52,8 @@ if TYPE_CHECKING:
     from .controller import Controller
 
 S = AxisState
+#: The input edges a homing acts on (its edge hook ignores every other signal).
+HOMING_SIGNALS = ("pel", "mel", "org", "ez")
 
 
 def _has_index(axis: Axis) -> bool:
@@ -158,8 +160,8 @@ class Homing:
         self._plan = list(self._table)
         self._k = 0
         self._recovered = False
-        self.ctl.add_edge_hook(self._on_edge)
-        self.ctl.add_cycle_hook(self._on_cycle)
+        self.ctl.add_edge_hook(self._on_edge, signals=HOMING_SIGNALS)
+        self.ctl.add_cycle_hook(self._on_cycle, due=self._due)
         first = self._plan[0]
         if self._escape_only:  # HSL escape_home: leave the switch, back off, no counters
             self._plan = []
@@ -472,6 +474,28 @@ class Homing:
         need = self.config.ez_count + EZ_COUNT_BASE if ph.ez_counted else 1
         if self._hits >= need:
             self._trigger(ph, e)
+
+    def _due(self, ctl: Controller) -> float:
+        """When `_on_cycle` may next act (Controller.add_cycle_hook): now while the axis
+        left Homing or rests in a stage that moves on; the timeout; the end of a settle
+        time; never while the axis moves (its motion's end and the edges land a jump)."""
+        if not self.running:
+            return math.inf
+        ax = self.axis
+        if ax.state is not S.HOMING:
+            return -math.inf
+        # (a margin below the exact instants: landing a cycle early only costs a step)
+        due = self._t_begin + self.config.timeout_s - 1e-9
+        if ax.is_moving:
+            return due
+        stage = self._stage
+        if stage in ("stop", "final"):
+            if self._t_rest < 0.0:
+                return -math.inf
+            return min(due, self._t_rest + self.config.settle_s - 1e-9)
+        if stage in ("search", "move"):
+            return -math.inf
+        return due
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         if not self.running:

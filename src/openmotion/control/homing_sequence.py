@@ -3,6 +3,7 @@ number home together, the next order starts when all of the previous ones are do
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from ..errors import MotionError, check_int
@@ -44,7 +45,7 @@ class HomeSequence:
 
     def start(self) -> None:
         self.state = "running"
-        self.ctl.add_cycle_hook(self._on_cycle)
+        self.ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._next_group()
 
     def abort(self) -> None:
@@ -66,6 +67,17 @@ class HomeSequence:
             self.state = state
             self.reason = reason
             self.ctl.remove_cycle_hook(self._on_cycle)
+
+    def _due(self, ctl: Controller) -> float:
+        """Now when the running group of homings failed or is done (the homings change
+        state only inside hooks, so this hook acts in the cycle after), else never."""
+        if self.state != "running":
+            return math.inf
+        group = self.groups[self._g]
+        if any(h.status.state in ("error", "aborted") for h in group) or \
+                all(h.done for h in group):
+            return -math.inf
+        return math.inf
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         if self.state != "running":

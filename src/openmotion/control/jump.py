@@ -8,7 +8,8 @@ itself (hw.interface.QueuedHardware) and every cycle hook can say when it must n
 which nothing needs Python:
 
 - the cycle in which an axis's motion reaches its end (it settles there);
-- the first cycle ending at or after the earliest hook's due time;
+- the first cycle ending at or after the earliest cycle hook's due time, and the cycle
+  before the first one containing a pre-advance hook's due time (that one runs on its own);
 - the cycles asked for (`advance`, `run_until`).
 
 `jump` then queues, for every moving axis, the very pieces the cycle-by-cycle path would
@@ -18,10 +19,12 @@ some edge hook acts on (`add_edge_hook(..., signals=...)`; edges no hook acts on
 encoder index pulses with nobody latching them, are dropped), and
 finishes that landing cycle exactly as `Controller.step` finishes a cycle. The cycles in
 between are the ones that would have been no-ops, so counters, events, histories and
-outputs are identical (tests/test_jump_equivalence.py runs both ways).
+outputs are identical (tests/test_jump_equivalence.py runs both ways). Jump observers
+(`Controller.add_jump_observer`) get the command positions of the crossed cycles, so a
+per-cycle record (the program runner's trace) stays complete.
 
 Jumping is off, and every cycle runs, while anything needs each cycle: a sample hook (a
-servo loop closed in Python), a pre-advance hook, a cycle hook without a due function, a
+servo loop closed in Python), a pre-advance or cycle hook without a due function, a
 command transform, an axis waiting for INP or a done gate. The recorder does not stop
 jumps: the back end reports the readback at every cycle end (`run_cycles(trace=True)`)
 and the crossed cycles are recorded from it and the pieces' end states (`record_trace`),
@@ -64,11 +67,20 @@ def plan_jump(ctl: Controller, cycles: int) -> int:
     when the next cycle must run on its own (then `Controller.step` runs it)."""
     n0 = ctl._n
     nxt = n0 + 1
-    if (cycles < 2 or not ctl.virtual_jumps
-            or ctl._sample_hooks or ctl._pre_hooks
+    if (cycles < 2 or not ctl.virtual_jumps or ctl._sample_hooks
             or not isinstance(ctl.hardware, QueuedHardware)):
         return nxt
     land = n0 + cycles
+    pre_dues = ctl._pre_dues
+    for pre in ctl._pre_hooks:  # a pre-advance hook's cycle must run on its own: land before
+        due = pre_dues.get(pre)
+        if due is None:
+            return nxt
+        t = due(ctl)
+        if t != math.inf:
+            land = min(land, first_cycle_at(ctl, t) - 1)
+            if land <= nxt:
+                return nxt
     for ax in ctl.axes:
         if ax.command_transforms or ax._waiting_inp or ax._gated:
             return nxt
@@ -136,6 +148,8 @@ def jump(ctl: Controller, land: int) -> None:
         last = run.cycle < stop or run.edges or stop >= land
         if rec is not None:  # the landing cycle is recorded by _finish_cycle
             record_trace(ctl, movers, ends, n, run.trace[:run.cycle - n - (1 if last else 0)])
+        if ctl._jump_observers:
+            _observe(ctl, n, run.cycle - 1 if last else stop, movers, ends)
         if last:
             break
         n = stop
@@ -183,3 +197,17 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     state = np.broadcast_to(np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int64),
                             (m, len(axes)))
     ctl.recorder.record_block(t, cmd_pos=pos, fb_pos=fb, cmd_vel=vel, state=state, io=io)
+
+
+def _observe(ctl: Controller, n: int, last: int, movers: list,
+             ends: list[np.ndarray]) -> None:
+    """Hand the jump observers the command positions of the crossed cycles n+1..last."""
+    if last <= n:
+        return
+    rows = [[ax.position] * (last - n) for ax in ctl.axes]
+    for ax, p1v1 in zip(movers, ends, strict=True):
+        off = ax.counters._cmd_off  # Axis.position = raw position + this offset
+        rows[ax.index] = (p1v1[:last - n, 0] + off).tolist()
+    positions = [list(r) for r in zip(*rows, strict=True)]
+    for obs in tuple(ctl._jump_observers):
+        obs(ctl, n + 1, last, positions)

@@ -281,7 +281,8 @@ class ProgramRunner:
         self.group.set_sys_max_speed(float(np.max(self.scales.vmax_units)))
         self.state = RunState.RUNNING
         self.t_start = self._ctl.time
-        self._ctl.add_cycle_hook(self._on_cycle)
+        self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
+        self._ctl.add_jump_observer(self._on_jump)
 
     def pause(self) -> None:
         """Hold: decelerate along the path and stop; resume() continues."""
@@ -317,8 +318,10 @@ class ProgramRunner:
         self._finish(RunState.ABORTED, "aborted by the operator")
 
     def wait(self, timeout: float) -> bool:
-        """Virtual time: run the controller until the program is no longer running."""
-        return self._ctl.run_until(lambda: self.state is not RunState.RUNNING, timeout)
+        """Virtual time: run the controller until the program is no longer running (the
+        state changes only inside the cycle's hooks, so virtual time may jump)."""
+        return self._ctl.run_until(lambda: self.state is not RunState.RUNNING, timeout,
+                                   event_driven=True)
 
     @property
     def running(self) -> bool:
@@ -378,12 +381,20 @@ class ProgramRunner:
         self.t_end = self._ctl.time
         self._event(state.value, self.current_line, text)
         self._ctl.remove_cycle_hook(self._on_cycle)
+        self._ctl.remove_jump_observer(self._on_jump)
         if self.group is not None:
             if state is not RunState.ABORTED:
                 self.group.close()
             else:
                 self._closing = True
-                self._ctl.add_cycle_hook(self._close_when_idle)
+                self._ctl.add_cycle_hook(self._close_when_idle, due=self._close_due)
+
+    def _close_due(self, ctl: Controller) -> float:
+        from ..control.group import GroupState
+
+        g = self.group
+        return -math.inf if g is not None and g.state in (GroupState.IDLE,
+                                                          GroupState.ERROR) else math.inf
 
     def _close_when_idle(self, ctl: Controller, t: float) -> None:
         from ..control.group import GroupState
@@ -399,6 +410,50 @@ class ProgramRunner:
         g = self.group
         assert g is not None
         return g.state is GroupState.IDLE and g.queue_length == 0
+
+    def _due(self, ctl: Controller) -> float:
+        """When `_on_cycle` may next act beyond its trace (Controller.add_cycle_hook): now
+        when the group is in error, an M62/M63 is armed (it watches the command index) or
+        `_feed` has work; otherwise the group's own hook acts first and this one follows
+        in the same cycle, so never. The crossed cycles' trace comes from `_on_jump`."""
+        from ..control.group import GroupState
+
+        g = self.group
+        assert g is not None
+        if g.state is GroupState.ERROR or self.synced.armed:
+            return -math.inf
+        if self.state is not RunState.RUNNING:
+            return math.inf
+        return -math.inf if self._feed_ready(g) else math.inf
+
+    def _feed_ready(self, g: Group) -> bool:
+        """Whether `_feed` would change anything now (mirrors its tests)."""
+        p = self._pass
+        opts = self.options
+        if p.pc >= len(p.ops):
+            return self._idle() and not self.synced.armed
+        if g.queue_length >= opts.window:
+            return False
+        op = p.ops[p.pc]
+        if opts.single_block and self._step_line is not None and op.line != self._step_line:
+            return self._idle()
+        if op.kind in ("line", "arc", "delay", "output") or (
+                op.kind == "action" and not op.barrier):
+            return True
+        return self._idle()
+
+    def _on_jump(self, ctl: Controller, first: int, last: int,
+                 positions: list[list[float]]) -> None:
+        """A jump crossed cycles first..last: their trace rows, as `_on_cycle` records."""
+        g = self.group
+        assert g is not None
+        idx = [ax.index for ax in g.axes]
+        origin, period = ctl._t_origin, ctl.period
+        for k, row in zip(range(first, last + 1), positions, strict=True):
+            t = origin + k * period
+            self._trace_t.append(t)
+            self._trace_i.append(g.index_at(t))
+            self._trace_p.append([row[i] for i in idx])
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         from ..control.group import GroupError, GroupState

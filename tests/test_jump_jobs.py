@@ -1,0 +1,122 @@
+"""Jobs jump too: a running group line/arc, a homing sequence, a G-code job and an armed
+compare table cross the cycles between the instants they act (control/groupdue.py,
+Homing._due, ProgramRunner._due, control/compare_due.py), with results identical to the
+cycle-by-cycle run. Each scenario runs both ways and must jump over most of its cycles."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from openmotion.control import Controller
+from openmotion.control.compare import AxisSource, CompareEngine, LevelJob, Pulse, Toggle, WindowJob
+from openmotion.control.group import Group
+from openmotion.control.homing import HomeConfig, home_search
+from openmotion.program.runner import ProgramRunner
+from test_jump_equivalence import observe
+
+
+def both(run: Callable[[Controller], object], cfg=None) -> tuple[object, int, int]:
+    """run(ctl) cycle by cycle and jumping; returns its observation (equal both ways),
+    the cycles run and the cycles the jumping run crossed without running them."""
+    out = []
+    steps = 0
+    for jumping in (False, True):
+        ctl = Controller(cfg)
+        ctl.virtual_jumps = jumping
+        ctl.enable_all()
+        ctl.hardware.record_pulses(True)
+        if jumping:  # count the cycles run one by one (steps and jump landings)
+            real = ctl._finish_cycle
+
+            def counting(n, edges, real=real) -> None:  # noqa: ANN001
+                nonlocal steps
+                steps += 1
+                real(n, edges)
+
+            ctl._finish_cycle = counting  # type: ignore[method-assign]
+        res = run(ctl)
+        out.append((res, observe(ctl)))
+        cycles = ctl.cycles
+    assert out[0] == out[1]
+    print(f"cycles {cycles}, crossed {cycles - steps}")
+    return out[0][0], cycles, cycles - steps
+
+
+def test_a_group_line_and_arc_jump():
+    def run(ctl: Controller) -> object:
+        g = Group(ctl, [0, 1], feed=30_000.0, acc_time=0.05)
+        g.line([20_000.0, 5_000.0])
+        g.arc([20_000.0, 15_000.0], [20_000.0, 25_000.0])
+        g.delay(0.0123)
+        g.line([0.0, 0.0])
+        ctl.run_until(lambda: g.state.value == "idle" and g.queue_length == 0, 10.0,
+                      event_driven=True)
+        return g.state, g.error_code, ctl.time
+    res, cycles, crossed = both(run)
+    assert res[1] == 0
+    assert crossed > 0.8 * cycles
+
+
+def test_a_streamed_blended_chain_jumps():
+    def run(ctl: Controller) -> object:
+        g = Group(ctl, [0, 1], feed=40_000.0, acc_time=0.02)
+        g.enable_blend(50.0)
+        rng = np.random.default_rng(3)
+        for _ in range(40):
+            g.line(rng.uniform(0.0, 8000.0, 2).tolist())
+        ctl.run_until(lambda: g.state.value == "idle" and g.queue_length == 0, 30.0,
+                      event_driven=True)
+        return g.state, g.error_code, ctl.time
+    res, cycles, crossed = both(run)
+    assert res[1] == 0
+    assert crossed > 0.3 * cycles
+
+
+def test_homing_jumps():
+    def run(ctl: Controller) -> object:
+        ctl.axes[0].move_relative(20_000, max_vel=40_000, tacc=0.05)
+        ctl.wait_motion_done()
+        h = home_search(ctl, 0, HomeConfig(mode=0, str_vel=2000.0, max_vel=20000.0,
+                                           tacc=0.05, settle_s=0.0105))
+        ctl.run_until(lambda: not h.running, 20.0, event_driven=True)
+        return h.status.state, h.status.history, h.status.mark, ctl.axes[0].position
+    res, cycles, crossed = both(run)
+    assert res[0] == "done"
+    assert crossed > 0.8 * cycles
+
+
+def test_a_gcode_job_jumps():
+    prog = ("G21 G90 G17\nG0 X5 Y5\nG1 X20 Y5 F1200\nG2 X30 Y15 I0 J10\nG4 P0.25\n"
+            "G1 X5 Y20 F2400\nG3 X5 Y5 I0 J-7.5\nG0 X0 Y0\nM2\n")
+
+    def run(ctl: Controller) -> object:
+        r = ProgramRunner(ctl, prog, axes={"X": 0, "Y": 1})
+        r.start()
+        ctl.run_until(lambda: not r.running, 120.0, event_driven=True)
+        t, idx, p = r.trace()
+        return (r.state, r.error, list(r.events),
+                t.tolist(), idx.tolist(), p.tolist())
+    res, cycles, crossed = both(run)
+    assert res[0].value == "done" and len(res[3]) > 1000
+    assert crossed > 0.5 * cycles
+
+
+def test_compare_tables_jump():
+    def run(ctl: Controller) -> object:
+        eng = CompareEngine(ctl)
+        lv = LevelJob(AxisSource(0), np.arange(1000.0, 40_000.0, 3000.0), Pulse(0, 0.002))
+        win = WindowJob([0, 1], [[10_000.0, 5_000.0], [30_000.0, 15_000.0]], 20.0,
+                        Toggle(1))
+        eng.add(lv)
+        eng.add(win)
+        ctl.axes[0].move_relative(40_000, max_vel=20_000, tacc=0.05)
+        ctl.axes[1].move_relative(20_000, max_vel=10_000, tacc=0.05)
+        ctl.wait_motion_done(timeout=10.0)
+        return ({k: v.tolist() for k, v in eng.log.arrays().items()},
+                [(e.time, e.kind, e.axis) for e in ctl.events.events()],
+                eng.output(0).edges, eng.output(1).edges, lv.hits, win.hits)
+    res, cycles, crossed = both(run)
+    assert res[4] == 13 and res[5] == 2
+    assert crossed > 0.5 * cycles
