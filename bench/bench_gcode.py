@@ -19,12 +19,14 @@ import argparse
 import math
 import os
 import sys
+import tempfile
 import time
 import tracemalloc
 from collections.abc import Callable
 from typing import Any
 
 from openmotion.program import GCodeOptions, compile_text, parse_program
+from openmotion.program.stream import stream_file
 
 
 def cam_program(n: int) -> str:
@@ -139,6 +141,24 @@ def main() -> None:
             print(f"{'':12s} Klipper GCodeDispatch + cmd_G1 {tk:.3f} s ({n / tk:,.0f} "
                   f"lines/s, {len(moves)} moves); ratio {tk / tc:.2f}x; goal >= 1.0x: "
                   f"{'met' if tk >= tc else 'not met'}")
+        if make is cam_program:
+            stream_row(text, opts, n)
+
+
+def stream_row(text: str, opts: GCodeOptions, n: int) -> None:
+    """program.stream.stream_file on the same program as a file: speed and traced peak
+    while the commands are consumed one by one (none kept)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "cam.ngc")
+        with open(path, "w") as fh:
+            fh.write(text)
+        count, ts = timed(lambda: sum(1 for _ in stream_file(path, opts)))
+        tracemalloc.start()
+        sum(1 for _ in stream_file(path, opts))
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+    print(f"{'':12s} stream_file {ts:.3f} s ({n / ts:,.0f} lines/s, {count} commands), "
+          f"peak {peak / 2**20:.1f} MiB traced ({peak / n:.0f} B/line; flat in the length)")
 
 
 if __name__ == "__main__":

@@ -1,13 +1,19 @@
 """Compile fast path: plain word lines (N, G0/G1, axis words, F) run without a Block.
 
 CAM programs are almost all lines like `N120 G1 X12.5 Y-3.25 F1200`. Such a line needs no
-comment handling, expressions or O-words, so `compile_plain` matches it with one regex on
-the raw text and applies exactly what `Modal.execute` would (feed word, motion mode, the
-target in machine coordinates, soft limits, a `Rapid` or `Feed` record) straight to the
-modal state. Every other line goes through `parse_line` and `Modal.execute` as before, and
-whenever anything is unusual (a line the fast path does not cover in the present modal
-state, an error, an O-word anywhere in the program) the caller's full path decides: the
-result and every error are those of parse_program + interpret, only faster.
+comment handling, expressions or O-words, so `plain_commands` matches it with one regex on
+the raw text and applies exactly what `Modal.execute` would (F with feed_lin/feed_ang,
+motion mode, motion_prev, the end of a canned-cycle series, the target through the work,
+G92 and tool offsets, soft limits, a `Rapid` or `Feed` record) straight to the modal state.
+
+It does so only while the modal state is one whose effect on a plain line it models
+(`_plain_modes`): no cutter compensation, no rotated coordinate system, no G7 diameter
+mode, a G0/G1 motion mode; feed moves also need G94 (not G93/G95). In any other state, and
+for every other line, the line goes through `parse_line` and `Modal.execute` as before; a
+plain line the fast code cannot finish (soft limit, zero feed) is re-run that way too, so
+its error is the general path's own. A program with an O-word, an M98/M99 request or more
+lines than `max_blocks` is handed whole to the general interpreter (`_Defer`). The result
+and every error are those of parse_program + interpret, only faster.
 
 The garbage collector is paused while a program compiles: the command list only grows,
 and the collections it would trigger rescan every command made so far (O(n) pauses).
@@ -17,9 +23,11 @@ from __future__ import annotations
 
 import gc
 import re
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 
 from . import canon
+from .cuttercomp import CutterComp
+from .cycles import CycleState
 from .modal import Modal
 from .options import ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
@@ -28,32 +36,45 @@ from .parser import parse_line
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)"
 
 #: Modal's attributes this module knows. A Modal with others (a dialect feature added
-#: later, e.g. cutter compensation) may change what a plain line does: then the fast path
-#: stays off until this list and the code below are brought up to date (a test checks it
-#: is on for a plain program).
+#: later) may change what a plain line does: then the fast path stays off until this list
+#: and `_plain_modes` are brought up to date (a test checks it is on for a plain program).
 KNOWN_STATE = frozenset((
     "opt", "params", "pos", "machine_mm", "units", "lscale", "ldiv", "incremental",
-    "arc_incremental", "plane", "inverse_time", "feed", "motion", "coord", "tool_z",
+    "arc_incremental", "plane", "inverse_time", "feed", "feed_lin", "feed_ang", "motion",
+    "motion_prev", "cycle", "polar_inc", "comp", "saved_states", "blend", "coord", "tools",
     "selected_tool", "tool", "spindle_on", "spindle_cw", "speed", "mist", "flood", "ended",
-    "letters", "g92", "off"))
+    "flow_request", "letters", "g92", "off", "work", "rot", "rotated", "tool_offset", "line",
+    "per_rev", "css", "retract_old_z", "diameter_mode"))
+
+
+class _Defer(Exception):
+    """The program needs the general interpreter (O-words, M98/M99, max_blocks)."""
 
 
 def fast_path_available(modal: Modal) -> bool:
     """Whether `modal` holds only the state this module knows (module docstring)."""
-    return type(modal) is Modal and set(vars(modal)) <= KNOWN_STATE
+    return (type(modal) is Modal and set(vars(modal)) <= KNOWN_STATE
+            and type(modal.comp) is CutterComp and type(modal.cycle) is CycleState)
+
+
+def _plain_modes(modal: Modal) -> tuple[bool, bool]:
+    """(plain rapids and motion-mode words allowed, plain feed moves allowed)."""
+    moves = (not modal.comp.side and not modal.rotated and not modal.diameter_mode
+             and modal.flow_request is None)
+    return moves, moves and not modal.inverse_time and not modal.per_rev
 
 
 def compile_plain(lines: Iterable[str], options: GCodeOptions, file: str,
                   full: Callable[[], list[canon.Command]]) -> list[canon.Command]:
     """Compile the program `lines` (str lines, no line ends) with the fast path; `full()`
-    is the general compile of the same program, used for O-words and on any error so that
-    the result and the error raised are exactly its own."""
+    is the general compile of the same program, used when the program needs it and on
+    any error, so that the result and the error raised are exactly its own."""
     enabled = gc.isenabled()
     gc.disable()
     try:
         try:
-            out = _run(lines, options, file)
-        except Exception:  # GCodeError or not: the general path says what is wrong
+            out = list(plain_commands(lines, options, file))
+        except Exception:  # GCodeError or _Defer: the general path says what is wrong
             out = None
         return full() if out is None else out
     finally:
@@ -69,15 +90,19 @@ def _canonical_regex(letters: Iterable[str]) -> re.Pattern[str]:
                       rf"(?:F({_NUM})[ \t]*)?\Z")
 
 
-def _run(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
-         file: str) -> list[canon.Command] | None:
-    """The fast compile; None where the general path must decide (O-words, limits)."""
+def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
+                   file: str) -> Iterator[canon.Command]:
+    """The commands of a program without O-words, line by line (module docstring).
+
+    Raises the general path's GCodeError for a line that is wrong, and `_Defer` where the
+    whole program must go to the interpreter. Lines are read one at a time, so `lines`
+    may be a file being read.
+    """
     params = Parameters(options.parameters)
     modal = Modal(options, params)
     if not fast_path_available(modal):
-        return None
-    out: list[canon.Command] = []
-    append = out.append
+        raise _Defer("modal state unknown to the fast path")
+    general: list[canon.Command] = []
     max_len = options.max_line_length
     limit = options.max_blocks
     skip_deleted = options.block_delete
@@ -88,85 +113,112 @@ def _run(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
     slots = [(gi, letters[L][0], letters[L][1], L not in ROTARY_LETTERS)
              for gi, L in enumerate(order, 1)]
     n_groups = len(order) + 2
+    xy_groups = [gi for gi, L in enumerate(order, 1) if L in "XY"]
+    # Modal._rotary_only: (machine axis, rotary) of every mapped letter, in its order
+    movers = [(ax, L in ROTARY_LETTERS) for L, (ax, _k) in letters.items()]
+    any_rotary = any(rot for _ax, rot in movers)
     canonical = _canonical_regex(order).match
     Feed, Rapid = canon.Feed, canon.Rapid
+    comp, cycle = modal.comp, modal.cycle
     seen_code = False
     running = True
     steps = 0
-    feed_key: tuple[float, float, float] | None = None
-    feed_per_s = 0.0
     # the modal state a plain line reads, refreshed after every general line
     motion, pos = modal.motion, modal.pos
     incremental, off = modal.incremental, modal.off
-    lscale, ldiv, unit = modal.lscale, modal.ldiv, modal.lscale == 1.0 == modal.ldiv
-    inverse = modal.inverse_time
+    lscale, ldiv = modal.lscale, modal.ldiv
+    unit = lscale == 1.0 == ldiv
+    moves_ok, feeds_ok = _plain_modes(modal)
     for k, text in enumerate(lines, 1):
-        if not running:
-            if canonical(text) is None:
+        if not running:  # after M2/M30: later lines are still parsed (their errors count)
+            if len(text) > max_len or canonical(text) is None:
                 if text.strip() == "%":
                     break
-                b = parse_line(text, k, file, max_len)  # parse errors are still errors
+                b = parse_line(text, k, file, max_len)
                 if b is not None and b.oword is not None:
-                    return None
+                    raise _Defer("O-word")
             continue
-        m = canonical(text) if len(text) <= max_len else None
+        m = canonical(text) if moves_ok and len(text) <= max_len else None
         if m is not None:
             grp = m.groups()
             g = grp[0]
             f = grp[-1]
             mode = motion if g is None else (0 if g == "0" else 10)
+            fv = 0.0
             if f is not None:
                 fv = float(f)
                 if fv < 0.0:
-                    m = None
-            if m is not None:
-                moving = False
-                for gi in range(1, n_groups - 1):
-                    if grp[gi] is not None:
-                        moving = True
-                        break
-                if moving and (mode == 0 or (mode == 10 and not inverse)):
-                    steps += 1
-                    seen_code = True
-                    if steps > limit:
-                        return None
-                    if f is not None:
-                        modal.feed = fv
-                    motion = mode
-                    target = pos[:]
-                    for gi, ax, kk, linear in slots:
-                        sv = grp[gi]
-                        if sv is not None:
-                            v = float(sv)
-                            if linear and not unit:
-                                v = v * lscale / ldiv
-                            target[ax] = pos[ax] + v if incremental else v + off[kk]
-                    if mode == 10:
-                        key = (modal.feed, lscale, ldiv)
-                        if key != feed_key:
-                            if modal.feed <= 0.0:
-                                return None  # the general path's error
-                            feed_key = key
-                            feed_per_s = modal.lin(modal.feed) / 60.0
-                    if soft:
-                        modal.check_limits(_FakeBlock, target, target, "", 0)
-                    if mode == 10:
-                        append(Feed(tuple(target), feed_per_s, k, file, None))
+                    m = None  # the general path's error
+            moving = False
+            for gi in range(1, n_groups - 1):
+                if grp[gi] is not None:
+                    moving = True
+                    break
+            if m is not None and moving and (mode == 0 or (mode == 10 and feeds_ok)):
+                steps += 1
+                seen_code = True
+                if steps > limit:
+                    raise _Defer("max_blocks")
+                feed = modal.feed
+                if f is not None:
+                    feed = fv
+                    f_lin = fv * lscale / ldiv
+                    f_ang = fv
+                else:
+                    f_lin, f_ang = modal.feed_lin, modal.feed_ang
+                target = pos[:]
+                for gi, ax, kk, linear in slots:
+                    sv = grp[gi]
+                    if sv is not None:
+                        v = float(sv)
+                        if linear and not unit:
+                            v = v * lscale / ldiv
+                        target[ax] = pos[ax] + v if incremental else v + off[kk]
+                per_s = 0.0
+                if mode == 10:
+                    if feed <= 0.0:
+                        m = None  # "feed rate is zero or not set": the general path
                     else:
-                        append(Rapid(tuple(target), k, file))
+                        rotary_only = False
+                        if any_rotary:
+                            moved = [rot for ax, rot in movers if target[ax] != pos[ax]]
+                            rotary_only = bool(moved) and all(moved)
+                        per_s = (f_ang if rotary_only else f_lin) / 60.0
+                if m is not None and soft:
+                    try:
+                        modal.check_limits(_FakeBlock, target, target, "", 0)
+                    except _Reroute:
+                        m = None
+                if m is not None:
+                    if f is not None:
+                        modal.feed, modal.feed_lin, modal.feed_ang = feed, f_lin, f_ang
+                    modal.motion_prev = motion
+                    motion = mode
+                    cycle.initial = None
+                    if comp.arc_not_allowed:
+                        for gi in xy_groups:
+                            if grp[gi] is not None:
+                                comp.arc_not_allowed = False
+                    if mode == 10:
+                        yield Feed(tuple(target), per_s, k, file, None)
+                    else:
+                        yield Rapid(tuple(target), k, file)
                     pos = target
                     continue
-                if not moving:
-                    if f is not None:
-                        modal.feed = fv
-                    if g is not None:
-                        motion = mode
-                    if text.strip():
-                        seen_code = True
-                        steps += 1
-                        if steps > limit:
-                            return None
-                    continue
+                steps -= 1  # the general path below counts the line again
+            elif m is not None and not moving:
+                if f is not None:
+                    modal.feed, modal.feed_lin, modal.feed_ang = fv, fv * lscale / ldiv, fv
+                if g is not None:
+                    modal.motion_prev = motion
+                    motion = mode
+                    cycle.initial = None
+                if text.strip():
+                    seen_code = True
+                    steps += 1
+                    if steps > limit:
+                        raise _Defer("max_blocks")
+                continue
         # anything else: the general parser and Modal.execute
         if text.strip() == "%":
             if seen_code:
@@ -178,26 +230,33 @@ def _run(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
             continue
         seen_code = True
         if b.oword is not None:
-            return None  # O-word control flow: the general interpreter
+            raise _Defer("O-word")
         steps += 1
         if steps > limit:
-            return None
+            raise _Defer("max_blocks")
         if b.delete and skip_deleted:
             continue
         modal.motion, modal.pos = motion, pos
-        if not modal.execute(b, out):
-            running = False
+        running = modal.execute(b, general)
+        if modal.flow_request is not None:
+            raise _Defer("M98/M99")
+        if general and not comp.side and not comp.queue:
+            # cutter compensation edits the moves it queued (indices into this list):
+            # they leave only once it is off
+            yield from general
+            general.clear()
         motion, pos = modal.motion, modal.pos
         incremental, off = modal.incremental, modal.off
-        lscale, ldiv, unit = modal.lscale, modal.ldiv, modal.lscale == 1.0 == modal.ldiv
-        inverse = modal.inverse_time
+        lscale, ldiv = modal.lscale, modal.ldiv
+        unit = lscale == 1.0 == ldiv
+        moves_ok, feeds_ok = _plain_modes(modal)
     modal.motion, modal.pos = motion, pos
-    return out
+    yield from general
 
 
 class _FakeBlock:
-    """Stands in for a Block where a check may raise: any error sends the program to the
-    general path, which raises it with the real line and column."""
+    """Stands in for a Block where a check may raise: the line then runs through the
+    general path, which raises the error with the real line and column."""
 
     @staticmethod
     def error(message: str, pos: int = -1, word: str = "") -> Exception:
