@@ -109,6 +109,28 @@ def test_feed_acc_and_dec_steps_and_acceleration():
     assert lib.MCC_GetCurPos(0)[1] == 30.0
 
 
+@pytest.mark.parametrize("acc,dec", [(20, 20), (10, 40)])
+def test_s_curve_ramps_last_the_acc_and_dec_times(acc, dec):
+    # 2.6.3 I: s-factor 1, the acceleration a triangle over the acceleration time
+    lib = open_lib(period_ms=5)
+    assert lib.MCC_SetFeedSpeed(20.0, 0) == 0
+    assert lib.MCC_SetAccStep(acc, 0) == 0 and lib.MCC_SetDecStep(dec, 0) == 0
+    assert lib.MCC_SetAccType("S", 0) == 0 and lib.MCC_GetAccType(0) == "S"
+    t0 = lib.controller.time
+    assert lib.MCC_Line(30, 0, 0, 0, 0, 0, 0) == 0
+    assert lib.wait_motion(0)
+    t = np.arange(t0, lib.controller.time, 1e-5)
+    st = lib.controller.history.sample(0, t)
+    v = st.v / 500.0
+    moving = np.nonzero(v > 1e-9)[0]
+    cruise = np.nonzero(v >= 20.0 * (1 - 1e-9))[0]
+    assert t[cruise[0]] - t[moving[0]] == pytest.approx(acc * 0.005, abs=3e-5)
+    assert t[moving[-1]] - t[cruise[-1]] == pytest.approx(dec * 0.005, abs=3e-5)
+    short = min(acc, dec) * 0.005
+    assert np.abs(st.a).max() / 500.0 == pytest.approx(2 * 20.0 / short, rel=1e-3)
+    assert lib.MCC_GetCurPos(0)[1] == 30.0
+
+
 def test_ptp_acc_and_dec_steps():
     lib = open_lib(period_ms=5)
     assert lib.MCC_SetPtPAccStep(10, 0) == 0

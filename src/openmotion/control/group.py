@@ -183,6 +183,7 @@ class Group(GroupSettings):
         self._refuse = True
         self._ptp_ratio = 10.0
         self._path_jerk = 0.0   # 0: T-curve path speed; > 0: S-curve with this path jerk
+        self._path_sfactor = 0.0  # > 0: S-curve sized from the ramp times (MCCL)
         self._str_vel = 0.0     # StrVel of the following path commands (0: from/to rest)
         self._ptp_shapes = ("T",) * len(ax)
         self._ptp_acc_time: float | None = None  # None: the path commands' times

@@ -40,6 +40,7 @@ class GroupSettings(GroupChecks):
     _ptp_shapes: tuple[str, ...]
     _ptp_acc_time: float | None
     _ptp_dec_time: float | None
+    _path_sfactor: float
 
     def set_feed(self, feed: float) -> None:
         """MCC_SetFeedSpeed: vector speed (pps, or user units/s) of the following path
@@ -162,21 +163,42 @@ class GroupSettings(GroupChecks):
             raise MotionError(f"on must be a bool, got {on!r}")
         self._wait_inpos = on
 
-    def set_path_shape(self, shape: str, jerk: float | None = None) -> None:
+    def set_path_shape(self, shape: str, jerk: float | None = None, *,
+                       s_factor: float | None = None) -> None:
         """Speed profile of the following path commands: "T" (constant path acceleration)
         or "S" (jerk-limited: the jerk of the path position stays within `jerk`, pps^3 or
         user units/s^3). S paths blend, stream, hold and take overrides like T paths: the
         T plan is smoothed by a moving average of window 2*accel/jerk, its speed caps held
-        that much further along the path, exact-stop corners passed at rest."""
+        that much further along the path, exact-stop corners passed at rest.
+
+        Instead of `jerk`, `s_factor` in (0, 1] sizes the S from the ramp times (MCCL's
+        S-curve, s-factor 1 = a triangular acceleration): a ramp from rest to the feed then
+        lasts exactly the acceleration time and one to rest the deceleration time, as with
+        "T"; the jerk phases take `s_factor` of the shorter ramp (the window is
+        s_factor * min(Tacc, Tdec) / 2), so with equal times every ramp's acceleration
+        rises and falls over s_factor of it (peak feed / (Tacc * (1 - s_factor/2)))."""
         if not isinstance(shape, str) or shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
         if shape == "T":
+            if s_factor is not None:
+                raise MotionError("s_factor is only for shape 'S'")
             self._path_jerk = 0.0
+            self._path_sfactor = 0.0
+            return
+        if s_factor is not None:
+            if jerk is not None:
+                raise MotionError("give either jerk or s_factor for shape 'S', not both")
+            s = check_finite("s_factor", s_factor)
+            if not 0.0 < s <= 1.0:
+                raise MotionError(f"s_factor must be in (0, 1], got {s_factor!r}")
+            self._path_jerk = 0.0
+            self._path_sfactor = s
             return
         j = check_finite("jerk", jerk) if jerk is not None else math.nan
         if not j > 0.0:
             raise MotionError(f"jerk must be a finite number > 0 for shape 'S', got {jerk!r}")
         self._path_jerk = j
+        self._path_sfactor = 0.0
 
     def set_str_vel(self, speed: float) -> None:
         """Start velocity (PCL6045 StrVel, HSL-4XMO 4.6) of the following path commands, in
