@@ -147,14 +147,18 @@ def test_ptp_acc_and_dec_steps():
 
 
 @pytest.mark.parametrize("period", [1, 5, 10])
-def test_delay_200_interpolation_times_is_exact(period):
+@pytest.mark.parametrize("kinds", ["line-line", "line-ptp", "ptp-ptp"])
+def test_delay_200_interpolation_times_is_exact(period, kinds):
     # 2.6.3 V: after command A ends, delay 200 x interpolation time, then command B
+    # (a path or a point-to-point command: both start at the delay's exact end)
     if True:
         lib = open_lib(period_ms=period)
         T = period / 1000.0
-        assert lib.MCC_Line(10, 10, 10, 0, 0, 0, 0) == 0     # A
+        a_kind, b_kind = kinds.split("-")
+        cmd = {"line": lib.MCC_Line, "ptp": lib.MCC_PtP}
+        assert cmd[a_kind](10.003, 10, 10, 0, 0, 0, 0) == 0  # A (X ends last, inside a cycle)
         assert lib.MCC_DelayMotion(200, 0) == 1
-        assert lib.MCC_Line(15, 15, 15, 0, 0, 0, 0) == 2     # B
+        assert cmd[b_kind](15, 15, 15, 0, 0, 0, 0) == 2     # B
         lib.controller.run_until(lambda: lib.MCC_GetMotionStatus(0) == D.GMS_DELAYING,
                                  10)
         assert lib.MCC_CheckDelay(0) == 1
@@ -271,3 +275,26 @@ def test_blend_and_dry_run():
     assert lib.MCC_GetCurPos(0)[1:3] == (10.0, 10.0)
     assert lib.MCC_DisableDryRun() == 0
     assert lib.MCC_DisableBlend(0) == 0 and lib.MCC_CheckBlend(0) == 0
+
+
+def test_blended_ptp_keeps_each_axis_moving():
+    # 2.6.3 II: continuous trajectory of point-to-point motion, each axis's speed and
+    # trajectory continuous: the next PtP starts while the last axis decelerates
+    def run(blend):
+        lib = open_lib(period_ms=5)
+        assert lib.MCC_SetPtPSpeed(30, 0) == 0
+        if blend:
+            assert lib.MCC_EnableBlend(0) == 0
+        t0 = lib.controller.time
+        for x, y in ((20, 5), (40, 30), (10, 30)):
+            assert lib.MCC_PtP(x, y, 0, 0, 0, 0, 0) >= 0
+        assert lib.wait_motion(0)
+        assert lib.MCC_GetPulsePos(0)[1:3] == (5000, 15000)
+        t = np.arange(t0, lib.controller.time, 1e-4)
+        return t - t0, lib.controller.history.sample(0, t).v
+    t_apart, v_apart = run(False)
+    t_blend, v_blend = run(True)
+    assert t_blend[-1] < t_apart[-1] - 0.05
+    # x goes 0 -> 20 -> 40 mm: blended it never stops between the two commands
+    first_stop = lambda t, v: t[np.nonzero((t > 0.05) & (np.abs(v) < 1e-6))[0][0]]  # noqa: E731
+    assert first_stop(t_blend, v_blend) > first_stop(t_apart, v_apart) + 0.1

@@ -515,7 +515,8 @@ class Group(GroupSettings):
         r = self._run
         if r is not None and r.kind == "ptp" and not self._dry:
             for a, spec in zip(self.axes, r.cmds[0].specs, strict=True):
-                if a.motion is not None and a.state is AxisState.DISCRETE_MOTION:
+                if a.motion is not None and a.state is AxisState.DISCRETE_MOTION and \
+                        a.motion.spec is not None:  # a blended PtP (ptpblend) keeps its speed
                     a.fix_speed_range(min(a.max_speed, spec.max_vel * 2.0))
                     # too close to the target: the move finishes at its speed
                     with contextlib.suppress(InfeasibleError), self._commanding():
