@@ -298,3 +298,26 @@ def test_blended_ptp_keeps_each_axis_moving():
     # x goes 0 -> 20 -> 40 mm: blended it never stops between the two commands
     first_stop = lambda t, v: t[np.nonzero((t > 0.05) & (np.abs(v) < 1e-6))[0][0]]  # noqa: E731
     assert first_stop(t_blend, v_blend) > first_stop(t_apart, v_apart) + 0.1
+
+
+def test_ptp_acc_and_dec_types_apart():
+    # 2.6.3 I: for point-to-point motion each axis has its own types; S up, T down on X
+    lib = open_lib(period_ms=5)
+    assert lib.MCC_SetPtPAccType("S", "T", "T", "T", "T", "T", 0) == 0
+    assert lib.MCC_SetPtPDecType("T", "S", "T", "T", "T", "T", 0) == 0
+    assert lib.MCC_GetPtPAccType(0)[:2] == ("S", "T")
+    assert lib.MCC_GetPtPDecType(0)[:2] == ("T", "S")
+    assert lib.MCC_SetPtPSpeed(20, 0) == 0             # keeps the types
+    assert lib.MCC_GetPtPAccType(0)[:2] == ("S", "T")
+    t0 = lib.controller.time
+    assert lib.MCC_PtP(30, 30, 0, 0, 0, 0, 0) == 0
+    assert lib.wait_motion(0)
+    t = np.arange(t0, lib.controller.time, 1e-5)
+    ctl = lib.controller
+    for axis, (up_s, down_s) in ((0, (True, False)), (1, (False, True))):
+        st = ctl.history.sample(axis, t)
+        cruise = np.nonzero(st.v >= st.v.max() * (1 - 1e-9))[0]
+        up, down = slice(0, cruise[0]), slice(cruise[-1], None)
+        assert bool(np.abs(st.j[up]).max() > 1.0) is up_s
+        assert bool(np.abs(st.j[down]).max() > 1.0) is down_s
+    assert lib.MCC_GetCurPos(0)[1:3] == (30.0, 30.0)

@@ -227,24 +227,26 @@ class MCCLSpeed(MCCLBase):
     @_api
     def MCC_SetPtPAccType(self, cType0: str, cType1: str, cType2: str, cType3: str,
                           cType4: str = "T", cType5: str = "T", wGroupIndex: int = 0) -> int:
-        """PtP shape of each axis x..w ('T' or 'S'); the deceleration takes the same."""
+        """PtP acceleration shape of each axis x..w ('T' or 'S'; 2.6.3 I)."""
         gs = self._g(wGroupIndex)
         types = tuple(self._type(f"cType{k}", c) for k, c in
                       enumerate((cType0, cType1, cType2, cType3, cType4, cType5)))
-        gs.group.set_ptp_shapes([types[s] for s in gs.slots])
-        gs.ptp_acc_types = gs.ptp_dec_types = types
+        gs.group.set_ptp_shapes([types[s] for s in gs.slots],
+                                [gs.ptp_dec_types[s] for s in gs.slots])
+        gs.ptp_acc_types = types
         return D.NO_ERR
 
     @_api
     def MCC_SetPtPDecType(self, cType0: str, cType1: str, cType2: str, cType3: str,
                           cType4: str = "T", cType5: str = "T", wGroupIndex: int = 0) -> int:
-        """Must equal the PtP acceleration types (one shape per axis move in the core)."""
+        """PtP deceleration shape of each axis x..w ('T' or 'S'; 2.6.3 I), apart from the
+        acceleration's (`Group.set_ptp_shapes(shapes, dec_shapes)`)."""
         gs = self._g(wGroupIndex)
         types = tuple(self._type(f"cType{k}", c) for k, c in
                       enumerate((cType0, cType1, cType2, cType3, cType4, cType5)))
-        if types != gs.ptp_acc_types:
-            raise Refused(D.PARAMETER_ERR, "PtP deceleration types must equal the "
-                                           "acceleration types")
+        gs.group.set_ptp_shapes([gs.ptp_acc_types[s] for s in gs.slots],
+                                [types[s] for s in gs.slots])
+        gs.ptp_dec_types = types
         return D.NO_ERR
 
     @_api

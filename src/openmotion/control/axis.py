@@ -273,13 +273,14 @@ class Axis(AxisEngine):
         return v
 
     def _spec(self, shape: str, str_vel: float, max_vel: float, tacc: float,
-              tdec: float | None, vs_acc: float, vs_dec: float, units: bool) -> MoveSpec:
+              tdec: float | None, vs_acc: float, vs_dec: float, units: bool,
+              dec_shape: str = "") -> MoveSpec:
         sv = self.check_speed("str_vel", str_vel, units)
         mv = self.check_speed("max_vel", max_vel, units)
         va = self.check_speed("vs_acc", vs_acc, units)
         vd = self.check_speed("vs_dec", vs_dec, units)
         td = tacc if tdec is None else tdec
-        spec = MoveSpec(shape, sv, mv, tacc, td, va, vd)
+        spec = MoveSpec(shape, sv, mv, tacc, td, va, vd, dec_shape)
         return spec if self.speed_model is None else self.speed_model.move(spec)
 
     def _check_can_start(self) -> None:
@@ -333,15 +334,18 @@ class Axis(AxisEngine):
     @_locked
     def move_relative(self, distance: float, *, max_vel: float, str_vel: float = 0.0,
                       tacc: float = 0.1, tdec: float | None = None, shape: str = "T",
-                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False) -> None:
+                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False,
+                      dec_shape: str = "") -> None:
         """Relative T/S move (HSL start_tr_move / start_sr_move) of `distance` pulses.
 
         The target is the command position plus the distance rounded to a whole pulse; the
-        move ends exactly there. `tdec` defaults to `tacc`.
+        move ends exactly there. `tdec` defaults to `tacc`; `dec_shape` ('T'/'S', default
+        `shape`) the deceleration's shape.
         """
         d = check_finite("distance", distance)
         d = float(self.units.to_pulses(d)) if units else d
-        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units)
+        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units,
+                          dec_shape)
         self._check_can_start()
         target = round(self._pos + d)
         self._start_discrete(spec, target, "relative", None)
@@ -351,12 +355,13 @@ class Axis(AxisEngine):
     def move_absolute(self, position: float, *, max_vel: float, str_vel: float = 0.0,
                       tacc: float = 0.1, tdec: float | None = None, shape: str = "T",
                       vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False,
-                      start_in: float = 0.0) -> None:
+                      start_in: float = 0.0, dec_shape: str = "") -> None:
         """Absolute T/S move (HSL start_ta_move / start_sa_move) to `position` (command
         counter frame). As the HSL manual describes, the distance is measured from the
         *feedback* position converted through the move ratio: distance = position -
         feedback/ratio. `start_in` (0 <= s < one period): the move starts that long after
         now, inside the coming cycle, at rest until then (a command after an exact delay).
+        `dec_shape` as in `move_relative`.
         """
         p = check_finite("position", position)
         p = float(self.units.to_pulses(p)) if units else p
@@ -367,7 +372,8 @@ class Axis(AxisEngine):
         if not 0.0 <= lead < self._ctl.period:
             raise MotionError(f"start_in must be in [0, period {self._ctl.period!r}) s, "
                               f"got {start_in!r}")
-        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units)
+        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units,
+                          dec_shape)
         self._check_can_start()
         d = p - self.counters.feedback_in_pulses()
         target = round(self._pos + d)

@@ -186,6 +186,7 @@ class Group(GroupSettings):
         self._path_sfactor = 0.0  # > 0: S-curve sized from the ramp times (MCCL)
         self._str_vel = 0.0     # StrVel of the following path commands (0: from/to rest)
         self._ptp_shapes = ("T",) * len(ax)
+        self._ptp_dec_shapes = ("T",) * len(ax)
         self._ptp_acc_time: float | None = None  # None: the path commands' times
         self._ptp_dec_time: float | None = None
         for a in ax:
@@ -353,7 +354,8 @@ class Group(GroupSettings):
         tacc, tdec = self.ptp_times
         for k, a in enumerate(self.axes):
             v = min(a.max_speed, self._vmax[k]) * (ratio or self._ptp_ratio) / 100.0
-            specs.append(MoveSpec(self._ptp_shapes[k], 0.0, v, tacc, tdec, 0.0, 0.0))
+            specs.append(MoveSpec(self._ptp_shapes[k], 0.0, v, tacc, tdec, 0.0, 0.0,
+                                  self._ptp_dec_shapes[k]))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
 
     @_locked

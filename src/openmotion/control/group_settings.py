@@ -38,6 +38,7 @@ class GroupSettings(GroupChecks):
     _period_pulse_acc: np.ndarray
     _ptp_ratio: float
     _ptp_shapes: tuple[str, ...]
+    _ptp_dec_shapes: tuple[str, ...]
     _ptp_acc_time: float | None
     _ptp_dec_time: float | None
     _path_sfactor: float
@@ -211,22 +212,31 @@ class GroupSettings(GroupChecks):
             raise GroupError(ERR_ARGUMENT, f"speed (StrVel) must be >= 0, got {speed!r}")
         self._str_vel = v
 
-    def set_ptp_speed(self, ratio: float, *, shape: str = "T") -> None:
-        """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10)."""
+    def set_ptp_speed(self, ratio: float, *, shape: str | None = None) -> None:
+        """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10);
+        `shape` 'T'/'S' also sets every axis's PtP shape (None keeps set_ptp_shapes')."""
         r = check_finite("ratio", ratio)
         if not 0.0 < r <= 100.0:
             raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
-        if not isinstance(shape, str) or shape not in ("T", "S"):
+        if shape is not None and (not isinstance(shape, str) or shape not in ("T", "S")):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
-        self._ptp_ratio, self._ptp_shapes = r, (shape,) * len(self.axes)
+        self._ptp_ratio = r
+        if shape is not None:
+            self._ptp_shapes = self._ptp_dec_shapes = (shape,) * len(self.axes)
 
-    def set_ptp_shapes(self, shapes: Sequence[str]) -> None:
-        """MCC_SetPtPAccType per axis: "T" or "S" for each logical axis's PtP profile."""
-        if isinstance(shapes, str) or not isinstance(shapes, Sequence) or \
-                len(shapes) != len(self.axes) or \
-                any(not isinstance(x, str) or x not in ("T", "S") for x in shapes):
-            raise MotionError(f"shapes must be {len(self.axes)} of 'T'/'S', got {shapes!r}")
-        self._ptp_shapes = tuple(shapes)
+    def set_ptp_shapes(self, shapes: Sequence[str],
+                       dec_shapes: Sequence[str] | None = None) -> None:
+        """MCC_SetPtPAccType / MCC_SetPtPDecType per axis: "T" or "S" for each logical
+        axis's PtP acceleration and deceleration (`dec_shapes` None: as `shapes`)."""
+        def check(name: str, v: object) -> tuple[str, ...]:
+            if isinstance(v, str) or not isinstance(v, Sequence) or \
+                    len(v) != len(self.axes) or \
+                    any(not isinstance(x, str) or x not in ("T", "S") for x in v):
+                raise MotionError(f"{name} must be {len(self.axes)} of 'T'/'S', got {v!r}")
+            return tuple(v)
+        acc = check("shapes", shapes)
+        dec = acc if dec_shapes is None else check("dec_shapes", dec_shapes)
+        self._ptp_shapes, self._ptp_dec_shapes = acc, dec
 
     def set_ptp_acc_time(self, seconds: float) -> None:
         """MCC_SetPtPAccStep x T: acceleration time of point-to-point axes (default: the

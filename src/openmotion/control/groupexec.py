@@ -572,7 +572,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 with self._commanding():
                     a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
                                     tdec=spec.tdec, shape=spec.shape,
-                                    start_in=lead if lead > 1e-12 else 0.0)
+                                    start_in=lead if lead > 1e-12 else 0.0,
+                                    dec_shape=spec.dec_shape)
         self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target,
                          blend_at=None if self._dry else ptpblend.blend_at(self))
 
