@@ -109,6 +109,28 @@ def test_feed_acc_and_dec_steps_and_acceleration():
     assert lib.MCC_GetCurPos(0)[1] == 30.0
 
 
+@pytest.mark.parametrize("acc,dec", [(20, 20), (10, 40)])
+def test_s_curve_ramps_last_the_acc_and_dec_times(acc, dec):
+    # 2.6.3 I: s-factor 1, the acceleration a triangle over the acceleration time
+    lib = open_lib(period_ms=5)
+    assert lib.MCC_SetFeedSpeed(20.0, 0) == 0
+    assert lib.MCC_SetAccStep(acc, 0) == 0 and lib.MCC_SetDecStep(dec, 0) == 0
+    assert lib.MCC_SetAccType("S", 0) == 0 and lib.MCC_GetAccType(0) == "S"
+    t0 = lib.controller.time
+    assert lib.MCC_Line(30, 0, 0, 0, 0, 0, 0) == 0
+    assert lib.wait_motion(0)
+    t = np.arange(t0, lib.controller.time, 1e-5)
+    st = lib.controller.history.sample(0, t)
+    v = st.v / 500.0
+    moving = np.nonzero(v > 1e-9)[0]
+    cruise = np.nonzero(v >= 20.0 * (1 - 1e-9))[0]
+    assert t[cruise[0]] - t[moving[0]] == pytest.approx(acc * 0.005, abs=3e-5)
+    assert t[moving[-1]] - t[cruise[-1]] == pytest.approx(dec * 0.005, abs=3e-5)
+    short = min(acc, dec) * 0.005
+    assert np.abs(st.a).max() / 500.0 == pytest.approx(2 * 20.0 / short, rel=1e-3)
+    assert lib.MCC_GetCurPos(0)[1] == 30.0
+
+
 def test_ptp_acc_and_dec_steps():
     lib = open_lib(period_ms=5)
     assert lib.MCC_SetPtPAccStep(10, 0) == 0
@@ -125,14 +147,18 @@ def test_ptp_acc_and_dec_steps():
 
 
 @pytest.mark.parametrize("period", [1, 5, 10])
-def test_delay_200_interpolation_times_is_exact(period):
+@pytest.mark.parametrize("kinds", ["line-line", "line-ptp", "ptp-ptp"])
+def test_delay_200_interpolation_times_is_exact(period, kinds):
     # 2.6.3 V: after command A ends, delay 200 x interpolation time, then command B
+    # (a path or a point-to-point command: both start at the delay's exact end)
     if True:
         lib = open_lib(period_ms=period)
         T = period / 1000.0
-        assert lib.MCC_Line(10, 10, 10, 0, 0, 0, 0) == 0     # A
+        a_kind, b_kind = kinds.split("-")
+        cmd = {"line": lib.MCC_Line, "ptp": lib.MCC_PtP}
+        assert cmd[a_kind](10.003, 10, 10, 0, 0, 0, 0) == 0  # A (X ends last, inside a cycle)
         assert lib.MCC_DelayMotion(200, 0) == 1
-        assert lib.MCC_Line(15, 15, 15, 0, 0, 0, 0) == 2     # B
+        assert cmd[b_kind](15, 15, 15, 0, 0, 0, 0) == 2     # B
         lib.controller.run_until(lambda: lib.MCC_GetMotionStatus(0) == D.GMS_DELAYING,
                                  10)
         assert lib.MCC_CheckDelay(0) == 1
@@ -249,3 +275,49 @@ def test_blend_and_dry_run():
     assert lib.MCC_GetCurPos(0)[1:3] == (10.0, 10.0)
     assert lib.MCC_DisableDryRun() == 0
     assert lib.MCC_DisableBlend(0) == 0 and lib.MCC_CheckBlend(0) == 0
+
+
+def test_blended_ptp_keeps_each_axis_moving():
+    # 2.6.3 II: continuous trajectory of point-to-point motion, each axis's speed and
+    # trajectory continuous: the next PtP starts while the last axis decelerates
+    def run(blend):
+        lib = open_lib(period_ms=5)
+        assert lib.MCC_SetPtPSpeed(30, 0) == 0
+        if blend:
+            assert lib.MCC_EnableBlend(0) == 0
+        t0 = lib.controller.time
+        for x, y in ((20, 5), (40, 30), (10, 30)):
+            assert lib.MCC_PtP(x, y, 0, 0, 0, 0, 0) >= 0
+        assert lib.wait_motion(0)
+        assert lib.MCC_GetPulsePos(0)[1:3] == (5000, 15000)
+        t = np.arange(t0, lib.controller.time, 1e-4)
+        return t - t0, lib.controller.history.sample(0, t).v
+    t_apart, v_apart = run(False)
+    t_blend, v_blend = run(True)
+    assert t_blend[-1] < t_apart[-1] - 0.05
+    # x goes 0 -> 20 -> 40 mm: blended it never stops between the two commands
+    first_stop = lambda t, v: t[np.nonzero((t > 0.05) & (np.abs(v) < 1e-6))[0][0]]  # noqa: E731
+    assert first_stop(t_blend, v_blend) > first_stop(t_apart, v_apart) + 0.1
+
+
+def test_ptp_acc_and_dec_types_apart():
+    # 2.6.3 I: for point-to-point motion each axis has its own types; S up, T down on X
+    lib = open_lib(period_ms=5)
+    assert lib.MCC_SetPtPAccType("S", "T", "T", "T", "T", "T", 0) == 0
+    assert lib.MCC_SetPtPDecType("T", "S", "T", "T", "T", "T", 0) == 0
+    assert lib.MCC_GetPtPAccType(0)[:2] == ("S", "T")
+    assert lib.MCC_GetPtPDecType(0)[:2] == ("T", "S")
+    assert lib.MCC_SetPtPSpeed(20, 0) == 0             # keeps the types
+    assert lib.MCC_GetPtPAccType(0)[:2] == ("S", "T")
+    t0 = lib.controller.time
+    assert lib.MCC_PtP(30, 30, 0, 0, 0, 0, 0) == 0
+    assert lib.wait_motion(0)
+    t = np.arange(t0, lib.controller.time, 1e-5)
+    ctl = lib.controller
+    for axis, (up_s, down_s) in ((0, (True, False)), (1, (False, True))):
+        st = ctl.history.sample(axis, t)
+        cruise = np.nonzero(st.v >= st.v.max() * (1 - 1e-9))[0]
+        up, down = slice(0, cruise[0]), slice(cruise[-1], None)
+        assert bool(np.abs(st.j[up]).max() > 1.0) is up_s
+        assert bool(np.abs(st.j[down]).max() > 1.0) is down_s
+    assert lib.MCC_GetCurPos(0)[1:3] == (30.0, 30.0)

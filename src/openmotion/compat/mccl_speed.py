@@ -24,7 +24,6 @@ class MCCLSpeed(MCCLBase):
         gs = self._g(wGroupIndex)
         f = _num("dfFeedSpeed", dfFeedSpeed) * gs.scale
         gs.group.set_feed(f)
-        self._update_shapes(gs)
         return D.NO_ERR
 
     @_api
@@ -66,7 +65,6 @@ class MCCLSpeed(MCCLBase):
         gs = self._g(wGroupIndex)
         r = _num("dfRatio", dfRatio)
         gs.group.set_ptp_speed(r)
-        self._update_shapes(gs)
         return D.NO_ERR
 
     @_api
@@ -141,7 +139,6 @@ class MCCLSpeed(MCCLBase):
         n = self._step("wStep", wStep)
         gs.group.set_acc_time(n * self._period)
         gs.acc_step = n
-        self._update_shapes(gs)
         return D.NO_ERR
 
     @_api
@@ -151,7 +148,6 @@ class MCCLSpeed(MCCLBase):
         n = self._step("wStep", wStep)
         gs.group.set_dec_time(n * self._period)
         gs.dec_step = n
-        self._update_shapes(gs)
         return D.NO_ERR
 
     @_api
@@ -185,13 +181,12 @@ class MCCLSpeed(MCCLBase):
         return str(c).upper()
 
     def _update_shapes(self, gs: GroupSlot) -> None:
-        """The group's path shape from its acc type: S = jerk-limited (s-factor 1: a
-        triangular acceleration over the acceleration time, jerk 4 F / Tacc**2)."""
-        g = gs.group
+        """The group's path shape from its acc type: S = s-factor 1 (2.6.3 I: a triangular
+        acceleration lasting the acceleration / deceleration time)."""
         if gs.acc_type == "S":
-            g.set_path_shape("S", jerk=4.0 * g._feed / (g.acc_time ** 2))
+            gs.group.set_path_shape("S", s_factor=1.0)
         else:
-            g.set_path_shape("T")
+            gs.group.set_path_shape("T")
 
     @_api
     def MCC_SetAccType(self, cType: str, wGroupIndex: int = 0) -> int:
@@ -232,24 +227,26 @@ class MCCLSpeed(MCCLBase):
     @_api
     def MCC_SetPtPAccType(self, cType0: str, cType1: str, cType2: str, cType3: str,
                           cType4: str = "T", cType5: str = "T", wGroupIndex: int = 0) -> int:
-        """PtP shape of each axis x..w ('T' or 'S'); the deceleration takes the same."""
+        """PtP acceleration shape of each axis x..w ('T' or 'S'; 2.6.3 I)."""
         gs = self._g(wGroupIndex)
         types = tuple(self._type(f"cType{k}", c) for k, c in
                       enumerate((cType0, cType1, cType2, cType3, cType4, cType5)))
-        gs.group.set_ptp_shapes([types[s] for s in gs.slots])
-        gs.ptp_acc_types = gs.ptp_dec_types = types
+        gs.group.set_ptp_shapes([types[s] for s in gs.slots],
+                                [gs.ptp_dec_types[s] for s in gs.slots])
+        gs.ptp_acc_types = types
         return D.NO_ERR
 
     @_api
     def MCC_SetPtPDecType(self, cType0: str, cType1: str, cType2: str, cType3: str,
                           cType4: str = "T", cType5: str = "T", wGroupIndex: int = 0) -> int:
-        """Must equal the PtP acceleration types (one shape per axis move in the core)."""
+        """PtP deceleration shape of each axis x..w ('T' or 'S'; 2.6.3 I), apart from the
+        acceleration's (`Group.set_ptp_shapes(shapes, dec_shapes)`)."""
         gs = self._g(wGroupIndex)
         types = tuple(self._type(f"cType{k}", c) for k, c in
                       enumerate((cType0, cType1, cType2, cType3, cType4, cType5)))
-        if types != gs.ptp_acc_types:
-            raise Refused(D.PARAMETER_ERR, "PtP deceleration types must equal the "
-                                           "acceleration types")
+        gs.group.set_ptp_shapes([gs.ptp_acc_types[s] for s in gs.slots],
+                                [types[s] for s in gs.slots])
+        gs.ptp_dec_types = types
         return D.NO_ERR
 
     @_api

@@ -81,6 +81,7 @@ class Axis(AxisEngine):
         self._powered = False
         self._servo = config.drive.type in ("servo", "dc_servo")  # axes with SVON
         self._motion: ActiveMotion | None = None
+        self.motion_ended_at: float | None = None  # exact end time of the last motion
         self._pos = 0.0       # commanded position, raw pulse frame, at controller time
         self._vel = 0.0
         self._inp_enabled = False
@@ -280,13 +281,14 @@ class Axis(AxisEngine):
         return v
 
     def _spec(self, shape: str, str_vel: float, max_vel: float, tacc: float,
-              tdec: float | None, vs_acc: float, vs_dec: float, units: bool) -> MoveSpec:
+              tdec: float | None, vs_acc: float, vs_dec: float, units: bool,
+              dec_shape: str = "") -> MoveSpec:
         sv = self.check_speed("str_vel", str_vel, units)
         mv = self.check_speed("max_vel", max_vel, units)
         va = self.check_speed("vs_acc", vs_acc, units)
         vd = self.check_speed("vs_dec", vs_dec, units)
         td = tacc if tdec is None else tdec
-        spec = MoveSpec(shape, sv, mv, tacc, td, va, vd)
+        spec = MoveSpec(shape, sv, mv, tacc, td, va, vd, dec_shape)
         return spec if self.speed_model is None else self.speed_model.move(spec)
 
     def _check_can_start(self) -> None:
@@ -340,15 +342,18 @@ class Axis(AxisEngine):
     @_locked
     def move_relative(self, distance: float, *, max_vel: float, str_vel: float = 0.0,
                       tacc: float = 0.1, tdec: float | None = None, shape: str = "T",
-                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False) -> None:
+                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False,
+                      dec_shape: str = "") -> None:
         """Relative T/S move (HSL start_tr_move / start_sr_move) of `distance` pulses.
 
         The target is the command position plus the distance rounded to a whole pulse; the
-        move ends exactly there. `tdec` defaults to `tacc`.
+        move ends exactly there. `tdec` defaults to `tacc`; `dec_shape` ('T'/'S', default
+        `shape`) the deceleration's shape.
         """
         d = check_finite("distance", distance)
         d = float(self.units.to_pulses(d)) if units else d
-        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units)
+        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units,
+                          dec_shape)
         self._check_can_start()
         target = round(self._pos + d)
         self._start_discrete(spec, target, "relative", None)
@@ -357,21 +362,30 @@ class Axis(AxisEngine):
     @_locked
     def move_absolute(self, position: float, *, max_vel: float, str_vel: float = 0.0,
                       tacc: float = 0.1, tdec: float | None = None, shape: str = "T",
-                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False) -> None:
+                      vs_acc: float = 0.0, vs_dec: float = 0.0, units: bool = False,
+                      start_in: float = 0.0, dec_shape: str = "") -> None:
         """Absolute T/S move (HSL start_ta_move / start_sa_move) to `position` (command
-        counter frame). As the seed describes, the distance is measured from the *feedback*
-        position converted through the move ratio: distance = position - feedback/ratio.
+        counter frame). As the HSL manual describes, the distance is measured from the
+        *feedback* position converted through the move ratio: distance = position -
+        feedback/ratio. `start_in` (0 <= s < one period): the move starts that long after
+        now, inside the coming cycle, at rest until then (a command after an exact delay).
+        `dec_shape` as in `move_relative`.
         """
         p = check_finite("position", position)
         p = float(self.units.to_pulses(p)) if units else p
         if not COUNTER_MIN <= p <= COUNTER_MAX:
             raise MotionError(f"position must be in [{COUNTER_MIN}, {COUNTER_MAX}] "
                               f"(28-bit counter), got {position!r}")
-        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units)
+        lead = check_finite("start_in", start_in)
+        if not 0.0 <= lead < self._ctl.period:
+            raise MotionError(f"start_in must be in [0, period {self._ctl.period!r}) s, "
+                              f"got {start_in!r}")
+        spec = self._spec(shape, str_vel, max_vel, tacc, tdec, vs_acc, vs_dec, units,
+                          dec_shape)
         self._check_can_start()
         d = p - self.counters.feedback_in_pulses()
         target = round(self._pos + d)
-        self._start_discrete(spec, target, "absolute", p)
+        self._start_discrete(spec, target, "absolute", p, lead)
         self.counters.add_target(p - self.counters.target)
 
     @_locked
@@ -408,9 +422,10 @@ class Axis(AxisEngine):
 
         Positions are in the command-counter frame; the profile must start where the axis
         is (within 1e-6 pulse) and at its velocity (a replaced `run_profile` motion's, with
-        `replace_running=True`). `str_vel` (pps, default 0) is the PCL6045 StrVel: like a
-        T/S move (`MoveSpec.plan`), the profile may jump from rest to a speed <= str_vel at
-        its start when the axis is at rest. Its end state (rest) is held; the last segment
+        `replace_running=True`, or a T/S positioning move's: a blended PtP). `str_vel`
+        (pps, default 0) is the PCL6045 StrVel: like a T/S move (`MoveSpec.plan`), the
+        profile may jump from rest to a speed <= str_vel at its start when the axis is at
+        rest. Its end state (rest) is held; the last segment
         may end at a speed (a StrVel end jumps to rest, as a T/S move's does). A
         decelerating `stop()` uses `stop_accel` (pps^2) and `stop_jerk` (pps^3).
         """
@@ -448,9 +463,10 @@ class Axis(AxisEngine):
         m = self._motion
         homing = self._state is S.HOMING
         if replace_running and m is not None:
-            if m.kind != "profile" or self._state not in (S.DISCRETE_MOTION, S.HOMING):
+            if m.kind not in ("profile", "absolute", "relative") or \
+                    self._state not in (S.DISCRETE_MOTION, S.HOMING):
                 raise MotionError(f"axis {self.name}: replace_running needs a running "
-                                  "run_profile motion")
+                                  "run_profile or T/S positioning motion")
         elif not (homing and m is None and not self._waiting_inp and not self._gated):
             self._check_can_start()
         shifted = profile.shifted(-self.counters._cmd_off)
@@ -562,8 +578,12 @@ class Axis(AxisEngine):
 
     # ------------------------------------------------------------------ internals
     def _start_discrete(self, spec: MoveSpec, target: int, kind: str,
-                        abs_target: float | None) -> None:
+                        abs_target: float | None, lead: float = 0.0) -> None:
         profile = planning.position_move(spec, self._pos, float(target))
+        if lead > 0.0:
+            from .pathaxes import delayed
+
+            profile = delayed(profile, lead)
         self._start(ActiveMotion(profile, self._ctl.time, kind, spec, float(target),
                                  abs_target), S.DISCRETE_MOTION)
 

@@ -35,6 +35,7 @@ class AxisEngine:
     _ctl: Controller
     _state: AxisState
     _motion: ActiveMotion | None
+    motion_ended_at: float | None
     _pos: float
     _vel: float
     _inp_enabled: bool
@@ -116,6 +117,7 @@ class AxisEngine:
         m = self._motion
         if m is not None and m.finished(t1):
             self._motion = None
+            self.motion_ended_at = m.t_end  # inside the cycle (an exact MCC_DelayMotion)
             self._vel = 0.0
             self._pos = m.profile.end.p
             if self._state is S.ERROR_STOP:

@@ -184,8 +184,10 @@ class Group(GroupSettings):
         self._refuse = True
         self._ptp_ratio = 10.0
         self._path_jerk = 0.0   # 0: T-curve path speed; > 0: S-curve with this path jerk
+        self._path_sfactor = 0.0  # > 0: S-curve sized from the ramp times (MCCL)
         self._str_vel = 0.0     # StrVel of the following path commands (0: from/to rest)
         self._ptp_shapes = ("T",) * len(ax)
+        self._ptp_dec_shapes = ("T",) * len(ax)
         self._ptp_acc_time: float | None = None  # None: the path commands' times
         self._ptp_dec_time: float | None = None
         for a in ax:
@@ -362,7 +364,8 @@ class Group(GroupSettings):
         tacc, tdec = self.ptp_times
         for k, a in enumerate(self.axes):
             v = min(a.max_speed, self._vmax[k]) * (ratio or self._ptp_ratio) / 100.0
-            specs.append(MoveSpec(self._ptp_shapes[k], 0.0, v, tacc, tdec, 0.0, 0.0))
+            specs.append(MoveSpec(self._ptp_shapes[k], 0.0, v, tacc, tdec, 0.0, 0.0,
+                                  self._ptp_dec_shapes[k]))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
 
     @_locked
@@ -524,7 +527,8 @@ class Group(GroupSettings):
         r = self._run
         if r is not None and r.kind == "ptp" and not self._dry:
             for a, spec in zip(self.axes, r.cmds[0].specs, strict=True):
-                if a.motion is not None and a.state is AxisState.DISCRETE_MOTION:
+                if a.motion is not None and a.state is AxisState.DISCRETE_MOTION and \
+                        a.motion.spec is not None:  # a blended PtP (ptpblend) keeps its speed
                     a.fix_speed_range(min(a.max_speed, spec.max_vel * 2.0))
                     # too close to the target: the move finishes at its speed
                     with contextlib.suppress(InfeasibleError), self._commanding():

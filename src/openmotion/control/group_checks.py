@@ -53,6 +53,7 @@ class GroupChecks(GroupEngine):
     _dec_time: float | None
     _str_vel: float
     _path_jerk: float
+    _path_sfactor: float
     _refuse: bool
 
     def _axis_values(self, name: str, values: Sequence[float]) -> np.ndarray:
@@ -149,8 +150,7 @@ class GroupChecks(GroupEngine):
         self._check_soft_limits(el)
         feed, sv = self._feed, self._str_vel
         tan = el.max_abs_tangent
-        accel = feed / self._acc_time
-        decel = None if self._dec_time is None else feed / self._dec_time
+        accel, decel, jerk = self._path_ramps(feed)
         self._check_str_vel(sv, feed, tan)
         if self._refuse:  # MCCL: refused; "slow": the planner slows down to the axis limits
             vmax, amax = self._caps()
@@ -167,7 +167,22 @@ class GroupChecks(GroupEngine):
                                             f"pps^2, above its maximum pulse acceleration "
                                             f"{self._amax[k]:g} pps^2")
         return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
-                               decel=decel, jerk=self._path_jerk, str_vel=sv), end)
+                               decel=decel, jerk=jerk, str_vel=sv), end)
+
+    def _path_ramps(self, feed: float) -> tuple[float, float | None, float]:
+        """(acceleration, deceleration or None = the same, jerk or 0 = T) of a path command
+        at `feed`. With an s-factor the T plan's ramps are shortened by the smoothing window
+        tj so that the smoothed ramps last the acceleration / deceleration times exactly
+        (moving average over tj: ramp + tj), and the jerk is the one giving that window."""
+        s = self._path_sfactor
+        if not s:
+            decel = None if self._dec_time is None else feed / self._dec_time
+            return feed / self._acc_time, decel, self._path_jerk
+        ta = self._acc_time
+        td = ta if self._dec_time is None else self._dec_time
+        tj = 0.5 * s * min(ta, td)
+        accel, dec = feed / (ta - tj), feed / (td - tj)
+        return accel, (None if self._dec_time is None else dec), 2.0 * max(accel, dec) / tj
 
     def _check_str_vel(self, sv: float, feed: float, tan: np.ndarray) -> None:
         """StrVel of a path command: <= its feed, within every axis's maximum speed along

@@ -38,8 +38,10 @@ class GroupSettings(GroupChecks):
     _period_pulse_acc: np.ndarray
     _ptp_ratio: float
     _ptp_shapes: tuple[str, ...]
+    _ptp_dec_shapes: tuple[str, ...]
     _ptp_acc_time: float | None
     _ptp_dec_time: float | None
+    _path_sfactor: float
 
     def set_feed(self, feed: float) -> None:
         """MCC_SetFeedSpeed: vector speed (pps, or user units/s) of the following path
@@ -162,21 +164,42 @@ class GroupSettings(GroupChecks):
             raise MotionError(f"on must be a bool, got {on!r}")
         self._wait_inpos = on
 
-    def set_path_shape(self, shape: str, jerk: float | None = None) -> None:
+    def set_path_shape(self, shape: str, jerk: float | None = None, *,
+                       s_factor: float | None = None) -> None:
         """Speed profile of the following path commands: "T" (constant path acceleration)
         or "S" (jerk-limited: the jerk of the path position stays within `jerk`, pps^3 or
         user units/s^3). S paths blend, stream, hold and take overrides like T paths: the
         T plan is smoothed by a moving average of window 2*accel/jerk, its speed caps held
-        that much further along the path, exact-stop corners passed at rest."""
+        that much further along the path, exact-stop corners passed at rest.
+
+        Instead of `jerk`, `s_factor` in (0, 1] sizes the S from the ramp times (MCCL's
+        S-curve, s-factor 1 = a triangular acceleration): a ramp from rest to the feed then
+        lasts exactly the acceleration time and one to rest the deceleration time, as with
+        "T"; the jerk phases take `s_factor` of the shorter ramp (the window is
+        s_factor * min(Tacc, Tdec) / 2), so with equal times every ramp's acceleration
+        rises and falls over s_factor of it (peak feed / (Tacc * (1 - s_factor/2)))."""
         if not isinstance(shape, str) or shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
         if shape == "T":
+            if s_factor is not None:
+                raise MotionError("s_factor is only for shape 'S'")
             self._path_jerk = 0.0
+            self._path_sfactor = 0.0
+            return
+        if s_factor is not None:
+            if jerk is not None:
+                raise MotionError("give either jerk or s_factor for shape 'S', not both")
+            s = check_finite("s_factor", s_factor)
+            if not 0.0 < s <= 1.0:
+                raise MotionError(f"s_factor must be in (0, 1], got {s_factor!r}")
+            self._path_jerk = 0.0
+            self._path_sfactor = s
             return
         j = check_finite("jerk", jerk) if jerk is not None else math.nan
         if not j > 0.0:
             raise MotionError(f"jerk must be a finite number > 0 for shape 'S', got {jerk!r}")
         self._path_jerk = j
+        self._path_sfactor = 0.0
 
     def set_str_vel(self, speed: float) -> None:
         """Start velocity (PCL6045 StrVel, HSL-4XMO 4.6) of the following path commands, in
@@ -189,22 +212,31 @@ class GroupSettings(GroupChecks):
             raise GroupError(ERR_ARGUMENT, f"speed (StrVel) must be >= 0, got {speed!r}")
         self._str_vel = v
 
-    def set_ptp_speed(self, ratio: float, *, shape: str = "T") -> None:
-        """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10)."""
+    def set_ptp_speed(self, ratio: float, *, shape: str | None = None) -> None:
+        """MCC_SetPtPSpeed: each axis runs at ratio % of its maximum speed (default 10);
+        `shape` 'T'/'S' also sets every axis's PtP shape (None keeps set_ptp_shapes')."""
         r = check_finite("ratio", ratio)
         if not 0.0 < r <= 100.0:
             raise MotionError(f"ratio must be in (0, 100] percent, got {ratio!r}")
-        if not isinstance(shape, str) or shape not in ("T", "S"):
+        if shape is not None and (not isinstance(shape, str) or shape not in ("T", "S")):
             raise MotionError(f"shape must be 'T' or 'S', got {shape!r}")
-        self._ptp_ratio, self._ptp_shapes = r, (shape,) * len(self.axes)
+        self._ptp_ratio = r
+        if shape is not None:
+            self._ptp_shapes = self._ptp_dec_shapes = (shape,) * len(self.axes)
 
-    def set_ptp_shapes(self, shapes: Sequence[str]) -> None:
-        """MCC_SetPtPAccType per axis: "T" or "S" for each logical axis's PtP profile."""
-        if isinstance(shapes, str) or not isinstance(shapes, Sequence) or \
-                len(shapes) != len(self.axes) or \
-                any(not isinstance(x, str) or x not in ("T", "S") for x in shapes):
-            raise MotionError(f"shapes must be {len(self.axes)} of 'T'/'S', got {shapes!r}")
-        self._ptp_shapes = tuple(shapes)
+    def set_ptp_shapes(self, shapes: Sequence[str],
+                       dec_shapes: Sequence[str] | None = None) -> None:
+        """MCC_SetPtPAccType / MCC_SetPtPDecType per axis: "T" or "S" for each logical
+        axis's PtP acceleration and deceleration (`dec_shapes` None: as `shapes`)."""
+        def check(name: str, v: object) -> tuple[str, ...]:
+            if isinstance(v, str) or not isinstance(v, Sequence) or \
+                    len(v) != len(self.axes) or \
+                    any(not isinstance(x, str) or x not in ("T", "S") for x in v):
+                raise MotionError(f"{name} must be {len(self.axes)} of 'T'/'S', got {v!r}")
+            return tuple(v)
+        acc = check("shapes", shapes)
+        dec = acc if dec_shapes is None else check("dec_shapes", dec_shapes)
+        self._ptp_shapes, self._ptp_dec_shapes = acc, dec
 
     def set_ptp_acc_time(self, seconds: float) -> None:
         """MCC_SetPtPAccStep x T: acceleration time of point-to-point axes (default: the

@@ -38,7 +38,7 @@ from ..path.lookahead import _element_limits as element_limits
 from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
 from ..profile.segments import Profile, State
-from . import pathaxes, pathrun, planning
+from . import pathaxes, pathrun, planning, ptpblend
 from . import pathexec as px
 from .group_corners import LookaheadSettings
 from .groupjoin import AsyncJoin
@@ -120,6 +120,7 @@ class _Run:
     t_until: float = 0.0
     target: np.ndarray | None = None
     window_end: float | None = None        # path: the axes' profiles end here (windowed)
+    blend_at: float | None = None          # ptp: when the next PtP may blend in (ptpblend)
 
     @property
     def t_end(self) -> float:
@@ -240,17 +241,20 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         if r is not None and r.kind == "delay" and self._queue and \
                 self._state is GroupState.MOVING and \
                 1e-12 < r.t_until - t < self._ctl.period - 1e-12 and \
-                self._queue[0].kind == "path" and not self._queue[0].str_vel:
-            # the delay ends inside the coming cycle: start the path now, at rest until
+                self._queue[0].kind in ("path", "ptp") and not self._queue[0].str_vel:
+            # the delay ends inside the coming cycle: start the command now, at rest until
             # the delay's exact end (MCC_DelayMotion is exact, not rounded to a cycle)
             self._run = None
             self._ended_at = r.t_until
             self._start_next(t, start=r.t_until)
             return
+        if r is not None and r.blend_at is not None and self._queue and \
+                r.blend_at < t + self._ctl.period - 1e-12 and self._blend_ptp(r, t):
+            return
         if r is not None and t >= r.t_end - 1e-12 and (self._dry or not any(
                 a.is_moving for a in self.axes)):
             self._run = None
-            self._ended_at = r.t_end
+            self._ended_at = self._exact_end(r)
             if r.kind in ("path", "ptp") and r.target is not None and self._dry:
                 self._dry_pos = self._pulses_of(r.target) if r.kind == "path" \
                     else r.target.copy()
@@ -281,6 +285,29 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             if len(self._queue) == n:  # no join this cycle
                 self._preblend()
 
+    def _blend_ptp(self, r: _Run, t: float) -> bool:
+        """Velocity blending (MCCL 2.6.3 II): the next PtP starts while this one's last
+        axis decelerates, each axis following the sum of both moves (control.ptpblend)."""
+        cmd = self._queue[0]
+        if not self._blend or cmd.kind != "ptp" or self._wait_inpos or self._dry or \
+                self._state is not GroupState.MOVING:
+            return False
+        start, r.blend_at = r.blend_at, None  # one try: a refused blend runs them apart
+        if start is None or not ptpblend.start_blend(self, cmd, t, max(start, t)):
+            return False
+        self._queue.popleft()
+        assert cmd.target is not None
+        self._run = _Run("ptp", [cmd], t, target=self._pulses_of(cmd.target),
+                         blend_at=ptpblend.blend_at(self))
+        return True
+
+    def _exact_end(self, r: _Run) -> float:
+        """When run `r` ended: a PtP when its last axis came to rest (inside a cycle)."""
+        if r.kind != "ptp" or self._dry:
+            return r.t_end
+        ends = [e for a in self.axes if (e := a.motion_ended_at) is not None and e >= r.t0]
+        return max(ends, default=r.t_end)
+
     def _start_next(self, t: float, start: float | None = None) -> None:
         try:
             self._start_queued(t, start)
@@ -298,7 +325,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             base = end if end is not None and 0.0 <= t - end < self._ctl.period else t
             self._run = _Run("delay", [cmd], base, t_until=base + cmd.seconds)
         elif cmd.kind == "ptp":
-            self._launch_ptp(cmd, t)
+            self._launch_ptp(cmd, t, 0.0 if start is None else start - t)
         else:
             tj = jerk_window(cmd.window_accel, cmd.jerk) if cmd.jerk else 0.0
             cmds = [cmd, *self._take(tj, cmd.elements[0].length, [cmd])]
@@ -527,7 +554,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         return b.first, b.arc, b.second
 
     # ------------------------------------------------------------------ launching
-    def _launch_ptp(self, cmd: _Cmd, t: float) -> None:
+    def _launch_ptp(self, cmd: _Cmd, t: float, lead: float = 0.0) -> None:
+        """Every axis its own move to the target, `lead` seconds after t (an exact delay)."""
         assert cmd.target is not None
         profiles = []
         start = self._pulses_of(self.position)
@@ -538,13 +566,16 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 spec = spec.derived(
                     max_vel=min(a.max_speed, spec.max_vel * self._ptp_override))
             if self._dry:
-                profiles.append(planning.position_move(spec, float(start[k]),
-                                                       float(target[k])))
+                prof = planning.position_move(spec, float(start[k]), float(target[k]))
+                profiles.append(pathaxes.delayed(prof, lead) if lead > 1e-12 else prof)
             elif target[k] != a.position:
                 with self._commanding():
                     a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
-                                    tdec=spec.tdec, shape=spec.shape)
-        self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target)
+                                    tdec=spec.tdec, shape=spec.shape,
+                                    start_in=lead if lead > 1e-12 else 0.0,
+                                    dec_shape=spec.dec_shape)
+        self._run = _Run("ptp", [cmd], t, profiles=profiles, target=target,
+                         blend_at=None if self._dry else ptpblend.blend_at(self))
 
     def _launch(self, plan: pathrun.PathPlan, cmds: list[_Cmd], t: float) -> None:
         """Run `plan` from now: per-axis profiles along the chain, started all or none;

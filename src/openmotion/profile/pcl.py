@@ -55,7 +55,9 @@ class Rates:
 @dataclass(frozen=True)
 class MoveSpec:
     """PCL6045 move parameters: shape 'T' or 'S', StrVel, MaxVel (pps), Tacc, Tdec (s),
-    VSacc, VSdec (pps, S-curve only; 0 = pure S). Validated on construction."""
+    VSacc, VSdec (pps, S-curve only; 0 = pure S); `dec_shape` 'T' or 'S' gives the
+    deceleration its own shape (MCCL MCC_SetPtPDecType; "" = `shape`). Validated on
+    construction."""
 
     shape: str
     str_vel: float
@@ -64,10 +66,14 @@ class MoveSpec:
     tdec: float
     vs_acc: float = 0.0
     vs_dec: float = 0.0
+    dec_shape: str = ""
 
     def __post_init__(self) -> None:
         if not isinstance(self.shape, str) or self.shape not in ("T", "S"):
             raise MotionError(f"shape must be 'T' or 'S', got {self.shape!r}")
+        if not isinstance(self.dec_shape, str) or self.dec_shape not in ("", "T", "S"):
+            raise MotionError(f"dec_shape must be 'T', 'S' or '' (as shape), got "
+                              f"{self.dec_shape!r}")
         sv = check_quantity("str_vel", self.str_vel, "pps", zero=True)
         mv = check_quantity("max_vel", self.max_vel, "pps")
         if mv < sv:
@@ -109,16 +115,22 @@ class MoveSpec:
                         strict=True):
             object.__setattr__(new, k, x)
         object.__setattr__(new, "shape", self.shape)
+        object.__setattr__(new, "dec_shape", self.dec_shape)
         return new
+
+    @property
+    def decel_shape(self) -> str:
+        """The deceleration's shape ('T' or 'S')."""
+        return self.dec_shape or self.shape
 
     @property
     def rates(self) -> Rates:
         """Acceleration, deceleration and jerks implied by the parameters."""
         dv = self.max_vel - self.str_vel
-        if self.shape == "T":
-            return Rates(dv / self.tacc, dv / self.tdec, math.inf, math.inf)
-        a, ja = _s_rates(dv, self.tacc, self.vs_acc)
-        d, jd = _s_rates(dv, self.tdec, self.vs_dec)
+        a, ja = (dv / self.tacc, math.inf) if self.shape == "T" else \
+            _s_rates(dv, self.tacc, self.vs_acc)
+        d, jd = (dv / self.tdec, math.inf) if self.decel_shape == "T" else \
+            _s_rates(dv, self.tdec, self.vs_dec)
         return Rates(a, d, ja, jd)
 
     def plan(self, distance: float, start: float = 0.0) -> MovePlan:
@@ -289,16 +301,15 @@ def _reduced_spec(spec: MoveSpec, r: Rates, v: float) -> MoveSpec:
     tacc = ramp_time(x, r.accel, r.jerk_acc)
     tdec = ramp_time(x, r.decel, r.jerk_dec)
     half = x / 2.0
-    if spec.shape == "T":  # VS is ignored by a T-curve; keep it valid
-        return spec.derived(max_vel=v, tacc=tacc, tdec=tdec,
-                            vs_acc=min(spec.vs_acc, half), vs_dec=min(spec.vs_dec, half))
-    vs_a = r.accel * r.accel / (2.0 * r.jerk_acc)
-    vs_d = r.decel * r.decel / (2.0 * r.jerk_dec)
-    return spec.derived(
-        max_vel=v, tacc=tacc, tdec=tdec,
-        vs_acc=spec.vs_acc if vs_a <= half else half,
-        vs_dec=spec.vs_dec if vs_d <= half else half,
-    )
+
+    def vs(given: float, rate: float, jerk: float) -> float:
+        if math.isinf(jerk):  # VS is ignored by a T ramp; keep it valid
+            return min(given, half)
+        return given if rate * rate / (2.0 * jerk) <= half else half
+
+    return spec.derived(max_vel=v, tacc=tacc, tdec=tdec,
+                        vs_acc=vs(spec.vs_acc, r.accel, r.jerk_acc),
+                        vs_dec=vs(spec.vs_dec, r.decel, r.jerk_dec))
 
 
 def _spec(shape: str, str_vel: float, max_vel: float, tacc: float, tdec: float,
