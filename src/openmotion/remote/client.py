@@ -62,8 +62,10 @@ class RemoteClient:
         headers = {"Authorization": f"Bearer {token}"} if token else None
         self.timeout = timeout
         try:
+            # entered as a context manager (closed in close()): websockets >= 17.1 warns
+            # about a connection used without one
             self._ws = ws_connect(url, additional_headers=headers, open_timeout=timeout,
-                                  max_size=64 << 20)
+                                  max_size=64 << 20).__enter__()
         except Exception as exc:
             raise MotionError(f"cannot connect to {url}: {exc}") from None
         self._ids = itertools.count(1)

@@ -84,12 +84,14 @@ def axis_move(ctx: Context, p: Params) -> dict[str, Any]:
     kind = p.choice("kind", ("absolute", "relative", "velocity"))
     ctl = ctx.svc.ctl
     ax = ctl.axis(axis)
+    srange = _speed(p, ax, "speed_range", -1.0) if p.has("speed_range") else None
     if kind == "velocity":
         v = p.number("velocity")
         kw = _move_params(p, ax, max_vel=False)
         p.done()
         with ctl.lock:
             _no_repeat(ctx, ax)
+            _fix_range(ax, srange)
             ax.move_velocity(v, units=True, **kw)
         return {"duration": None}
     target = p.number("position" if kind == "absolute" else "distance")
@@ -97,12 +99,24 @@ def axis_move(ctx: Context, p: Params) -> dict[str, Any]:
     p.done()
     with ctl.lock:
         _no_repeat(ctx, ax)
+        _fix_range(ax, srange)
         if kind == "absolute":
             ax.move_absolute(target, units=True, **kw)
         else:
             ax.move_relative(target, units=True, **kw)
         m = ax.motion
         return {"duration": None if m is None else float(m.profile.duration)}
+
+
+def _fix_range(ax: Any, srange: float | None) -> None:
+    """HSL fix_speed_range: the highest speed a later change of speed may reach (a move
+    without it may only change up to its own MaxVel); 0 unfixes it."""
+    if srange is None:
+        return
+    if srange == 0.0:
+        ax.unfix_speed_range()
+    else:
+        ax.fix_speed_range(srange, units=True)
 
 
 def _no_repeat(ctx: Context, ax: Any) -> None:

@@ -37,6 +37,7 @@ class RpcError(Exception):
         self.code = code
         self.message = message
         self.data = data
+        self.req_id: str | int | None = None   # the request's id, when it was readable
 
     def to_json(self) -> dict[str, Any]:
         err: dict[str, Any] = {"code": self.code, "message": self.message}
@@ -120,11 +121,11 @@ def _request(obj: Any) -> Request | RpcError:
     if not notify and (isinstance(rid, bool) or not isinstance(rid, (str, int))):
         return RpcError(INVALID_REQUEST, "id must be a string or an integer")
     params = obj.get("params", {})
-    if isinstance(params, list):
-        return RpcError(INVALID_PARAMS, "params must be an object of named parameters "
-                        "(positional arrays are not accepted)")
     if not isinstance(params, dict):
-        return RpcError(INVALID_PARAMS, "params must be an object")
+        err = RpcError(INVALID_PARAMS, "params must be an object of named parameters "
+                       "(positional arrays are not accepted)")
+        err.req_id = rid   # the id is valid: the answer carries it
+        return err
     return Request(method, params, None if notify else rid, notify)
 
 

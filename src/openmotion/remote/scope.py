@@ -150,6 +150,7 @@ class Scope:
     def _arm_state(self) -> None:
         self.triggered_at: float | None = None
         self._stop_at: int | None = None
+        self._floor = 0   # triggered: the first sample kept (pre_s before the trigger)
         self._prev: float | None = None
         self._prev_raw: float | None = None
         tr = self.trigger
@@ -205,6 +206,7 @@ class Scope:
                                   or (tr.mode == "falling" and prev > tr.level >= v)))
         if hit:
             self.triggered_at = t
+            self._floor = max(0, self.n - 1 - self._pre)
             self._stop_at = self.n + (self.cap - self._pre - 1)
 
     # ------------------------------------------------------------------ reading
@@ -236,16 +238,19 @@ class Scope:
 
     def _slice(self, since: int) -> tuple[int, int, np.ndarray, np.ndarray, np.ndarray | None]:
         """Samples [start, n) in time order (copies), and the row before start."""
-        first = max(0, self.n - self.cap)
+        first = self._first()
         start = first if since < 0 else min(max(since, first), self.n)
         idx = np.arange(start, self.n) % self.cap
         prev = self._buf[(start - 1) % self.cap].copy() if start > first else None
         return start, self.n, self._t[idx].copy(), self._buf[idx].copy(), prev
 
+    def _first(self) -> int:
+        return max(self._floor, self.n - self.cap)
+
     def data(self, since: int = -1, max_points: int = 5000) -> dict[str, Any]:
         with self._lock:
             start, end, t, raw, prev = self._slice(since)
-            first = max(0, self.n - self.cap)
+            first = self._first()
             version, trig = self.version, self.triggered_at
         cols = self._columns(t, raw, prev)
         t_out, cols = _decimate(t, cols, max_points)
@@ -273,7 +278,7 @@ class Scope:
             return {"channels": list(self.channels), "divider": self.divider,
                     "seconds": self.seconds, "trigger": self.trigger.to_json(),
                     "running": self.running, "scope_version": self.version,
-                    "samples": min(self.n, self.cap), "first": max(0, self.n - self.cap),
+                    "samples": self.n - self._first(), "first": self._first(),
                     "next": self.n, "triggered_at": self.triggered_at,
                     "rate_hz": 1.0 / self.dt}
 

@@ -274,7 +274,7 @@ class RemoteServer:
         out = []
         for r in reqs:
             if isinstance(r, RpcError):
-                out.append(error_response(None, r))
+                out.append(error_response(r.req_id, r))
                 continue
             res = await self._call(ctx, r)
             if not r.notify:

@@ -19,13 +19,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..config import MachineConfig, default_machine, dumps_machine, load_machine
+from ..config import MachineConfig, default_machine, dumps_machine
 from ..control.clock import RealtimePacer
 from ..control.controller import Controller
 from ..control.homing import Homing
 from ..control.homing_modes import HomeConfig
 from ..control.states import AxisState
 from ..errors import MotionError
+from ..program.runjob import load_machine_arg
 from .deadman import JogRegistry
 from .homeconf import default_home, home_from_user, home_to_user
 from .interface import (
@@ -56,7 +57,7 @@ class MachineService:
         self.file: Path | None = None
         if file is not None:
             self.file = Path(file)
-            config = load_machine(self.file)
+            config = load_machine_arg(str(self.file), "--machine")
         self.config = config if config is not None else default_machine()
         self.config_version = 1
         self.command_lock = threading.Lock()
@@ -289,7 +290,7 @@ class MachineService:
 
     def load(self, path: str) -> None:
         p = Path(path)
-        cfg = load_machine(p)
+        cfg = load_machine_arg(path, "path")
         side = load_sidecar(sidecar_path(p))
         resp = {a.name: check_responses(f"interface.{a.name}",
                                         side["interface"].get(a.name, {}),
