@@ -20,11 +20,10 @@ def program_load(ctx: Context, p: Params) -> dict[str, Any]:
     p.done()
     if (text is None) == (path is None):
         raise MotionError("give exactly one of text and path")
-    prog = ctx.svc.program
-    with ctx.svc.ctl.lock:
-        if path is not None:
-            return prog.load_path(path)
-        return prog.load(text, name or "program.ngc")
+    prog = ctx.svc.program   # compiled outside the controller's lock (a big program
+    if path is not None:     # takes seconds; the cycle must not wait for it)
+        return prog.load_path(path)
+    return prog.load(text, name or "program.ngc")
 
 
 @method("program.preview", command=False)
@@ -50,8 +49,7 @@ def program_run(ctx: Context, p: Params) -> dict[str, Any]:
           "repeat": p.integer("repeat", 1, lo=1, hi=10_000),
           "acc_time": p.number("acc_time", 0.05, lo=0.0, hi=1000.0, lo_open=True)}
     p.done()
-    with ctx.svc.ctl.lock:
-        ctx.svc.program.run(**kw)
+    ctx.svc.program.run(**kw)
     return {}
 
 

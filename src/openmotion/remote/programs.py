@@ -85,23 +85,27 @@ class ProgramSession:
     # ------------------------------------------------------------------ running
     def run(self, *, feed_override: float, single_block: bool, optional_stop: bool,
             repeat: int, acc_time: float) -> None:
-        if self.runner is None:
+        """Start the loaded program. The compile (the costly part) runs outside the
+        controller's lock; only the start holds it."""
+        r = self.runner
+        if r is None:
             raise MotionError("no program loaded: program.load first")
         self._check_idle("start the program")
         opts = RunOptions(single_block=single_block, optional_stop=optional_stop,
                           repeat=repeat, acc_time=acc_time)
         if not 1.0 <= feed_override <= 200.0:
             raise MotionError(f"feed_override must be in [1, 200] %, got {feed_override!r}")
-        params = {} if sets_work_offset(self.text) else work_origin(self.ctl)
-        runner = ProgramRunner(self.ctl, self.text, options=opts, file=self.file,
-                               gcode={"parameters": params})
-        runner.start()
-        if runner.group is not None:
-            runner.group.set_override(feed_override)
-        self.runner = runner
-        self.feed_override = feed_override
-        self.single_block = single_block
-        self.path.start(runner)
+        if r.state is not RunState.READY:   # ran before: compile it again
+            r = self._make_runner(self.text, self.file)
+        r.options = opts   # run-time settings only: the compiled operations stay valid
+        with self.ctl.lock:
+            r.start()   # recompiles only if the axes moved since
+            if r.group is not None:
+                r.group.set_override(feed_override)
+            self.runner = r
+            self.feed_override = feed_override
+            self.single_block = single_block
+            self.path.start(r)
 
     def _running(self) -> ProgramRunner:
         if self.runner is None:

@@ -90,6 +90,12 @@ class Scope:
             raise MotionError(f"divider must be an integer in [1, 1000], got {divider!r}")
         if not 1.0 <= seconds <= 600.0:
             raise MotionError(f"seconds must be in [1, 600], got {seconds!r}")
+        with ctl.lock:   # never between the getters and the write of a cycle's sample
+            self._configure(channels, divider, seconds, trigger)
+
+    def _configure(self, channels: Sequence[str], divider: int, seconds: float,
+                   trigger: Trigger) -> None:
+        ctl = self.ctl
         specs = [self._parse(c) for c in channels]
         if trigger.mode not in TRIGGER_MODES:
             raise MotionError(f"trigger.mode must be one of {', '.join(TRIGGER_MODES)}, "
@@ -158,7 +164,7 @@ class Scope:
         self._pre = int(round(tr.pre_s / self.dt))
 
     def arm(self) -> None:
-        with self._lock:
+        with self.ctl.lock, self._lock:
             self.n = 0
             self.running = True
             self.version += 1

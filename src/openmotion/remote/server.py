@@ -224,8 +224,7 @@ class RemoteServer:
         svc = self.svc
 
         def load(ctx: Context, p: Params) -> Any:
-            with svc.ctl.lock:
-                return svc.program.load(text, name)
+            return svc.program.load(text, name)
 
         req = Request("program.load", {}, 0, False)
         res = await asyncio.get_running_loop().run_in_executor(
