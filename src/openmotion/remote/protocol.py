@@ -69,8 +69,16 @@ def notification(method: str, params: list[Any] | dict[str, Any]) -> dict[str, A
 
 
 def dumps(obj: Any) -> str:
-    """JSON text with non-finite floats sent as null (JSON has no NaN / Infinity)."""
-    return json.dumps(_finite(obj), separators=(",", ":"), allow_nan=False)
+    """JSON text with non-finite floats sent as null (JSON has no NaN / Infinity) and numpy
+    scalars as plain numbers."""
+    return json.dumps(_finite(obj), separators=(",", ":"), allow_nan=False, default=_scalar)
+
+
+def _scalar(obj: Any) -> Any:
+    item = getattr(obj, "item", None)   # numpy scalars
+    if callable(item) and getattr(obj, "shape", None) == ():
+        return _finite(item())
+    raise TypeError(f"{type(obj).__name__} is not JSON serialisable")
 
 
 def _finite(obj: Any) -> Any:
