@@ -107,7 +107,7 @@ def machine_load(ctx: Context, p: Params) -> dict[str, Any]:
     return machine_info(ctx)
 
 
-@method("machine.estop")
+@method("machine.estop", command=False)  # a stop never waits behind commands
 def machine_estop(ctx: Context, p: Params) -> dict[str, Any]:
     reason = p.string("reason", "emergency stop", max_len=200)
     p.done()

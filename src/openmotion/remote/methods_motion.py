@@ -164,7 +164,7 @@ def axis_change_position(ctx: Context, p: Params) -> dict[str, Any]:
     return {}
 
 
-@method("axis.stop")
+@method("axis.stop", command=False)  # a stop never waits behind commands
 def axis_stop(ctx: Context, p: Params) -> dict[str, Any]:
     axis = p.axis("axis", None)
     mode = p.choice("mode", ("decel", "immediate"), "decel")
@@ -326,7 +326,7 @@ def sim_alarm(ctx: Context, p: Params) -> dict[str, Any]:
     return {}
 
 
-@method("sim.estop")
+@method("sim.estop", command=False)  # a stop never waits behind commands
 def sim_estop(ctx: Context, p: Params) -> dict[str, Any]:
     pressed = p.boolean("pressed")
     p.done()
