@@ -194,6 +194,9 @@ def test_estop_stops_everything(machine):
     m.call("machine.estop")
     assert m.wait(lambda s: s["axes"]["x"]["state"] == "ErrorStop", WAIT)
     assert any(e["kind"] == "estop" for e in m.call("machine.events")["events"])
+    # the events were pushed too (notify_event), as they happened
+    assert m.wait(lambda s: any(e["kind"] == "estop" and e["axis"] == "x" for e in m.events),
+                  WAIT)
 
 
 def test_tripped_limit_stops_the_axis(machine):
@@ -234,6 +237,18 @@ def test_scope_records_on_the_server_with_trigger_and_csv(machine):
     with client(m.server) as other:
         again = other.call("scope.data", since=-1, max_points=100000)
     assert again["t"][:len(data["t"])] == data["t"]
+    # live pushes: only new samples, numbered on from the history
+    sub = m.call("scope.subscribe", rate_hz=20)
+    m.call("scope.configure", channels=["x.command"], seconds=2.0)
+    assert m.wait(lambda s: len(m.scope_pushes) >= 3, WAIT)
+    pushes = [p for p in list(m.scope_pushes) if p["scope_version"] == svc.scope.version]
+    assert all(a["next"] == b["start"] for a, b in zip(pushes, pushes[1:], strict=False))
+    m.call("unsubscribe", subscription=sub["subscription"])
+    with pytest.raises(RemoteError, match="unknown"):
+        m.call("unsubscribe", subscription=sub["subscription"])
+    m.call("scope.configure", channels=chans, seconds=5.0)
+    m.call("axis.move", axis="x", kind="relative", distance=1.0, max_vel=20.0, tacc=0.05)
+    assert m.wait(lambda s: s["axes"]["x"]["command"] == 6000 and at_rest("x")(s), WAIT)
     csv = m.call("scope.csv")["csv"].splitlines()
     assert csv[0] == "t," + ",".join(chans) and len(csv) > 10
     with pytest.raises(RemoteError, match="quantity"):
