@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -137,9 +138,18 @@ def _request(obj: Any) -> Request | RpcError:
     return Request(method, params, None if notify else rid, notify)
 
 
+#: the parameter a library message starts with: "max_vel on axis x must ...",
+#: "axes.x.pulse_mode must ...", "changes.colour: unknown key", "trigger.channel must ..."
+_PARAM = re.compile(r"^([A-Za-z_][\w]*(?:\.[\w]+|\[\d+\])*)(?=(?: on axis \w+)? must |: )")
+
+
 def refused(exc: MotionError) -> RpcError:
-    """A MotionError from the controller as a -32000 Refused error."""
-    return RpcError(REFUSED, str(exc), {"type": type(exc).__name__})
+    """A MotionError from the controller as a -32000 Refused error; `data.param` is the
+    parameter (or field path) its message names first, when it names one."""
+    text = str(exc)
+    m = _PARAM.match(text)
+    return RpcError(REFUSED, text, {"type": type(exc).__name__,
+                                    "param": m.group(1) if m else None})
 
 
 _MISSING = object()
