@@ -107,8 +107,10 @@ def test_repeat_runs_count_moves_with_the_dwell():
     ctl.advance(5.0)
     assert not reps.active(0) and reps.last_reason[0] == "done: 3 moves"
     assert ctl.axis("x").counters.command == 1000
-    # each move starts 0.25 s (+ one cycle) after the previous one ended
+    # each move (0.1 s: 1 mm at 20 mm/s, 0.05 s ramps) starts after the 0.25 s dwell
     assert len(starts) == 3
+    gaps = [b - a for a, b in zip(starts, starts[1:], strict=False)]
+    assert all(0.35 - 1e-9 <= g <= 0.35 + 0.0021 for g in gaps), gaps
     with pytest.raises(MotionError, match="p1 and p2 must differ"):
         reps.start("x", 1.0, 1.0, 0.1, 0, {"max_vel": 20.0})
     with pytest.raises(MotionError, match="max_vel"):
