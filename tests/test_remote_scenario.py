@@ -70,9 +70,9 @@ def test_set_and_reset_positions(machine):
 
 def test_jog_and_release_stops(machine):
     svc, m = machine
-    with m.jog("x", +1, speed=20.0) as jog_id:
+    with m.jog("x", +1, speed=20.0, confirm_s=0.02) as jog_id:
         assert m.wait(lambda s: s["axes"]["x"]["jog"] == jog_id, WAIT)
-        time.sleep(0.4)   # longer than the deadman: the confirmations keep it going
+        time.sleep(0.3)   # longer than the deadman: the confirmations keep it going
         assert svc.ctl.axis("x").state.value == "ContinuousMotion"
     assert m.wait(at_rest("x"), WAIT)
     assert m.call("jog.confirm", jog=jog_id) == {"active": False, "reason": "released"}
