@@ -148,6 +148,10 @@ def test_token_gates_http_and_websocket():
             client(th, token="wrong-token-0123456789")
         with client(th, token=token) as c:
             assert c.call("server.info")["api"] == 1
+        from openmotion.remote import connect
+
+        with connect(th.ws_url + f"?token={token}") as c:   # as the browser gives it
+            assert c.call("server.info")["api"] == 1
 
 
 def test_host_needs_a_token():
