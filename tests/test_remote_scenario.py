@@ -47,6 +47,7 @@ def test_move_changes_counters_and_lamps(machine):
     m.call("axis.stop", axis="y")
     assert m.wait(at_rest("y"), WAIT)
     assert svc.ctl.axis("y").velocity == 0.0
+    assert len(m.status["board"]["do"]) == 16 and not any(m.status["board"]["do"])
 
 
 def test_repeat_between_two_positions_then_stop(machine):
@@ -157,12 +158,13 @@ def test_program_pause_resume_abort_and_override(machine):
     svc, m = machine
     for ax in ("z", "u"):
         m.call("axis.servo", axis=ax, on=True)
-    m.call("program.load", text="G21 G90\nG1 X20 F300\nM0\nG1 X0\nM2\n")
+    m.call("program.load", text="G21 G90\nM64 P3\nG1 X20 F300\nM0\nG1 X0\nM2\n")
     m.call("program.run", feed_override=50.0)
     assert m.wait(lambda s: s["program"]["state"] == "running", WAIT)
     m.call("program.feed_override", percent=150.0)
     assert m.wait(lambda s: s["program"]["state"] == "paused", 60)   # M0
-    assert m.status["program"]["line"] == 3
+    assert m.status["program"]["line"] == 4
+    assert m.wait(lambda s: s["board"]["do"][3], WAIT)               # M64 P3
     m.call("program.resume")
     assert m.wait(lambda s: s["program"]["state"] == "running", WAIT)
     m.call("program.abort")
