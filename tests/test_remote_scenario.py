@@ -213,6 +213,10 @@ def test_tripped_limit_stops_the_axis(machine):
     m.call("sim.alarm", axis="y", active=True)
     assert m.wait(lambda s: s["axes"]["y"]["io"]["alm"], WAIT)
     m.call("sim.alarm", axis="y", active=False)
+    m.call("sim.input", index=2, level=True)
+    assert m.wait(lambda s: s["board"]["di"][2], WAIT)
+    with pytest.raises(RemoteError, match="index must be in"):
+        m.call("sim.input", index=99, level=True)
     assert m.call("sim.speed", factor=4)["speed"] == 4.0
     assert svc.running
 

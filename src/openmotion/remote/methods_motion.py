@@ -343,6 +343,21 @@ def sim_estop(ctx: Context, p: Params) -> dict[str, Any]:
     return {}
 
 
+@method("sim.input")
+def sim_input(ctx: Context, p: Params) -> dict[str, Any]:
+    index = p.integer("index", lo=0)
+    level = p.boolean("level")
+    p.done()
+    n = ctx.svc.config.digital_inputs
+    if index >= n:
+        raise MotionError(f"index must be in [0, {n - 1}] (the machine's digital inputs), "
+                          f"got {index}")
+    sc = _scenario(ctx)
+    with ctx.svc.ctl.lock:
+        sc.set_input(f"di{index}", level)
+    return {}
+
+
 @method("sim.speed")
 def sim_speed(ctx: Context, p: Params) -> dict[str, Any]:
     factor = p.number("factor", lo=1.0, hi=20.0)
