@@ -268,24 +268,33 @@ class PathRecorder:
         self._t = np.zeros(PATH_CAPACITY)
         self._p = np.zeros((PATH_CAPACITY, 3))
         self.n = 0
+        self._closed = False
         self._cols: list[tuple[int, int, float]] = []
 
     def start(self, runner: ProgramRunner) -> None:
         self.runner = runner
         self.n = 0
         self._tick = 0
+        self._closed = False
         axes = runner.axis_indices
         self._cols = [(k, axes[runner.letters.index(c)], float(runner.scales.ppu[
             runner.letters.index(c)])) for k, c in enumerate(_XYZ) if c in runner.letters]
 
     def sample(self, t: float) -> None:
         r = self.runner
-        if r is None or r.state not in (RunState.RUNNING, RunState.PAUSED):
+        if r is None or self._closed:
+            return
+        if r.state not in (RunState.RUNNING, RunState.PAUSED):
+            self._record(t)      # the end point: every firing lies within the samples
+            self._closed = True
             return
         self._tick += 1
         if self._tick < self._every:
             return
         self._tick = 0
+        self._record(t)
+
+    def _record(self, t: float) -> None:
         i = self.n % PATH_CAPACITY
         self._t[i] = t
         axes = self.ctl.axes
@@ -310,12 +319,19 @@ class PathRecorder:
             sel = np.unique(np.linspace(0, len(t) - 1, max_points).astype(int))
         firings = []
         r = self.runner
-        if r is not None and len(t):
-            t_lo = t[0]
+        if r is not None and n > first:
+            # the firings after the point before `start` up to the last point returned (the
+            # recorder takes a last point when the run ends), so reading on with since=next
+            # gives each firing exactly once
+            t_lo = self._t[(start - 1) % PATH_CAPACITY] if start > first else -np.inf
+            t_hi = t[-1] if len(t) else t_lo
+            all_idx = np.arange(first, n) % PATH_CAPACITY
+            all_t = self._t[all_idx]
             for ev in r.events:
-                if ev.kind == "sync_output" and ev.t >= t_lo:
-                    k = int(np.clip(np.searchsorted(t, ev.t), 0, len(t) - 1))
-                    firings.append({"t": ev.t, "point": np.round(p[k], 6).tolist(),
+                if ev.kind == "sync_output" and t_lo < ev.t <= t_hi:
+                    k = int(np.clip(np.searchsorted(all_t, ev.t), 0, len(all_t) - 1))
+                    firings.append({"t": ev.t,
+                                    "point": np.round(self._p[all_idx[k]], 6).tolist(),
                                     "output": ev.index, "level": ev.level})
         vmax = float(speed.max()) if len(speed) else 0.0
         return {"axes": "".join(r.letters) if r is not None else "", "first": first,
