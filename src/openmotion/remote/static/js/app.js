@@ -161,15 +161,21 @@ class App extends EventTarget {
     const estop = $("#estop");
     estop.classList.toggle("active", Boolean(s.estop));
     const banner = $("#safety-banner");
-    if (s.estop) {
+    const faulted = Object.entries(s.axes || {}).filter(([, a]) => a.state === "ErrorStop");
+    if (s.estop || faulted.length) {
+      const text = (s.estop ? "E-STOP active: every axis is stopped. " : "") +
+        (faulted.length ? `ErrorStop: ${faulted.map(([n, a]) => `${n}${a.fault ? ` (${a.fault})` : ""}`).join(", ")}. ` : "");
+      if (banner.hidden || banner.dataset.text !== text) {
+        banner.dataset.text = text;
+        banner.replaceChildren(text,
+          el("button", { type: "button", id: "estop-reset", onclick: () => this.call("machine.reset").catch(() => {}) }, "Reset"));
+      }
       banner.hidden = false;
-      banner.replaceChildren("E-STOP active: every axis is stopped. ",
-        el("button", { type: "button", id: "estop-reset", onclick: () => this.call("machine.reset").catch(() => {}) }, "Reset"));
     } else banner.hidden = true;
     const p = s.program || {};
     const a = this.axisStatus();
     $("#status-line").textContent = `t = ${(s.time ?? 0).toFixed(2)} s · speed ×${s.speed ?? 1} · ` +
-      `cycle ${s.cycle ? (s.cycle.busy_us ?? 0).toFixed(0) : "-"} µs · program ${p.state || "-"}` +
+      `cycle ${s.cycle ? (s.cycle.busy_us ?? 0).toFixed(0) : "-"} µs, ${s.cycle ? s.cycle.overruns : "-"} overruns · program ${p.state || "-"}` +
       (a ? ` · ${this.axis}: ${a.state}` : "");
     this.dispatchEvent(new CustomEvent("status"));
   }
@@ -198,8 +204,9 @@ class App extends EventTarget {
     });
     this.rpc.on("notify_event", (params) => {
       const ev = params[0] || {};
-      this.log(`event: ${ev.kind}${ev.axis ? " " + ev.axis : ""}${ev.detail ? ": " + ev.detail : ""}`, ev.kind === "fault");
       this.dispatchEvent(new CustomEvent("event", { detail: ev }));
+      if (ev.kind === "overrun") return;   // counted in the status line (cycle.overruns)
+      this.log(`event: ${ev.kind}${ev.axis ? " " + ev.axis : ""}${ev.detail ? ": " + ev.detail : ""}`, ev.kind === "fault");
     });
 
     $("#axis-select").addEventListener("change", (e) => this.selectAxis(e.target.value));

@@ -41,16 +41,20 @@ export function mount(a, node) {
 
 export function show() { load(); }
 
+let loadSeq = 0;
 async function load() {
   if (!app.info) return;
-  axis = app.axis;
+  const seq = ++loadSeq;   // a newer load (another axis) wins over a late answer
+  const ax = app.axis;
   let res;
   try {
-    res = await app.call("home.get", { axis });
+    res = await app.call("home.get", { axis: ax });
+    if (seq !== loadSeq) return;
   } catch (err) {
     root.replaceChildren(el("p", { class: "form-error" }, `could not read the homing settings of ${axis}: ${err.message}`));
     return;
   }
+  axis = ax;
   loaded = res.config;
   sequence = res.sequence || [];
   seqCache.clear();
@@ -60,7 +64,10 @@ async function load() {
 
 function build(choices) {
   fs = new FieldSet(el("div", { id: "home-fields", class: "fields-2" }), specs(app.axisInfo(axis), choices), {
-    onChange: (name) => { if (name === "mode" || name === "direction" || name === "ez_count") redraw(); },
+    onChange: (name) => {
+      if (name === "mode") applyMode();
+      else if (name === "direction" || name === "ez_count" || name === "final") redraw();
+    },
   });
   fs.setAll(loaded);
   drawing = document.createElementNS(SVGNS, "svg");
@@ -125,28 +132,40 @@ async function start() {
   try { await app.call("home.start", { axis }); } catch (err) { serverError(err, [fs]); }
 }
 
-async function redraw() {
+/** Selecting a mode applies it at once (as Motion Creator's home dialog does): the server
+ * describes the phases of the mode in use, and the drawing shows them. */
+async function applyMode() {
+  const raw = fs.raw();
+  const v = fs.values(["mode"]);
+  if (!v || String(v.mode) === String(loaded.mode)) { redraw(); return; }
+  if (!seqCache.has(String(v.mode))) {
+    try {
+      const res = await app.call("home.set", { axis, changes: { mode: v.mode } });
+      if (res.config_version !== undefined) app.configVersion = res.config_version;
+      loaded = { ...loaded, mode: res.config.mode };
+      seqCache.set(String(res.config.mode), res.sequence || []);
+      savedNote.textContent = `mode ${res.config.mode} applied${res.saved ? `, saved to ${res.saved}` : ""}`;
+    } catch (err) {
+      serverError(err, [fs]);
+      return;
+    }
+  }
+  fs.set("direction", raw.direction);
+  redraw();
+}
+
+function redraw() {
   const raw = fs.raw();
   const mode = raw.mode;
-  let seq = seqCache.get(String(mode));
-  if (!seq) {
-    // the server draws only the saved mode; ask for another one if it can (home.get mode=)
-    try {
-      const m = /^\d+$/.test(mode) ? Number(mode) : mode;
-      const res = await app.call("home.get", { axis, mode: m }, { quiet: true });
-      if (res.sequence && String(res.config.mode) === String(mode)) seq = res.sequence;
-      else if (res.sequence && res.mode !== undefined && String(res.mode) === String(mode)) seq = res.sequence;
-      if (seq) seqCache.set(String(mode), seq);
-    } catch { /* older server: only the saved mode is drawn */ }
-  }
+  const seq = seqCache.get(String(mode));
   const dirNow = Number(raw.direction) || loaded.direction;
   if (!seq) {
     draw([], dirNow);
-    seqNote.textContent = `Save to draw mode ${mode} (the server describes the saved mode's phases).`;
+    seqNote.textContent = `Save to draw mode ${mode}.`;
     return;
   }
   // the server's directions are for the saved direction: flip them for an unsaved one
-  const flip = String(mode) === String(loaded.mode) && dirNow !== loaded.direction ? -1 : 1;
+  const flip = dirNow !== loaded.direction ? -1 : 1;
   const s = seq.map((p) => ({ ...p, direction: p.direction * flip }));
   draw(s, dirNow);
   const unit = app.axisInfo(axis) ? app.axisInfo(axis).unit : "";

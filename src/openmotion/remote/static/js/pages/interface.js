@@ -56,24 +56,27 @@ function nest(flat) {
   return out;
 }
 
-/** The allowed values of a field, whatever shape `choices` has. */
-function choicesFor(name, value) {
+/** The allowed values (or [min, max] range) of a field, whatever shape `choices` has. */
+function choicesFor(name) {
   const parts = name.split(".");
-  const tries = [choices[name], choices[parts[parts.length - 1]], parts.reduce((o, p) => (o && typeof o === "object" ? o[p] : undefined), choices)];
-  if (parts[0] === "logic") tries.push(choices.logic);
-  for (const t of tries) if (Array.isArray(t)) return t;
-  if (parts[0] === "logic") return ["no", "nc"];
-  if (name.endsWith("el") || name.endsWith("alm")) return ["immediate", "decel"];
-  return [value];
+  const nested = parts.reduce((o, p) => (o && typeof o === "object" ? o[p] : undefined), choices);
+  for (const t of [nested, choices[name], parts[0] === "logic" ? undefined : choices[parts[parts.length - 1]]]) {
+    if (Array.isArray(t)) return t;
+  }
+  return null;
 }
 
 function specFor(name, value) {
   const label = LABELS[name] || name;
   if (typeof value === "boolean") return { name, label, kind: "bool" };
+  const ch = choicesFor(name);
   if (typeof value === "string") {
-    return { name, label, kind: "select", options: choicesFor(name, value).map((v) => [v, OPTION_TEXT[v] ? `${v} — ${OPTION_TEXT[v]}` : v]) };
+    const opts = ch || (name.startsWith("logic.") ? ["no", "nc"] : [value]);
+    return { name, label, kind: "select", options: opts.map((v) => [v, OPTION_TEXT[v] ? `${v} — ${OPTION_TEXT[v]}` : v]) };
   }
-  return { name, label, kind: "number", ...(NUMBERS[name] || {}) };
+  const spec = { name, label, kind: "number", ...(NUMBERS[name] || {}) };
+  if (ch && ch.length === 2 && ch.every((x) => typeof x === "number")) { spec.min = ch[0]; spec.max = ch[1]; }
+  return spec;
 }
 
 export function mount(a, node) {
@@ -85,12 +88,15 @@ export function mount(a, node) {
 
 export function show() { load(); }
 
+let loadSeq = 0;
 async function load() {
   if (!app.info) return;
+  const seq = ++loadSeq;   // a newer load (another axis) wins over a late answer
   const axis = app.axis;
   let res;
   try {
     res = await app.call("interface.get", { axis });
+    if (seq !== loadSeq) return;
   } catch (err) {
     root.replaceChildren(el("p", { class: "form-error" }, `could not read the interface of ${axis}: ${err.message}`));
     return;

@@ -5,7 +5,7 @@ import { el, button, num } from "../dom.js";
 import { FieldSet, serverError } from "../fields.js";
 import { panel } from "./common.js";
 
-let app, root, fsFile, serverInfo = null;
+let app, root, fsFile, serverInfo = null, fileMsg = "", typedPath = null;
 
 export function mount(a, node) {
   app = a;
@@ -34,8 +34,9 @@ function build() {
   fsFile = new FieldSet(el("div", { id: "machine-file-fields" }), [
     { name: "path", label: "Machine file", kind: "text", optional: true, value: info.file || "",
       check: (v) => (v && !/\.toml$/i.test(v) ? "Machine file must end in .toml" : "") },
-  ]);
-  const result = el("div", { class: "small", id: "machine-file-result" });
+  ], { onChange: () => { typedPath = fsFile.raw().path; } });
+  if (typedPath !== null) fsFile.set("path", typedPath);   // a rebuild keeps what was typed
+  const result = el("div", { class: "small", id: "machine-file-result" }, fileMsg);
   const toml = el("pre", { class: "file", id: "machine-toml" }, "…");
   root.replaceChildren(el("div", { class: "grid" },
     el("div", { class: "panel wide" }, el("h3", {}, "Machine"),
@@ -65,7 +66,9 @@ async function save(result) {
   const params = v.path && v.path !== app.info.file ? { path: v.path } : {};
   try {
     const r = await app.call("machine.save", params);
-    result.textContent = `saved ${r.file}${r.sidecar ? ` and ${r.sidecar}` : ""}`;
+    fileMsg = `saved ${r.file}${r.sidecar ? ` and ${r.sidecar}` : ""}`;
+    result.textContent = fileMsg;
+    typedPath = null;
     if (params.path) await app.reloadConfig();
   } catch (err) { serverError(err, [fsFile]); }
 }
@@ -77,7 +80,9 @@ async function load(result) {
   try {
     const r = await app.call("machine.load", { path: v.path });
     app.configVersion = r.config_version;
-    result.textContent = `loaded ${r.file}`;
+    fileMsg = `loaded ${r.file}`;
+    result.textContent = fileMsg;
+    typedPath = null;
     await app.reloadConfig();
   } catch (err) { serverError(err, [fsFile]); }
 }

@@ -90,12 +90,13 @@ function build() {
   view.state = el("span", { class: "state", id: "op-state" }, "-");
   view.fault = el("div", { class: "small", id: "op-fault", style: "color: var(--bad)" });
   view.homing = el("div", { class: "small muted", id: "op-homing" });
-  view.servo = button("Servo On", () => servo(), { id: "op-servo" });
+  view.servo = el("input", { type: "checkbox", id: "op-servo", onchange: () => servo() });
+  const servoLabel = el("label", { class: "row", title: "the SVON output (HSL_M_set_servo)" }, view.servo, "Servo On");
   view.reset = button("Reset axis", () => act("axis.reset", {}), { id: "op-reset", title: "clears ErrorStop" });
   fsSet = new FieldSet(el("div", { id: "op-setpos" }), [
     { name: "position", label: "Position", unit: info.unit, value: 0 }]);
   const posPanel = panel(`Axis ${app.axis} — position`, counters,
-    el("div", { class: "row" }, "State ", view.state, view.servo, view.reset),
+    el("div", { class: "row" }, "State ", view.state, servoLabel, view.reset),
     view.fault, view.homing,
     fsSet.container,
     el("div", { class: "row" },
@@ -113,7 +114,7 @@ function build() {
   view.play1 = button("Play 1", () => play(1), { id: "op-play1", class: "primary" });
   view.play2 = button("Play 2", () => play(2), { id: "op-play2", class: "primary" });
   const movePanel = el("div", { class: "panel wide" }, el("h3", {}, "Operation mode"),
-    el("div", { class: "grid" }, fsTarget.container, fsMotion.container, fsRepeat.container),
+    el("div", { class: "move-grid" }, fsTarget.container, fsMotion.container, fsRepeat.container),
     el("div", { class: "row" }, view.play1, view.play2,
       button("Stop", () => stop("decel"), { id: "op-stop", class: "danger", title: "decelerate and stop (Decel. time)" }),
       button("Stop now", () => stop("immediate"), { id: "op-stop-now", class: "danger" }),
@@ -146,6 +147,7 @@ function build() {
     { key: "velocity", label: "velocity", unit: `${info.unit}/s` },
     { key: "position", label: "position", unit: info.unit },
   ], windowS: 10, capacity: 20000, height: 220 });
+  app.opChart = chart;
   if (keep && keepAxis === app.axis) {
     fsTarget.setAll(keep.t); fsMotion.setAll(keep.m); fsRepeat.setAll(keep.r); fsJog.setAll(keep.j);
   }
@@ -176,10 +178,9 @@ function update() {
   view.fault.textContent = s.fault ? `fault: ${s.fault}` : "";
   const h = s.homing || {};
   view.homing.textContent = h.state && h.state !== "idle" ? `homing: ${h.state}${h.phase ? " · " + h.phase : ""}${h.reason ? " · " + h.reason : ""}` : "";
-  view.servo.textContent = s.servo ? "Servo On ✓" : "Servo Off";
-  view.servo.classList.toggle("on", Boolean(s.servo));
+  if (!view.servoBusy) view.servo.checked = Boolean(s.servo);
   view.reset.disabled = s.state !== "ErrorStop";
-  lamps.update({ ...(s.io || {}), svon: s.io && s.io.svon !== undefined ? s.io.svon : s.servo });
+  lamps.update({ ...(s.io || {}), svon: s.servo });   // SVON = the servo-on output axis.servo sets
   if (chart && app.status && typeof app.status.time === "number") chart.append([app.status.time], [[s.velocity], [s.position]]);
 }
 
@@ -195,9 +196,9 @@ async function act(method, params, sets = [fsTarget, fsMotion]) {
   }
 }
 
-function servo() {
-  const s = app.axisStatus();
-  return act("axis.servo", { on: !(s && s.servo) }, [fsSet]);
+async function servo() {
+  view.servoBusy = true;
+  try { await act("axis.servo", { on: view.servo.checked }, [fsSet]); } finally { view.servoBusy = false; update(); }
 }
 
 function motionParams() {

@@ -64,7 +64,8 @@ export function mount(a, node) {
           button("Run", () => run(), { id: "prog-run-btn", class: "primary" }),
           button("Pause", () => app.call("program.pause").catch(() => {}), { id: "prog-pause" }),
           button("Resume / continue", () => app.call("program.resume").catch(() => {}), { id: "prog-resume", title: "also continues after M0/M1 and a single-block stop" }),
-          button("Abort", () => app.call("program.abort").catch(() => {}), { id: "prog-abort", class: "danger" })),
+          button("Abort", () => app.call("program.abort").catch(() => {}), { id: "prog-abort", class: "danger" }),
+          button("Servo on, all axes", () => servoAll(), { id: "prog-servo-all", title: "a program needs every axis enabled" })),
         stateBox)),
     el("div", { class: "grid two", style: "margin-top:12px" },
       panel("Preview (dashed = rapid, grey = done)",
@@ -94,6 +95,10 @@ async function refresh() {
 
 /** Number of lines of the loaded program, found with program.lines (exponential search). */
 async function countLines() {
+  try {
+    const r = await app.call("program.lines", { first: 1, count: 1 }, { quiet: true });
+    if (typeof r.total === "number") return r.total;
+  } catch { return 0; }
   const has = async (n) => {
     try { return (await app.call("program.lines", { first: n, count: 1 }, { quiet: true })).lines.length > 0; } catch { return false; }
   };
@@ -226,4 +231,13 @@ async function run() {
   try {
     await app.call("program.run", { feed_override: Number(ovr.value), single_block: sbox.checked, optional_stop: v.optional_stop, repeat: v.repeat });
   } catch (err) { serverError(err, [fsRun]); }
+}
+
+async function servoAll() {
+  for (const a of app.info.axes) {
+    const st = app.axisStatus(a.name);
+    if (st && !st.servo) {
+      try { await app.call("axis.servo", { axis: a.name, on: true }); } catch { return; }
+    }
+  }
 }

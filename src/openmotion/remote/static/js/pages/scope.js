@@ -36,7 +36,7 @@ async function start() {
     build();
     await loadHistory();
     if (sub === null) {
-      const r = await app.call("scope.subscribe", { rate_hz: 20 });
+      const r = await app.call("scope.subscribe", { rate_hz: 25 });
       sub = r.subscription;
     }
   } catch (err) {
