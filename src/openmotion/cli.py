@@ -229,13 +229,16 @@ def build_parser() -> argparse.ArgumentParser:
                    "feed / acc-time)")
     r.add_argument("--feed-override", type=float, default=100.0,
                    help="feed override in %% of the programmed feed (1 .. 200)")
+    from .remote.ui_cmd import add_parser as add_ui_parser  # `openmotion ui` (remote/)
+
+    add_ui_parser(sub, _FMT)
     return ap
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     handler = {"profile": cmd_profile, "demo": cmd_demo, "config": cmd_config,
-               "run": cmd_run, "examples": cmd_examples}[args.command]
+               "run": cmd_run, "examples": cmd_examples}.get(args.command) or args.handler
     try:
         return handler(args)
     except (MotionError, OSError) as exc:

@@ -1,0 +1,166 @@
+"""Interface I/O settings of an axis (Motion Creator "I/O configuration"), as the API sees
+them: machine-file fields (signal logic, pulse and encoder modes, inversions, move ratio)
+plus the responses (EL / ALM stop modes, ERC, SD, INP, RDY) that live in control.safety.
+
+`split_changes` checks a partial change against the rules and splits it into a new
+AxisConfig (validated by the config dataclass itself) and new responses; `apply_responses`
+puts responses on a controller. The UI sidecar file `<machine>.ui.toml` keeps the responses
+and the homing settings next to the machine file (they are not machine-file keys).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import tempfile
+import tomllib
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import tomli_w
+
+from ..config import ENCODER_MODES, LOGIC_SIGNALS, PULSE_MODES, SIGNAL_LOGIC, AxisConfig
+from ..errors import MotionError
+
+if TYPE_CHECKING:
+    from ..control.controller import Controller
+
+CONFIG_FIELDS = ("pulse_mode", "pulse_width_us", "encoder_mode", "invert_a", "invert_b",
+                 "invert_z", "swap_ab", "reverse", "move_ratio")
+RESPONSE_KEYS = ("el", "el_enabled", "el_direction_sensitive", "alm", "erc_width_s", "sd",
+                 "inp", "rdy")
+SD_KEYS = ("enabled", "latched", "stop")
+STOP_MODES = ("immediate", "decel")
+MAX_ERC_S = 1.0
+
+
+def default_responses() -> dict[str, Any]:
+    return {"el": "immediate", "el_enabled": True, "el_direction_sensitive": True,
+            "alm": "immediate", "erc_width_s": 0.0,
+            "sd": {"enabled": False, "latched": False, "stop": False},
+            "inp": False, "rdy": False}
+
+
+def choices() -> dict[str, Any]:
+    return {"logic": {s: list(SIGNAL_LOGIC) for s in LOGIC_SIGNALS},
+            "pulse_mode": list(PULSE_MODES), "encoder_mode": list(ENCODER_MODES),
+            "el": list(STOP_MODES), "alm": list(STOP_MODES),
+            "pulse_width_us": [0.0, 1000.0], "erc_width_s": [0.0, MAX_ERC_S],
+            "move_ratio": "> 0"}
+
+
+def interface_of(cfg: AxisConfig, responses: dict[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {"logic": {s: cfg.signal_logic(s) for s in LOGIC_SIGNALS}}
+    for f in CONFIG_FIELDS:
+        out[f] = getattr(cfg, f)
+    out["responses"] = {k: (dict(v) if isinstance(v, dict) else v)
+                        for k, v in responses.items()}
+    return out
+
+
+def _bool(path: str, v: Any) -> bool:
+    if not isinstance(v, bool):
+        raise MotionError(f"{path} must be true or false, got {v!r}")
+    return v
+
+
+def _keys(path: str, table: Any, allowed: tuple[str, ...]) -> dict[str, Any]:
+    if not isinstance(table, dict):
+        raise MotionError(f"{path} must be an object, got {table!r}")
+    for k in table:
+        if k not in allowed:
+            raise MotionError(f"{path}.{k}: unknown key; valid keys: {', '.join(allowed)}")
+    return table
+
+
+def check_responses(path: str, changes: dict[str, Any], old: dict[str, Any]
+                    ) -> dict[str, Any]:
+    """`old` with `changes` applied, every value checked (messages name `path.key`)."""
+    _keys(path, changes, RESPONSE_KEYS)
+    new = {k: (dict(v) if isinstance(v, dict) else v) for k, v in old.items()}
+    for k, v in changes.items():
+        p = f"{path}.{k}"
+        if k in ("el", "alm"):
+            if v not in STOP_MODES:
+                raise MotionError(f"{p} must be one of {', '.join(STOP_MODES)}; got {v!r}")
+            new[k] = v
+        elif k == "erc_width_s":
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or \
+                    not 0.0 <= v <= MAX_ERC_S:
+                raise MotionError(f"{p} must be a number in [0, {MAX_ERC_S:g}] s "
+                                  f"(0 = no ERC pulse), got {v!r}")
+            new[k] = float(v)
+        elif k == "sd":
+            _keys(p, v, SD_KEYS)
+            new["sd"] = {**new["sd"], **{s: _bool(f"{p}.{s}", x) for s, x in v.items()}}
+        else:
+            new[k] = _bool(p, v)
+    return new
+
+
+def split_changes(cfg: AxisConfig, responses: dict[str, Any], changes: Any
+                  ) -> tuple[AxisConfig, dict[str, Any]]:
+    """The axis config and responses after `changes` (a partial interface)."""
+    path = f"axes.{cfg.name}"
+    _keys("changes", changes, ("logic", "responses", *CONFIG_FIELDS))
+    kw: dict[str, Any] = {}
+    if "logic" in changes:
+        logic = _keys(f"{path}.logic", changes["logic"], LOGIC_SIGNALS)
+        kw["logic"] = {**cfg.logic, **logic}
+    for f in CONFIG_FIELDS:
+        if f in changes:
+            kw[f] = changes[f]
+    new_cfg = dataclasses.replace(cfg, **kw) if kw else cfg   # validates every field
+    new_resp = check_responses(f"{path}.responses", changes.get("responses", {}), responses)
+    return new_cfg, new_resp
+
+
+def apply_responses(ctl: Controller, axis: int, r: dict[str, Any]) -> None:
+    """Put the responses of one axis on the controller's safety layer."""
+    safety = ctl.safety
+    if safety is None:
+        raise MotionError("the controller has no safety layer")
+    safety.set_el(axis, r["el"])
+    safety.set_limit_check(axis, r["el_enabled"], direction_sensitive=r["el_direction_sensitive"])
+    safety.set_alm(axis, r["alm"])
+    safety.set_erc(axis, r["erc_width_s"])
+    safety.set_sd(axis, r["sd"]["enabled"], latched=r["sd"]["latched"], stop=r["sd"]["stop"])
+    safety.set_inp(axis, r["inp"])
+    safety.set_rdy_check(axis, r["rdy"])
+
+
+# -- the UI sidecar file ----------------------------------------------------------------
+def sidecar_path(machine_file: Path) -> Path:
+    return machine_file.with_name(machine_file.stem + ".ui.toml")
+
+
+def load_sidecar(path: Path) -> dict[str, Any]:
+    """The sidecar's tables ({"interface": {axis: responses}, "home": {axis: {...}}});
+    empty when there is no file. A malformed file is a MotionError naming it."""
+    if not path.is_file():
+        return {"interface": {}, "home": {}}
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise MotionError(f"UI settings file {str(path)!r}: {exc}") from None
+    _keys(str(path), data, ("interface", "home"))
+    return {"interface": dict(data.get("interface", {})), "home": dict(data.get("home", {}))}
+
+
+def atomic_write(path: Path, text: str) -> None:
+    """Write `text` to `path` through a temporary file and a rename (never half a file)."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def save_sidecar(path: Path, interface: dict[str, Any], home: dict[str, Any]) -> None:
+    atomic_write(path, "# openmotion ui: interface responses and homing settings\n"
+                 + tomli_w.dumps({"interface": interface, "home": home}))

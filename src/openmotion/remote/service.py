@@ -1,0 +1,382 @@
+"""The machine behind the remote API: a Controller on the simulator, paced in real time on a
+background thread, plus what the pages need around it (jogs with a deadman, repeats, the
+scope, the program, homing runs, the machine file and its UI sidecar, config_version).
+
+Threads: the real-time pacer runs `Controller.step`; every change to the controller holds
+`ctl.lock` (the lock every cycle runs under), and the server runs commands one at a time
+(`command_lock`). The service's own per-cycle work (deadman check, repeats, scope and path
+sampling) is one cycle hook that never raises: a failure there turns the part that failed
+off and is reported in `hook_errors`, the cycle goes on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ..config import MachineConfig, default_machine, dumps_machine
+from ..control.clock import RealtimePacer
+from ..control.controller import Controller
+from ..control.homing import Homing
+from ..control.homing_modes import HomeConfig
+from ..control.states import AxisState
+from ..errors import MotionError
+from ..program.runjob import load_machine_arg
+from .deadman import JogRegistry
+from .homeconf import default_home, home_from_user, home_to_user
+from .interface import (
+    apply_responses,
+    atomic_write,
+    check_responses,
+    default_responses,
+    load_sidecar,
+    save_sidecar,
+    sidecar_path,
+    split_changes,
+)
+from .programs import ProgramSession
+from .repeat import RepeatRegistry
+from .scope import Scope, Trigger
+
+MAX_SPEED = 20.0
+EVENT_KEEP = 2000
+
+Listener = Callable[[str, dict[str, Any]], None]
+
+
+class MachineService:
+    """One simulated machine running in real time (see the module docstring)."""
+
+    def __init__(self, config: MachineConfig | None = None, file: str | Path | None = None,
+                 *, speed: float = 1.0) -> None:
+        self.file: Path | None = None
+        if file is not None:
+            self.file = Path(file)
+            config = load_machine_arg(str(self.file), "--machine")
+        self.config = config if config is not None else default_machine()
+        self.config_version = 1
+        self.command_lock = threading.Lock()
+        self.speed = _check_speed(speed)
+        self._listeners: list[Listener] = []
+        self.events: deque[dict[str, Any]] = deque(maxlen=EVENT_KEEP)
+        self.hook_errors: list[str] = []
+        side = load_sidecar(sidecar_path(self.file)) if self.file else \
+            {"interface": {}, "home": {}}
+        self.responses = {a.name: check_responses(
+            f"interface.{a.name}", side["interface"].get(a.name, {}), default_responses())
+            for a in self.config.axes}
+        self._home_user = dict(side["home"])
+        self._pacer: RealtimePacer | None = None
+        self._build(self.config, scope=None)
+
+    # ------------------------------------------------------------------ building
+    def _build(self, config: MachineConfig, scope: dict[str, Any] | None) -> None:
+        ctl = Controller(config)
+        self.ctl = ctl
+        self.config = config
+        for ax in ctl.axes:
+            apply_responses(ctl, ax.index, self.responses[ax.name])
+        self.homes: dict[str, HomeConfig] = {}
+        for ax in ctl.axes:
+            base = default_home(ax)
+            user = self._home_user.get(ax.name)
+            self.homes[ax.name] = home_from_user(ax, base, user) if user else base
+        self.homings: dict[int, Homing] = {}
+        self.jogs = JogRegistry(ctl)
+        self.repeats = RepeatRegistry(ctl)
+        self.scope = Scope(ctl)
+        if scope is not None:
+            with contextlib.suppress(MotionError):
+                self.scope.configure(scope["channels"], scope["divider"], scope["seconds"],
+                                     Trigger(**scope["trigger"]))
+        self.program = ProgramSession(ctl)
+        self._cmp_time = [-1.0] * len(ctl.axes)
+        if ctl.safety is not None:
+            ctl.safety.cmp.on_event(self._on_compare)
+        ctl.events.on_event(self._on_event)
+        self._parts: list[tuple[str, Callable[[float], None]]] = [
+            ("deadman", lambda t: self.jogs.check()), ("repeat", self.repeats.step),
+            ("scope", self.scope.sample), ("path", self.program.path.sample)]
+        ctl.add_cycle_hook(self._on_cycle)
+
+    def _on_cycle(self, ctl: Controller, t: float) -> None:
+        for part in self._parts:
+            name, fn = part
+            try:
+                fn(t)
+            except Exception as exc:  # never out of the cycle: drop the part, tell why
+                if name == "deadman":  # the deadman must not die: stop every jog instead
+                    with contextlib.suppress(Exception):
+                        self.jogs.stop_all(f"deadman check failed: {exc}")
+                    continue
+                self._parts = [p for p in self._parts if p is not part]
+                self.hook_errors.append(f"{name}: {type(exc).__name__}: {exc}")
+
+    def _on_compare(self, ev: Any) -> None:
+        axis = getattr(ev, "axis", None)
+        if isinstance(axis, int) and 0 <= axis < len(self._cmp_time):
+            self._cmp_time[axis] = self.ctl.time
+
+    def _on_event(self, ev: Any) -> None:
+        name = None if ev.axis is None else self.ctl.axes[ev.axis].name
+        pos = None
+        if ev.position is not None and ev.axis is not None:
+            pos = float(self.ctl.axes[ev.axis].units.to_units(ev.position))
+        item = {"seq": ev.seq, "t": ev.time, "kind": ev.kind, "axis": name, "position": pos,
+                "detail": ev.detail}
+        self.events.append(item)
+        self._notify("event", item)
+
+    def cmp_active(self, axis: int) -> bool:
+        t = self._cmp_time[axis]
+        return t >= 0.0 and self.ctl.time - t <= 0.1
+
+    # ------------------------------------------------------------------ listeners
+    def add_listener(self, fn: Listener) -> None:
+        self._listeners.append(fn)
+
+    def remove_listener(self, fn: Listener) -> None:
+        if fn in self._listeners:
+            self._listeners.remove(fn)
+
+    def _notify(self, kind: str, payload: dict[str, Any]) -> None:
+        for fn in tuple(self._listeners):
+            with contextlib.suppress(Exception):
+                fn(kind, payload)
+
+    # ------------------------------------------------------------------ real time
+    def start(self) -> None:
+        if self._pacer is not None and self._pacer.running:
+            return
+        self._pacer = RealtimePacer(self.ctl.step, self.ctl.period / self.speed,
+                                    self._overran)
+        self._pacer.start()
+
+    def stop(self) -> None:
+        if self._pacer is not None:
+            self._pacer.stop()
+            self._pacer = None
+
+    @property
+    def running(self) -> bool:
+        return self._pacer is not None and self._pacer.running
+
+    def cycle_stats(self, max_age_s: float = 1.0) -> Any:
+        """The pacer's CycleStats, recomputed at most every `max_age_s` (they cost a
+        percentile over the 65536-cycle window)."""
+        if self._pacer is None:
+            return None
+        now = time.monotonic()
+        cached = getattr(self, "_stats_cache", None)
+        if cached is None or now - cached[0] > max_age_s or cached[2] is not self._pacer:
+            cached = (now, self._pacer.stats(), self._pacer)
+            self._stats_cache = cached
+        return cached[1]
+
+    def _overran(self, count: int, behind: int) -> None:
+        with contextlib.suppress(Exception):
+            self.ctl.events.record("overrun", None, self.ctl.time, None,
+                                   f"cycle overran its period (overrun {count}, {behind} "
+                                   "slots behind)")
+
+    def set_speed(self, factor: float) -> None:
+        self.speed = _check_speed(factor)
+        if self.running:
+            self.stop()
+            self.start()
+
+    def shutdown(self) -> None:
+        """Stop every axis (decelerating), let them come to rest, stop the thread."""
+        with contextlib.suppress(Exception), self.ctl.lock:
+            self.jogs.stop_all("server shutdown")
+            self.repeats.stop_all("server shutdown")
+            self.program.abort_if_running()
+            for ax in self.ctl.axes:
+                if ax.is_moving:
+                    ax.stop()
+        t_end = time.monotonic() + 5.0
+        while self.running and time.monotonic() < t_end and \
+                any(a.is_moving for a in self.ctl.axes):
+            time.sleep(0.01)
+        self.stop()
+
+    # ------------------------------------------------------------------ configuration
+    def check_version(self, version: Any) -> None:
+        from .protocol import RELOAD, RpcError
+
+        if version is None:
+            return
+        if isinstance(version, bool) or not isinstance(version, int):
+            from .protocol import INVALID_PARAMS
+
+            raise RpcError(INVALID_PARAMS, f"params.config_version must be an integer, "
+                           f"got {version!r}", {"param": "config_version"})
+        if version != self.config_version:
+            raise RpcError(RELOAD, f"the configuration changed (version {version} -> "
+                           f"{self.config_version}) since this client loaded it: reload",
+                           {"config_version": self.config_version})
+
+    def _bump(self) -> None:
+        self.config_version += 1
+        self._notify("config", {"config_version": self.config_version})
+
+    def _check_at_rest(self, what: str) -> None:
+        busy = [a.name for a in self.ctl.axes if a.is_moving or a.state in (
+            AxisState.HOMING, AxisState.STOPPING)]
+        if busy:
+            raise MotionError(f"{what} needs every axis at rest; moving: {', '.join(busy)}")
+        self.program._check_idle(what)
+
+    def rebuild(self, config: MachineConfig) -> None:
+        """Run `config`: the simulated machine restarts (as a power cycle of the card:
+        positions 0) with the servo state, responses, homing and scope settings kept."""
+        self._check_at_rest("changing the machine")
+        enabled = {a.name for a in self.ctl.axes if a.powered}
+        info = self.scope.info()
+        scope = {"channels": info["channels"], "divider": info["divider"],
+                 "seconds": info["seconds"], "trigger": info["trigger"]}
+        was_running = self.running
+        self.stop()
+        old = self.ctl
+        try:
+            for name in list(self.responses):
+                if name not in config.axis_names:
+                    del self.responses[name]
+            for a in config.axes:
+                self.responses.setdefault(a.name, default_responses())
+            self._build(config, scope)
+        except Exception:
+            self.ctl = old
+            raise
+        finally:
+            if was_running:
+                self.start()
+        for ax in self.ctl.axes:
+            if ax.name in enabled:
+                with contextlib.suppress(MotionError):
+                    ax.enable()
+
+    def set_interface(self, axis: Any, changes: Any) -> Path | None:
+        ax = self.ctl.axis(axis)
+        cfg = self.config.axis(ax.name)
+        new_cfg, new_resp = split_changes(cfg, self.responses[ax.name], changes)
+        if new_cfg != cfg:
+            old_resp = self.responses[ax.name]
+            self.responses[ax.name] = new_resp
+            try:
+                self.rebuild(self.config.with_axis(new_cfg))
+            except Exception:
+                self.responses[ax.name] = old_resp
+                raise
+        else:
+            with self.ctl.lock:
+                apply_responses(self.ctl, ax.index, new_resp)
+            self.responses[ax.name] = new_resp
+        self._bump()
+        return self.autosave()
+
+    def set_home(self, axis: Any, changes: Any) -> Path | None:
+        ax = self.ctl.axis(axis)
+        new = home_from_user(ax, self.homes[ax.name], changes)
+        self.homes[ax.name] = new
+        self._home_user[ax.name] = home_to_user(ax, new)
+        self._bump()
+        return self.autosave()
+
+    def load(self, path: str) -> None:
+        p = Path(path)
+        cfg = load_machine_arg(path, "path")
+        side = load_sidecar(sidecar_path(p))
+        resp = {a.name: check_responses(f"interface.{a.name}",
+                                        side["interface"].get(a.name, {}),
+                                        default_responses()) for a in cfg.axes}
+        self._check_at_rest("loading a machine")
+        old = (self.responses, self._home_user)
+        self.responses, self._home_user = resp, dict(side["home"])
+        try:
+            self.rebuild(cfg)
+        except Exception:
+            self.responses, self._home_user = old
+            raise
+        self.file = p
+        self._bump()
+
+    def autosave(self) -> Path | None:
+        if self.file is None:
+            return None
+        self.save(self.file)
+        return self.file
+
+    def save(self, path: str | Path | None = None) -> tuple[Path, Path]:
+        p = Path(path) if path is not None else self.file
+        if p is None:
+            raise MotionError("path is required: the server has no machine file yet")
+        if p.suffix != ".toml":
+            raise MotionError(f"path must name a .toml file, got {str(p)!r}")
+        if not p.parent.is_dir():
+            raise MotionError(f"path {str(p)!r}: folder {str(p.parent)!r} does not exist")
+        try:
+            atomic_write(p, dumps_machine(self.config))
+            side = sidecar_path(p)
+            save_sidecar(side, self.responses, self._home_user)
+        except OSError as exc:
+            raise MotionError(f"path {str(p)!r}: cannot write ({exc.strerror or exc})") from None
+        self.file = p
+        return p, side
+
+    # ------------------------------------------------------------------ homing
+    def start_home(self, axis: Any) -> None:
+        ax = self.ctl.axis(axis)
+        with self.ctl.lock:
+            h = Homing(self.ctl, ax.index, self.homes[ax.name])
+            h.start()
+            self.homings[ax.index] = h
+
+    def abort_home(self, axis: Any) -> None:
+        ax = self.ctl.axis(axis)
+        with self.ctl.lock:
+            h = self.homings.get(ax.index)
+            if h is None or not h.running:
+                raise MotionError(f"axis {ax.name} is not homing")
+            h.abort()
+
+    # ------------------------------------------------------------------ stops
+    def estop(self, reason: str) -> None:
+        """Software E-stop: jogs, repeats and the program end, every axis stops at once."""
+        with self.ctl.lock:
+            self.jogs.stop_all("emergency stop")
+            self.repeats.stop_all("emergency stop")
+            self.program.abort_if_running()
+            for h in self.homings.values():
+                if h.running:
+                    with contextlib.suppress(MotionError):
+                        h.abort()
+            self.ctl.emergency_stop(reason)
+
+    def stop_axis(self, axis: Any | None, immediate: bool, tdec: float | None) -> None:
+        with self.ctl.lock:
+            axes = self.ctl.axes if axis is None else (self.ctl.axis(axis),)
+            for ax in axes:
+                self.repeats.stop(ax.index, "stop command")
+                h = self.homings.get(ax.index)
+                if h is not None and h.running:
+                    h.abort()
+                if immediate:
+                    ax.stop_immediately()
+                elif ax.is_moving:
+                    ax.stop(tdec)
+            if axis is None:
+                self.jogs.stop_all("stop command")
+
+
+def _check_speed(factor: Any) -> float:
+    if isinstance(factor, bool) or not isinstance(factor, (int, float)) or \
+            not 1.0 <= factor <= MAX_SPEED:
+        raise MotionError(f"speed must be a number in [1, {MAX_SPEED:g}] (1 = real time), "
+                          f"got {factor!r}")
+    return float(factor)

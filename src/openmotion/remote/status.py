@@ -1,0 +1,97 @@
+"""Status snapshots of the machine and the diffs the subscriptions push.
+
+`snapshot` reads everything the operation page shows in one pass under the controller's
+lock (so a snapshot is one consistent instant); `diff(old, new)` keeps only the leaves that
+changed, nested like the snapshot (Moonraker's notify_status_update), so merging every diff
+into the first snapshot gives the current one.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ..control.safety import IO_STATUS_BITS, io_status
+
+if TYPE_CHECKING:
+    from .service import MachineService
+
+LAMPS = ("alm", "pel", "mel", "org", "ez", "inp", "sd", "rdy", "erc", "emg", "ltc", "svon")
+FIELDS = ("time", "cycles", "estop", "config_version", "speed", "axes", "program", "scope",
+          "cycle")
+
+
+def axis_status(svc: MachineService, ax: Any) -> dict[str, Any]:
+    ctl = svc.ctl
+    c = ax.counters
+    u = ax.units
+    word = io_status(ctl, ax.index)
+    io = {k: bool(word >> IO_STATUS_BITS[k] & 1) for k in LAMPS}
+    io["cmp"] = svc.cmp_active(ax.index)
+    h = svc.homings.get(ax.index)
+    homing = {"state": "idle", "phase": "", "reason": None} if h is None else {
+        "state": h.status.state, "phase": h.status.phase, "reason": h.status.reason}
+    return {
+        "command": int(c.command), "feedback": int(c.feedback), "error": int(c.error),
+        "target": int(round(c.target)),
+        "position": round(float(u.to_units(ax.position)), 6),
+        "velocity": round(float(u.velocity_to_units(ax.velocity)), 6),
+        "state": ax.state.value, "fault": ax.fault, "servo": bool(ax.powered),
+        "moving": bool(ax.is_moving), "repeat": svc.repeats.active(ax.index),
+        "jog": svc.jogs.jog_of(ax.index), "homing": homing, "io": io,
+    }
+
+
+def snapshot(svc: MachineService, fields: tuple[str, ...] = FIELDS) -> dict[str, Any]:
+    ctl = svc.ctl
+    out: dict[str, Any] = {}
+    with ctl.lock:
+        if "time" in fields:
+            out["time"] = round(ctl.time, 6)
+        if "cycles" in fields:
+            out["cycles"] = ctl.cycles
+        if "estop" in fields:
+            out["estop"] = bool(ctl.estop_active)
+        if "config_version" in fields:
+            out["config_version"] = svc.config_version
+        if "speed" in fields:
+            out["speed"] = svc.speed
+        if "axes" in fields:
+            out["axes"] = {ax.name: axis_status(svc, ax) for ax in ctl.axes}
+        if "program" in fields:
+            out["program"] = svc.program.status()
+    if "scope" in fields:
+        info = svc.scope.info()
+        out["scope"] = {"running": info["running"], "scope_version": info["scope_version"],
+                        "next": info["next"]}
+    if "cycle" in fields:
+        st = svc.cycle_stats()
+        out["cycle"] = {"busy_us": 0.0, "overruns": 0} if st is None else {
+            "busy_us": round(st.mean_busy * 1e6, 1), "overruns": st.overruns}
+    return out
+
+
+def diff(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
+    """The fields of `new` that differ from `old` (nested dicts compared per key)."""
+    out: dict[str, Any] = {}
+    for k, v in new.items():
+        if k not in old:
+            out[k] = v
+            continue
+        o = old[k]
+        if isinstance(v, dict) and isinstance(o, dict):
+            d = diff(o, v)
+            if d:
+                out[k] = d
+        elif v != o or type(v) is not type(o):
+            out[k] = v
+    return out
+
+
+def merge(base: dict[str, Any], d: dict[str, Any]) -> dict[str, Any]:
+    """Apply a diff to a snapshot in place (the client's side of `diff`)."""
+    for k, v in d.items():
+        if isinstance(v, dict) and isinstance(base.get(k), dict):
+            merge(base[k], v)
+        else:
+            base[k] = v
+    return base
