@@ -43,8 +43,11 @@ def ready_axis(pg, axis: str = "x") -> None:
         pg.click("#op-reset")
         wait_status(pg, f"s.axes.{axis}.state !== 'ErrorStop'")
     if not status(pg, f"s.axes.{axis}.servo"):
-        pg.check("#op-servo")
-        wait_status(pg, f"s.axes.{axis}.servo")
+        pg.click("#op-servo")
+        try:
+            wait_status(pg, f"s.axes.{axis}.servo", 5)
+        except Exception as exc:
+            raise AssertionError(f"servo on {axis} failed: {pg.inner_text('#log')}") from exc
     wait_status(pg, f"!s.axes.{axis}.moving", 15)
 
 
