@@ -301,3 +301,36 @@ def test_screenshots_of_the_other_pages(page):
         goto(page, name)
         page.wait_for_timeout(800)
         shot(page, name)
+
+
+def test_with_a_token_the_page_loads_everything_with_it(browser, server):
+    """`--token`: the page passes the token on to its styles, scripts, modules and socket."""
+    token = "s3cret-token-for-the-ui-test"
+    srv = ui_browser.Server(server.workdir, "--token", token)
+    try:
+        assert srv.url.endswith(f"?token={token}")
+        ctx = browser.new_context()
+        pg = ctx.new_page()
+        errors: list[str] = []
+        pg.on("pageerror", lambda e: errors.append(str(e)))
+        pg.goto(srv.url)
+        pg.wait_for_selector("#conn[data-state=open]", timeout=15000)
+        pg.wait_for_selector("#op-state", timeout=15000)
+        assert pg.evaluate("getComputedStyle(document.querySelector('header')).display") == "flex"
+        ctx.close()
+        assert not errors, errors
+        bare = browser.new_context()
+        p2 = bare.new_page()
+        resp = p2.goto(srv.url.split("?")[0])
+        assert resp.status == 401
+        bare.close()
+    finally:
+        srv.stop()
+
+
+def test_the_page_lists_every_module_for_the_token_import_map():
+    static = ui_browser.SRC / "openmotion" / "remote" / "static"
+    html = (static / "index.html").read_text()
+    listed = set(re.findall(r'"((?:pages/)?\w+)"', html.split("var MODULES = [")[1].split("];")[0]))
+    files = {str(p.relative_to(static / "js"))[:-3] for p in (static / "js").rglob("*.js")}
+    assert listed == files
