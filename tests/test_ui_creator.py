@@ -334,3 +334,40 @@ def test_the_page_lists_every_module_for_the_token_import_map():
     listed = set(re.findall(r'"((?:pages/)?\w+)"', html.split("var MODULES = [")[1].split("];")[0]))
     files = {str(p.relative_to(static / "js"))[:-3] for p in (static / "js").rglob("*.js")}
     assert listed == files
+
+
+def big_program(path, size_bytes: int) -> int:
+    """A spiral of short G1 moves, `size_bytes` long; returns its number of lines."""
+    import math
+
+    lines = ["G21 G90 G17 G54", "G0 X0 Y0 Z0", "F3000"]
+    size, i = 60, 0
+    while size < size_bytes:
+        a, r = i * 0.01, 20 + 15 * math.sin(i * 0.0005)
+        line = f"G1 X{r * math.cos(a):.4f} Y{r * math.sin(a):.4f} Z{(i % 5000) * 0.0002:.4f}"
+        lines.append(line)
+        size += len(line) + 1
+        i += 1
+    lines.append("M30")
+    path.write_text("\n".join(lines) + "\n")
+    return len(lines)
+
+
+def test_a_big_program_stays_responsive(page, server, long_run):
+    """Upload (20 MB with --long, else 1.5 MB): the preview and the listing stay bounded."""
+    size = 20_000_000 if long_run else 1_500_000
+    path = server.workdir / "big.ngc"
+    n = big_program(path, size)
+    goto(page, "program")
+    page.set_input_files("#prog-file", str(path))
+    page.wait_for_selector(f"#prog-loaded:has-text('{n} lines')", timeout=600_000)
+    page.wait_for_function("() => (window.openmotion.programView.data || {n: 0}).n > 1000",
+                           timeout=60_000)
+    kept = page.evaluate("window.openmotion.programView.data.n")
+    assert kept <= 50_000           # what one frame draws is bounded, whatever the file size
+    page.click("#prog-view-3d")
+    page.evaluate("document.querySelector('#prog-listing').scrollTop = 1e9")
+    page.wait_for_selector(f"#prog-listing .ln[data-line='{n}']:has-text('M30')", timeout=20_000)
+    assert page.locator("#prog-listing .ln").count() < 100   # the listing is virtual
+    page.evaluate("document.querySelector('#prog-listing').scrollTop = 0")
+    page.wait_for_selector("#prog-listing .ln[data-line='4']:has-text('G1 X')")
