@@ -52,6 +52,11 @@ export function motionSpecs(info) {
     { name: "vs_dec", label: "SVdec (S range)", unit: `${unit}/s`, min: 0, value: 0,
       check: (v, all) => (v > 0 && Number(all.max_vel) > 0 && 2 * v > Number(all.max_vel) - Number(all.str_vel || 0)
         ? "SVdec must be <= (MaxVel - StrVel) / 2" : "") },
+    // Motion Creator's Speed Range: "Fix" = the highest speed a change on the fly may reach;
+    // "Not fix" = the move's own MaxVel (its velocity in Cont. move) is that limit.
+    { name: "fix_range", label: "Fix speed range", kind: "bool", value: true },
+    { name: "speed_range", label: "Speed range", unit: `${unit}/s`, min: 0, minExclusive: true, max: vmax,
+      value: vmax || 100, disabled: (raw) => !raw.fix_range },
   ];
 }
 

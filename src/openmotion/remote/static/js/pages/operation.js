@@ -204,7 +204,9 @@ async function servo() {
 function motionParams() {
   const m = fsMotion.values();
   if (!m) return null;
-  return compact({ ...m, vs_acc: m.shape === "S" ? m.vs_acc : undefined, vs_dec: m.shape === "S" ? m.vs_dec : undefined });
+  const { fix_range, ...rest } = m;
+  return compact({ ...rest, vs_acc: m.shape === "S" ? m.vs_acc : undefined, vs_dec: m.shape === "S" ? m.vs_dec : undefined,
+    speed_range: fix_range ? m.speed_range : undefined });
 }
 
 async function play(which) {
@@ -228,7 +230,8 @@ async function play(which) {
       p1 = here;
       p2 = here + (which === 2 ? t.distance : -t.distance);
     }
-    return act("axis.repeat", { p1, p2, delay_s: r.delay_s, count: r.count, ...m }, sets);
+    const { speed_range, ...rm } = m;   // eslint-disable-line no-unused-vars (repeat has no speed range)
+    return act("axis.repeat", { p1, p2, delay_s: r.delay_s, count: r.count, ...rm }, sets);
   }
   if (mode === "absolute") return act("axis.move", { kind: "absolute", position: which === 1 ? t.position1 : t.position2, ...m }, sets);
   return act("axis.move", { kind: "relative", distance: which === 2 ? t.distance : -t.distance, ...m }, sets);
@@ -249,6 +252,12 @@ function changeSpeed() {
     if (!t) return;
     const s = app.axisStatus();
     velocity = s && s.velocity < 0 ? -Math.abs(t.velocity) : Math.abs(t.velocity);
+  }
+  const r = fsMotion.values(["fix_range", "speed_range"]);
+  if (r && r.fix_range && Math.abs(velocity) > r.speed_range) {
+    (mode === "velocity" ? fsTarget : fsMotion).showError(mode === "velocity" ? "velocity" : "max_vel",
+      `the new speed must be <= the fixed speed range ${r.speed_range} ${app.axisInfo().unit}/s`);
+    return;
   }
   return act("axis.change_speed", { velocity, tacc: m.tacc }, [mode === "velocity" ? fsTarget : fsMotion, fsMotion]);
 }

@@ -65,7 +65,9 @@ async function poll() {
       view.setMarkers(firings.map((f) => ({ x: f.point[0], y: f.point[1] ?? 0, z: f.point[2] ?? 0 })));
     }
     next = d.next;
-    $("#path-vmax", root).textContent = ` (0 … ${num(d.vmax ?? view.vmax, 3)} ${d.units || ""}/s)`;
+    const first = (Array.isArray(axes) ? axes[0] : String(axes)[0] || "x").toLowerCase();
+    const unit = (Array.isArray(d.units) ? d.units[0] : d.units) || (app.axisInfo(first) || {}).unit;
+    $("#path-vmax", root).textContent = ` (0 … ${num(d.vmax ?? view.vmax, 3)} ${unit || ""}/s)`;
     info.textContent = `${pts.x.length} points · ${firings.length} firings · axes ${Array.isArray(axes) ? axes.join("") : axes}`;
     marker();
   } catch (err) {

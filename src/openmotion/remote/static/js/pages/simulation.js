@@ -50,9 +50,8 @@ function build() {
       el("p", { class: "small muted" }, "The red E-STOP button in the header is the software E-stop (machine.estop); this one is the EMG input of the simulated machine.")),
     panel("Time", fsSpeed.container,
       el("div", { class: "row" }, button("Apply", () => speed(), { id: "sim-speed-apply" }),
-        button("Real time", () => { fsSpeed.set("factor", 1); speed(); }),
-        button("×5", () => { fsSpeed.set("factor", 5); speed(); }),
-        button("×20", () => { fsSpeed.set("factor", 20); speed(); })), cycleBox)));
+        ...[[1, "Real time"], [5, "×5"], [20, "×20"]].map(([f, label]) =>
+          button(label, () => { fsSpeed.set("factor", f); speed(); }, { id: `sim-speed-${f}` }))), cycleBox)));
   update();
 }
 

@@ -1,0 +1,176 @@
+"""Motion Creator in the browser, the rest of commissioning: repeat between two positions,
+changes on the fly, set/reset positions, the homing drawing of the selected mode, the scope
+trigger, tripping limits and alarms, simulation speed, single block and feed override.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import ui_browser
+from test_ui_creator import field, goto, ready_axis
+from ui_browser import status, wait_status
+
+server = ui_browser.server
+browser = ui_browser.browser
+page = ui_browser.page
+
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+
+
+def motion(pg, **values: object) -> None:
+    for name, v in values.items():
+        form = "op-target" if name in ("mode", "position1", "position2", "distance", "velocity") \
+            else "op-repeat" if name in ("delay_s", "count") else "op-motion"
+        f = field(pg, form, name)
+        if name in ("mode", "shape"):
+            f.select_option(str(v))
+        else:
+            f.fill(str(v))
+
+
+def test_repeat_between_two_positions_with_a_delay(page):
+    ready_axis(page, "z")
+    motion(page, mode="absolute", position1=1, position2=3, max_vel=20, tacc=0.05, tdec=0.05,
+           delay_s=0.2, count=0)
+    page.check("#op-repeat [data-name='repeat'] input")
+    page.click("#op-play1")
+    wait_status(page, "s.axes.z.repeat", 5)
+    # it visits both ends, resting at each
+    wait_status(page, "Math.abs(s.axes.z.position - 3) < 1e-6 && !s.axes.z.moving", 10)
+    wait_status(page, "Math.abs(s.axes.z.position - 1) < 1e-6 && !s.axes.z.moving", 10)
+    assert "(repeat)" in page.inner_text("#op-state")
+    page.click("#op-stop")
+    wait_status(page, "!s.axes.z.repeat && !s.axes.z.moving", 5)
+    page.uncheck("#op-repeat [data-name='repeat'] input")
+
+
+def test_change_speed_and_position_on_the_fly_then_stop(page):
+    ready_axis(page, "x")
+    page.click("#op-reset-position")
+    wait_status(page, "s.axes.x.command === 0 && s.axes.x.target === 0", 5)
+    motion(page, mode="velocity", velocity=10, max_vel=50, tacc=0.05)
+    page.click("#op-play2")
+    wait_status(page, "Math.abs(s.axes.x.velocity - 10) < 1e-6", 5)
+    field(page, "op-target", "velocity").fill("25")
+    page.click("#op-vchange")
+    wait_status(page, "Math.abs(s.axes.x.velocity - 25) < 1e-6", 5)
+    page.click("#op-stop")
+    wait_status(page, "!s.axes.x.moving && s.axes.x.velocity === 0", 5)
+    # a positioning move retargeted on the fly ends on the new target
+    here = status(page, "s.axes.x.position")
+    motion(page, mode="absolute", position1=here + 40, position2=here + 15, max_vel=20,
+           tacc=0.05, tdec=0.05)
+    page.click("#op-play1")
+    wait_status(page, "s.axes.x.moving && s.axes.x.velocity > 0", 5)
+    page.click("#op-pchange")
+    wait_status(page, "!s.axes.x.moving", 10)
+    assert abs(status(page, "s.axes.x.position") - (here + 15)) < 1e-6
+    # set and reset the counters
+    field(page, "op-setpos", "position").fill("12.5")
+    page.click("#op-set-position")
+    wait_status(page, "s.axes.x.command === 12500 && s.axes.x.feedback === 12500", 5)
+    page.click("#op-reset-position")
+    wait_status(page, "s.axes.x.command === 0 && s.axes.x.feedback === 0", 5)
+
+
+def test_the_homing_drawing_follows_the_selected_mode(page):
+    ready_axis(page, "y")
+    goto(page, "homing")
+    page.wait_for_selector("#home-drawing")
+    field(page, "home-fields", "mode").select_option("11")
+    page.wait_for_function("() => document.querySelector('#home-seq-note').children.length === 3")
+    note = page.inner_text("#home-seq-note")
+    assert "EZ" in note and "ORG" in note and "home mark" in note
+    arrows = page.locator("#home-drawing line[marker-end]").count()
+    assert arrows == 4          # three phases and the final move to the mark
+    field(page, "home-fields", "mode").select_option("0")
+    page.wait_for_function("() => document.querySelector('#home-seq-note').children.length === 1")
+    # an invalid speed is refused beside its field, nothing saved
+    field(page, "home-fields", "str_vel").fill("1e9")
+    assert "must be <=" in page.inner_text("#home-fields [data-name='str_vel'] .field-error")
+    field(page, "home-fields", "str_vel").fill("5")
+
+
+def test_scope_trigger_captures_a_move(page):
+    ready_axis(page, "x")
+    goto(page, "scope")
+    page.wait_for_selector("#scope-apply")
+    field(page, "scope-trig", "mode").select_option("single")
+    field(page, "scope-trig", "channel").select_option("x.velocity")
+    field(page, "scope-trig", "edge").select_option("rising")
+    field(page, "scope-trig", "level").fill("5")
+    field(page, "scope-trig", "pre_s").fill("0.2")
+    field(page, "scope-cfg", "seconds").fill("2")
+    page.click("#scope-apply")
+    page.wait_for_timeout(500)
+    page.click("#scope-arm")
+    page.wait_for_timeout(300)
+    goto(page, "operation")
+    motion(page, mode="relative", distance=10, max_vel=30, tacc=0.05, tdec=0.05)
+    page.click("#op-play2")
+    wait_status(page, "!s.axes.x.moving", 10)
+    goto(page, "scope")
+    page.wait_for_selector("#scope-info:has-text('triggered at')", timeout=10000)
+    t = page.evaluate("window.openmotion.scopeChart.t")
+    assert t[-1] - t[0] <= 2.0 + 1e-6
+    # back to free run
+    field(page, "scope-trig", "mode").select_option("off")
+    field(page, "scope-cfg", "seconds").fill("30")
+    page.click("#scope-apply")
+    page.wait_for_timeout(500)
+    page.click("#scope-run")
+
+
+def test_simulation_trips_a_limit_and_an_alarm_and_runs_faster(page):
+    ready_axis(page, "y")
+    motion(page, mode="velocity", velocity=10, max_vel=20, tacc=0.05)
+    page.click("#op-play2")
+    wait_status(page, "s.axes.y.velocity > 0", 5)
+    goto(page, "simulation")
+    page.click("#sim-y-pel")
+    wait_status(page, "s.axes.y.io.pel && !s.axes.y.moving && s.axes.y.velocity === 0", 5)
+    assert page.get_attribute("#sim-y-lamp-pel", "data-on") == "true"
+    page.click("#sim-y-pel")
+    wait_status(page, "!s.axes.y.io.pel", 5)
+    page.click("#sim-y-alm")
+    wait_status(page, "s.axes.y.io.alm && s.axes.y.state === 'ErrorStop'", 5)
+    page.click("#sim-y-alm")
+    wait_status(page, "!s.axes.y.io.alm", 5)
+    page.click("#sim-reset")
+    wait_status(page, "s.axes.y.state !== 'ErrorStop'", 5)
+    page.click("#sim-speed-5")
+    wait_status(page, "s.speed === 5", 5)
+    t0 = status(page, "s.time")
+    page.wait_for_timeout(1000)
+    assert status(page, "s.time") - t0 > 2.0     # control time runs faster than the wall
+    page.click("#sim-speed-1")
+    wait_status(page, "s.speed === 1", 5)
+    field(page, "sim-speed", "factor").fill("50")
+    assert "must be <= 20" in page.inner_text("#sim-speed [data-name='factor'] .field-error")
+
+
+PROGRAM = "G21 G90\nG0 X0 Y0\nG1 F600 X5\nG1 Y5\nG1 X0\nG1 Y0\nM30\n"
+
+
+def test_single_block_and_feed_override(page):
+    ready_axis(page)
+    goto(page, "program")
+    page.click("#prog-servo-all")
+    wait_status(page, "Object.values(s.axes).every((a) => a.servo)", 5)
+    page.fill("#prog-text", PROGRAM)
+    page.click("#prog-load-text")
+    page.wait_for_selector("#prog-loaded:has-text('7 lines')", timeout=15000)
+    page.check("#prog-single")
+    page.click("#prog-run-btn")
+    wait_status(page, "s.program.state === 'paused' && s.program.line >= 2", 10)
+    first = status(page, "s.program.line")
+    page.click("#prog-resume")
+    wait_status(page, f"s.program.state === 'paused' && s.program.line > {first}", 10)
+    page.uncheck("#prog-single")
+    wait_status(page, "!s.program.single_block", 5)
+    page.eval_on_selector("#prog-ovr",
+                          "(e) => { e.value = 150; e.dispatchEvent(new Event('input')); }")
+    wait_status(page, "s.program.feed_override === 150", 5)
+    page.click("#prog-resume")
+    wait_status(page, "s.program.state === 'done'", 20)
