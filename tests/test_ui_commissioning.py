@@ -174,3 +174,72 @@ def test_single_block_and_feed_override(page):
     wait_status(page, "s.program.feed_override === 150", 5)
     page.click("#prog-resume")
     wait_status(page, "s.program.state === 'done'", 20)
+
+
+LASER = "G21 G90\nG0 X0 Y0\nM62 P0\nG1 F900 X6\nM63 P0\nG1 Y6\nM62 P0\nG1 X0\nM63 P0\nM30\n"
+
+
+def test_path_marks_the_output_firings_and_keyboard_jog_survives_a_job(page):
+    ready_axis(page)
+    goto(page, "program")
+    page.click("#prog-servo-all")
+    wait_status(page, "Object.values(s.axes).every((a) => a.servo)", 5)
+    page.fill("#prog-text", LASER)
+    page.click("#prog-load-text")
+    page.wait_for_selector("#prog-loaded:has-text('10 lines')", timeout=15000)
+    page.click("#prog-run-btn")
+    wait_status(page, "s.program.state === 'done'", 30)
+    goto(page, "path")
+    page.wait_for_function("() => window.openmotion.pathView.markers.length >= 4", timeout=10000)
+    assert "firings" in page.inner_text("#path-info")
+    # keyboard jog still works after the job (a known complaint against other senders)
+    goto(page, "operation")
+    if not page.is_checked("#op-keyboard"):
+        page.check("#op-keyboard")
+    page.locator("#op-chart").click()
+    page.keyboard.down("ArrowRight")
+    wait_status(page, "s.axes.x.velocity > 0", 5)
+    page.keyboard.up("ArrowRight")
+    wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
+
+
+def test_a_second_tab_is_told_to_reload_and_sees_the_scope_history(page, browser, server):
+    other = browser.new_context().new_page()
+    other.goto(server.url + "#interface")
+    other.wait_for_selector("#conn[data-state=open]")
+    other.wait_for_selector("#if-save")
+    # this tab changes a setting: the other one is told, and its own change is refused
+    goto(page, "interface")
+    page.wait_for_selector("#if-save")
+    width = field(page, "if-pulse", "pulse_width_us")
+    width.fill("3" if width.input_value() != "3" else "4")
+    page.click("#if-save")
+    page.wait_for_selector("#if-saved:has-text('applied'), #if-saved:has-text('saved to')")
+    other.wait_for_selector("#reload-banner:not([hidden])", timeout=5000)
+    w2 = field(other, "if-pulse", "pulse_width_us")
+    w2.fill("9")
+    other.click("#if-save")
+    other.wait_for_selector("#if-error:has-text('reload')", timeout=5000)
+    other.click("#reload-config")
+    other.wait_for_selector("#reload-banner[hidden]", state="attached")
+    other.wait_for_timeout(500)
+    field(other, "if-pulse", "pulse_width_us").fill("9")
+    other.click("#if-save")
+    other.wait_for_selector("#if-saved:has-text('applied'), #if-saved:has-text('saved to')",
+                            timeout=5000)
+    # now the first tab is the stale one: it reloads, then its commands go through
+    page.wait_for_selector("#reload-banner:not([hidden])", timeout=5000)
+    page.click("#reload-config")
+    # the scope history lives on the server: the other tab draws the same samples
+    ready_axis(page)
+    field(page, "op-target", "mode").select_option("relative")
+    field(page, "op-target", "distance").fill("5")
+    page.click("#op-play2")
+    wait_status(page, "s.axes.x.moving", 5)
+    wait_status(page, "!s.axes.x.moving", 10)
+    goto(other, "scope")
+    other.wait_for_function("() => (window.openmotion.scopeChart || {t: []}).t.length > 1000",
+                            timeout=10000)
+    t_other = other.evaluate("window.openmotion.scopeChart.t[0]")
+    assert t_other < status(page, "s.time") - 1.0   # history from before the tab opened it
+    other.context.close()
