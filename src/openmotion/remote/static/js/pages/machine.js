@@ -44,7 +44,7 @@ function build() {
         el("span", { class: "muted" }, `control period ${num(info.period_s * 1000, 3)} ms`), el("span", { class: "muted" }, info.simulated ? "simulated" : "hardware"),
         el("span", { class: "muted", id: "machine-config-version" }, `configuration v${info.config_version}`)),
       axes),
-    panel("Machine file", fsFile.container,
+    el("div", { class: "panel wide" }, el("h3", {}, "Machine file"), fsFile.container,
       el("div", { class: "row" },
         button("Save", () => save(result), { id: "machine-save", class: "primary", title: "write the machine file (to the path given: save as)" }),
         button("Load", () => load(result), { id: "machine-load", title: "load this machine file (every axis at rest)" }),

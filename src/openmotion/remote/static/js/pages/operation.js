@@ -140,7 +140,11 @@ function build() {
 
   // velocity curve
   const chartBox = el("div", { class: "chart", id: "op-chart" });
-  const curvePanel = el("div", { class: "panel wide" }, el("h3", {}, "Velocity curve"), chartBox);
+  const curvePanel = el("div", { class: "panel wide" },
+    el("div", { class: "row" }, el("h3", { style: "margin:0" }, "Velocity curve"), el("span", { class: "spacer" }),
+      button("Clear", () => chart && chart.clear(), { id: "op-chart-clear" }),
+      el("a", { href: "#scope", class: "small" }, "Scope: every cycle, trigger, CSV →")),
+    chartBox);
 
   root.append(el("div", { class: "grid" }, posPanel, ioPanel, jogPanel), el("div", { class: "grid", style: "margin-top:12px" }, movePanel, curvePanel));
   chart = new LiveChart(chartBox, { channels: [

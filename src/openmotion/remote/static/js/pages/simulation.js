@@ -37,7 +37,7 @@ function build() {
     table.append(el("tr", {}, el("td", {}, el("b", {}, ax.name)), el("td", {}, sw), el("td", {}, alm), el("td", {}, lamps.node)));
   }
   fsSpeed = new FieldSet(el("div", { id: "sim-speed" }), [
-    { name: "factor", label: "Simulation speed", unit: "× real time", min: 1, max: 20, value: 1 },
+    { name: "factor", label: "Speed (× real time)", min: 1, max: 20, value: 1 },
   ]);
   estopBox = el("div", { id: "sim-estop-state" });
   cycleBox = el("div", { class: "small muted", id: "sim-cycle" });
