@@ -243,3 +243,32 @@ def test_a_second_tab_is_told_to_reload_and_sees_the_scope_history(page, browser
     t_other = other.evaluate("window.openmotion.scopeChart.t[0]")
     assert t_other < status(page, "s.time") - 1.0   # history from before the tab opened it
     other.context.close()
+
+
+def test_a_jog_stops_when_the_connection_drops(page):
+    ready_axis(page)
+    plus = page.locator("#op-jog-plus").bounding_box()
+    page.mouse.move(plus["x"] + plus["width"] / 2, plus["y"] + plus["height"] / 2)
+    page.mouse.down()
+    wait_status(page, "s.axes.x.velocity > 0", 5)
+    page.evaluate("window.openmotion.rpc.ws.close()")      # the button is still held
+    page.wait_for_selector("#conn[data-state=open]", timeout=10000)
+    wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 5)
+    page.wait_for_timeout(300)
+    assert status(page, "s.axes.x.velocity") == 0            # and it does not start again
+    page.mouse.up()
+
+
+def test_scope_pause_freezes_the_recording_and_run_resumes_it(page):
+    goto(page, "scope")
+    page.wait_for_function("() => (window.openmotion.scopeChart || {t: []}).t.length > 10",
+                           timeout=10000)
+    page.click("#scope-pause")
+    page.wait_for_selector("#log:has-text('paused')")
+    page.wait_for_timeout(300)
+    n = page.evaluate("window.openmotion.scopeChart.t.length")
+    page.wait_for_timeout(800)
+    assert page.evaluate("window.openmotion.scopeChart.t.length") == n
+    page.click("#scope-run")
+    page.wait_for_selector("#log:has-text('running')")
+    page.wait_for_function(f"() => window.openmotion.scopeChart.t.length > {n}", timeout=5000)

@@ -93,6 +93,12 @@ function showStatus() {
   const s = app.axisStatus(axis);
   if (!s) return;
   const h = s.homing || {};
+  // the phase running now is drawn thicker, in orange
+  for (const line of drawing.querySelectorAll("line.phase")) {
+    const on = h.state === "running" && line.getAttribute("data-phase") === h.phase;
+    line.setAttribute("stroke", on ? "#ff7f0e" : "#1f5fbf");
+    line.setAttribute("stroke-width", on ? "4" : "2");
+  }
   status.replaceChildren(
     el("div", {}, "Homing: ", el("span", { class: "state", "data-state": h.state || "idle", id: "home-state" }, h.state || "idle"),
       h.phase ? ` · ${h.phase}` : "", h.reason ? ` · ${h.reason}` : ""),
@@ -225,7 +231,7 @@ function draw(seq, homeDir) {
     const stopAfter = p.reaction === "stop" || p.reaction === "el";
     const end = stopAfter ? target + step * 2.5 : target;
     drawing.append(svg("line", { x1: X(u), y1: y, x2: X(end), y2: y, stroke: "#1f5fbf", "stroke-width": 2, "marker-end": "url(#arr)",
-      "stroke-dasharray": p.speed && loaded && p.speed < loaded.max_vel * 0.5 ? "5,3" : "" }));
+      "stroke-dasharray": p.speed && loaded && p.speed < loaded.max_vel * 0.5 ? "5,3" : "", "data-phase": p.phase, class: "phase" }));
     drawing.append(svg("text", { x: Math.min(X(u), X(end)), y: y - 5, "font-size": 11 },
       `${row + 1}. ${p.phase} (${p.reaction})`));
     if (p.mark) {
