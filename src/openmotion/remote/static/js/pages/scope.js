@@ -54,25 +54,35 @@ function unitOf(name) {
 function build() {
   built = true;
   const chosen = new Set(cfg.channels);
-  // channel picker grouped by axis
+  // channel picker: one row per axis, one column per quantity
   picks = new Map();
   const groups = new Map();
+  const quantities = [];
   for (const c of all) {
-    const g = c.name.includes(".") ? c.name.split(".")[0] : "";
-    if (!groups.has(g)) groups.set(g, []);
-    groups.get(g).push(c);
+    const dot = c.name.indexOf(".");
+    const g = dot > 0 ? c.name.slice(0, dot) : "";
+    const q = dot > 0 ? c.name.slice(dot + 1) : c.name;
+    if (!groups.has(g)) groups.set(g, new Map());
+    groups.get(g).set(q, c);
+    if (!quantities.includes(q)) quantities.push(q);
   }
-  const pickBox = el("div", { id: "scope-picks" });
-  for (const [g, list] of groups) {
-    const row = el("div", { class: "chans" }, el("b", {}, g || "-"));
-    for (const c of list) {
-      const box = el("input", { type: "checkbox", value: c.name });
+  const short = (q) => q.replace(/^io\./, "").replace("command", "cmd").replace("feedback", "fb")
+    .replace("velocity", "vel").replace("acceleration", "acc").replace("error", "err");
+  const table = el("table", { class: "kv picks" },
+    el("tr", {}, el("th", {}, ""), ...quantities.map((q) => el("th", { title: q }, short(q)))));
+  for (const [g, byQ] of groups) {
+    const row = el("tr", {}, el("th", {}, g || "-"));
+    for (const q of quantities) {
+      const c = byQ.get(q);
+      if (!c) { row.append(el("td", {})); continue; }
+      const box = el("input", { type: "checkbox", value: c.name, title: `${c.name}${c.unit ? ` (${c.unit})` : ""}` });
       box.checked = chosen.has(c.name);
       picks.set(c.name, box);
-      row.append(el("label", {}, box, c.name.slice(g ? g.length + 1 : 0)));
+      row.append(el("td", {}, box));
     }
-    pickBox.append(row);
+    table.append(row);
   }
+  const pickBox = el("div", { id: "scope-picks", style: "overflow-x:auto" }, table);
   const pickErr = el("div", { class: "form-error", id: "scope-pick-error" });
   const trig = cfg.trigger || {};
   fsCfg = new FieldSet(el("div", { id: "scope-cfg" }), [
@@ -109,7 +119,7 @@ function build() {
       box,
       el("div", { class: "small muted" }, "Drag across the chart to zoom; double click to follow live again. Click a legend entry to hide a channel.")),
     el("div", { class: "grid", style: "margin-top:12px" },
-      panel("Channels (1 to 16)", pickBox, pickErr),
+      el("div", { class: "panel wide" }, el("h3", {}, "Channels (1 to 16)"), pickBox, pickErr),
       panel("Recording", fsCfg.container),
       panel("Trigger", fsTrig.container,
         el("div", { class: "row" }, button("Apply (clears the history)", () => configure(pickErr), { id: "scope-apply", class: "primary" })))));
