@@ -272,3 +272,43 @@ def test_scope_pause_freezes_the_recording_and_run_resumes_it(page):
     page.click("#scope-run")
     page.wait_for_selector("#log:has-text('running')")
     page.wait_for_function(f"() => window.openmotion.scopeChart.t.length > {n}", timeout=5000)
+
+
+def test_the_page_logic_in_the_browser(page):
+    """The pure parts of the front end: field rules, error placement, decimation, diffs."""
+    out = page.evaluate("""async () => {
+        const f = await import('/static/js/fields.js');
+        const v = await import('/static/js/view3d.js');
+        const a = await import('/static/js/app.js');
+        const spec = {name: 'max_vel', label: 'MaxVel', unit: 'mm/s', min: 0, minExclusive: true,
+                      max: 500};
+        const xs = [], ys = [], zs = [];
+        for (let i = 0; i <= 1000; i++) { xs.push(i * 0.001); ys.push(0); zs.push(0); }
+        const idx = v.decimate(xs, ys, zs, 0.01, null);
+        const snap = {axes: {x: {command: 1, io: {inp: true, org: false}}}, estop: false};
+        a.mergeDiff(snap, {axes: {x: {io: {inp: false}, fault: null}}, estop: true});
+        return {
+            ok: f.parseField(spec, '12.5'), zero: f.parseField(spec, '0'),
+            big: f.parseField(spec, '501'), text: f.parseField(spec, '1,5'),
+            exp: f.parseField(spec, '1e2'), empty: f.parseField(spec, ''),
+            int: f.parseField({name: 'n', label: 'N', kind: 'int'}, '2.5'),
+            param: f.findParam({data: {param: 'changes.logic.pel'}}, ['logic.pel', 'pel']),
+            msg: f.findParam({message: 'str_vel must be <= max_vel'}, ['max_vel', 'str_vel']),
+            none: f.findParam({message: 'axis z: disabled'}, ['max_vel']),
+            idx: [idx.length, idx[0], idx[idx.length - 1]], snap,
+        };
+    }""")
+    assert out["ok"] == [12.5, ""]
+    assert out["zero"][1] == "MaxVel must be > 0 mm/s"
+    assert out["big"][1] == "MaxVel must be <= 500 mm/s"
+    assert out["text"][1] == "MaxVel must be a number"
+    assert out["exp"] == [100, ""]
+    assert out["empty"][1] == "MaxVel is required"
+    assert out["int"][1] == "N must be a whole number"
+    assert out["param"] == "logic.pel"
+    assert out["msg"] == "str_vel"
+    assert out["none"] is None
+    n, first, last = out["idx"]
+    assert first == 0 and last == 1000 and 95 <= n <= 110     # one point per 0.01 of 1.0
+    assert out["snap"] == {"axes": {"x": {"command": 1, "io": {"inp": False, "org": False},
+                                          "fault": None}}, "estop": True}
