@@ -106,3 +106,16 @@ def test_large_program_preview_is_decimated():
         # machine coordinates: program zero sits mid-travel (x 150 mm), as `openmotion run`
         assert prev["bounds"]["max"][0] == pytest.approx(150.0 + 19.5)
         assert time.process_time() - t0 < 120
+
+
+def test_the_commissioning_example_runs_against_a_server():
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "remote_commission.py"
+    spec = importlib.util.spec_from_file_location("remote_commission", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    with served() as (_svc, th):
+        out = mod.commission(th.ws_url, None)
+    assert out["position"] == pytest.approx(20.0)
+    assert out["peak_velocity"] == pytest.approx(40.0, rel=1e-6)

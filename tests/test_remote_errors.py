@@ -148,6 +148,10 @@ def test_token_gates_http_and_websocket():
             client(th, token="wrong-token-0123456789")
         with client(th, token=token) as c:
             assert c.call("server.info")["api"] == 1
+        from openmotion.remote import connect
+
+        with connect(th.ws_url + f"?token={token}") as c:   # as the browser gives it
+            assert c.call("server.info")["api"] == 1
 
 
 def test_host_needs_a_token():
@@ -160,3 +164,15 @@ def test_host_needs_a_token():
         check_bind("0.0.0.0", "short")
     check_bind("0.0.0.0", "x" * 16)
     check_bind("127.0.0.1", None)
+
+
+def test_a_frame_past_the_hard_limit_closes_that_connection_only(server):
+    from openmotion.remote.server import WS_HARD_LIMIT
+
+    th = server[1]
+    with client(th) as bad, client(th) as good:
+        with pytest.raises(Exception):  # noqa: B017 - closed by the WebSocket layer (1009)
+            bad.raw("x" * (WS_HARD_LIMIT + 10), timeout=20)
+        assert good.call("server.info")["api"] == 1
+    with client(th) as again:
+        assert again.call("server.info")["api"] == 1

@@ -111,3 +111,19 @@ def test_merging_the_diff_gives_the_new_snapshot(old, new):
     assert merged == new
     assert diff(new, new) == {}
     assert all(k in new for k in diff(old, new))
+
+
+@pytest.mark.parametrize("text, param", [
+    ("max_vel on axis x must be in (0, 500] mm/s (maximum safe speed), got 900", "max_vel"),
+    ("axes.x.pulse_mode must be one of out_dir, cw_ccw; got 'bogus'", "axes.x.pulse_mode"),
+    ("changes.colour: unknown key; valid keys: mode", "changes.colour"),
+    ("axes.x.drive.pitch_error[2] must be a finite number", "axes.x.drive.pitch_error[2]"),
+    ("axis 'w' is unknown; axes: x, y", None),
+    ("E-stop is active: release it before resetting the axes", None),
+])
+def test_refusals_name_the_parameter_for_the_field(text, param):
+    from openmotion.errors import MotionError
+    from openmotion.remote.protocol import REFUSED, refused
+
+    err = refused(MotionError(text))
+    assert err.code == REFUSED and err.data == {"type": "MotionError", "param": param}

@@ -47,6 +47,7 @@ def test_move_changes_counters_and_lamps(machine):
     m.call("axis.stop", axis="y")
     assert m.wait(at_rest("y"), WAIT)
     assert svc.ctl.axis("y").velocity == 0.0
+    assert len(m.status["board"]["do"]) == 16 and not any(m.status["board"]["do"])
 
 
 def test_repeat_between_two_positions_then_stop(machine):
@@ -70,9 +71,9 @@ def test_set_and_reset_positions(machine):
 
 def test_jog_and_release_stops(machine):
     svc, m = machine
-    with m.jog("x", +1, speed=20.0) as jog_id:
+    with m.jog("x", +1, speed=20.0, confirm_s=0.02) as jog_id:
         assert m.wait(lambda s: s["axes"]["x"]["jog"] == jog_id, WAIT)
-        time.sleep(0.4)   # longer than the deadman: the confirmations keep it going
+        time.sleep(0.3)   # longer than the deadman: the confirmations keep it going
         assert svc.ctl.axis("x").state.value == "ContinuousMotion"
     assert m.wait(at_rest("x"), WAIT)
     assert m.call("jog.confirm", jog=jog_id) == {"active": False, "reason": "released"}
@@ -157,12 +158,13 @@ def test_program_pause_resume_abort_and_override(machine):
     svc, m = machine
     for ax in ("z", "u"):
         m.call("axis.servo", axis=ax, on=True)
-    m.call("program.load", text="G21 G90\nG1 X20 F300\nM0\nG1 X0\nM2\n")
+    m.call("program.load", text="G21 G90\nM64 P3\nG1 X20 F300\nM0\nG1 X0\nM2\n")
     m.call("program.run", feed_override=50.0)
     assert m.wait(lambda s: s["program"]["state"] == "running", WAIT)
     m.call("program.feed_override", percent=150.0)
     assert m.wait(lambda s: s["program"]["state"] == "paused", 60)   # M0
-    assert m.status["program"]["line"] == 3
+    assert m.status["program"]["line"] == 4
+    assert m.wait(lambda s: s["board"]["do"][3], WAIT)               # M64 P3
     m.call("program.resume")
     assert m.wait(lambda s: s["program"]["state"] == "running", WAIT)
     m.call("program.abort")
@@ -194,6 +196,9 @@ def test_estop_stops_everything(machine):
     m.call("machine.estop")
     assert m.wait(lambda s: s["axes"]["x"]["state"] == "ErrorStop", WAIT)
     assert any(e["kind"] == "estop" for e in m.call("machine.events")["events"])
+    # the events were pushed too (notify_event), as they happened
+    assert m.wait(lambda s: any(e["kind"] == "estop" and e["axis"] == "x" for e in m.events),
+                  WAIT)
 
 
 def test_tripped_limit_stops_the_axis(machine):
@@ -208,6 +213,10 @@ def test_tripped_limit_stops_the_axis(machine):
     m.call("sim.alarm", axis="y", active=True)
     assert m.wait(lambda s: s["axes"]["y"]["io"]["alm"], WAIT)
     m.call("sim.alarm", axis="y", active=False)
+    m.call("sim.input", index=2, level=True)
+    assert m.wait(lambda s: s["board"]["di"][2], WAIT)
+    with pytest.raises(RemoteError, match="index must be in"):
+        m.call("sim.input", index=99, level=True)
     assert m.call("sim.speed", factor=4)["speed"] == 4.0
     assert svc.running
 
@@ -234,6 +243,18 @@ def test_scope_records_on_the_server_with_trigger_and_csv(machine):
     with client(m.server) as other:
         again = other.call("scope.data", since=-1, max_points=100000)
     assert again["t"][:len(data["t"])] == data["t"]
+    # live pushes: only new samples, numbered on from the history
+    sub = m.call("scope.subscribe", rate_hz=20)
+    m.call("scope.configure", channels=["x.command"], seconds=2.0)
+    assert m.wait(lambda s: len(m.scope_pushes) >= 3, WAIT)
+    pushes = [p for p in list(m.scope_pushes) if p["scope_version"] == svc.scope.version]
+    assert all(a["next"] == b["start"] for a, b in zip(pushes, pushes[1:], strict=False))
+    m.call("unsubscribe", subscription=sub["subscription"])
+    with pytest.raises(RemoteError, match="unknown"):
+        m.call("unsubscribe", subscription=sub["subscription"])
+    m.call("scope.configure", channels=chans, seconds=5.0)
+    m.call("axis.move", axis="x", kind="relative", distance=1.0, max_vel=20.0, tacc=0.05)
+    assert m.wait(lambda s: s["axes"]["x"]["command"] == 6000 and at_rest("x")(s), WAIT)
     csv = m.call("scope.csv")["csv"].splitlines()
     assert csv[0] == "t," + ",".join(chans) and len(csv) > 10
     with pytest.raises(RemoteError, match="quantity"):

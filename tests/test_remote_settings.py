@@ -127,3 +127,19 @@ def test_two_clients_commands_are_serialised():
         a.subscribe(rate_hz=20)
         assert a.wait(lambda s: s["axes"]["x"]["command"] == 5000 and at_rest("x")(s), WAIT)
         assert a.call("server.info")["clients"] == 2
+
+
+def test_stops_do_not_wait_behind_a_long_command():
+    with served() as (svc, th), client(th) as m:
+        m.call("axis.servo", axis="x", on=True)
+        m.call("axis.move", axis="x", kind="velocity", velocity=10.0)
+        release = threading.Event()
+        th.server._commands.submit(release.wait, 30)   # a command that takes its time
+        try:
+            m.call("machine.estop", timeout=10)          # answered while it still runs
+            assert svc.ctl.axis("x").state.value == "ErrorStop"
+            m.call("axis.stop", timeout=10)
+            with pytest.raises(Exception, match="no answer"):
+                m.call("axis.reset", axis="x", timeout=0.5)   # a command: it waits
+        finally:
+            release.set()

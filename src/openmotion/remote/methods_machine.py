@@ -44,7 +44,8 @@ def server_info(ctx: Context, p: Params) -> dict[str, Any]:
     return {"name": "openmotion", "version": __version__, "api": API_VERSION,
             "period_s": svc.ctl.period, "speed": svc.speed, "realtime": svc.running,
             "clients": clients, "max_message_bytes": MAX_MESSAGE_BYTES,
-            "deadman_ms": int(DEADMAN_S * 1e3), "confirm_ms": CONFIRM_MS}
+            "deadman_ms": int(DEADMAN_S * 1e3), "confirm_ms": CONFIRM_MS,
+            "hook_errors": list(svc.hook_errors)[-10:]}
 
 
 def axis_info(ax: Any) -> dict[str, Any]:
@@ -106,7 +107,7 @@ def machine_load(ctx: Context, p: Params) -> dict[str, Any]:
     return machine_info(ctx)
 
 
-@method("machine.estop")
+@method("machine.estop", command=False)  # a stop never waits behind commands
 def machine_estop(ctx: Context, p: Params) -> dict[str, Any]:
     reason = p.string("reason", "emergency stop", max_len=200)
     p.done()

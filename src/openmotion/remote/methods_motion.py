@@ -164,7 +164,7 @@ def axis_change_position(ctx: Context, p: Params) -> dict[str, Any]:
     return {}
 
 
-@method("axis.stop")
+@method("axis.stop", command=False)  # a stop never waits behind commands
 def axis_stop(ctx: Context, p: Params) -> dict[str, Any]:
     axis = p.axis("axis", None)
     mode = p.choice("mode", ("decel", "immediate"), "decel")
@@ -326,7 +326,7 @@ def sim_alarm(ctx: Context, p: Params) -> dict[str, Any]:
     return {}
 
 
-@method("sim.estop")
+@method("sim.estop", command=False)  # a stop never waits behind commands
 def sim_estop(ctx: Context, p: Params) -> dict[str, Any]:
     pressed = p.boolean("pressed")
     p.done()
@@ -340,6 +340,21 @@ def sim_estop(ctx: Context, p: Params) -> dict[str, Any]:
             sc.press_estop()
         else:
             sc.release_estop()
+    return {}
+
+
+@method("sim.input")
+def sim_input(ctx: Context, p: Params) -> dict[str, Any]:
+    index = p.integer("index", lo=0)
+    level = p.boolean("level")
+    p.done()
+    n = ctx.svc.config.digital_inputs
+    if index >= n:
+        raise MotionError(f"index must be in [0, {n - 1}] (the machine's digital inputs), "
+                          f"got {index}")
+    sc = _scenario(ctx)
+    with ctx.svc.ctl.lock:
+        sc.set_input(f"di{index}", level)
     return {}
 
 

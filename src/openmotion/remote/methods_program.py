@@ -53,19 +53,19 @@ def program_run(ctx: Context, p: Params) -> dict[str, Any]:
     return {}
 
 
-def _simple(name: str, action: str) -> None:
+def _simple(name: str, action: str, urgent: bool = False) -> None:
     def handler(ctx: Context, p: Params) -> dict[str, Any]:
         p.done()
         with ctx.svc.ctl.lock:
             getattr(ctx.svc.program, action)()
         return {}
     handler.__name__ = f"program_{action}"
-    method(name)(handler)
+    method(name, command=not urgent)(handler)
 
 
-_simple("program.pause", "pause")
+_simple("program.pause", "pause", urgent=True)   # stops never wait behind commands
 _simple("program.resume", "resume")
-_simple("program.abort", "abort")
+_simple("program.abort", "abort", urgent=True)
 
 
 @method("program.single_block")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -69,8 +70,16 @@ def notification(method: str, params: list[Any] | dict[str, Any]) -> dict[str, A
 
 
 def dumps(obj: Any) -> str:
-    """JSON text with non-finite floats sent as null (JSON has no NaN / Infinity)."""
-    return json.dumps(_finite(obj), separators=(",", ":"), allow_nan=False)
+    """JSON text with non-finite floats sent as null (JSON has no NaN / Infinity) and numpy
+    scalars as plain numbers."""
+    return json.dumps(_finite(obj), separators=(",", ":"), allow_nan=False, default=_scalar)
+
+
+def _scalar(obj: Any) -> Any:
+    item = getattr(obj, "item", None)   # numpy scalars
+    if callable(item) and getattr(obj, "shape", None) == ():
+        return _finite(item())
+    raise TypeError(f"{type(obj).__name__} is not JSON serialisable")
 
 
 def _finite(obj: Any) -> Any:
@@ -129,9 +138,18 @@ def _request(obj: Any) -> Request | RpcError:
     return Request(method, params, None if notify else rid, notify)
 
 
+#: the parameter a library message starts with: "max_vel on axis x must ...",
+#: "axes.x.pulse_mode must ...", "changes.colour: unknown key", "trigger.channel must ..."
+_PARAM = re.compile(r"^([A-Za-z_][\w]*(?:\.[\w]+|\[\d+\])*)(?=(?: on axis \w+)? must |: )")
+
+
 def refused(exc: MotionError) -> RpcError:
-    """A MotionError from the controller as a -32000 Refused error."""
-    return RpcError(REFUSED, str(exc), {"type": type(exc).__name__})
+    """A MotionError from the controller as a -32000 Refused error; `data.param` is the
+    parameter (or field path) its message names first, when it names one."""
+    text = str(exc)
+    m = _PARAM.match(text)
+    return RpcError(REFUSED, text, {"type": type(exc).__name__,
+                                    "param": m.group(1) if m else None})
 
 
 _MISSING = object()

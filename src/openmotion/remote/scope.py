@@ -35,6 +35,7 @@ LAMPS = ("alm", "pel", "mel", "org", "ez", "inp", "sd", "rdy", "erc", "emg", "lt
 TRIGGER_MODES = ("none", "level", "rising", "falling")
 MAX_CHANNELS = 16
 MAX_SAMPLES = 600_000
+FLUSH_ROWS = 64
 DEFAULT_QUANTITIES = ("command", "velocity", "acceleration", "error")
 
 
@@ -123,6 +124,8 @@ class Scope:
             self._t = np.zeros(cap)
             self._buf = np.zeros((cap, len(channels)))
             self.n = 0
+            self._pend_t: list[float] = []
+            self._pend: list[list[float]] = []
             self._tick = 0
             self.running = True
             self.version += 1
@@ -166,6 +169,7 @@ class Scope:
     def arm(self) -> None:
         with self.ctl.lock, self._lock:
             self.n = 0
+            self._pend_t, self._pend = [], []
             self.running = True
             self.version += 1
             self._arm_state()
@@ -185,10 +189,13 @@ class Scope:
         self._tick = 0
         row = [g() for g in self._getters]
         with self._lock:
-            i = self.n % self.cap
-            self._t[i] = t
-            self._buf[i] = row
+            # rows wait in a list and reach the ring in blocks: one numpy write per
+            # FLUSH_ROWS samples instead of one per cycle (a row write costs microseconds)
+            self._pend_t.append(t)
+            self._pend.append(row)
             self.n += 1
+            if len(self._pend) >= min(FLUSH_ROWS, self.cap):
+                self._flush()
             if self._trig_col >= 0:
                 self._check_trigger(row[self._trig_col], t)
 
@@ -242,8 +249,19 @@ class Scope:
             cols[name] = col
         return cols
 
+    def _flush(self) -> None:
+        """Move the waiting rows into the ring (lock held)."""
+        k = len(self._pend)
+        if not k:
+            return
+        idx = np.arange(self.n - k, self.n) % self.cap
+        self._t[idx] = self._pend_t
+        self._buf[idx] = self._pend
+        self._pend_t, self._pend = [], []
+
     def _slice(self, since: int) -> tuple[int, int, np.ndarray, np.ndarray, np.ndarray | None]:
         """Samples [start, n) in time order (copies), and the row before start."""
+        self._flush()
         first = self._first()
         start = first if since < 0 else min(max(since, first), self.n)
         idx = np.arange(start, self.n) % self.cap

@@ -76,11 +76,13 @@ class Connection:
         self.closed = False
 
     async def send(self, obj: Any) -> None:
+        """Send a message (an object, or JSON text already serialised)."""
         if self.closed:
             return
+        text = obj if isinstance(obj, str) else dumps(obj)
         async with self._send_lock:
             try:
-                await self.ws.send_text(dumps(obj))
+                await self.ws.send_text(text)
             except Exception:  # the client went away: the reader loop ends the connection
                 self.closed = True
 
@@ -227,11 +229,11 @@ class RemoteServer:
             return svc.program.load(text, name)
 
         req = Request("program.load", {}, 0, False)
-        res = await asyncio.get_running_loop().run_in_executor(
-            self._commands, self._run, load, Context(svc), req, time.monotonic())
+        res = json.loads(await asyncio.get_running_loop().run_in_executor(
+            self._commands, self._run, load, Context(svc), req, time.monotonic()))
         if "error" in res:
             return JSONResponse({"error": res["error"]}, 400)
-        return JSONResponse(json.loads(dumps(res["result"])))
+        return JSONResponse(res["result"])
 
     # -- WebSocket ------------------------------------------------------------------------
     async def _ws(self, ws: WebSocket) -> None:
@@ -269,24 +271,25 @@ class RemoteServer:
         try:
             reqs, batch = parse_frame(frame)
         except RpcError as err:
-            return error_response(None, err)
-        out = []
+            return dumps(error_response(None, err))
+        out: list[str] = []
         for r in reqs:
             if isinstance(r, RpcError):
-                out.append(error_response(r.req_id, r))
+                out.append(dumps(error_response(r.req_id, r)))
                 continue
             res = await self._call(ctx, r)
             if not r.notify:
                 out.append(res)
         if not out:
             return None
-        return out if batch else out[0]
+        return "[" + ",".join(out) + "]" if batch else out[0]
 
-    async def _call(self, ctx: Context, req: Request) -> dict[str, Any]:
+    async def _call(self, ctx: Context, req: Request) -> str:
+        """The JSON text of the response to one request."""
         m = self.methods.get(req.method)
         if m is None:
-            return error_response(req.id, RpcError(
-                METHOD_NOT_FOUND, f"method {req.method!r} is unknown", {"method": req.method}))
+            return dumps(error_response(req.id, RpcError(
+                METHOD_NOT_FOUND, f"method {req.method!r} is unknown", {"method": req.method})))
         if m.command:
             queued = time.monotonic()
             fut = asyncio.get_running_loop().run_in_executor(
@@ -296,23 +299,23 @@ class RemoteServer:
                 None, self._run, m.fn, ctx, req, None)
         return await fut
 
-    def _run(self, fn: Any, ctx: Context, req: Request, queued: float | None
-             ) -> dict[str, Any]:
+    def _run(self, fn: Any, ctx: Context, req: Request, queued: float | None) -> str:
+        """Run a handler (on a worker thread) and serialise its answer there too."""
         try:
             if queued is not None:
                 if time.monotonic() - queued > BUSY_S:
                     raise RpcError(BUSY, f"the command waited more than {BUSY_S:g} s for "
                                    "the commands before it; try again")
                 self.svc.check_version(req.params.get("config_version"))
-            return response(req.id, fn(ctx, Params(req.params)))
+            return dumps(response(req.id, fn(ctx, Params(req.params))))
         except RpcError as err:
-            return error_response(req.id, err)
+            return dumps(error_response(req.id, err))
         except MotionError as exc:
-            return error_response(req.id, refused(exc))
+            return dumps(error_response(req.id, refused(exc)))
         except Exception as exc:  # a server bug: answered, logged, the server goes on
             log.error("method %s failed:\n%s", req.method, traceback.format_exc())
-            return error_response(req.id, RpcError(
-                INTERNAL_ERROR, f"internal error in {req.method}: {type(exc).__name__}: {exc}"))
+            return dumps(error_response(req.id, RpcError(
+                INTERNAL_ERROR, f"internal error in {req.method}: {type(exc).__name__}: {exc}")))
 
     def close(self) -> None:
         self.svc.remove_listener(self._on_service)
@@ -383,7 +386,8 @@ class ServerThread:
         check_bind(host, server.token)
         self.server = server
         cfg = uvicorn.Config(server.app, host=host, port=port, ws_max_size=WS_HARD_LIMIT,
-                             log_level="warning", lifespan="off", ws_ping_interval=None)
+                             log_level="warning", lifespan="off", ws_ping_interval=None,
+                             timeout_graceful_shutdown=2)
         self._uv = uvicorn.Server(cfg)
         self._thread = threading.Thread(target=self._uv.run, name="om-uvicorn", daemon=True)
         self.host = host

@@ -64,7 +64,7 @@ class MachineService:
         self.speed = _check_speed(speed)
         self._listeners: list[Listener] = []
         self.events: deque[dict[str, Any]] = deque(maxlen=EVENT_KEEP)
-        self.hook_errors: list[str] = []
+        self.hook_errors: deque[str] = deque(maxlen=100)   # failures in the cycle hook
         side = load_sidecar(sidecar_path(self.file)) if self.file else \
             {"interface": {}, "home": {}}
         self.responses = {a.name: check_responses(
@@ -118,19 +118,25 @@ class MachineService:
                 self.hook_errors.append(f"{name}: {type(exc).__name__}: {exc}")
 
     def _on_compare(self, ev: Any) -> None:
-        axis = getattr(ev, "axis", None)
-        if isinstance(axis, int) and 0 <= axis < len(self._cmp_time):
-            self._cmp_time[axis] = self.ctl.time
+        """Inside the cycle (comparator callback): never raises."""
+        with contextlib.suppress(Exception):
+            axis = getattr(ev, "axis", None)
+            if isinstance(axis, int) and 0 <= axis < len(self._cmp_time):
+                self._cmp_time[axis] = self.ctl.time
 
     def _on_event(self, ev: Any) -> None:
-        name = None if ev.axis is None else self.ctl.axes[ev.axis].name
-        pos = None
-        if ev.position is not None and ev.axis is not None:
-            pos = float(self.ctl.axes[ev.axis].units.to_units(ev.position))
-        item = {"seq": ev.seq, "t": ev.time, "kind": ev.kind, "axis": name, "position": pos,
-                "detail": ev.detail}
-        self.events.append(item)
-        self._notify("event", item)
+        """Inside the cycle (event-log callback): keep and push the event; never raises."""
+        try:
+            name = None if ev.axis is None else self.ctl.axes[ev.axis].name
+            pos = None
+            if ev.position is not None and ev.axis is not None:
+                pos = float(self.ctl.axes[ev.axis].units.to_units(ev.position))
+            item = {"seq": ev.seq, "t": ev.time, "kind": ev.kind, "axis": name,
+                    "position": pos, "detail": ev.detail}
+            self.events.append(item)
+            self._notify("event", item)
+        except Exception as exc:
+            self.hook_errors.append(f"event: {type(exc).__name__}: {exc}")
 
     def cmp_active(self, axis: int) -> bool:
         t = self._cmp_time[axis]

@@ -16,8 +16,8 @@ if TYPE_CHECKING:
     from .service import MachineService
 
 LAMPS = ("alm", "pel", "mel", "org", "ez", "inp", "sd", "rdy", "erc", "emg", "ltc", "svon")
-FIELDS = ("time", "cycles", "estop", "config_version", "speed", "axes", "program", "scope",
-          "cycle")
+FIELDS = ("time", "cycles", "estop", "config_version", "speed", "axes", "board", "program",
+          "scope", "cycle")
 
 
 def axis_status(svc: MachineService, ax: Any) -> dict[str, Any]:
@@ -41,6 +41,17 @@ def axis_status(svc: MachineService, ax: Any) -> dict[str, Any]:
     }
 
 
+def board_io(svc: MachineService) -> dict[str, list[bool]]:
+    """General digital inputs (electrical levels) and outputs (levels written)."""
+    ctl = svc.ctl
+    hw = ctl.hardware
+    read_out = getattr(hw, "read_output", None)
+    di = [bool(hw.read_input(f"di{k}")) for k in range(ctl.config.digital_inputs)]
+    do = [bool(read_out(None, f"do{k}")) if read_out is not None else False
+          for k in range(ctl.config.digital_outputs)]
+    return {"di": di, "do": do}
+
+
 def snapshot(svc: MachineService, fields: tuple[str, ...] = FIELDS) -> dict[str, Any]:
     ctl = svc.ctl
     out: dict[str, Any] = {}
@@ -57,6 +68,8 @@ def snapshot(svc: MachineService, fields: tuple[str, ...] = FIELDS) -> dict[str,
             out["speed"] = svc.speed
         if "axes" in fields:
             out["axes"] = {ax.name: axis_status(svc, ax) for ax in ctl.axes}
+        if "board" in fields:
+            out["board"] = board_io(svc)
         if "program" in fields:
             out["program"] = svc.program.status()
     if "scope" in fields:
