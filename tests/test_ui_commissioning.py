@@ -139,6 +139,13 @@ def test_simulation_trips_a_limit_and_an_alarm_and_runs_faster(page):
     wait_status(page, "!s.axes.y.io.alm", 5)
     page.click("#sim-reset")
     wait_status(page, "s.axes.y.state !== 'ErrorStop'", 5)
+    # a general input switched from the page reaches the board and its lamp
+    level = bool(status(page, "s.board.di[3]"))
+    page.click("#sim-di-3")
+    wait_status(page, f"s.board.di[3] === {str(not level).lower()}", 5)
+    page.wait_for_selector(f"#sim-di-lamp-3[data-on={str(not level).lower()}]")
+    page.click("#sim-di-3")
+    wait_status(page, f"s.board.di[3] === {str(level).lower()}", 5)
     page.click("#sim-speed-5")
     wait_status(page, "s.speed === 5", 5)
     t0 = status(page, "s.time")

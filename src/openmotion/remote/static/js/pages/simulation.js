@@ -43,11 +43,22 @@ function build() {
   cycleBox = el("div", { class: "small muted", id: "sim-cycle" });
   const press = button("Press E-stop button (EMG)", () => app.call("sim.estop", { pressed: true }).catch(() => {}), { id: "sim-estop-press", class: "danger" });
   const release = button("Release E-stop button", () => app.call("sim.estop", { pressed: false }).catch(() => {}), { id: "sim-estop-release" });
+  const nIn = app.info.digital_inputs || 0, nOut = app.info.digital_outputs || 0;
+  const lamp = (id, label, good) => el("span", { class: `lampbox${good ? " good" : ""}`, id, "data-on": "null" }, el("span", { class: "lamp" }), label);
+  const dis = el("div", { class: "lamps", style: "grid-template-columns: repeat(8, auto)" },
+    ...Array.from({ length: nIn }, (_, i) => {
+      const b = el("button", { type: "button", class: "small", id: `sim-di-${i}`, title: `drive general input ${i} (sim.input)`,
+        onclick: () => app.call("sim.input", { index: i, level: !boardLevel("di", i) }).catch(() => {}) }, lamp(`sim-di-lamp-${i}`, `DI${i}`, true));
+      return b;
+    }));
+  const dos = el("div", { class: "lamps", style: "grid-template-columns: repeat(8, auto)" },
+    ...Array.from({ length: nOut }, (_, i) => lamp(`sim-do-lamp-${i}`, `DO${i}`, true)));
   root.replaceChildren(el("div", { class: "grid" },
     el("div", { class: "panel wide" }, el("h3", {}, "Switches and drive alarms"), table),
     panel("E-stop", el("div", { class: "row" }, press, release,
       button("Reset axes", () => app.call("machine.reset").catch(() => {}), { id: "sim-reset" })), estopBox,
       el("p", { class: "small muted" }, "The red E-STOP button in the header is the software E-stop (machine.estop); this one is the EMG input of the simulated machine.")),
+    panel("General inputs (click to switch) and outputs (M62-M65)", dis, el("div", { style: "height:8px" }), dos),
     panel("Time", fsSpeed.container,
       el("div", { class: "row" }, button("Apply", () => speed(), { id: "sim-speed-apply" }),
         ...[[1, "Real time"], [5, "×5"], [20, "×20"]].map(([f, label]) =>
@@ -82,9 +93,22 @@ async function speed() {
   } catch (err) { fsSpeed.serverError(err, { factor: "factor" }); }
 }
 
+function boardLevel(kind, i) {
+  const b = app.status && app.status.board;
+  return Boolean(b && b[kind] && b[kind][i]);
+}
+
 function update() {
   const s = app.status;
   if (!s || !table) return;
+  if (s.board) {
+    for (const kind of ["di", "do"]) {
+      (s.board[kind] || []).forEach((v, i) => {
+        const n = document.getElementById(`sim-${kind}-lamp-${i}`);
+        if (n) n.dataset.on = String(Boolean(v));
+      });
+    }
+  }
   for (const [name, lamps] of lampsByAxis) {
     const a = s.axes && s.axes[name];
     if (!a) continue;
