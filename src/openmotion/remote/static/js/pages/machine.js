@@ -52,7 +52,9 @@ function build() {
     panel("Modules", modules, el("p", { class: "small muted" }, `digital inputs ${info.digital_inputs ?? "-"}, outputs ${info.digital_outputs ?? "-"}`)),
     panel("Versions", versions, serverInfo ? el("p", { class: "small muted", id: "server-info" },
       `server ${serverInfo.name} ${serverInfo.version} · API ${serverInfo.api} · ${serverInfo.clients} client(s) · ` +
-      `deadman ${serverInfo.deadman_ms} ms · ${serverInfo.realtime ? "real time" : "as fast as possible"} ×${serverInfo.speed}`) : null)));
+      `deadman ${serverInfo.deadman_ms} ms · ${serverInfo.realtime ? "real time" : "as fast as possible"} ×${serverInfo.speed}`) : null,
+      serverInfo && serverInfo.hook_errors && serverInfo.hook_errors.length
+        ? el("div", { class: "form-error", id: "server-hook-errors" }, `server per-cycle work turned off: ${serverInfo.hook_errors.join("; ")}`) : null)));
   showToml(toml);
 }
 
