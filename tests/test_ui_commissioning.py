@@ -1,0 +1,321 @@
+"""Motion Creator in the browser, the rest of commissioning: repeat between two positions,
+changes on the fly, set/reset positions, the homing drawing of the selected mode, the scope
+trigger, tripping limits and alarms, simulation speed, single block and feed override.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import ui_browser
+from test_ui_creator import field, goto, ready_axis
+from ui_browser import status, wait_status
+
+server = ui_browser.server
+browser = ui_browser.browser
+page = ui_browser.page
+
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+
+
+def motion(pg, **values: object) -> None:
+    for name, v in values.items():
+        form = "op-target" if name in ("mode", "position1", "position2", "distance", "velocity") \
+            else "op-repeat" if name in ("delay_s", "count") else "op-motion"
+        f = field(pg, form, name)
+        if name in ("mode", "shape"):
+            f.select_option(str(v))
+        else:
+            f.fill(str(v))
+
+
+def test_repeat_between_two_positions_with_a_delay(page):
+    ready_axis(page, "z")
+    motion(page, mode="absolute", position1=1, position2=3, max_vel=20, tacc=0.05, tdec=0.05,
+           delay_s=0.2, count=0)
+    page.check("#op-repeat [data-name='repeat'] input")
+    page.click("#op-play1")
+    wait_status(page, "s.axes.z.repeat", 5)
+    # it visits both ends, resting at each
+    wait_status(page, "Math.abs(s.axes.z.position - 3) < 1e-6 && !s.axes.z.moving", 10)
+    wait_status(page, "Math.abs(s.axes.z.position - 1) < 1e-6 && !s.axes.z.moving", 10)
+    assert "(repeat)" in page.inner_text("#op-state")
+    page.click("#op-stop")
+    wait_status(page, "!s.axes.z.repeat && !s.axes.z.moving", 5)
+    page.uncheck("#op-repeat [data-name='repeat'] input")
+
+
+def test_change_speed_and_position_on_the_fly_then_stop(page):
+    ready_axis(page, "x")
+    page.click("#op-reset-position")
+    wait_status(page, "s.axes.x.command === 0 && s.axes.x.target === 0", 5)
+    motion(page, mode="velocity", velocity=10, max_vel=50, tacc=0.05)
+    page.click("#op-play2")
+    wait_status(page, "Math.abs(s.axes.x.velocity - 10) < 1e-6", 5)
+    field(page, "op-target", "velocity").fill("25")
+    page.click("#op-vchange")
+    wait_status(page, "Math.abs(s.axes.x.velocity - 25) < 1e-6", 5)
+    page.click("#op-stop")
+    wait_status(page, "!s.axes.x.moving && s.axes.x.velocity === 0", 5)
+    # a positioning move retargeted on the fly ends on the new target
+    here = status(page, "s.axes.x.position")
+    motion(page, mode="absolute", position1=here + 40, position2=here + 15, max_vel=20,
+           tacc=0.05, tdec=0.05)
+    page.click("#op-play1")
+    wait_status(page, "s.axes.x.moving && s.axes.x.velocity > 0", 5)
+    page.click("#op-pchange")
+    wait_status(page, "!s.axes.x.moving", 10)
+    assert abs(status(page, "s.axes.x.position") - (here + 15)) < 1e-6
+    # set and reset the counters
+    field(page, "op-setpos", "position").fill("12.5")
+    page.click("#op-set-position")
+    wait_status(page, "s.axes.x.command === 12500 && s.axes.x.feedback === 12500", 5)
+    page.click("#op-reset-position")
+    wait_status(page, "s.axes.x.command === 0 && s.axes.x.feedback === 0", 5)
+
+
+def test_the_homing_drawing_follows_the_selected_mode(page):
+    ready_axis(page, "y")
+    goto(page, "homing")
+    page.wait_for_selector("#home-drawing")
+    field(page, "home-fields", "mode").select_option("11")
+    page.wait_for_function("() => document.querySelector('#home-seq-note').children.length === 3")
+    note = page.inner_text("#home-seq-note")
+    assert "EZ" in note and "ORG" in note and "home mark" in note
+    arrows = page.locator("#home-drawing line[marker-end]").count()
+    assert arrows == 4          # three phases and the final move to the mark
+    field(page, "home-fields", "mode").select_option("0")
+    page.wait_for_function("() => document.querySelector('#home-seq-note').children.length === 1")
+    # an invalid speed is refused beside its field, nothing saved
+    field(page, "home-fields", "str_vel").fill("1e9")
+    assert "must be <=" in page.inner_text("#home-fields [data-name='str_vel'] .field-error")
+    field(page, "home-fields", "str_vel").fill("5")
+
+
+def test_scope_trigger_captures_a_move(page):
+    ready_axis(page, "x")
+    goto(page, "scope")
+    page.wait_for_selector("#scope-apply")
+    field(page, "scope-trig", "mode").select_option("single")
+    field(page, "scope-trig", "channel").select_option("x.velocity")
+    field(page, "scope-trig", "edge").select_option("rising")
+    field(page, "scope-trig", "level").fill("5")
+    field(page, "scope-trig", "pre_s").fill("0.2")
+    field(page, "scope-cfg", "seconds").fill("2")
+    page.click("#scope-apply")
+    page.wait_for_timeout(500)
+    page.click("#scope-arm")
+    page.wait_for_timeout(300)
+    goto(page, "operation")
+    motion(page, mode="relative", distance=10, max_vel=30, tacc=0.05, tdec=0.05)
+    page.click("#op-play2")
+    wait_status(page, "!s.axes.x.moving", 10)
+    goto(page, "scope")
+    page.wait_for_selector("#scope-info:has-text('triggered at')", timeout=10000)
+    t = page.evaluate("window.openmotion.scopeChart.t")
+    assert t[-1] - t[0] <= 2.0 + 1e-6
+    # back to free run
+    field(page, "scope-trig", "mode").select_option("off")
+    field(page, "scope-cfg", "seconds").fill("30")
+    page.click("#scope-apply")
+    page.wait_for_timeout(500)
+    page.click("#scope-run")
+
+
+def test_simulation_trips_a_limit_and_an_alarm_and_runs_faster(page):
+    ready_axis(page, "y")
+    motion(page, mode="velocity", velocity=10, max_vel=20, tacc=0.05)
+    page.click("#op-play2")
+    wait_status(page, "s.axes.y.velocity > 0", 5)
+    goto(page, "simulation")
+    page.click("#sim-y-pel")
+    wait_status(page, "s.axes.y.io.pel && !s.axes.y.moving && s.axes.y.velocity === 0", 5)
+    assert page.get_attribute("#sim-y-lamp-pel", "data-on") == "true"
+    page.click("#sim-y-pel")
+    wait_status(page, "!s.axes.y.io.pel", 5)
+    page.click("#sim-y-alm")
+    wait_status(page, "s.axes.y.io.alm && s.axes.y.state === 'ErrorStop'", 5)
+    page.click("#sim-y-alm")
+    wait_status(page, "!s.axes.y.io.alm", 5)
+    page.click("#sim-reset")
+    wait_status(page, "s.axes.y.state !== 'ErrorStop'", 5)
+    # a general input switched from the page reaches the board and its lamp
+    level = bool(status(page, "s.board.di[3]"))
+    page.click("#sim-di-3")
+    wait_status(page, f"s.board.di[3] === {str(not level).lower()}", 5)
+    page.wait_for_selector(f"#sim-di-lamp-3[data-on={str(not level).lower()}]")
+    page.click("#sim-di-3")
+    wait_status(page, f"s.board.di[3] === {str(level).lower()}", 5)
+    page.click("#sim-speed-5")
+    wait_status(page, "s.speed === 5", 5)
+    t0 = status(page, "s.time")
+    page.wait_for_timeout(1000)
+    assert status(page, "s.time") - t0 > 2.0     # control time runs faster than the wall
+    page.click("#sim-speed-1")
+    wait_status(page, "s.speed === 1", 5)
+    field(page, "sim-speed", "factor").fill("50")
+    assert "must be <= 20" in page.inner_text("#sim-speed [data-name='factor'] .field-error")
+
+
+PROGRAM = "G21 G90\nG0 X0 Y0\nG1 F600 X5\nG1 Y5\nG1 X0\nG1 Y0\nM30\n"
+
+
+def test_single_block_and_feed_override(page):
+    ready_axis(page)
+    goto(page, "program")
+    page.click("#prog-servo-all")
+    wait_status(page, "Object.values(s.axes).every((a) => a.servo)", 5)
+    page.fill("#prog-text", PROGRAM)
+    page.click("#prog-load-text")
+    page.wait_for_selector("#prog-loaded:has-text('7 lines')", timeout=15000)
+    page.check("#prog-single")
+    page.click("#prog-run-btn")
+    wait_status(page, "s.program.state === 'paused' && s.program.line >= 2", 10)
+    first = status(page, "s.program.line")
+    page.click("#prog-resume")
+    wait_status(page, f"s.program.state === 'paused' && s.program.line > {first}", 10)
+    page.uncheck("#prog-single")
+    wait_status(page, "!s.program.single_block", 5)
+    page.eval_on_selector("#prog-ovr",
+                          "(e) => { e.value = 150; e.dispatchEvent(new Event('input')); }")
+    wait_status(page, "s.program.feed_override === 150", 5)
+    page.click("#prog-resume")
+    wait_status(page, "s.program.state === 'done'", 20)
+
+
+LASER = "G21 G90\nG0 X0 Y0\nM62 P0\nG1 F900 X6\nM63 P0\nG1 Y6\nM62 P0\nG1 X0\nM63 P0\nM30\n"
+
+
+def test_path_marks_the_output_firings_and_keyboard_jog_survives_a_job(page):
+    ready_axis(page)
+    goto(page, "program")
+    page.click("#prog-servo-all")
+    wait_status(page, "Object.values(s.axes).every((a) => a.servo)", 5)
+    page.fill("#prog-text", LASER)
+    page.click("#prog-load-text")
+    page.wait_for_selector("#prog-loaded:has-text('10 lines')", timeout=15000)
+    page.click("#prog-run-btn")
+    wait_status(page, "s.program.state === 'done'", 30)
+    goto(page, "path")
+    page.wait_for_function("() => window.openmotion.pathView.markers.length >= 4", timeout=10000)
+    assert "firings" in page.inner_text("#path-info")
+    # keyboard jog still works after the job (a known complaint against other senders)
+    goto(page, "operation")
+    if not page.is_checked("#op-keyboard"):
+        page.check("#op-keyboard")
+    page.locator("#op-chart").click()
+    page.keyboard.down("ArrowRight")
+    wait_status(page, "s.axes.x.velocity > 0", 5)
+    page.keyboard.up("ArrowRight")
+    wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
+
+
+def test_a_second_tab_is_told_to_reload_and_sees_the_scope_history(page, browser, server):
+    other = browser.new_context().new_page()
+    other.goto(server.url + "#interface")
+    other.wait_for_selector("#conn[data-state=open]")
+    other.wait_for_selector("#if-save")
+    # this tab changes a setting: the other one is told, and its own change is refused
+    goto(page, "interface")
+    page.wait_for_selector("#if-save")
+    width = field(page, "if-pulse", "pulse_width_us")
+    width.fill("3" if width.input_value() != "3" else "4")
+    page.click("#if-save")
+    page.wait_for_selector("#if-saved:has-text('applied'), #if-saved:has-text('saved to')")
+    other.wait_for_selector("#reload-banner:not([hidden])", timeout=5000)
+    w2 = field(other, "if-pulse", "pulse_width_us")
+    w2.fill("9")
+    other.click("#if-save")
+    other.wait_for_selector("#if-error:has-text('reload')", timeout=5000)
+    other.click("#reload-config")
+    other.wait_for_selector("#reload-banner[hidden]", state="attached")
+    other.wait_for_timeout(500)
+    field(other, "if-pulse", "pulse_width_us").fill("9")
+    other.click("#if-save")
+    other.wait_for_selector("#if-saved:has-text('applied'), #if-saved:has-text('saved to')",
+                            timeout=5000)
+    # now the first tab is the stale one: it reloads, then its commands go through
+    page.wait_for_selector("#reload-banner:not([hidden])", timeout=5000)
+    page.click("#reload-config")
+    # the scope history lives on the server: the other tab draws the same samples
+    ready_axis(page)
+    field(page, "op-target", "mode").select_option("relative")
+    field(page, "op-target", "distance").fill("5")
+    page.click("#op-play2")
+    wait_status(page, "s.axes.x.moving", 5)
+    wait_status(page, "!s.axes.x.moving", 10)
+    goto(other, "scope")
+    other.wait_for_function("() => (window.openmotion.scopeChart || {t: []}).t.length > 1000",
+                            timeout=10000)
+    t_other = other.evaluate("window.openmotion.scopeChart.t[0]")
+    assert t_other < status(page, "s.time") - 1.0   # history from before the tab opened it
+    other.context.close()
+
+
+def test_a_jog_stops_when_the_connection_drops(page):
+    ready_axis(page)
+    plus = page.locator("#op-jog-plus").bounding_box()
+    page.mouse.move(plus["x"] + plus["width"] / 2, plus["y"] + plus["height"] / 2)
+    page.mouse.down()
+    wait_status(page, "s.axes.x.velocity > 0", 5)
+    page.evaluate("window.openmotion.rpc.ws.close()")      # the button is still held
+    page.wait_for_selector("#conn[data-state=open]", timeout=10000)
+    wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 5)
+    page.wait_for_timeout(300)
+    assert status(page, "s.axes.x.velocity") == 0            # and it does not start again
+    page.mouse.up()
+
+
+def test_scope_pause_freezes_the_recording_and_run_resumes_it(page):
+    goto(page, "scope")
+    page.wait_for_function("() => (window.openmotion.scopeChart || {t: []}).t.length > 10",
+                           timeout=10000)
+    page.click("#scope-pause")
+    page.wait_for_selector("#log:has-text('paused')")
+    page.wait_for_timeout(300)
+    n = page.evaluate("window.openmotion.scopeChart.t.length")
+    page.wait_for_timeout(800)
+    assert page.evaluate("window.openmotion.scopeChart.t.length") == n
+    page.click("#scope-run")
+    page.wait_for_selector("#log:has-text('running')")
+    page.wait_for_function(f"() => window.openmotion.scopeChart.t.length > {n}", timeout=5000)
+
+
+def test_the_page_logic_in_the_browser(page):
+    """The pure parts of the front end: field rules, error placement, decimation, diffs."""
+    out = page.evaluate("""async () => {
+        const f = await import('/static/js/fields.js');
+        const v = await import('/static/js/view3d.js');
+        const a = await import('/static/js/app.js');
+        const spec = {name: 'max_vel', label: 'MaxVel', unit: 'mm/s', min: 0, minExclusive: true,
+                      max: 500};
+        const xs = [], ys = [], zs = [];
+        for (let i = 0; i <= 1000; i++) { xs.push(i * 0.001); ys.push(0); zs.push(0); }
+        const idx = v.decimate(xs, ys, zs, 0.01, null);
+        const snap = {axes: {x: {command: 1, io: {inp: true, org: false}}}, estop: false};
+        a.mergeDiff(snap, {axes: {x: {io: {inp: false}, fault: null}}, estop: true});
+        return {
+            ok: f.parseField(spec, '12.5'), zero: f.parseField(spec, '0'),
+            big: f.parseField(spec, '501'), text: f.parseField(spec, '1,5'),
+            exp: f.parseField(spec, '1e2'), empty: f.parseField(spec, ''),
+            int: f.parseField({name: 'n', label: 'N', kind: 'int'}, '2.5'),
+            param: f.findParam({data: {param: 'changes.logic.pel'}}, ['logic.pel', 'pel']),
+            msg: f.findParam({message: 'str_vel must be <= max_vel'}, ['max_vel', 'str_vel']),
+            none: f.findParam({message: 'axis z: disabled'}, ['max_vel']),
+            idx: [idx.length, idx[0], idx[idx.length - 1]], snap,
+        };
+    }""")
+    assert out["ok"] == [12.5, ""]
+    assert out["zero"][1] == "MaxVel must be > 0 mm/s"
+    assert out["big"][1] == "MaxVel must be <= 500 mm/s"
+    assert out["text"][1] == "MaxVel must be a number"
+    assert out["exp"] == [100, ""]
+    assert out["empty"][1] == "MaxVel is required"
+    assert out["int"][1] == "N must be a whole number"
+    assert out["param"] == "logic.pel"
+    assert out["msg"] == "str_vel"
+    assert out["none"] is None
+    n, first, last = out["idx"]
+    assert first == 0 and last == 1000 and 95 <= n <= 110     # one point per 0.01 of 1.0
+    assert out["snap"] == {"axes": {"x": {"command": 1, "io": {"inp": False, "org": False},
+                                          "fault": None}}, "estop": True}

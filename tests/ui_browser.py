@@ -1,0 +1,157 @@
+"""Fixtures of the browser tests: the real `openmotion ui` server and Debian's chromium.
+
+The server runs as a subprocess (`python -m openmotion ui --port 0`, the address read from
+its first line) on a machine file in a temporary directory, so saving settings is real.
+Playwright drives /usr/bin/chromium (it cannot download its own browser here). Without
+chromium or the playwright package the tests are skipped, except under CI=1, where they fail.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+import openmotion
+
+CHROMIUM = os.environ.get("OPENMOTION_CHROMIUM", "/usr/bin/chromium")
+SRC = Path(openmotion.__file__).resolve().parent.parent
+ROOT = SRC.parent
+SHOTS = ROOT / "docs" / "img"
+
+
+def need_browser() -> None:
+    """Skip (locally) or fail (CI=1) when Playwright or chromium is missing."""
+    missing = []
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        missing.append("the playwright package (pip install playwright)")
+    if not Path(CHROMIUM).exists():
+        missing.append(f"{CHROMIUM} (apt-get install chromium)")
+    if missing:
+        msg = "browser tests need " + " and ".join(missing)
+        if os.environ.get("CI") == "1":
+            pytest.fail(msg)
+        pytest.skip(msg)
+
+
+class Server:
+    """`openmotion ui` in a subprocess; `url` is the address it printed."""
+
+    def __init__(self, workdir: Path, *extra: str) -> None:
+        env = dict(os.environ, PYTHONPATH=str(SRC) + os.pathsep + os.environ.get("PYTHONPATH", ""),
+                   PYTHONUNBUFFERED="1")
+        self.workdir = workdir
+        self.log = workdir / "server.log"
+        self._log = open(self.log, "w")   # noqa: SIM115 (closed in stop())
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "openmotion", "ui", "--port", "0", *extra],
+            cwd=workdir, env=env, stdout=subprocess.PIPE, stderr=self._log, text=True)
+        self.url = self._address()
+
+    def _address(self) -> str:
+        deadline = time.monotonic() + 60
+        assert self.proc.stdout is not None
+        while time.monotonic() < deadline:
+            line = self.proc.stdout.readline()
+            if not line:
+                if self.proc.poll() is not None:
+                    raise RuntimeError(f"openmotion ui exited: {self.log.read_text()[-2000:]}")
+                time.sleep(0.05)
+                continue
+            m = re.search(r"(http://\S+)", line)
+            if m:
+                return m.group(1)
+        raise RuntimeError("openmotion ui printed no address within 60 s")
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(5)
+        self._log.close()
+
+
+class External:
+    """A server already running (OPENMOTION_UI_URL): for debugging the tests by hand."""
+
+    def __init__(self, url: str, workdir: Path) -> None:
+        self.url = url
+        self.workdir = workdir
+
+    def stop(self) -> None:
+        pass
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server | External]:
+    need_browser()
+    work = tmp_path_factory.mktemp("ui")
+    url = os.environ.get("OPENMOTION_UI_URL")
+    srv: Server | External = External(url, work) if url else Server(work)
+    try:
+        yield srv
+    finally:
+        srv.stop()
+
+
+@pytest.fixture(scope="module")
+def browser(server: Server | External) -> Iterator[object]:
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, headless=True,
+                               args=["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"])
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+@pytest.fixture
+def page(browser: object, server: Server | External) -> Iterator[object]:
+    """A fresh tab on the UI, connected (lamp green) and showing the operation page."""
+    ctx = browser.new_context(viewport={"width": 1400, "height": 1000})   # type: ignore[attr-defined]
+    pg = ctx.new_page()
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.goto(server.url)
+    pg.wait_for_selector("#conn[data-state=open]", timeout=15000)
+    pg.wait_for_function("() => window.openmotion && window.openmotion.status !== null",
+                         timeout=15000)
+    pg.page_errors = errors   # type: ignore[attr-defined]
+    try:
+        yield pg
+    finally:
+        ctx.close()
+    assert not errors, f"JavaScript errors on the page: {errors}"
+
+
+def status(pg: object, expr: str) -> object:
+    """Evaluate `expr` on the page's merged live status (`s`)."""
+    return pg.evaluate(f"() => {{ const s = window.openmotion.status; return {expr}; }}")  # type: ignore[attr-defined]
+
+
+def wait_status(pg: object, cond: str, timeout_s: float = 10) -> None:
+    """Wait until the JS condition `cond` on the live status `s` holds."""
+    pg.wait_for_function(   # type: ignore[attr-defined]
+        f"() => {{ const s = window.openmotion.status; return Boolean(s && ({cond})); }}",
+        timeout=timeout_s * 1000)
+
+
+def shot(pg: object, name: str) -> None:
+    """Save docs/img/creator-<name>.png when OPENMOTION_SHOTS=1 (the committed screenshots)."""
+    if os.environ.get("OPENMOTION_SHOTS") == "1":
+        SHOTS.mkdir(parents=True, exist_ok=True)
+        pg.screenshot(path=str(SHOTS / f"creator-{name}.png"), full_page=True)   # type: ignore[attr-defined]
+
