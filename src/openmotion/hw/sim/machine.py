@@ -16,7 +16,7 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Callable, Collection, Sequence
 
 from openmotion.config import MachineConfig
 from openmotion.errors import MotionError, check_finite, check_nonnegative
@@ -77,6 +77,8 @@ class SimMachine:
         self.output_record = OutputRecord()  # every output edge at its exact time
         self.scenario = Scenario(self)
         self._queues = [PieceQueue() for _ in self._axes]  # QueuedHardware
+        # inputs derived from axis positions (probe.py): raw edges -> board edges
+        self._edge_filters: list[Callable[[list], list]] = []
 
     # -- Hardware protocol --------------------------------------------------------------------
     @property
@@ -223,6 +225,8 @@ class SimMachine:
         for tk, _, sig, lv in self._timed.pop_due(t):
             self._set_do(tk, sig, lv)
         raw.sort(key=lambda e: e[0])
+        for f in self._edge_filters:
+            raw = f(raw)
         n = len(self._axes)
         edges = []
         for tm, axis, sig, lv, own in raw:
