@@ -262,3 +262,35 @@ def test_runner_m66_analog_is_refused_without_analog_inputs():
     ctl = Controller()
     with pytest.raises(GCodeError, match="analog input number must be < 0"):
         ProgramRunner(ctl, "M66 E0\nM2\n")
+
+
+def test_runner_contact_during_a_non_probe_move_stops_the_run():
+    ctl, probe, run = _runner("G0 Z5\nG1 Z-4 F300\nG0 X5\nM2\n")
+    run.start()
+    run.wait(60)
+    assert run.state is RunState.ERROR
+    assert "Probe tripped during non-probe move." in run.error and "line 2" in run.error
+    assert ctl.axes[0].position == 0.0
+    # without a probe input configured nothing watches it
+    ctl, probe = _ctl()
+    probe.place([{2: (-INF, -8000.0)}])
+    run = ProgramRunner(ctl, "G1 Z-4 F300\nM2\n")
+    run.start()
+    run.wait(60)
+    assert run.state is RunState.DONE
+
+
+def test_probe_example_finds_the_block_corner():
+    import runpy
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "gcode_probe.py"
+    run = runpy.run_path(str(path))["main"]()
+    assert run.state is RunState.DONE
+    corner = [e.text for e in run.events if e.kind == "message"][-1]
+    import re
+
+    x, y, z = (float(v) for v in re.findall(r"[XYZ](-?[\d.]+)", corner))
+    # within one pulse of X 10, Y 8, Z 20 (1000, 2000, 4000 pulses per mm)
+    assert x == pytest.approx(10.0, abs=1e-3) and y == pytest.approx(8.0, abs=5e-4)
+    assert z == pytest.approx(20.0, abs=2.5e-4)

@@ -60,6 +60,7 @@ if TYPE_CHECKING:
     from ..control.compare import CompareEngine
     from ..control.controller import Controller
     from ..control.group import Group
+    from ..hw.interface import InputEdge
 
 
 class RunState(Enum):
@@ -235,6 +236,7 @@ class ProgramRunner:
             isinstance(c, Probe | WaitInput) for c in self.commands)
         self._session: Session | None = None
         self._request: ProbeMove | InputWait | None = None
+        self._stray_trip: str | None = None
         probe = next((c for c in self.commands if isinstance(c, Probe)), None)
         if probe is not None:
             if self.options.probe_input is None:
@@ -328,6 +330,8 @@ class ProgramRunner:
         self.state = RunState.RUNNING
         self.t_start = self._ctl.time
         self._ctl.add_cycle_hook(self._on_cycle)
+        if self.options.probe_input is not None:
+            self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
 
     def pause(self) -> None:
         """Hold: decelerate along the path and stop; resume() continues."""
@@ -427,6 +431,8 @@ class ProgramRunner:
         self.t_end = self._ctl.time
         self._event(state.value, self.current_line, text)
         self._ctl.remove_cycle_hook(self._on_cycle)
+        if self.options.probe_input is not None:
+            self._ctl.remove_edge_hook(self._on_probe_edge)
         if self.group is not None:
             if state is not RunState.ABORTED:
                 self.group.close()
@@ -454,6 +460,12 @@ class ProgramRunner:
 
         g = self.group
         assert g is not None
+        if self._stray_trip is not None:  # LinuxCNC: a contact outside G38 stops the run
+            g.abort()
+            self.error = f"line {self.current_line}: {self._stray_trip}"
+            self._event("fault", self.current_line, self._stray_trip)
+            self._finish(RunState.ERROR, self.error)
+            return
         if g.state is GroupState.ERROR:
             self.error = f"line {self.current_line}: {g.error_message}"
             self._event("fault", self.current_line, g.error_message)
@@ -545,6 +557,14 @@ class ProgramRunner:
                 self._step_line = op.line
         if p.pc >= len(p.ops) and self._idle() and not self.synced.armed:
             self._end_of_pass()
+
+    def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
+        """The probe makes contact while no probe move runs and the axes move: LinuxCNC's
+        "Probe tripped during non-probe move." (the cycle hook then stops the run)."""
+        if e.axis is None and e.signal == self.options.probe_input and e.level \
+                and not isinstance(self._request, ProbeMove) and self.group is not None \
+                and not self._idle() and self.state is RunState.RUNNING:
+            self._stray_trip = "Probe tripped during non-probe move."
 
     def _begin_request(self, g: Group, op: Op) -> None:
         """At rest before a probe move or an M66: arm the probe (and start the move) or
