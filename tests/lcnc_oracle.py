@@ -34,6 +34,7 @@ from openmotion.program import (
     SyncedFeed,
     compile_text,
 )
+from openmotion.program.probing import Probe
 
 DEFAULT_RS274 = "/opt/linuxcnc-rs274/rs274"
 LETTERS = "XYZABC"
@@ -237,6 +238,8 @@ def openmotion_motions(text: str, options: GCodeOptions = OPTIONS) -> list[Motio
             out.append(Motion("feed", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0, tol=tol))
         elif isinstance(cmd, SyncedFeed):
             out.append(Motion("sync", tuple(cmd.end[:6]), cmd.pitch, tol=tol))
+        elif isinstance(cmd, Probe):
+            out.append(Motion("probe", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0, tol=tol))
         elif isinstance(cmd, ArcMove):
             i, j = cmd.plane
             name = LETTERS[i] + LETTERS[j]
@@ -287,8 +290,7 @@ def compare(ours: list[Motion], theirs: list[Motion], feed_rel: float = 1e-6) ->
     for n, (a, b) in enumerate(zip(ours, theirs, strict=False)):
         tol = max(a.tol, b.tol) + 1e-9
         where = f"motion {n} ({b.line})"
-        kinds = {a.kind, b.kind}
-        if a.kind != b.kind and kinds != {"feed", "probe"}:
+        if a.kind != b.kind:
             diffs.append(f"{where}: kind {a.kind} != {b.kind}")
             continue
         if any(abs(x - y) > tol for x, y in zip(a.end, b.end, strict=True)):

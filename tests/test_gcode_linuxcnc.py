@@ -121,7 +121,7 @@ def test_debug_messages_as_linuxcnc_prints_them(rs274: str) -> None:
 
 
 @pytest.mark.parametrize("name", ["predefined_params.ngc", "fanuc_params.ngc", "tool_offsets.ngc",
-                                  "modal_state.ngc", "rotation.ngc"])
+                                  "modal_state.ngc", "rotation.ngc", "probing.ngc"])
 def test_messages_as_linuxcnc_prints_them(rs274: str, name: str) -> None:
     """Programs whose DEBUG lines print modal state: the same text from both."""
 

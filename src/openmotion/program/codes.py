@@ -9,7 +9,7 @@ from .cycles import REFUSED as CYCLE_REFUSED
 G_GROUP = {
     40: 0, 100: 0, 520: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
     0: 1, 10: 1, 20: 1, 30: 1, 330: 1, 760: 1, 800: 1, 730: 1, 740: 1, 810: 1, 820: 1,
-    830: 1, 840: 1, 850: 1, 860: 1, 880: 1, 890: 1,
+    830: 1, 840: 1, 850: 1, 860: 1, 880: 1, 890: 1, 382: 1, 383: 1, 384: 1, 385: 1,
     170: 2, 180: 2, 190: 2,
     900: 3, 910: 3,
     901: 4, 911: 4,
@@ -28,7 +28,6 @@ G_REFUSED = {
     50: "cubic spline G5 is not supported", 51: "quadratic B-spline G5.1 is not supported",
     52: "NURBS G5.2 is not supported", 53: "NURBS G5.3 is not supported",
     331: "rigid tapping (G33.1) is not supported",
-    **{c: f"probing (G38.{c - 380}) is not supported" for c in (382, 383, 384, 385)},
     700: "lathe finishing cycle (G70) is not supported",
     710: "lathe roughing cycle (G71) is not supported",
     720: "lathe roughing cycle (G72) is not supported",
@@ -43,10 +42,9 @@ M_REFUSED = {
     51: "spindle override control (M51) is not supported",
     52: "adaptive feed (M52) is not supported", 53: "feed stop control (M53) is not supported",
     60: "pallet change (M60) is not supported",
-    66: "waiting for an input (M66) is not supported",
     67: "synchronized analog output (M67) is not supported",
     68: "analog output (M68) is not supported",
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
-           62: 5, 63: 5, 64: 5, 65: 5, 98: 11, 99: 11, 61: 6,
+           62: 5, 63: 5, 64: 5, 65: 5, 66: 5, 98: 11, 99: 11, 61: 6,
            70: 12, 71: 12, 72: 12, 73: 12}

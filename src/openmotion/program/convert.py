@@ -38,6 +38,7 @@ from ..path import Arc, Direction
 from ..units import AxisUnits
 from . import canon
 from .options import MM_PER_INCH, ROTARY_LETTERS
+from .probing import Probe, WaitInput
 from .source import GCodeError
 
 #: Blend tolerance (machine units) standing for G64 without P.
@@ -46,7 +47,8 @@ UNBOUNDED_BLEND = 1e12
 
 @dataclass(frozen=True)
 class Op:
-    """One runner operation. kind: line, arc, delay, blend, pause, end, output, action.
+    """One runner operation. kind: line, arc, delay, blend, pause, end, output, action,
+    wait (M66; `source` the WaitInput). A probe move is a line whose `source` is a Probe.
 
     line/arc: `end` (machine units, all group axes), `target` (the same point in command
     pulses), `feed` (machine units/s), `rapid`; arc also `centre` (2 plane values, machine
@@ -140,8 +142,13 @@ def _fail(cmd: canon.Command, msg: str) -> GCodeError:
 
 
 def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
-            opts: ConvertOptions) -> list[Op]:
-    """Validate and convert a canonical program that starts at `start` (pulses)."""
+            opts: ConvertOptions, rpm: float = 0.0) -> list[Op]:
+    """Validate and convert a canonical program that starts at `start` (pulses); `rpm`:
+    the spindle speed commanded before it (a program continued after a probe).
+
+    G38.x (`probing.Probe`) becomes a feed line whose `source` is the Probe record (the
+    runner arms the probe input for it), M66 (`probing.WaitInput`) an op "wait".
+    """
     lin = ~scales.rotary
     vmax = scales.vmax_units
     sys_max = float(np.max(vmax))
@@ -163,9 +170,17 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             raise _fail(cmd, f"feed {cmd.feed_per_s:g} units/s gives no usable speed")
         return min(f, sys_max)  # F above the machine maxima is clamped (as LinuxCNC)
 
-    rpm = 0.0  # commanded spindle speed, for synchronised moves
     for cmd in cmds:
-        if isinstance(cmd, canon.SyncedFeed):
+        if isinstance(cmd, Probe):
+            end = np.asarray(cmd.end, dtype=float)
+            f = min(cmd.feed_per_s, sys_max) if cmd.feed_per_s > 0 else sys_max
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), f, end=end,
+                          source=cmd))
+            pos = end
+        elif isinstance(cmd, WaitInput):
+            ops.append(Op("wait", cmd.line, cmd.file, index=cmd.index, seconds=cmd.timeout,
+                          source=cmd))
+        elif isinstance(cmd, canon.SyncedFeed):
             end = np.asarray(cmd.end, dtype=float)
             length = float(np.linalg.norm(end - pos))
             if length == 0.0:

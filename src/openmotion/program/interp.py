@@ -16,6 +16,7 @@ GCodeError (line, column, word) and no command list exists, so nothing can move.
 from __future__ import annotations
 
 import os
+from collections.abc import Generator
 from dataclasses import dataclass, field
 
 from . import canon
@@ -26,6 +27,7 @@ from .modalstate import on_return
 from .options import GCodeOptions
 from .params import Parameters
 from .parser import MAX_LINES, Block, Program, parse_program
+from .probing import Request, Result, apply_result, preview_result
 from .source import GCodeError, decode_program, read_program
 
 _OPENERS = {"SUB": "ENDSUB", "IF": "ENDIF", "WHILE": "ENDWHILE", "DO": "WHILE",
@@ -204,7 +206,25 @@ class Interpreter:
         assert o is not None
         return self.modal.evaluate(b, o.args[0], f"O{o.label}") != 0.0
 
-    def run(self) -> list[canon.Command]:  # noqa: C901
+    def run(self) -> list[canon.Command]:
+        """Interpret the whole program; probes and input waits get LinuxCNC rs274's
+        answers without a machine (probing.preview_result)."""
+        steps = self._steps()
+        try:
+            req = next(steps)
+            while True:
+                req = steps.send(preview_result(self.modal, req))
+        except StopIteration as stop:
+            return stop.value
+
+    def session(self) -> Session:
+        """Interpret step by step, stopping at each probe / input wait until its result
+        is given (the runner's live interpretation; see `Session`)."""
+        return Session(self)
+
+    def _steps(self) -> Generator[Request, Result, list]:  # noqa: C901
+        """The interpreter loop: yields every probe / M66 request (after its line ran) and
+        continues with the result sent in; returns the command list."""
         blocks = self.blocks
         flow = self.flow
         modal = self.modal
@@ -238,7 +258,13 @@ class Interpreter:
             modal.line = b.line
             if o is None:
                 try:
-                    if not modal.execute(b, out):
+                    more = modal.execute(b, out)
+                    req = modal.wait_request
+                    if req is not None:
+                        modal.wait_request = None
+                        result = yield req
+                        apply_result(modal, req, result)
+                    if not more:
                         break
                 except GCodeError as exc:
                     if len(frames) == 1:
@@ -410,6 +436,53 @@ class Interpreter:
         frames.append(_Frame(label, pc + 1, fanuc=True, repeat_left=count - 1,
                              start=start))
         return start
+
+
+class Session:
+    """A program interpreted piece by piece against a machine.
+
+        s = Interpreter(program, options).session()
+        cmds = s.advance()            # commands up to and including the first request
+        while s.request is not None:  # a probing.Probe or probing.WaitInput
+            ... run cmds, then the request, on the machine ...
+            cmds = s.advance(result)  # ProbeResult / InputResult -> the next piece
+
+    Each piece ends with its request (or the program's end, `done`). An error in the
+    rest of the program raises GCodeError from `advance` (the machine has not run it).
+    """
+
+    def __init__(self, interp: Interpreter) -> None:
+        self._interp = interp
+        self._steps = interp._steps()
+        self._taken = 0
+        self._started = False
+        self.request: Request | None = None
+        self.done = False
+
+    def advance(self, result: Result | None = None) -> list[canon.Command]:
+        """Run to the next request (the first call: from the start); the new commands."""
+        if self.done:
+            raise GCodeError("the program has ended: nothing to advance")
+        if self._started and result is None:
+            raise GCodeError("advance needs the result of the pending request "
+                             f"({type(self.request).__name__})")
+        try:
+            if self._started:
+                self.request = self._steps.send(result)  # type: ignore[arg-type]
+            else:
+                self._started = True
+                self.request = next(self._steps)
+        except StopIteration:
+            self.request = None
+            self.done = True
+        except GCodeError:
+            self.request = None
+            self.done = True
+            raise
+        out = self._interp._out
+        chunk = out[self._taken:]
+        self._taken = len(out)
+        return chunk
 
 
 def sub_file_name(label: str) -> str:

@@ -33,6 +33,7 @@ from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
+from .probing import PROBE_CODES, g38, m66
 from .threading import g33, g76
 from .tooloffsets import set_tool_parameters, tool_length
 from .words import Word, feed_length, fmt
@@ -84,6 +85,9 @@ class Modal:
         #: M98 (call: P number, L count) or M99 for the interpreter, after the line ran:
         #: (kind, P, L, column)
         self.flow_request: tuple[str, float, int, int] | None = None
+        #: a G38.x probe or M66 wait on this line: the interpreter stops after the line
+        #: until the machine's answer is in (probing.py)
+        self.wait_request: object | None = None
         # letter -> (machine axis, parameter offset k)
         self.letters = {L: (options.axes[L], AXIS_LETTERS.index(L)) for L in options.axes}
         self.g92 = [params.numbers[5211 + k] for k in range(9)]
@@ -345,7 +349,9 @@ class Modal:
             self.flood = self.flood or 8 in coolant
             out.append(canon.Coolant(self.mist, self.flood, self.opt.mist_output,
                                      self.opt.flood_output, line, file))
-        if 5 in ms:
+        if 5 in ms and ms[5][0] == 66:
+            m66(self, b, ms[5][1], words, used, out)
+        elif 5 in ms:
             code, pos = ms[5]
             p = words.get("P")
             if p is None:
@@ -598,6 +604,10 @@ class Modal:
                 g76(self, b, gpos, axes, words, used, out)
             else:
                 g33(self, b, gpos, self.target_position(b, axes), words, used, out)
+            return
+        if mode in PROBE_CODES:
+            target = self.target_position(b, axes)
+            g38(self, b, mode, gpos, target, words, used, out)
             return
         if mode in (20, 30) and self.comp.arc_not_allowed:
             raise b.error("the move just after cutter compensation ends (G40) must be a "

@@ -48,6 +48,7 @@ class GCodeOptions:
         offsets per axis for G43 and diameters for cutter compensation; tool_lengths adds
         Z-only tools not in it.
     n_outputs: M62-M65 P must be in [0, n_outputs).
+    n_inputs / n_analog_inputs: M66 P / M66 E must be below them (digital, analog inputs).
     spindle_output / mist_output / flood_output: outputs carried by Spindle/Coolant.
     block_delete: skip lines starting with '/' (the block-delete switch is on).
     keep_comments: also emit plain comments as Message(kind="comment").
@@ -66,6 +67,8 @@ class GCodeOptions:
     parameters: Mapping[int, float] = field(default_factory=dict)
     tool_lengths: Mapping[int, float] = field(default_factory=dict)
     n_outputs: int = 16
+    n_inputs: int = 16
+    n_analog_inputs: int = 4
     spindle_output: int | None = None
     mist_output: int | None = None
     flood_output: int | None = None
@@ -146,6 +149,8 @@ class GCodeOptions:
                 raise MotionError(f"tool_lengths keys must be integers >= 0, got {key!r}")
             check_finite(f"tool_lengths[{key}]", v)
         check_int("n_outputs", self.n_outputs, 0)
+        check_int("n_inputs", self.n_inputs, 0)
+        check_int("n_analog_inputs", self.n_analog_inputs, 0)
         for name in ("spindle_output", "mist_output", "flood_output"):
             _opt_index(name, getattr(self, name))
         for name, lo in (("max_call_depth", 1), ("max_blocks", 1),

@@ -48,8 +48,11 @@ from ..errors import MotionError
 from ..units import AxisUnits
 from . import canon
 from .convert import ConvertOptions, Op, Scales, convert
-from .interp import compile_text
+from .interp import Interpreter, Session, compile_text
 from .options import AXIS_LETTERS, GCodeOptions
+from .parser import parse_program
+from .probing import InputResult, Probe, ProbeResult, WaitInput
+from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
 from .syncout import SyncedOutputs
 
@@ -57,6 +60,7 @@ if TYPE_CHECKING:
     from ..control.compare import CompareEngine
     from ..control.controller import Controller
     from ..control.group import Group
+    from ..hw.interface import InputEdge
 
 
 class RunState(Enum):
@@ -92,6 +96,7 @@ class RunOptions:
     repeat: int = 1
     single_block: bool = False
     optional_stop: bool = False
+    probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
 
     def __post_init__(self) -> None:
         ConvertOptions(self.rapid_ratio, self.feed_mode, self.chord_tol)
@@ -105,6 +110,10 @@ class RunOptions:
         for name in ("single_block", "optional_stop"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False")
+        pi = self.probe_input
+        if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
+                                   and pi[2:].isdigit()):
+            raise MotionError(f"probe_input must be a board input 'di<n>' or None, got {pi!r}")
 
 
 def machine_axes(ctl: Controller, axes: Mapping[str, int | str] | None = None) -> dict[str, int]:
@@ -193,6 +202,8 @@ class ProgramRunner:
             if bad in self._gextra:
                 raise MotionError(f"gcode must not set {bad!r} (the runner sets it)")
         self._gextra.setdefault("n_outputs", ctl.config.digital_outputs)
+        self._gextra.setdefault("n_inputs", ctl.config.digital_inputs)
+        self._gextra.setdefault("n_analog_inputs", 0)  # no analog inputs in the hardware
         if "soft_limits" not in self._gextra:  # moves past the EL switches fail to compile
             lims = []
             for k, i in zip(self.letters, self.axis_indices, strict=True):
@@ -211,13 +222,28 @@ class ProgramRunner:
             self._text = program
         elif isinstance(program, Sequence):
             self._commands = list(program)
-            bad_cmd = [c for c in self._commands if not isinstance(c, canon.Command)]
+            bad_cmd = [c for c in self._commands
+                       if not isinstance(c, canon.Command | Probe | WaitInput)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
             raise MotionError(f"program must be G-code text, a path or commands, got "
                               f"{type(program).__name__}")
         self._pass = self._compile(self._positions())
+        # G38.x / M66: the rest of the program depends on the machine's answer, so it is
+        # interpreted piece by piece while running (interp.Session, runwait.py)
+        self._live = self._text is not None and any(
+            isinstance(c, Probe | WaitInput) for c in self.commands)
+        self._session: Session | None = None
+        self._request: ProbeMove | InputWait | None = None
+        self._stray_trip: str | None = None
+        probe = next((c for c in self.commands if isinstance(c, Probe)), None)
+        if probe is not None:
+            if self.options.probe_input is None:
+                raise MotionError(f"line {probe.line}: G{probe.code / 10:g} needs "
+                                  "RunOptions(probe_input='di<n>'), the board input the "
+                                  "probe is wired to")
+            ctl.hardware.read_input(self.options.probe_input)  # validates the input
         self.state = RunState.READY
         self.events: list[RunEvent] = []
         self.passes_done = 0
@@ -257,6 +283,26 @@ class ProgramRunner:
             self.options.rapid_ratio, self.options.feed_mode, self.options.chord_tol))
         return _Pass(ops, start.copy())
 
+    def _live_pass(self, start: np.ndarray) -> _Pass:
+        """Start interpreting the program against the machine: the ops up to the first
+        probe or input wait (the rest follows each answer, `_answer`)."""
+        assert self._text is not None
+        opts = self._goptions(start)
+        program = parse_program(self._text, self.file, opts.max_line_length)
+        self._session = Interpreter(program, opts).session()
+        chunk = self._session.advance()
+        self._rpm = 0.0
+        return _Pass(self._convert(chunk, start), start.copy())
+
+    def _convert(self, chunk: list[canon.Command], start: np.ndarray) -> list[Op]:
+        ops = convert(chunk, self.scales, start, ConvertOptions(
+            self.options.rapid_ratio, self.options.feed_mode, self.options.chord_tol),
+            rpm=self._rpm)
+        for c in chunk:
+            if isinstance(c, canon.Spindle):
+                self._rpm = c.speed if c.on else 0.0
+        return ops
+
     @property
     def ops(self) -> list[Op]:
         return self._pass.ops
@@ -269,7 +315,9 @@ class ProgramRunner:
         if self.state is not RunState.READY:
             raise MotionError(f"start needs a ready runner (state {self.state.value})")
         pos = self._positions()
-        if not np.array_equal(pos, self._pass.start):
+        if self._live:
+            self._pass = self._live_pass(pos)
+        elif not np.array_equal(pos, self._pass.start):
             self._pass = self._compile(pos)  # the axes moved since compiling
         self._cursor = self._pass.start
         # the group works in machine units (true feed and arcs on mixed pulse scales)
@@ -283,6 +331,8 @@ class ProgramRunner:
         self.t_start = self._ctl.time
         self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._ctl.add_jump_observer(self._on_jump)
+        if self.options.probe_input is not None:
+            self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
 
     def pause(self) -> None:
         """Hold: decelerate along the path and stop; resume() continues."""
@@ -377,11 +427,16 @@ class ProgramRunner:
                                     index=index, level=level))
 
     def _finish(self, state: RunState, text: str) -> None:
+        if self._request is not None:  # disarm a probe / input wait in progress
+            self._request.close()
+            self._request = None
         self.state = state
         self.t_end = self._ctl.time
         self._event(state.value, self.current_line, text)
         self._ctl.remove_cycle_hook(self._on_cycle)
         self._ctl.remove_jump_observer(self._on_jump)
+        if self.options.probe_input is not None:
+            self._ctl.remove_edge_hook(self._on_probe_edge)
         if self.group is not None:
             if state is not RunState.ABORTED:
                 self.group.close()
@@ -422,6 +477,8 @@ class ProgramRunner:
         assert g is not None
         if g.state is GroupState.ERROR or self.synced.armed:
             return -math.inf
+        if self._request is not None or self._stray_trip is not None:
+            return -math.inf  # a probe move or M66 wait polls its input every cycle
         if self.state is not RunState.RUNNING:
             return math.inf
         return -math.inf if self._feed_ready(g) else math.inf
@@ -460,6 +517,12 @@ class ProgramRunner:
 
         g = self.group
         assert g is not None
+        if self._stray_trip is not None:  # LinuxCNC: a contact outside G38 stops the run
+            g.abort()
+            self.error = f"line {self.current_line}: {self._stray_trip}"
+            self._event("fault", self.current_line, self._stray_trip)
+            self._finish(RunState.ERROR, self.error)
+            return
         if g.state is GroupState.ERROR:
             self.error = f"line {self.current_line}: {g.error_message}"
             self._event("fault", self.current_line, g.error_message)
@@ -472,6 +535,8 @@ class ProgramRunner:
         if self.state is not RunState.RUNNING:
             return
         try:
+            if self._request is not None and not self._answer(g):
+                return
             self._feed(g)
         except (GroupError, MotionError) as err:
             line = self._pass.ops[self._pass.pc].line if self._pass.pc < len(self._pass.ops) \
@@ -496,6 +561,13 @@ class ProgramRunner:
                 self.state = RunState.PAUSED
                 self._step_line = None
                 self._event("single_block", self._last_line, "block done")
+                return
+            if isinstance(op.source, Probe) or op.kind == "wait":
+                if not self._idle():
+                    return
+                self._begin_request(g, op)
+                p.pc += 1
+                self._last_line = op.line
                 return
             if op.kind in ("line", "arc", "delay"):
                 idx = self._push(g, op)
@@ -543,6 +615,67 @@ class ProgramRunner:
         if p.pc >= len(p.ops) and self._idle() and not self.synced.armed:
             self._end_of_pass()
 
+    def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
+        """The probe makes contact while no probe move runs and the axes move: LinuxCNC's
+        "Probe tripped during non-probe move." (the cycle hook then stops the run)."""
+        if e.axis is None and e.signal == self.options.probe_input and e.level \
+                and not isinstance(self._request, ProbeMove) and self.group is not None \
+                and not self._idle() and self.state is RunState.RUNNING:
+            self._stray_trip = "Probe tripped during non-probe move."
+
+    def _begin_request(self, g: Group, op: Op) -> None:
+        """At rest before a probe move or an M66: arm the probe (and start the move) or
+        start watching the input."""
+        pos = self._positions()
+        if isinstance(op.source, Probe):
+            assert self.options.probe_input is not None
+            req = ProbeMove(self._ctl, self.axis_indices, self.options.probe_input,
+                            op.source, pos, self.scales.ppu)
+            self._request = req
+            self._event("probe", op.line, f"G{op.source.code / 10:g} on "
+                        f"{self.options.probe_input}")
+            if not req.at_start and not np.array_equal(op.target, pos):
+                idx = self._push(g, op)
+                self._line_of[idx] = op.line
+                self.op_of[idx] = op
+                self.starts_of[idx] = pos
+        else:
+            assert isinstance(op.source, WaitInput)
+            self._request = InputWait(self._ctl, op.source)
+            self._event("wait", op.line, f"M66 P{op.index} L{op.source.mode}")
+
+    def _answer(self, g: Group) -> bool:
+        """A probe or wait in progress: True once its answer is in and the rest of the
+        program (up to the next request) is queued as ops."""
+        req = self._request
+        if isinstance(req, ProbeMove):
+            if req.tripped and not req.stopping:
+                req.stopping = True
+                if not self._idle():
+                    g.abort()  # stop along the path, decelerating
+                t = req.trip_time
+                self._event("probe_trip", self._last_line,
+                            "tripped" + ("" if t is None else f" at t={t:.6f}"))
+            if not self._idle():
+                return False
+            rest = self._positions()
+            result: ProbeResult | InputResult = req.result(rest)
+        else:
+            assert req is not None
+            got = req.poll()
+            if got is None:
+                return False
+            result = got
+            rest = self._positions()
+            self._event("input", self._last_line, f"M66 read {result.value:g}")
+        req.close()
+        self._request = None
+        assert self._session is not None
+        chunk = self._session.advance(result)  # GCodeError: a fault at this line
+        self._cursor = rest
+        self._pass.ops.extend(self._convert(chunk, rest))
+        return True
+
     def _push(self, g: Group, op: Op) -> int:
         self._pushed += 1
         if op.kind == "delay":
@@ -564,7 +697,14 @@ class ProgramRunner:
         self._event("repeat", self._last_line, f"pass {self.passes_done + 1}")
         pos = self._positions()
         self._cursor = pos
-        if np.array_equal(pos, self._pass.start):
+        if self._live:
+            try:
+                self._pass = self._live_pass(pos)
+            except (GCodeError, MotionError) as err:
+                self.error = str(err)
+                self._event("fault", 0, str(err))
+                self._finish(RunState.ERROR, self.error)
+        elif np.array_equal(pos, self._pass.start):
             self._pass.pc = 0
         else:  # a program that does not return to its start: re-plan from here
             try:

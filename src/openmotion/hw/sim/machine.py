@@ -16,7 +16,7 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Callable, Collection, Sequence
 
 import numpy as np
 
@@ -84,6 +84,8 @@ class SimMachine:
         #: run quiet cycles of `run_cycles` in the compiled kernel (hw/sim/kernel.py) when
         #: it is built and models every axis; False: every cycle in Python (the reference)
         self.native = True
+        # inputs derived from axis positions (probe.py): raw edges -> board edges
+        self._edge_filters: list[Callable[[list], list]] = []
 
     # -- Hardware protocol --------------------------------------------------------------------
     @property
@@ -263,6 +265,8 @@ class SimMachine:
         for tk, _, sig, lv in self._timed.pop_due(t):
             self._set_do(tk, sig, lv)
         raw.sort(key=lambda e: e[0])
+        for f in self._edge_filters:
+            raw = f(raw)
         n = len(self._axes)
         edges = []
         for tm, axis, sig, lv, own in raw:
