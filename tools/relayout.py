@@ -86,7 +86,7 @@ MAPPING: dict[str, str] = {
     "group": "groups", "group_checks": "groups", "group_corners": "groups",
     "group_settings": "groups", "groupdue": "groups", "groupexec": "groups",
     "groupjoin": "groups", "pathaxes": "groups", "pathexec": "groups",
-    "pathpoints": "groups", "pathrun": "groups", "accuracy": "groups",
+    "pathpoints": "groups", "pathrun": "groups", "accuracy": "groups", "ptpblend": "groups",
     # manual motion
     "jog": "manual",
 }

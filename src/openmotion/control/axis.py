@@ -581,7 +581,7 @@ class Axis(AxisEngine):
                         abs_target: float | None, lead: float = 0.0) -> None:
         profile = planning.position_move(spec, self._pos, float(target))
         if lead > 0.0:
-            from .pathaxes import delayed
+            from ..profile.segments import delayed
 
             profile = delayed(profile, lead)
         self._start(ActiveMotion(profile, self._ctl.time, kind, spec, float(target),

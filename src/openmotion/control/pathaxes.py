@@ -129,14 +129,3 @@ def _near(grid: np.ndarray, brk: np.ndarray, tol: float) -> np.ndarray:
     """Which grid values lie within tol of a value of the sorted array brk."""
     k = np.clip(np.searchsorted(brk, grid), 1, len(brk) - 1)
     return np.minimum(np.abs(grid - brk[k - 1]), np.abs(grid - brk[k])) <= tol
-
-
-
-def delayed(p: Profile, lead: float) -> Profile:
-    """`p` starting `lead` seconds later, at rest on its start position until then (a
-    command that starts between two cycles: an exact MCC_DelayMotion)."""
-    from ..profile.segments import ProfileBuilder
-
-    rest = ProfileBuilder(p.start.p)
-    rest.segment(lead, 0.0, accel=0.0, label="delay")
-    return rest.build(end_p=p.start.p).splice(lead, p)

@@ -284,3 +284,11 @@ def empty_profile(p: float = 0.0) -> Profile:
     """A profile that stays at `p` (zero-distance move)."""
     p = check_pulses("p", p)
     return ProfileBuilder(p).build(end_p=p)
+
+
+def delayed(p: Profile, lead: float) -> Profile:
+    """`p` starting `lead` seconds later, at rest on its start position until then (a
+    command that starts between two cycles: an exact MCC_DelayMotion)."""
+    rest = ProfileBuilder(p.start.p)
+    rest.segment(lead, 0.0, accel=0.0, label="delay")
+    return rest.build(end_p=p.start.p).splice(lead, p)
