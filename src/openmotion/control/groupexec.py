@@ -37,9 +37,9 @@ from ..path.geometry import PathElement
 from ..path.lookahead import _element_limits as element_limits
 from ..path.smoothing import jerk_window
 from ..profile.pcl import MoveSpec
-from ..profile.segments import Profile, State
-from . import pathaxes, pathrun, planning, ptpblend
+from ..profile.segments import Profile, State, delayed
 from . import pathexec as px
+from . import pathrun, planning, ptpblend
 from .group_corners import LookaheadSettings
 from .groupjoin import AsyncJoin
 from .states import AxisState
@@ -567,7 +567,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                     max_vel=min(a.max_speed, spec.max_vel * self._ptp_override))
             if self._dry:
                 prof = planning.position_move(spec, float(start[k]), float(target[k]))
-                profiles.append(pathaxes.delayed(prof, lead) if lead > 1e-12 else prof)
+                profiles.append(delayed(prof, lead) if lead > 1e-12 else prof)
             elif target[k] != a.position:
                 with self._commanding():
                     a.move_absolute(float(target[k]), max_vel=spec.max_vel, tacc=spec.tacc,
@@ -587,7 +587,7 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                                                          self._ctl.period, self.position))
         lead = plan.t0 - t
         if lead > 1e-12:  # the plan starts later in this cycle (an exact delay)
-            profiles = [pathaxes.delayed(p, lead) for p in profiles]
+            profiles = [delayed(p, lead) for p in profiles]
         self._install(plan, profiles, cmds, t)
         if window and self._run is not None:
             self._run.window_end = plan.t0 + sp_w.duration  # t + the lead of a delay

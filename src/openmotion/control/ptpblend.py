@@ -18,9 +18,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import MotionError
-from ..profile.segments import Profile, empty_profile
+from ..profile.segments import Profile, delayed, empty_profile
 from ..profile.superpose import deceleration_start, superpose
-from . import pathaxes, planning
+from . import planning
 
 if TYPE_CHECKING:
     from .groupexec import GroupEngine, _Cmd
@@ -55,7 +55,7 @@ def blended_profiles(engine: GroupEngine, cmd: _Cmd, t: float, start: float
             if target[k] != old_end else None
         if m is None:
             out.append(None if nxt is None else
-                       (pathaxes.delayed(nxt, lead) if lead > 1e-12 else nxt))
+                       (delayed(nxt, lead) if lead > 1e-12 else nxt))
             continue
         if m.profile.end.v != 0.0:
             return None  # only moves that end at rest blend
