@@ -454,15 +454,20 @@ class Controller:
         self._n = n
         self._time = t1
         self._committed = None
+        # a hook may remove itself or another one: loop over a snapshot and skip the removed
+        # (removing from the live list skipped the hook after it in that cycle)
         if edges:
             hooks = self._edge_hooks
             for e in edges:
-                for h in hooks:
-                    h(self, e)
+                for h in tuple(hooks):
+                    if h in hooks:
+                        h(self, e)
         for ax in self.axes:
             ax._cycle_end(t1)
-        for h in self._cycle_hooks:
-            h(self, t1)
+        cycle_hooks = self._cycle_hooks
+        for h in tuple(cycle_hooks):
+            if h in cycle_hooks:
+                h(self, t1)
         if self.recorder is not None:
             self._record(t1)
 
