@@ -36,13 +36,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..hw.interface import AXIS_INPUTS, PieceBlock, QueuedHardware
+from . import motion as _motion
 
 if TYPE_CHECKING:
     from .controller import Controller
 
 #: Pieces are fed ahead in chunks of cycles, doubling from FIRST_CHUNK to MAX_CHUNK, so a
-#: jump that an edge ends early wastes little planning and memory stays flat.
+#: jump that an edge ends early wastes little planning and memory stays flat. With the
+#: compiled pieces (openmotion._kernel) a cycle's piece costs far less than a chunk's
+#: Python overhead, so chunks start at FIRST_CHUNK_COMPILED.
 FIRST_CHUNK = 32
+FIRST_CHUNK_COMPILED = 256
 MAX_CHUNK = 2048
 
 
@@ -112,7 +116,7 @@ def jump(ctl: Controller, land: int) -> None:
     wake = wake_signals(ctl)
     n = ctl._n
     t0 = ctl._time
-    chunk = FIRST_CHUNK
+    chunk = FIRST_CHUNK if _motion._kernel is None else FIRST_CHUNK_COMPILED
     ends: list[np.ndarray] = []
     while True:
         stop = min(land, n + chunk)
