@@ -339,7 +339,8 @@ PyDoc_STRVAR(run_doc,
 "-> (cycle reached, hardware time, record rows used)\n\n"
 "Run cycles start+1..stop over float64 ad[n, ND], int64 ai[n, NI], float64 sd[n, 8, 4],\n"
 "int64 si[n, 8, 2], float64 pieces[P, 6] (t0, dt, p0, v0, a0, j) with each axis's range\n"
-"and cursor in ai, popt[P] (the time each piece started), rows[R, 12] (pulse record),\n"
+"and cursor in ai, popt[P] (the time each piece started; empty: not wanted), rows[R, 12]\n"
+"(pulse record),\n"
 "int64 trace[stop - start, n, 3] (per cycle: pulse count, decoded count, input levels;\n"
 "an empty array: no trace).\n"
 "Stops before the first cycle ending at or after `limit`, or with an edge to report.");
@@ -364,9 +365,11 @@ static PyObject *run(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "run: axis arrays disagree in size");
         return NULL;
     }
-    double *AD = bufs[0].b.buf, *SD = bufs[2].b.buf, *PC = bufs[4].b.buf, *PT = bufs[5].b.buf;
+    double *AD = bufs[0].b.buf, *SD = bufs[2].b.buf, *PC = bufs[4].b.buf;
     int64_t *AI = bufs[1].b.buf, *SI = bufs[3].b.buf;
     Py_ssize_t npieces = bufs[4].b.len / (8 * 6);
+    /* piece start times only when the caller passes room for them (pulse recording) */
+    double *PT = bufs[5].b.len >= npieces * 8 ? bufs[5].b.buf : NULL;
     for (Py_ssize_t x = 0; x < n; x++) {
         int64_t *ai = AI + x * NI;
         if (ai[I_PBEGIN] < 0 || ai[I_PEND] > npieces || ai[I_CURSOR] < ai[I_PBEGIN]
@@ -408,7 +411,7 @@ static PyObject *run(PyObject *self, PyObject *args)
                     const double *pc = PC + ai[I_CURSOR] * 6;
                     ad[D_P0] = pc[2]; ad[D_V0] = pc[3]; ad[D_A0] = pc[4]; ad[D_J] = pc[5];
                     ad[D_TC] = pc[0]; ad[D_TE] = pc[0] + pc[1];
-                    PT[ai[I_CURSOR]] = now;
+                    if (PT != NULL) PT[ai[I_CURSOR]] = now;
                     ai[I_CURSOR]++;
                 }
                 if (ai[I_CURSOR] < ai[I_PEND] && PC[ai[I_CURSOR] * 6] < tn)

@@ -63,6 +63,18 @@ def first_cycle_at(ctl: Controller, t: float) -> int:
     return k
 
 
+_QUEUED: dict[type, bool] = {}
+
+
+def _queued(hw: object) -> bool:
+    """isinstance(hw, QueuedHardware), cached per class (a Protocol check is slow)."""
+    t = type(hw)
+    ok = _QUEUED.get(t)
+    if ok is None:
+        ok = _QUEUED[t] = isinstance(hw, QueuedHardware)
+    return ok
+
+
 def plan_jump(ctl: Controller, cycles: int) -> int:
     """Cycle number to jump to (at most `cycles` ahead), or the current cycle + 1 or less
     when the next cycle must run on its own (then `Controller.step` runs it)."""
@@ -70,7 +82,7 @@ def plan_jump(ctl: Controller, cycles: int) -> int:
     nxt = n0 + 1
     if (cycles < 2 or not ctl.virtual_jumps
             or ctl._sample_hooks or ctl._pre_hooks
-            or not isinstance(ctl.hardware, QueuedHardware)):
+            or not _queued(ctl.hardware)):
         return nxt
     land = n0 + cycles
     for ax in ctl.axes:
