@@ -77,8 +77,8 @@ def _wakes(name: str, switches: dict, wake: Collection[str] | None) -> bool:
 def level_bits(ax: SimAxis) -> int:
     """The axis's electrical input levels as a bit field, bit i = AXIS_INPUTS[i]."""
     word = 0
-    for i, sig in enumerate(AXIS_INPUTS):
-        if ax.level(sig):
+    for i, lv in enumerate(ax.levels()):
+        if lv:
             word |= 1 << i
     return word
 

@@ -278,7 +278,7 @@ class SimMachine:
     def read_axis(self, axis: int) -> AxisReadback:
         ax = self._axis(axis)
         return AxisReadback(ax.gen.count, ax.decoder.count,
-                            {s: ax.level(s) for s in AXIS_INPUTS})
+                            dict(zip(AXIS_INPUTS, ax.levels(), strict=True)))
 
     def write_output(self, axis: int | None, signal: str, level: bool) -> None:
         if not isinstance(level, bool):
