@@ -1,4 +1,4 @@
-"""Build of the compiled inner loops (openmotion._kernel, src/openmotion/_kernel.c); the rest is
+"""Build of the compiled inner loops (openmotion._kernel, src/openmotion/_kernel*.c); the rest is
 declared in pyproject.toml. Plain C against the CPython API: no build tool beyond setuptools.
 -ffp-contract=off keeps the compiler from fusing a*b+c, so the kernel's floats are
 bit-identical to the Python path's."""
@@ -9,5 +9,7 @@ from setuptools import Extension, setup
 
 flags = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off", "-fno-fast-math"]
 
-setup(ext_modules=[Extension("openmotion._kernel", ["src/openmotion/_kernel.c"],
+setup(ext_modules=[Extension("openmotion._kernel",
+                             ["src/openmotion/_kernel.c", "src/openmotion/_kernel_stepper.c"],
+                             depends=["src/openmotion/_kernel.h"],
                              extra_compile_args=flags)])

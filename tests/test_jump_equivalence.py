@@ -27,7 +27,12 @@ from openmotion.config import MachineConfig, SwitchConfig, default_machine
 from openmotion.control import Controller
 from openmotion.control.group import Group
 from openmotion.control.homing import HomeConfig, home_search
-from openmotion.control.jump import FIRST_CHUNK, first_cycle_at, plan_jump
+from openmotion.control.jump import (
+    FIRST_CHUNK,
+    FIRST_CHUNK_COMPILED,
+    first_cycle_at,
+    plan_jump,
+)
 from openmotion.errors import MotionError
 
 AXES = 3
@@ -340,9 +345,11 @@ def test_a_cycle_hook_without_due_keeps_every_cycle():
 
 
 @pytest.mark.parametrize("cycle", [FIRST_CHUNK - 1, FIRST_CHUNK, FIRST_CHUNK + 1,
-                                   3 * FIRST_CHUNK])
+                                   3 * FIRST_CHUNK, FIRST_CHUNK_COMPILED - 1,
+                                   FIRST_CHUNK_COMPILED, FIRST_CHUNK_COMPILED + 1])
 def test_an_edge_in_the_last_cycle_of_a_fed_chunk_ends_the_jump(cycle):
-    """Pieces are fed in chunks (FIRST_CHUNK, doubling): an E-stop in a chunk's last cycle
+    """Pieces are fed in chunks (FIRST_CHUNK, or FIRST_CHUNK_COMPILED with the compiled
+    pieces, doubling): an E-stop in a chunk's last cycle
     must land there, not be carried into the next chunk."""
     seen = []
     for jumping in (False, True):

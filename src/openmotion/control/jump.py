@@ -39,13 +39,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..hw.interface import AXIS_INPUTS, PieceBlock, QueuedHardware
+from . import motion as _motion
 
 if TYPE_CHECKING:
     from .controller import Controller
 
 #: Pieces are fed ahead in chunks of cycles, doubling from FIRST_CHUNK to MAX_CHUNK, so a
-#: jump that an edge ends early wastes little planning and memory stays flat.
+#: jump that an edge ends early wastes little planning and memory stays flat. With the
+#: compiled pieces (openmotion._kernel) a cycle's piece costs far less than a chunk's
+#: Python overhead, so chunks start at FIRST_CHUNK_COMPILED.
 FIRST_CHUNK = 32
+FIRST_CHUNK_COMPILED = 256
 MAX_CHUNK = 2048
 
 
@@ -62,13 +66,25 @@ def first_cycle_at(ctl: Controller, t: float) -> int:
     return k
 
 
+_QUEUED: dict[type, bool] = {}
+
+
+def _queued(hw: object) -> bool:
+    """isinstance(hw, QueuedHardware), cached per class (a Protocol check is slow)."""
+    t = type(hw)
+    ok = _QUEUED.get(t)
+    if ok is None:
+        ok = _QUEUED[t] = isinstance(hw, QueuedHardware)
+    return ok
+
+
 def plan_jump(ctl: Controller, cycles: int) -> int:
     """Cycle number to jump to (at most `cycles` ahead), or the current cycle + 1 or less
     when the next cycle must run on its own (then `Controller.step` runs it)."""
     n0 = ctl._n
     nxt = n0 + 1
     if (cycles < 2 or not ctl.virtual_jumps or ctl._sample_hooks
-            or not isinstance(ctl.hardware, QueuedHardware)):
+            or not _queued(ctl.hardware)):
         return nxt
     land = n0 + cycles
     pre_dues = ctl._pre_dues
@@ -124,7 +140,7 @@ def jump(ctl: Controller, land: int) -> None:
     wake = wake_signals(ctl)
     n = ctl._n
     t0 = ctl._time
-    chunk = FIRST_CHUNK
+    chunk = FIRST_CHUNK if _motion._kernel is None else FIRST_CHUNK_COMPILED
     ends: list[np.ndarray] = []
     while True:
         stop = min(land, n + chunk)

@@ -39,6 +39,10 @@ if TYPE_CHECKING:
     from .simaxis import SimAxis
 
 AVAILABLE = _k is not None
+# empty buffers for what a call does not want (never written: the kernel sees length 0)
+_NONE = np.zeros(0)
+_NO_PIECES = np.zeros((0, 6))
+_NO_TRACE = np.zeros(0, dtype=np.int64)
 _BIT = {sig: i for i, sig in enumerate(AXIS_INPUTS)}
 
 # field indices, kept in step with _kernel.c (checked against its constants below)
@@ -73,8 +77,8 @@ def _wakes(name: str, switches: dict, wake: Collection[str] | None) -> bool:
 def level_bits(ax: SimAxis) -> int:
     """The axis's electrical input levels as a bit field, bit i = AXIS_INPUTS[i]."""
     word = 0
-    for i, sig in enumerate(AXIS_INPUTS):
-        if ax.level(sig):
+    for i, lv in enumerate(ax.levels()):
+        if lv:
             word |= 1 << i
     return word
 
@@ -147,11 +151,11 @@ def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, peri
     ai = np.array(ail, dtype=np.int64)
     sd = np.array(sdl, dtype=float)
     si = np.array(sil, dtype=np.int64)
-    pieces = np.concatenate(blocks) if total else np.zeros((0, 6))
-    popt = np.zeros(len(pieces))
+    pieces = np.concatenate(blocks) if total else _NO_PIECES
+    popt = np.zeros(len(pieces)) if recording else _NONE
     cap = (stop - start) * n * 8 + 16 if recording else 0
-    rows = np.zeros((cap, _NREC))
-    tr = np.zeros((stop - start if trace else 0, n, 3), dtype=np.int64)
+    rows = np.zeros((cap, _NREC)) if cap else _NONE
+    tr = np.zeros((stop - start, n, 3), dtype=np.int64) if trace else _NO_TRACE
     k, t, used = _k.run(ad, ai, sd, si, pieces, popt, rows, tr, float(origin), float(period),
                         int(start), int(stop), float(now), float(limit))
     if k == start:

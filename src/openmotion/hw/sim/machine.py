@@ -156,7 +156,8 @@ class SimMachine:
         rows: list[np.ndarray] = []
         first = True
         while k < stop:
-            if not first and self._holding():
+            hold = self._holding()
+            if not first and hold:
                 k0 = k
                 k, edges = self._skip_idle(origin, period, k, stop)
                 if trace and k > k0:
@@ -164,7 +165,7 @@ class SimMachine:
                 if edges or k >= stop:
                     break
             first = False
-            if self.native and not self._pending and kernel.usable(self._axes):
+            if self.native and not hold and not self._pending and kernel.usable(self._axes):
                 k, self._t, tr = kernel.run_quiet(self._axes, queues, origin, period, k,
                                                   stop, self._t, self._next_action(), wake,
                                                   trace)
@@ -281,7 +282,7 @@ class SimMachine:
     def read_axis(self, axis: int) -> AxisReadback:
         ax = self._axis(axis)
         return AxisReadback(ax.gen.count, ax.decoder.count,
-                            {s: ax.level(s) for s in AXIS_INPUTS})
+                            dict(zip(AXIS_INPUTS, ax.levels(), strict=True)))
 
     def write_output(self, axis: int | None, signal: str, level: bool) -> None:
         if not isinstance(level, bool):

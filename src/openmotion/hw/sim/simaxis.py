@@ -32,6 +32,7 @@ if TYPE_CHECKING:
 
 #: Safety bound on toggles of one switch within one piece (an EZ window per revolution).
 _MAX_TOGGLES = 100_000
+_INPUT_INDEX = {sig: i for i, sig in enumerate(AXIS_INPUTS)}
 
 
 class SimAxis:
@@ -103,12 +104,28 @@ class SimAxis:
         return False
 
     def level(self, sig: str) -> bool:
-        shared = sig == "ltc" and "ltc" not in self.switches
-        nc = self.nc["sd" if shared else sig]
-        lv = self.active(sig) != nc
-        if sig == "ez":
-            lv = lv != self.z_flip
-        return lv
+        return self.levels()[_INPUT_INDEX[sig]]
+
+    def levels(self) -> tuple[bool, ...]:
+        """Electrical level of every input, in AXIS_INPUTS order: active XOR the contact
+        is NC (LTC shares the SD pin and its contact type while no LTC switch is placed;
+        EZ also XOR the wiring's Z inversion)."""
+        sws, nc = self.switches, self.nc
+        pel, mel, org, sd = (sws.get("pel"), sws.get("mel"), sws.get("org"), sws.get("sd"))
+        ltc = sws.get("ltc")
+        shared = ltc is None
+        if shared:
+            ltc = sd
+        ez = sws.get("ez")
+        return ((pel is not None and pel.active) != nc["pel"],
+                (mel is not None and mel.active) != nc["mel"],
+                (org is not None and org.active) != nc["org"],
+                (sd is not None and sd.active) != nc["sd"],
+                (ltc is not None and ltc.active) != nc["sd" if shared else "ltc"],
+                ((ez is not None and ez.active) != nc["ez"]) != self.z_flip,
+                self.active("alm") != nc["alm"],
+                self.active("inp") != nc["inp"],
+                self.active("rdy") != nc["rdy"])
 
     def _dec_state(self) -> tuple[int, int, int]:
         d = self.decoder

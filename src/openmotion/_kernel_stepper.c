@@ -1,0 +1,427 @@
+/* The simulator's stepper pipeline over a chunk of cycles (openmotion._kernel.run), called
+ * by hw/sim/kernel.py with flat arrays over all axes. For each cycle of the chunk it does
+ * what SimMachine.advance does for stepper axes without an armed stop or a pitch table:
+ * start queued pieces at their t0, cut the command into monotone stretches (velocity
+ * zeros, pull-out cuts), count pulses by the half-pulse rule, apply the stepper plant
+ * (stalls lose pulses), the backlash, the switches and the quadrature decoder. Crossings
+ * of switches nobody listens to (`wake` 0) only toggle the switch, as the Python path does
+ * before it drops those edges; a crossing that must be reported (`wake` 1) ends the chunk
+ * *before* that cycle (its state is rolled back), and the Python path runs that cycle and
+ * computes the edge's exact time and counts. Every formula repeats the Python operation
+ * order exactly (compiled with -ffp-contract=off), so the floats are bit-identical.
+ */
+#include "_kernel.h"
+
+#define EPS_PULSE 1e-9
+#define MAX_TOGGLES 100000
+#define BIG 4.0e15 /* beyond this the Python path (unbounded ints) takes over */
+
+/* per-axis double fields */
+enum { D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
+       D_UPP, ND };
+/* per-axis int64 fields */
+enum { I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
+       I_TURNF, I_TURNB, I_FWD, I_BWD = I_FWD + 5, I_PBEGIN = I_BWD + 5, I_PEND, I_CURSOR,
+       I_RECORD, I_LEVELS, NI };
+#define MAXSW 8
+/* per-switch double fields: kind (0 span, 1 index), lo|period, hi|width, hysteresis */
+enum { S_KIND, S_A, S_B, S_H, NSD };
+/* per-switch int64 fields: active, reported, the input-level bits it flips when active */
+enum { S_ACTIVE, S_WAKE, S_LEVELBITS, NSI };
+/* record row: axis, kind (0 jump, 1 cubic), t0, t1, tc, p0, v0, a0, j, d, c0, c1 */
+#define NREC 12
+
+enum { OK = 0, BAIL = 1 };
+
+typedef struct {
+    double *d;
+    int64_t *i;
+    double *sd;
+    int64_t *si;
+} Axis;
+
+typedef struct {
+    double *rows;
+    Py_ssize_t n, cap;
+    int axis;
+} Rec;
+
+static inline double cpos(const double *d, double s)
+{
+    return d[D_P0] + s * (d[D_V0] + s * (d[D_A0] / 2.0 + s * d[D_J] / 6.0));
+}
+
+static inline double cvel(const double *d, double s)
+{
+    return d[D_V0] + s * (d[D_A0] + s * d[D_J] / 2.0);
+}
+
+static inline double cacc(const double *d, double s) { return d[D_A0] + s * d[D_J]; }
+
+/* pieces.count_after; *bad set when the value leaves the exact integer range */
+static inline int64_t count_after(double u, int64_t count, int dir, double half, int *bad)
+{
+    if (dir > 0) {
+        double k = floor(u + half + EPS_PULSE);
+        if (!(fabs(k) < BIG)) { *bad = 1; return count; }
+        return (int64_t)k > count ? (int64_t)k : count;
+    }
+    if (dir < 0) {
+        double k = ceil(u - half - EPS_PULSE);
+        if (!(fabs(k) < BIG)) { *bad = 1; return count; }
+        return (int64_t)k < count ? (int64_t)k : count;
+    }
+    return count;
+}
+
+/* cubic.quadratic_roots: real roots strictly inside (lo, hi), ascending, no duplicates */
+static int quadratic_roots(double c2, double c1, double c0, double lo, double hi, double *out)
+{
+    double r[2];
+    int n = 0, m = 0;
+    if (c2 == 0.0) {
+        if (c1 == 0.0) return 0;
+        r[n++] = -c0 / c1;
+    } else {
+        double disc = c1 * c1 - 4.0 * c2 * c0;
+        if (disc < 0.0) return 0;
+        double sq = sqrt(disc);
+        double q = -0.5 * (c1 + copysign(sq, c1));
+        if (q != 0.0) {
+            r[n++] = q / c2;
+            r[n++] = c0 / q;
+            if (r[1] == r[0]) n = 1;
+        } else {
+            r[n++] = 0.0;
+        }
+    }
+    if (n == 2 && r[1] < r[0]) { double t = r[0]; r[0] = r[1]; r[1] = t; }
+    for (int k = 0; k < n; k++)
+        if (lo < r[k] && r[k] < hi) out[m++] = r[k];
+    return m;
+}
+
+/* pulses.limit_cuts */
+static int limit_cuts(const double *d, double vmax, double amax, double lo, double hi,
+                      double *out)
+{
+    int n = 0;
+    if (vmax > 0.0) {
+        n += quadratic_roots(d[D_J] / 2.0, d[D_A0], d[D_V0] - vmax, lo, hi, out + n);
+        n += quadratic_roots(d[D_J] / 2.0, d[D_A0], d[D_V0] + vmax, lo, hi, out + n);
+    }
+    if (amax > 0.0 && d[D_J] != 0.0) {
+        double as[2] = {amax, -amax};
+        for (int k = 0; k < 2; k++) {
+            double s = (as[k] - d[D_A0]) / d[D_J];
+            if (lo < s && s < hi) out[n++] = s;
+        }
+    }
+    return n;
+}
+
+/* switches.Switch / IndexSwitch.next_threshold; returns 0 for None */
+static inline int next_threshold(const double *sw, int active, double y, int d, double *thr)
+{
+    if (sw[S_KIND] == 0.0) {
+        if (active) { *thr = d > 0 ? sw[S_B] + sw[S_H] : sw[S_A] - sw[S_H]; return 1; }
+        if (d > 0) { if (y < sw[S_A]) { *thr = sw[S_A]; return 1; } return 0; }
+        if (y >= sw[S_B]) { *thr = sw[S_B]; return 1; }
+        return 0;
+    }
+    double p = sw[S_A], w = sw[S_B];
+    double base = floor(y / p) * p;
+    if (d > 0) { *thr = active ? base + w : base + p; return 1; }
+    if (active) { *thr = base; return 1; }
+    *thr = y >= base + w ? base + w : base - p + w;
+    return 1;
+}
+
+/* encoder._run_sum */
+static inline int64_t run_sum(const int64_t *pre, int64_t p, int64_t k0, int64_t n)
+{
+    int64_t full = n / p, rest = n % p;
+    int64_t total = full * pre[p];
+    int64_t start = ((k0 % p) + p) % p;
+    int64_t end = start + rest;
+    if (end <= p) total += pre[end] - pre[start];
+    else total += pre[p] - pre[start] + pre[end - p];
+    return total;
+}
+
+/* encoder.Decoder.advance */
+static inline int decoder_advance(Axis *a, double y, int d)
+{
+    int64_t *ai = a->i;
+    double x = y * a->d[D_UPP];
+    int64_t q = ai[I_Q], q1 = q;
+    if (d > 0) {
+        double k = floor(x + EPS_PULSE);
+        if (!(fabs(k) < BIG)) return BAIL;
+        if ((int64_t)k > q) q1 = (int64_t)k;
+    } else if (d < 0) {
+        double k = ceil(x - EPS_PULSE);
+        if (!(fabs(k) < BIG)) return BAIL;
+        if ((int64_t)k < q) q1 = (int64_t)k;
+    }
+    if (q1 == q) return OK;
+    int dd = q1 > q ? 1 : -1;
+    int64_t inc = dd != ai[I_LASTDIR] ? (dd > 0 ? ai[I_TURNF] : ai[I_TURNB]) : 0;
+    int64_t n = q1 > q ? q1 - q : q - q1;
+    int64_t p = ai[I_DPERIOD];
+    if (dd > 0) inc += run_sum(ai + I_FWD, p, q, n);
+    else inc += run_sum(ai + I_BWD, p, q - n + 1, n);
+    ai[I_DCOUNT] += inc;
+    ai[I_LASTDIR] = dd;
+    ai[I_Q] = q1;
+    return OK;
+}
+
+/* simaxis.SimAxis.scan for one motor piece ending at m1 in direction d */
+static int scan(Axis *a, double m1, int d)
+{
+    double *ad = a->d;
+    double z0 = ad[D_Z], z1;
+    if (d > 0) {
+        z1 = m1 > z0 ? m1 : z0;
+    } else {
+        double mb = m1 + ad[D_BACKLASH];
+        z1 = mb < z0 ? mb : z0;
+    }
+    double y1 = z1, y = ad[D_Y];
+    if (y1 != y) {
+        int nsw = (int)a->i[I_NSW];
+        for (int s = 0; s < nsw; s++) {
+            double *sw = a->sd + s * NSD;
+            int64_t *si = a->si + s * NSI;
+            double thr;
+            if (!next_threshold(sw, (int)si[S_ACTIVE], y, d, &thr)) continue;
+            if (d > 0 ? y1 < thr : y1 >= thr) continue;
+            if (si[S_WAKE]) return BAIL; /* an edge to report: the Python path runs it */
+            double yy = y;
+            for (int k = 0; k < MAX_TOGGLES; k++) {
+                if (!next_threshold(sw, (int)si[S_ACTIVE], yy, d, &thr)) break;
+                if (d > 0 ? y1 < thr : y1 >= thr) break;
+                si[S_ACTIVE] = !si[S_ACTIVE];
+                yy = thr;
+            }
+        }
+    }
+    ad[D_Z] = z1;
+    ad[D_Y] = y1;
+    return decoder_advance(a, y1, d);
+}
+
+static inline int record(Rec *rec, int kind, double t0, double t1, double tc, const double *d,
+                         int dir, int64_t c0, int64_t c1)
+{
+    if (rec->n >= rec->cap) return BAIL;
+    double *r = rec->rows + rec->n * NREC;
+    r[0] = rec->axis; r[1] = kind; r[2] = t0; r[3] = t1; r[4] = tc;
+    if (kind) { r[5] = d[D_P0]; r[6] = d[D_V0]; r[7] = d[D_A0]; r[8] = d[D_J]; }
+    else { r[5] = r[6] = r[7] = r[8] = 0.0; }
+    r[9] = dir; r[10] = (double)c0; r[11] = (double)c1;
+    rec->n++;
+    return OK;
+}
+
+/* StepperPlant.pieces (with PulseGenerator.stretches) + scan over [ta, tb] */
+static int run_axis(Axis *a, double ta, double tb, Rec *rec)
+{
+    double *ad = a->d;
+    int64_t *ai = a->i;
+    double tc = ad[D_TC], te = ad[D_TE], half = ad[D_HALF];
+    double vmax = ad[D_VMAX], amax = ad[D_AMAX];
+    int ideal = (int)ai[I_IDEAL], enabled = (int)ai[I_ENABLED], rec_on = (int)ai[I_RECORD];
+    int bad = 0;
+    double cuts[8];
+    int ncut = 0;
+    if (vmax > 0.0 || amax > 0.0) ncut = limit_cuts(ad, vmax, amax, ta - tc, tb - tc, cuts);
+    /* PulseGenerator.pos(ta), then _jump_to */
+    double x = ta - tc;
+    double mx = 0.0 > x ? 0.0 : x;
+    double lim = te - tc;
+    double s = lim < mx ? lim : mx;
+    double u = cpos(ad, s);
+    int64_t c0 = ai[I_COUNT];
+    int64_t c1 = count_after(u, c0, u > (double)c0 ? 1 : -1, half, &bad);
+    if (bad) return BAIL;
+    if (c1 != c0) {
+        ai[I_COUNT] = c1;
+        int dir = c1 > c0 ? 1 : -1;
+        if (rec_on && record(rec, 0, ta, ta, ta, ad, dir, c0, c1)) return BAIL;
+        if (enabled && ideal) {
+            if (scan(a, (double)(c1 - ai[I_LOST]), dir)) return BAIL;
+        } else {
+            ai[I_LOST] += c1 - c0;
+        }
+    }
+    double lo = tc > ta ? tc : ta, hi = te < tb ? te : tb;
+    if (!(hi > lo)) return OK;
+    double s_lo = lo - tc, s_hi = hi - tc;
+    double pts[12];
+    int np = 0;
+    pts[np++] = s_lo;
+    np += quadratic_roots(ad[D_J] / 2.0, ad[D_A0], ad[D_V0], s_lo, s_hi, pts + np);
+    for (int k = 0; k < ncut; k++)
+        if (s_lo < cuts[k] && cuts[k] < s_hi) pts[np++] = cuts[k];
+    for (int k = 1; k < np; k++) { /* insertion sort (a handful of points) */
+        double v = pts[k];
+        int m = k - 1;
+        while (m >= 0 && pts[m] > v) { pts[m + 1] = pts[m]; m--; }
+        pts[m + 1] = v;
+    }
+    pts[np++] = s_hi;
+    for (int k = 0; k + 1 < np; k++) {
+        double s0 = pts[k], s1 = pts[k + 1];
+        if (s1 <= s0) continue;
+        double p0 = cpos(ad, s0), p1 = cpos(ad, s1);
+        int d = p1 > p0 ? 1 : (p1 < p0 ? -1 : 0);
+        c0 = ai[I_COUNT];
+        c1 = count_after(p1, c0, d, half, &bad);
+        if (bad) return BAIL;
+        ai[I_COUNT] = c1;
+        double t0 = tc + s0, t1 = tc + s1;
+        if (rec_on && c1 != c0 && record(rec, 1, t0, t1, tc, ad, d, c0, c1)) return BAIL;
+        if (d == 0) continue;
+        double mid = 0.5 * (t0 + t1) - tc;
+        int over = (vmax > 0.0 && fabs(cvel(ad, mid)) > vmax)
+                   || (amax > 0.0 && fabs(cacc(ad, mid)) > amax);
+        if (!enabled || over) {
+            ai[I_LOST] += c1 - c0;
+            continue;
+        }
+        if (c1 != c0 && scan(a, (double)(c1 - ai[I_LOST]), d)) return BAIL;
+    }
+    return OK;
+}
+
+const char kernel_run_doc[] =
+"run(ad, ai, sd, si, pieces, popt, rows, trace, origin, period, start, stop, now, limit)\n"
+"-> (cycle reached, hardware time, record rows used)\n\n"
+"Run cycles start+1..stop over float64 ad[n, ND], int64 ai[n, NI], float64 sd[n, 8, 4],\n"
+"int64 si[n, 8, 2], float64 pieces[P, 6] (t0, dt, p0, v0, a0, j) with each axis's range\n"
+"and cursor in ai, popt[P] (the time each piece started; empty: not wanted), rows[R, 12]\n"
+"(pulse record),\n"
+"int64 trace[stop - start, n, 3] (per cycle: pulse count, decoded count, input levels;\n"
+"an empty array: no trace).\n"
+"Stops before the first cycle ending at or after `limit`, or with an edge to report.";
+
+PyObject *kernel_run(PyObject *self, PyObject *args)
+{
+    PyObject *o[8];
+    double origin, period, now, limit;
+    long long start, stop;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOddLLdd", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
+                          &o[6], &o[7], &origin, &period, &start, &stop, &now, &limit))
+        return NULL;
+    Buf bufs[8];
+    memset(bufs, 0, sizeof bufs);
+    static const char *names[8] = {"ad", "ai", "sd", "si", "pieces", "popt", "rows", "trace"};
+    for (int k = 0; k < 8; k++)
+        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, 8); return NULL; }
+    Py_ssize_t n = bufs[0].b.len / (8 * ND);
+    if (bufs[1].b.len != n * 8 * NI || bufs[2].b.len != n * 8 * MAXSW * NSD
+            || bufs[3].b.len != n * 8 * MAXSW * NSI) {
+        release(bufs, 8);
+        PyErr_SetString(PyExc_ValueError, "run: axis arrays disagree in size");
+        return NULL;
+    }
+    double *AD = bufs[0].b.buf, *SD = bufs[2].b.buf, *PC = bufs[4].b.buf;
+    int64_t *AI = bufs[1].b.buf, *SI = bufs[3].b.buf;
+    Py_ssize_t npieces = bufs[4].b.len / (8 * 6);
+    /* piece start times only when the caller passes room for them (pulse recording) */
+    double *PT = bufs[5].b.len >= npieces * 8 ? bufs[5].b.buf : NULL;
+    for (Py_ssize_t x = 0; x < n; x++) {
+        int64_t *ai = AI + x * NI;
+        if (ai[I_PBEGIN] < 0 || ai[I_PEND] > npieces || ai[I_CURSOR] < ai[I_PBEGIN]
+                || ai[I_CURSOR] > ai[I_PEND] || ai[I_NSW] < 0 || ai[I_NSW] > MAXSW
+                || ai[I_DPERIOD] < 1 || ai[I_DPERIOD] > 4) {
+            release(bufs, 8);
+            PyErr_SetString(PyExc_ValueError, "run: bad axis layout");
+            return NULL;
+        }
+    }
+    Rec rec = {bufs[6].b.buf, 0, bufs[6].b.len / (8 * NREC), 0};
+    /* trace[cycle - start - 1, axis] = (pulse count, decoded count, input levels: I_LEVELS
+     * with the S_LEVELBITS of every active switch flipped) when the
+     * caller asks for it (a buffer large enough for every cycle), else none */
+    int64_t *TR = bufs[7].b.len >= (stop - start) * n * 3 * 8 ? bufs[7].b.buf : NULL;
+    double *save_d = PyMem_Malloc(sizeof(double) * (n * ND + n * MAXSW * NSD + 1));
+    int64_t *save_i = PyMem_Malloc(sizeof(int64_t) * (n * NI + n * MAXSW * NSI + 1));
+    if (!save_d || !save_i) {
+        PyMem_Free(save_d); PyMem_Free(save_i); release(bufs, 8);
+        return PyErr_NoMemory();
+    }
+    long long k = start;
+    Py_BEGIN_ALLOW_THREADS
+    while (k < stop) {
+        double t = origin + (double)(k + 1) * period;
+        if (t >= limit) break;
+        memcpy(save_d, AD, sizeof(double) * n * ND);
+        memcpy(save_i, AI, sizeof(int64_t) * n * NI);
+        memcpy(save_i + n * NI, SI, sizeof(int64_t) * n * MAXSW * NSI);
+        Py_ssize_t rows0 = rec.n;
+        double now0 = now;
+        int status = OK;
+        for (;;) { /* SimMachine.advance: start due pieces, run to the next start or t */
+            double tn = t;
+            for (Py_ssize_t x = 0; x < n; x++) {
+                double *ad = AD + x * ND;
+                int64_t *ai = AI + x * NI;
+                while (ai[I_CURSOR] < ai[I_PEND] && PC[ai[I_CURSOR] * 6] <= now) {
+                    const double *pc = PC + ai[I_CURSOR] * 6;
+                    ad[D_P0] = pc[2]; ad[D_V0] = pc[3]; ad[D_A0] = pc[4]; ad[D_J] = pc[5];
+                    ad[D_TC] = pc[0]; ad[D_TE] = pc[0] + pc[1];
+                    if (PT != NULL) PT[ai[I_CURSOR]] = now;
+                    ai[I_CURSOR]++;
+                }
+                if (ai[I_CURSOR] < ai[I_PEND] && PC[ai[I_CURSOR] * 6] < tn)
+                    tn = PC[ai[I_CURSOR] * 6];
+            }
+            for (Py_ssize_t x = 0; x < n && status == OK; x++) {
+                Axis a = {AD + x * ND, AI + x * NI, SD + x * MAXSW * NSD, SI + x * MAXSW * NSI};
+                rec.axis = (int)x;
+                status = run_axis(&a, now, tn, &rec);
+            }
+            if (status != OK) break;
+            now = tn;
+            if (tn >= t) break;
+        }
+        if (status != OK) { /* roll the cycle back: the Python path runs it */
+            memcpy(AD, save_d, sizeof(double) * n * ND);
+            memcpy(AI, save_i, sizeof(int64_t) * n * NI);
+            memcpy(SI, save_i + n * NI, sizeof(int64_t) * n * MAXSW * NSI);
+            rec.n = rows0;
+            now = now0;
+            break;
+        }
+        if (TR != NULL) {
+            int64_t *tr = TR + (k - start) * n * 3;
+            for (Py_ssize_t x = 0; x < n; x++) {
+                const int64_t *ai = AI + x * NI, *si = SI + x * MAXSW * NSI;
+                int64_t levels = ai[I_LEVELS];
+                for (int sw = 0; sw < ai[I_NSW]; sw++)
+                    if (si[sw * NSI + S_ACTIVE]) levels ^= si[sw * NSI + S_LEVELBITS];
+                tr[x * 3] = ai[I_COUNT];
+                tr[x * 3 + 1] = ai[I_DCOUNT];
+                tr[x * 3 + 2] = levels;
+            }
+        }
+        k++;
+    }
+    Py_END_ALLOW_THREADS
+    PyMem_Free(save_d);
+    PyMem_Free(save_i);
+    release(bufs, 8);
+    return Py_BuildValue("LdN", k, now, PyLong_FromSsize_t(rec.n));
+}
+
+int kernel_layout(PyObject *m)
+{
+    return (PyModule_AddIntConstant(m, "ND", ND) < 0 || PyModule_AddIntConstant(m, "NI", NI) < 0
+            || PyModule_AddIntConstant(m, "MAXSW", MAXSW) < 0
+            || PyModule_AddIntConstant(m, "NSD", NSD) < 0
+            || PyModule_AddIntConstant(m, "NSI", NSI) < 0
+            || PyModule_AddIntConstant(m, "NREC", NREC) < 0) ? -1 : 0;
+}
