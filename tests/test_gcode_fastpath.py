@@ -147,7 +147,7 @@ def _tooled(**kw):
     return GCodeOptions(**kw, tool_table=ORACLE / "tools.tbl")
 
 
-@settings(max_examples=600, deadline=None)
+@settings(max_examples=300, deadline=None)
 @given(mixed, st.booleans(), st.sampled_from(["mm", "inch"]),
        st.sampled_from(["XYZA", "XYZ", "XZ", "XYZABC"]))
 def test_random_dialect_programs_same_as_general_path(lines, soft, units, axes):
@@ -219,7 +219,7 @@ long_programs = st.lists(st.one_of(plain_move, plain_move, plain_move, safe_dial
                          min_size=5, max_size=80)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(long_programs, st.sampled_from(["mm", "inch"]))
 def test_long_dialect_programs_same_as_general_path(lines, units):
     opts = _tooled(axes={"X": 0, "Y": 1, "Z": 2, "A": 3}, machine_units=units)
