@@ -50,10 +50,12 @@ from . import canon
 from .convert import ConvertOptions, Op, Scales, convert
 from .interp import Interpreter, Session, compile_text
 from .options import AXIS_LETTERS, GCodeOptions
+from .orient import Orient
 from .parser import parse_program
 from .probing import InputResult, Probe, ProbeResult, WaitInput
 from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
+from .spindle import OrientMove, SpindleDrive, SyncMove
 from .syncout import SyncedOutputs
 
 if TYPE_CHECKING:
@@ -97,6 +99,8 @@ class RunOptions:
     single_block: bool = False
     optional_stop: bool = False
     probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
+    spindle_axis: int | str | None = None  # the controller axis that is the spindle
+    spindle_acc_time: float = 0.5   # s of a spindle speed ramp
 
     def __post_init__(self) -> None:
         ConvertOptions(self.rapid_ratio, self.feed_mode, self.chord_tol)
@@ -110,6 +114,12 @@ class RunOptions:
         for name in ("single_block", "optional_stop"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False")
+        sa = self.spindle_acc_time
+        if isinstance(sa, bool) or not isinstance(sa, (int, float)) or not 0.0 < sa < 1e3:
+            raise MotionError(f"spindle_acc_time must be a number in (0, 1000) s, got {sa!r}")
+        sp = self.spindle_axis
+        if sp is not None and (isinstance(sp, bool) or not isinstance(sp, (int, str))):
+            raise MotionError(f"spindle_axis must be an axis index or name, got {sp!r}")
         pi = self.probe_input
         if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
                                    and pi[2:].isdigit()):
@@ -223,7 +233,7 @@ class ProgramRunner:
         elif isinstance(program, Sequence):
             self._commands = list(program)
             bad_cmd = [c for c in self._commands
-                       if not isinstance(c, canon.Command | Probe | WaitInput)]
+                       if not isinstance(c, canon.Command | Probe | WaitInput | Orient)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
@@ -235,8 +245,16 @@ class ProgramRunner:
         self._live = self._text is not None and any(
             isinstance(c, Probe | WaitInput) for c in self.commands)
         self._session: Session | None = None
-        self._request: ProbeMove | InputWait | None = None
+        self._request: ProbeMove | InputWait | SyncMove | OrientMove | None = None
         self._stray_trip: str | None = None
+        self.spindle: SpindleDrive | None = None
+        self.sync_moves: list[SyncMove] = []  # G33/G76 passes run against the spindle
+        self._spindle_index: int | None = None
+        if self.options.spindle_axis is not None:
+            self._spindle_index = ctl.axis(self.options.spindle_axis).index
+            if self._spindle_index in self.axis_indices:
+                raise MotionError(f"spindle_axis {self.options.spindle_axis!r} is one of the "
+                                  "program's axes")
         probe = next((c for c in self.commands if isinstance(c, Probe)), None)
         if probe is not None:
             if self.options.probe_input is None:
@@ -329,6 +347,9 @@ class ProgramRunner:
         self.group.set_sys_max_speed(float(np.max(self.scales.vmax_units)))
         self.state = RunState.RUNNING
         self.t_start = self._ctl.time
+        if self._spindle_index is not None:
+            self.spindle = SpindleDrive(self._ctl, self._spindle_index,
+                                        self.options.spindle_acc_time)
         self._ctl.add_cycle_hook(self._on_cycle)
         if self.options.probe_input is not None:
             self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
@@ -427,6 +448,9 @@ class ProgramRunner:
         if self._request is not None:  # disarm a probe / input wait in progress
             self._request.close()
             self._request = None
+        if self.spindle is not None:  # M2/M30, abort and faults stop the spindle
+            self.spindle.stop()
+            self.spindle.close()
         self.state = state
         self.t_end = self._ctl.time
         self._event(state.value, self.current_line, text)
@@ -471,6 +495,8 @@ class ProgramRunner:
             self._event("fault", self.current_line, g.error_message)
             self._finish(RunState.ERROR, self.error)
             return
+        if self.spindle is not None:
+            self.spindle.sample(t)
         self._trace_t.append(t)
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
@@ -505,7 +531,8 @@ class ProgramRunner:
                 self._step_line = None
                 self._event("single_block", self._last_line, "block done")
                 return
-            if isinstance(op.source, Probe) or op.kind == "wait":
+            synced = isinstance(op.source, canon.SyncedFeed) and self.spindle is not None
+            if isinstance(op.source, Probe) or op.kind in ("wait", "orient") or synced:
                 if not self._idle():
                     return
                 self._begin_request(g, op)
@@ -538,6 +565,8 @@ class ProgramRunner:
                         g.enable_blend(op.tolerance)
                     self.synced.set_blend(op.tolerance, float(np.max(np.abs(self.scales.ppu))))
                 elif op.kind == "action":
+                    if isinstance(op.source, canon.Spindle) and self.spindle is not None:
+                        self.spindle.apply(op.source)
                     for index, level in op.outputs:
                         self._set_output(op, index, level, "output")
                     self._event("action", op.line, op.text)
@@ -582,15 +611,49 @@ class ProgramRunner:
                 self._line_of[idx] = op.line
                 self.op_of[idx] = op
                 self.starts_of[idx] = pos
-        else:
-            assert isinstance(op.source, WaitInput)
+        elif isinstance(op.source, WaitInput):
             self._request = InputWait(self._ctl, op.source)
             self._event("wait", op.line, f"M66 P{op.index} L{op.source.mode}")
+        elif isinstance(op.source, Orient):
+            if self.spindle is None:
+                self._event("action", op.line, f"{op.text}: no spindle axis (ignored)")
+                return
+            self._request = OrientMove(self.spindle, op.source)
+            self._event("action", op.line, op.text)
+        else:
+            assert isinstance(op.source, canon.SyncedFeed) and self.spindle is not None
+            assert op.end is not None and op.target is not None
+            start = pos / self.scales.ppu
+
+            def push(feed: float, op: Op = op, start: np.ndarray = pos) -> None:
+                self._pushed += 1
+                g.set_feed(min(feed, float(np.max(self.scales.vmax_units))))
+                assert op.end is not None
+                idx = g.line(op.end)
+                self._line_of[idx] = op.line
+                self.op_of[idx] = op
+                self.starts_of[idx] = start
+                self._event("sync_start", op.line, "spindle index: synchronised move")
+
+            self._request = SyncMove(self.spindle, g, (start, op.end.copy()),
+                                     op.source.pitch, push)
+        self._cursor = op.target if op.target is not None else pos
 
     def _answer(self, g: Group) -> bool:
         """A probe or wait in progress: True once its answer is in and the rest of the
         program (up to the next request) is queued as ops."""
         req = self._request
+        if isinstance(req, SyncMove | OrientMove):
+            done = req.poll(self.scales.ppu) if isinstance(req, SyncMove) else req.poll()
+            if done:
+                if isinstance(req, SyncMove):
+                    self.sync_moves.append(req)
+                    self._event("sync_end", self._last_line, f"tool within "
+                                f"{req.steady_error:.3g} of pitch x spindle revolutions "
+                                "(settled, machine units)")
+                req.close()
+                self._request = None
+            return done
         if isinstance(req, ProbeMove):
             if req.tripped and not req.stopping:
                 req.stopping = True
