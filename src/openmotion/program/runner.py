@@ -622,21 +622,39 @@ class ProgramRunner:
             self._event("action", op.line, op.text)
         else:
             assert isinstance(op.source, canon.SyncedFeed) and self.spindle is not None
-            assert op.end is not None and op.target is not None
-            start = pos / self.scales.ppu
+            # the consecutive synchronised lines (a G76 pass with its tapers) run as one
+            p = self._pass
+            chain = [op]
+            while p.pc + len(chain) < len(p.ops) and isinstance(
+                    p.ops[p.pc + len(chain)].source, canon.SyncedFeed):
+                chain.append(p.ops[p.pc + len(chain)])
+            lines = []
+            at = pos / self.scales.ppu
+            for o in chain:
+                assert o.end is not None and isinstance(o.source, canon.SyncedFeed)
+                lines.append((at, o.end.copy(), o.source.pitch))
+                at = o.end
+            vmax = float(np.max(self.scales.vmax_units))
 
-            def push(feed: float, op: Op = op, start: np.ndarray = pos) -> None:
-                self._pushed += 1
-                g.set_feed(min(feed, float(np.max(self.scales.vmax_units))))
-                assert op.end is not None
-                idx = g.line(op.end)
-                self._line_of[idx] = op.line
-                self.op_of[idx] = op
-                self.starts_of[idx] = start
-                self._event("sync_start", op.line, "spindle index: synchronised move")
+            def push(rps: float, chain: list[Op] = chain, start: np.ndarray = pos
+                     ) -> list[int]:
+                idxs = []
+                for o in chain:
+                    assert o.end is not None and isinstance(o.source, canon.SyncedFeed)
+                    self._pushed += 1
+                    g.set_feed(min(o.source.pitch * rps, vmax))
+                    idx = g.line(o.end)
+                    self._line_of[idx] = o.line
+                    self.op_of[idx] = o
+                    self.starts_of[idx] = start
+                    start = o.target if o.target is not None else start
+                    idxs.append(idx)
+                self._event("sync_start", chain[0].line, "spindle index: synchronised move")
+                return idxs
 
-            self._request = SyncMove(self.spindle, g, (start, op.end.copy()),
-                                     op.source.pitch, push)
+            self._request = SyncMove(self.spindle, g, lines, push)
+            p.pc += len(chain) - 1
+            op = chain[-1]
         self._cursor = op.target if op.target is not None else pos
 
     def _answer(self, g: Group) -> bool:

@@ -145,28 +145,33 @@ class SpindleDrive:
 
 
 class SyncMove:
-    """One G33 / G76 pass on the group, locked to the spindle (module doc)."""
+    """One G33 / G76 pass on the group, locked to the spindle (module doc): a chain of
+    consecutive synchronised lines (a G76 pass with its tapers) runs as one, from one index
+    pulse; line k advances `pitch_k` per revolution."""
 
     GAIN = 40.0  # 1/s: position error -> speed correction
     EVERY = 4    # cycles between fine re-plans of the override
 
-    def __init__(self, drive: SpindleDrive, g: Group, line: tuple[np.ndarray, np.ndarray],
-                 pitch: float, push) -> None:
+    def __init__(self, drive: SpindleDrive, g: Group,
+                 lines: list[tuple[np.ndarray, np.ndarray, float]], push) -> None:
         self.drive = drive
         self.g = g
-        self.start, self.end = line  # machine units
-        d = self.end - self.start
-        self.length = float(np.linalg.norm(d))
-        self.u = d / self.length
-        self.pitch = pitch
-        self._push = push  # starts the group line (at the runner's feed); returns nothing
+        self.lines = lines  # (start, end, pitch), machine units
+        self.lengths = [float(np.linalg.norm(e - s)) for s, e, _ in lines]
+        self.length = sum(self.lengths)
+        self.pitch = min(p for _, _, p in lines)
+        self._cum_len = np.concatenate(([0.0], np.cumsum(self.lengths)))
+        self._cum_rev = np.concatenate(([0.0], np.cumsum(
+            [L / p for L, (_, _, p) in zip(self.lengths, lines, strict=True)])))
+        self._push = push  # push(speed_rps) queues the lines; returns their group indices
+        self._idx: list[int] = []
         self.c0: float | None = None
         self.t0: float | None = None
-        self.feed0 = 0.0
+        self.speed0 = 0.0
         self._pct = 100.0
         self._since = 0
-        #: per cycle after the start: (time, tool position along the line, position of
-        #: pitch x revolutions since the index - tool position), machine units
+        #: per cycle after the start: (time, tool position along the chain, position of
+        #: the spindle's revolutions since the index - tool position), machine units
         self.errors: list[tuple[float, float, float]] = []
         if abs(drive.revs_per_s()) * 60.0 < 1e-3 and drive.rpm == 0.0:
             raise MotionError("a synchronised move (G33/G76) needs the spindle turning")
@@ -177,10 +182,21 @@ class SyncMove:
             self.c0, self.t0 = count, t
             self.drive._index_listeners.remove(self._on_index)
 
-    def position(self) -> float:
-        """Tool position along the line (machine units from its start)."""
+    def position(self) -> tuple[float, int]:
+        """Tool position along the chain (machine units) and the line it is on."""
+        cur = self.g.current_index
+        k = self._idx.index(cur) if cur in self._idx else (
+            len(self.lines) - 1 if self.g.state is GroupState.IDLE else 0)
+        start, end, _ = self.lines[k]
+        u = (end - start) / self.lengths[k]
         pos = np.array([a.position for a in self.g.axes], dtype=float) / self._ppu
-        return float(np.dot(pos - self.start, self.u))
+        return float(self._cum_len[k] + np.dot(pos - start, u)), k
+
+    def _target(self, revs: float) -> float:
+        k = int(np.searchsorted(self._cum_rev, revs, side="right")) - 1
+        if k >= len(self.lines):
+            return self.length
+        return float(self._cum_len[k] + (revs - self._cum_rev[k]) * self.lines[k][2])
 
     def poll(self, ppu: np.ndarray) -> bool:
         """Per cycle; True when the pass has ended (the group at rest at its end)."""
@@ -188,20 +204,19 @@ class SyncMove:
         if self.c0 is None:
             return False
         revs = abs(self.drive.count() - self.c0) / self.drive.counts_per_rev
-        if self.feed0 == 0.0:  # the index has passed: start the line
+        if self.speed0 == 0.0:  # the index has passed: start the lines
             # the programmed feed is pitch x the commanded speed (the spindle may still be
             # ramping up to it): the override (1..200 %) then covers slower and catch-up
-            speed = max(abs(self.drive.revs_per_s()), abs(self.drive.rpm) / 60.0)
-            self.feed0 = max(self.pitch * speed, 1e-9)
-            self._push(self.feed0)
+            self.speed0 = max(abs(self.drive.revs_per_s()), abs(self.drive.rpm) / 60.0,
+                              1e-9)
+            self._idx = self._push(self.speed0)
             return False
-        s = self.position()
-        target = min(self.pitch * revs, self.length)
-        err = target - s
+        s, k = self.position()
+        err = self._target(revs) - s
         self.errors.append((self.drive.ctl.time, s, err))
-        if self.pitch * revs < self.length:
-            v = self.pitch * abs(self.drive.revs_per_s_now()) + self.GAIN * err
-            pct = min(200.0, max(1.0, 100.0 * v / self.feed0))
+        if revs < self._cum_rev[-1]:
+            rps = abs(self.drive.revs_per_s_now()) + self.GAIN * err / self.lines[k][2]
+            pct = min(200.0, max(1.0, 100.0 * rps / self.speed0))
             self._since += 1
             # a re-plan costs: only on a real change, or every few cycles to fine-tune
             step = abs(pct - self._pct)
