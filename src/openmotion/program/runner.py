@@ -52,7 +52,8 @@ from .interp import Interpreter, Session, compile_text
 from .options import AXIS_LETTERS, GCodeOptions
 from .orient import Orient
 from .parser import parse_program
-from .probing import InputResult, Probe, ProbeResult, WaitInput
+from .probing import Probe, WaitInput
+from .runrequests import answer, begin_request, on_probe_edge
 from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
 from .spindle import OrientMove, SpindleDrive, SyncMove
@@ -588,117 +589,13 @@ class ProgramRunner:
             self._end_of_pass()
 
     def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
-        """The probe makes contact while no probe move runs and the axes move: LinuxCNC's
-        "Probe tripped during non-probe move." (the cycle hook then stops the run)."""
-        if e.axis is None and e.signal == self.options.probe_input and e.level \
-                and not isinstance(self._request, ProbeMove) and self.group is not None \
-                and not self._idle() and self.state is RunState.RUNNING:
-            self._stray_trip = "Probe tripped during non-probe move."
+        on_probe_edge(self, ctl, e)
 
     def _begin_request(self, g: Group, op: Op) -> None:
-        """At rest before a probe move or an M66: arm the probe (and start the move) or
-        start watching the input."""
-        pos = self._positions()
-        if isinstance(op.source, Probe):
-            assert self.options.probe_input is not None
-            req = ProbeMove(self._ctl, self.axis_indices, self.options.probe_input,
-                            op.source, pos, self.scales.ppu)
-            self._request = req
-            self._event("probe", op.line, f"G{op.source.code / 10:g} on "
-                        f"{self.options.probe_input}")
-            if not req.at_start and not np.array_equal(op.target, pos):
-                idx = self._push(g, op)
-                self._line_of[idx] = op.line
-                self.op_of[idx] = op
-                self.starts_of[idx] = pos
-        elif isinstance(op.source, WaitInput):
-            self._request = InputWait(self._ctl, op.source)
-            self._event("wait", op.line, f"M66 P{op.index} L{op.source.mode}")
-        elif isinstance(op.source, Orient):
-            if self.spindle is None:
-                self._event("action", op.line, f"{op.text}: no spindle axis (ignored)")
-                return
-            self._request = OrientMove(self.spindle, op.source)
-            self._event("action", op.line, op.text)
-        else:
-            assert isinstance(op.source, canon.SyncedFeed) and self.spindle is not None
-            # the consecutive synchronised lines (a G76 pass with its tapers) run as one
-            p = self._pass
-            chain = [op]
-            while p.pc + len(chain) < len(p.ops) and isinstance(
-                    p.ops[p.pc + len(chain)].source, canon.SyncedFeed):
-                chain.append(p.ops[p.pc + len(chain)])
-            lines = []
-            at = pos / self.scales.ppu
-            for o in chain:
-                assert o.end is not None and isinstance(o.source, canon.SyncedFeed)
-                lines.append((at, o.end.copy(), o.source.pitch))
-                at = o.end
-            vmax = float(np.max(self.scales.vmax_units))
-
-            def push(rps: float, chain: list[Op] = chain, start: np.ndarray = pos
-                     ) -> list[int]:
-                idxs = []
-                for o in chain:
-                    assert o.end is not None and isinstance(o.source, canon.SyncedFeed)
-                    self._pushed += 1
-                    g.set_feed(min(o.source.pitch * rps, vmax))
-                    idx = g.line(o.end)
-                    self._line_of[idx] = o.line
-                    self.op_of[idx] = o
-                    self.starts_of[idx] = start
-                    start = o.target if o.target is not None else start
-                    idxs.append(idx)
-                self._event("sync_start", chain[0].line, "spindle index: synchronised move")
-                return idxs
-
-            self._request = SyncMove(self.spindle, g, lines, push)
-            p.pc += len(chain) - 1
-            op = chain[-1]
-        self._cursor = op.target if op.target is not None else pos
+        begin_request(self, g, op)
 
     def _answer(self, g: Group) -> bool:
-        """A probe or wait in progress: True once its answer is in and the rest of the
-        program (up to the next request) is queued as ops."""
-        req = self._request
-        if isinstance(req, SyncMove | OrientMove):
-            done = req.poll(self.scales.ppu) if isinstance(req, SyncMove) else req.poll()
-            if done:
-                if isinstance(req, SyncMove):
-                    self.sync_moves.append(req)
-                    self._event("sync_end", self._last_line, f"tool within "
-                                f"{req.steady_error:.3g} of pitch x spindle revolutions "
-                                "(settled, machine units)")
-                req.close()
-                self._request = None
-            return done
-        if isinstance(req, ProbeMove):
-            if req.tripped and not req.stopping:
-                req.stopping = True
-                if not self._idle():
-                    g.abort()  # stop along the path, decelerating
-                t = req.trip_time
-                self._event("probe_trip", self._last_line,
-                            "tripped" + ("" if t is None else f" at t={t:.6f}"))
-            if not self._idle():
-                return False
-            rest = self._positions()
-            result: ProbeResult | InputResult = req.result(rest)
-        else:
-            assert req is not None
-            got = req.poll()
-            if got is None:
-                return False
-            result = got
-            rest = self._positions()
-            self._event("input", self._last_line, f"M66 read {result.value:g}")
-        req.close()
-        self._request = None
-        assert self._session is not None
-        chunk = self._session.advance(result)  # GCodeError: a fault at this line
-        self._cursor = rest
-        self._pass.ops.extend(self._convert(chunk, rest))
-        return True
+        return answer(self, g)
 
     def _push(self, g: Group, op: Op) -> int:
         self._pushed += 1
