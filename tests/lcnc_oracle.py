@@ -214,9 +214,12 @@ def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None
         (d / "test.ini").write_text(INI)
         for name, body in (extra_files or {}).items():
             (d / name).write_text(body)
-        proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", "-g", "test.ngc"],
-                              cwd=d, capture_output=True, text=True, timeout=60,
-                              env={**os.environ, "TMPDIR": tmp})
+        for _ in range(2):  # rs274 was seen dying by a signal (SIGBUS) under load: retry
+            proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", "-g",
+                                   "test.ngc"], cwd=d, capture_output=True, text=True,
+                                  timeout=60, env={**os.environ, "TMPDIR": tmp})
+            if proc.returncode >= 0:
+                break
     listing = proc.stdout
     msgs = re.findall(r'MESSAGE\("(.*)"\)', listing)
     error = None

@@ -36,7 +36,6 @@ G_REFUSED = {
 }
 #: Why some well-known M-codes are refused.
 M_REFUSED = {
-    19: "spindle orientation (M19) is not supported",
     48: "override switches (M48) are not supported", 49: "override switches (M49)"
     " are not supported", 50: "feed override control (M50) is not supported",
     51: "spindle override control (M51) is not supported",
@@ -45,6 +44,6 @@ M_REFUSED = {
     67: "synchronized analog output (M67) is not supported",
     68: "analog output (M68) is not supported",
 }
-M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 7: 8, 8: 8, 9: 8,
+M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 19: 7, 7: 8, 8: 8, 9: 8,
            62: 5, 63: 5, 64: 5, 65: 5, 66: 5, 98: 11, 99: 11, 61: 6,
            70: 12, 71: 12, 72: 12, 73: 12}

@@ -38,6 +38,7 @@ from ..path import Arc, Direction
 from ..units import AxisUnits
 from . import canon
 from .options import MM_PER_INCH, ROTARY_LETTERS
+from .orient import Orient
 from .probing import Probe, WaitInput
 from .source import GCodeError
 
@@ -48,7 +49,9 @@ UNBOUNDED_BLEND = 1e12
 @dataclass(frozen=True)
 class Op:
     """One runner operation. kind: line, arc, delay, blend, pause, end, output, action,
-    wait (M66; `source` the WaitInput). A probe move is a line whose `source` is a Probe.
+    wait (M66; `source` the WaitInput), orient (M19; `source` the Orient). A probe move is
+    a line whose `source` is a Probe, a spindle-synchronised one (G33/G76) a line whose
+    `source` is the SyncedFeed.
 
     line/arc: `end` (machine units, all group axes), `target` (the same point in command
     pulses), `feed` (machine units/s), `rapid`; arc also `centre` (2 plane values, machine
@@ -177,6 +180,9 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), f, end=end,
                           source=cmd))
             pos = end
+        elif isinstance(cmd, Orient):
+            ops.append(Op("orient", cmd.line, cmd.file, seconds=cmd.timeout or 0.0,
+                          text=f"M19 R{cmd.angle:g} P{cmd.mode}", barrier=True, source=cmd))
         elif isinstance(cmd, WaitInput):
             ops.append(Op("wait", cmd.line, cmd.file, index=cmd.index, seconds=cmd.timeout,
                           source=cmd))

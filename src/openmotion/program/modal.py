@@ -30,6 +30,7 @@ from .messages import comment_commands
 from .modalstate import SavedState, state_word
 from .named import READ_ONLY, predefined
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
+from .orient import m19
 from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
@@ -333,7 +334,9 @@ class Modal:
             self.tool = self.selected_tool
             self.set_tool_parameters()
             out.append(canon.ToolChange(self.tool, line, file))
-        if 7 in ms:
+        if 7 in ms and ms[7][0] == 19:
+            m19(self, b, ms[7][1], words, used, out)
+        elif 7 in ms:
             code = ms[7][0]
             self.spindle_on = code != 5
             if code != 5:

@@ -50,10 +50,13 @@ from . import canon
 from .convert import ConvertOptions, Op, Scales, convert
 from .interp import Interpreter, Session, compile_text
 from .options import AXIS_LETTERS, GCodeOptions
+from .orient import Orient
 from .parser import parse_program
-from .probing import InputResult, Probe, ProbeResult, WaitInput
+from .probing import Probe, WaitInput
+from .runrequests import answer, begin_request, on_probe_edge
 from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
+from .spindle import OrientMove, SpindleDrive, SyncMove
 from .syncout import SyncedOutputs
 
 if TYPE_CHECKING:
@@ -97,6 +100,8 @@ class RunOptions:
     single_block: bool = False
     optional_stop: bool = False
     probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
+    spindle_axis: int | str | None = None  # the controller axis that is the spindle
+    spindle_acc_time: float = 0.5   # s of a spindle speed ramp
 
     def __post_init__(self) -> None:
         ConvertOptions(self.rapid_ratio, self.feed_mode, self.chord_tol)
@@ -110,6 +115,12 @@ class RunOptions:
         for name in ("single_block", "optional_stop"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False")
+        sa = self.spindle_acc_time
+        if isinstance(sa, bool) or not isinstance(sa, (int, float)) or not 0.0 < sa < 1e3:
+            raise MotionError(f"spindle_acc_time must be a number in (0, 1000) s, got {sa!r}")
+        sp = self.spindle_axis
+        if sp is not None and (isinstance(sp, bool) or not isinstance(sp, (int, str))):
+            raise MotionError(f"spindle_axis must be an axis index or name, got {sp!r}")
         pi = self.probe_input
         if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
                                    and pi[2:].isdigit()):
@@ -223,7 +234,7 @@ class ProgramRunner:
         elif isinstance(program, Sequence):
             self._commands = list(program)
             bad_cmd = [c for c in self._commands
-                       if not isinstance(c, canon.Command | Probe | WaitInput)]
+                       if not isinstance(c, canon.Command | Probe | WaitInput | Orient)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
@@ -235,8 +246,16 @@ class ProgramRunner:
         self._live = self._text is not None and any(
             isinstance(c, Probe | WaitInput) for c in self.commands)
         self._session: Session | None = None
-        self._request: ProbeMove | InputWait | None = None
+        self._request: ProbeMove | InputWait | SyncMove | OrientMove | None = None
         self._stray_trip: str | None = None
+        self.spindle: SpindleDrive | None = None
+        self.sync_moves: list[SyncMove] = []  # G33/G76 passes run against the spindle
+        self._spindle_index: int | None = None
+        if self.options.spindle_axis is not None:
+            self._spindle_index = ctl.axis(self.options.spindle_axis).index
+            if self._spindle_index in self.axis_indices:
+                raise MotionError(f"spindle_axis {self.options.spindle_axis!r} is one of the "
+                                  "program's axes")
         probe = next((c for c in self.commands if isinstance(c, Probe)), None)
         if probe is not None:
             if self.options.probe_input is None:
@@ -329,6 +348,9 @@ class ProgramRunner:
         self.group.set_sys_max_speed(float(np.max(self.scales.vmax_units)))
         self.state = RunState.RUNNING
         self.t_start = self._ctl.time
+        if self._spindle_index is not None:
+            self.spindle = SpindleDrive(self._ctl, self._spindle_index,
+                                        self.options.spindle_acc_time)
         self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._ctl.add_jump_observer(self._on_jump)
         if self.options.probe_input is not None:
@@ -430,6 +452,9 @@ class ProgramRunner:
         if self._request is not None:  # disarm a probe / input wait in progress
             self._request.close()
             self._request = None
+        if self.spindle is not None:  # M2/M30, abort and faults stop the spindle
+            self.spindle.stop()
+            self.spindle.close()
         self.state = state
         self.t_end = self._ctl.time
         self._event(state.value, self.current_line, text)
@@ -477,8 +502,10 @@ class ProgramRunner:
         assert g is not None
         if g.state is GroupState.ERROR or self.synced.armed:
             return -math.inf
-        if self._request is not None or self._stray_trip is not None:
-            return -math.inf  # a probe move or M66 wait polls its input every cycle
+        if self._request is not None or self._stray_trip is not None \
+                or self.spindle is not None:
+            # a probe move or M66 wait polls its input every cycle; the spindle is sampled
+            return -math.inf
         if self.state is not RunState.RUNNING:
             return math.inf
         return -math.inf if self._feed_ready(g) else math.inf
@@ -528,6 +555,8 @@ class ProgramRunner:
             self._event("fault", self.current_line, g.error_message)
             self._finish(RunState.ERROR, self.error)
             return
+        if self.spindle is not None:
+            self.spindle.sample(t)
         self._trace_t.append(t)
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
@@ -562,7 +591,8 @@ class ProgramRunner:
                 self._step_line = None
                 self._event("single_block", self._last_line, "block done")
                 return
-            if isinstance(op.source, Probe) or op.kind == "wait":
+            synced = isinstance(op.source, canon.SyncedFeed) and self.spindle is not None
+            if isinstance(op.source, Probe) or op.kind in ("wait", "orient") or synced:
                 if not self._idle():
                     return
                 self._begin_request(g, op)
@@ -595,6 +625,8 @@ class ProgramRunner:
                         g.enable_blend(op.tolerance)
                     self.synced.set_blend(op.tolerance, float(np.max(np.abs(self.scales.ppu))))
                 elif op.kind == "action":
+                    if isinstance(op.source, canon.Spindle) and self.spindle is not None:
+                        self.spindle.apply(op.source)
                     for index, level in op.outputs:
                         self._set_output(op, index, level, "output")
                     self._event("action", op.line, op.text)
@@ -616,65 +648,13 @@ class ProgramRunner:
             self._end_of_pass()
 
     def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
-        """The probe makes contact while no probe move runs and the axes move: LinuxCNC's
-        "Probe tripped during non-probe move." (the cycle hook then stops the run)."""
-        if e.axis is None and e.signal == self.options.probe_input and e.level \
-                and not isinstance(self._request, ProbeMove) and self.group is not None \
-                and not self._idle() and self.state is RunState.RUNNING:
-            self._stray_trip = "Probe tripped during non-probe move."
+        on_probe_edge(self, ctl, e)
 
     def _begin_request(self, g: Group, op: Op) -> None:
-        """At rest before a probe move or an M66: arm the probe (and start the move) or
-        start watching the input."""
-        pos = self._positions()
-        if isinstance(op.source, Probe):
-            assert self.options.probe_input is not None
-            req = ProbeMove(self._ctl, self.axis_indices, self.options.probe_input,
-                            op.source, pos, self.scales.ppu)
-            self._request = req
-            self._event("probe", op.line, f"G{op.source.code / 10:g} on "
-                        f"{self.options.probe_input}")
-            if not req.at_start and not np.array_equal(op.target, pos):
-                idx = self._push(g, op)
-                self._line_of[idx] = op.line
-                self.op_of[idx] = op
-                self.starts_of[idx] = pos
-        else:
-            assert isinstance(op.source, WaitInput)
-            self._request = InputWait(self._ctl, op.source)
-            self._event("wait", op.line, f"M66 P{op.index} L{op.source.mode}")
+        begin_request(self, g, op)
 
     def _answer(self, g: Group) -> bool:
-        """A probe or wait in progress: True once its answer is in and the rest of the
-        program (up to the next request) is queued as ops."""
-        req = self._request
-        if isinstance(req, ProbeMove):
-            if req.tripped and not req.stopping:
-                req.stopping = True
-                if not self._idle():
-                    g.abort()  # stop along the path, decelerating
-                t = req.trip_time
-                self._event("probe_trip", self._last_line,
-                            "tripped" + ("" if t is None else f" at t={t:.6f}"))
-            if not self._idle():
-                return False
-            rest = self._positions()
-            result: ProbeResult | InputResult = req.result(rest)
-        else:
-            assert req is not None
-            got = req.poll()
-            if got is None:
-                return False
-            result = got
-            rest = self._positions()
-            self._event("input", self._last_line, f"M66 read {result.value:g}")
-        req.close()
-        self._request = None
-        assert self._session is not None
-        chunk = self._session.advance(result)  # GCodeError: a fault at this line
-        self._cursor = rest
-        self._pass.ops.extend(self._convert(chunk, rest))
-        return True
+        return answer(self, g)
 
     def _push(self, g: Group, op: Op) -> int:
         self._pushed += 1
