@@ -83,19 +83,22 @@ def _figures(run: ProgramRunner, err: np.ndarray) -> list[tuple[str, object]]:
     lin = [k for k in moving if not rot[k]]
     # ---- path: rapids dashed, feeds coloured by the programmed feed (units/min)
     rapid = np.array([bool(getattr(run.op_of.get(int(i)), "rapid", False)) for i in idx])
+    cutting = np.array([run.op_of.get(int(i)) is not None for i in idx]) & ~rapid
     feed = np.array([60.0 * float(getattr(run.op_of.get(int(i)), "feed", 0.0)) for i in idx])
     if len(lin) >= 2:
         ax_x, ax_y = lin[0], lin[1]
         three = len(lin) >= 3
         fig = go.Figure()
         keep = screen_indices(pos[:, lin])
-        p, r, f, ti = _f32(pos[keep]), rapid[keep], _f32(feed[keep]), idx[keep]
+        p, r, f, ti = _f32(pos[keep]), ~cutting[keep], _f32(feed[keep]), idx[keep]
         lines = [run.line_of(int(i)) for i in ti]
         hover = [f"line {ln}, feed {fe:g} {units}/min" for ln, fe in zip(lines, f, strict=True)]
         cut = np.where(r, np.nan, 1.0)
         rap = np.where(r, 1.0, np.nan)
         cuts = f[~r]
         lo, hi = (float(cuts.min()), float(cuts.max())) if cuts.size else (0.0, 1.0)
+        if hi - lo <= 1e-6 * max(abs(hi), 1.0):  # one feed: a scale from 0 to it
+            lo, hi = 0.0, max(hi, 1.0)
         scale = {"colorscale": "Viridis", "cmin": lo, "cmax": max(hi, lo + 1e-9),
                  "colorbar": {"title": f"feed ({units}/min)"}}  # the cuts' feeds only
         labels = {"x": f"{run.letters[ax_x]} ({units}, machine)",
@@ -135,7 +138,7 @@ def _figures(run: ProgramRunner, err: np.ndarray) -> list[tuple[str, object]]:
         speed = np.linalg.norm(v[:, lin], axis=1) * 60.0
         keep = screen_indices(np.column_stack([speed, feed]))
         fig = go.Figure()
-        fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(np.where(rapid, np.nan, feed)[keep]),
+        fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(np.where(cutting, feed, np.nan)[keep]),
                                  name="programmed feed", line={"shape": "hv", "dash": "dot"}))
         fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(speed[keep]),
                                  name="actual path speed"))
@@ -156,7 +159,8 @@ def _figures(run: ProgramRunner, err: np.ndarray) -> list[tuple[str, object]]:
                                          legendgroup=run.letters[k], showlegend=row == 1,
                                          line={"color": _COLOURS[k % len(_COLOURS)]}),
                               row=row, col=1)
-            fig.update_yaxes(title_text=f"{'/'.join(sorted(set(unit_of)))}{per}", row=row,
+            shown = sorted({unit_of[k] for k in moving})
+            fig.update_yaxes(title_text=" or ".join(f"{u}{per}" for u in shown), row=row,
                              col=1)
         fig.update_xaxes(title_text="time (s)", row=4, col=1)
         fig.update_layout(height=900, legend={"orientation": "h"})
