@@ -64,3 +64,22 @@ def test_machine_jerk_makes_paths_jerk_limited():
     st = run_group(cfg, lambda g: g.line([60_000, 0]))
     assert np.abs(st[0].j).max() <= 1e8 * (1 + 1e-6)
     assert np.abs(st[0].j).max() > 1e7
+
+
+def test_refusals_of_a_units_group_speak_the_users_units():
+    from openmotion.control.group import GroupError
+
+    ctl = Controller(machine(max_accel=2000.0), safety=False)
+    ctl.enable_all()
+    g = Group(ctl, ["x", "y"], feed=100.0, acc_time=0.02, units=True)   # mm, mm/s
+    with pytest.raises(GroupError, match=r"axis x would need 5000 mm/s\^2 \(5e\+06 pps\^2\), "
+                                         r"above its maximum acceleration 2000 mm/s\^2"):
+        g.line([10.0, 0.0])
+    assert g.queue_length == 0
+    c2 = Controller(machine(), safety=False)
+    c2.enable_all()
+    p = Group(c2, ["x", "y"], feed=200_000.0)            # a group in pulses: as before
+    p.set_max_pulse_speed([100_000.0, 100_000.0])
+    with pytest.raises(GroupError, match=r"would need 200000 pps at feed 200000, above its "
+                                         r"maximum speed 100000 pps"):
+        p.line([10_000.0, 0.0])

@@ -32,7 +32,7 @@ from ..path import Arc, Arc3D, Line
 from ..profile.pcl import MoveSpec
 from ..units import AxisUnits
 from . import pathrun
-from .group_checks import unit_scales
+from .group_checks import unit_names, unit_scales
 from .group_settings import PERIOD_PULSES_DEFAULT, PERIOD_PULSES_MAX, GroupSettings
 from .groupexec import (
     ERR_ACCEL,
@@ -148,6 +148,7 @@ class Group(GroupSettings):
         self.axes: tuple[Axis, ...] = tuple(ax)
         self._k = k_units                       # signed pulses per logical unit, per axis
         self._ppu = np.abs(k_units)
+        self._unit_names = unit_names(controller, ax, units)  # messages in the user's units
         self._queue: deque[_Cmd] = deque()
         self._pre: dict[int, tuple[Any, ...]] = {}  # corners blended ahead (groupexec)
         self._pre_tail: tuple[int, Any] | None = None
