@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+from longrun import size
 from openmotion.cli import main
 from openmotion.program.report_html import screen_indices
 
@@ -28,17 +29,17 @@ def test_screen_indices_keep_ends_and_every_columns_extremes(y, n):
 
 
 def test_long_program_page_stays_small_and_shows_moving_axes(tmp_path, capsys):
-    # 3000 short moves (about 40 s of machine time at 1 ms cycles): the page is bounded by
-    # the screen, not by the program
+    # short moves (150: over 10,000 trace samples, more than a figure keeps; 3000 with
+    # --long): the page is bounded by the screen, not by the program
     rng = np.random.default_rng(5)
-    pts = rng.uniform(-40, 40, size=(3000, 2))
+    pts = rng.uniform(-5, 5, size=(size(150, 3000), 2))
     prog = tmp_path / "zigzag.ngc"
     prog.write_text("G21 G90 G64 P0.05 F6000\n" + "".join(
         f"G1 X{x:.3f} Y{y:.3f}\n" for x, y in pts) + "M2\n")
     assert main(["run", str(prog), "--out", str(tmp_path)]) == 0
     capsys.readouterr()
     page = (tmp_path / "zigzag.html")
-    assert page.stat().st_size < 2_000_000
+    assert page.stat().st_size < 1_500_000
     html = page.read_text()
     assert '"name":"X"' in html and '"name":"Y"' in html
     assert '"name":"Z"' not in html and '"name":"A"' not in html   # they do not move
