@@ -76,6 +76,8 @@ def test_refusals_of_a_units_group_speak_the_users_units():
                                          r"above its maximum acceleration 2000 mm/s\^2"):
         g.line([10.0, 0.0])
     assert g.queue_length == 0
+    with pytest.raises(GroupError, match=r"system maximum speed 500 mm/s, got 600"):
+        g.set_feed(600.0)
     c2 = Controller(machine(), safety=False)
     c2.enable_all()
     p = Group(c2, ["x", "y"], feed=200_000.0)            # a group in pulses: as before
