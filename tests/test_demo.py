@@ -27,7 +27,7 @@ def test_demo_command_writes_plots(tmp_path, capsys):
     assert (tmp_path / "demo_trace.png").stat().st_size > 1000
     assert (tmp_path / "demo_trace.html").exists()
     assert "faults         0" in out and "state          done" in out   # the G-code job
-    assert "<svg" in (tmp_path / "demo_laser.html").read_text()
+    assert "Plotly.newPlot" in (tmp_path / "demo_laser.html").read_text()
     # G64 P0.01: the executed contour (rapid-to-cut blends included) stays within 0.01 mm
     err = float(out.split("contour error")[1].split()[0])
     assert err <= 0.01 + 1e-9

@@ -132,3 +132,16 @@ def test_bad_input_writes_nothing(tmp_path, call, match) -> None:
     with pytest.raises(MotionError, match=match):
         call(tmp_path)
     assert not list(tmp_path.iterdir())
+
+
+def test_plot_trace_with_the_machine_names_axes_units_and_signals(tmp_path) -> None:
+    from openmotion.config import AxisConfig, MachineConfig
+
+    cfg = MachineConfig("t", (AxisConfig(name="x", lead=10.0), AxisConfig(name="a",
+                                                                         unit="degree",
+                                                                         lead=360.0)))
+    svg = plot_trace(trace(), tmp_path / "named.svg", machine=cfg)[0].read_text()
+    for text in ("X [mm/s]", "A [deg/s]", "X command [mm]", "X rdy (off/on)", "X state",
+                 "Standstill"):
+        assert text in svg, text
+    assert "axis 0" not in svg and "io0" not in svg and "state/" not in svg

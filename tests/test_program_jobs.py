@@ -82,7 +82,12 @@ def test_openmotion_run_writes_summary_and_report(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "done (2 pass(es))" in out and "contour error" in out
     html = (tmp_path / "out" / "job.html").read_text()
-    assert "<svg" in html and "sync_output" in html
+    assert "Plotly.newPlot" in html and "sync_output" in html
+    assert "<script src='plotly.min.js'>" in html and (tmp_path / "out" / "plotly.min.js").exists()
+    for heading in ("Path", "Path speed", "Axes (only those that move)", "Contour error",
+                    "Outputs", "Events"):
+        assert f"<h2>{heading}</h2>" in html
+    assert "acceleration time 0.05 s, feed override 100 %, 2 pass(es)" in html
     bad = tmp_path / "bad.ngc"
     bad.write_text("G1 X1 F600 Q\n")
     assert main(["run", str(bad), "--out", str(tmp_path / "out")]) == 2

@@ -224,6 +224,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--realtime", action="store_true", help="pace the run to the wall clock")
     r.add_argument("--repeat", type=int, default=1, help="run the program N times")
     r.add_argument("--out", default="out", help="folder for the report")
+    r.add_argument("--report", action="store_true",
+                   help="open the interactive report in the web browser when the run ends")
     r.add_argument("--acc-time", type=float, default=0.05,
                    help="seconds from rest to the programmed feed (path acceleration = "
                    "feed / acc-time)")

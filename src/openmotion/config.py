@@ -267,6 +267,8 @@ class AxisConfig:
     reverse: bool = False           # direction reversal
     unit: str = "mm"
     max_speed: float = 500.0        # maximum safe speed, user units/s
+    max_accel: float = 0.0          # acceleration limit, user units/s^2 (0: none)
+    max_jerk: float = 0.0           # jerk limit, user units/s^3 (0: none)
     pulse_mode: str = "out_dir"
     pulse_width_us: float = 2.0
     encoder_mode: str = "ab_x4"
@@ -304,6 +306,8 @@ class AxisConfig:
                 f"{p}.max_speed must be <= {MAX_PULSE_RATE / self.pulses_per_unit:g} "
                 f"{self.unit}/s (pulse output limit {MAX_PULSE_RATE:g} pps), "
                 f"got {self.max_speed!r}")
+        for lim in ("max_accel", "max_jerk"):
+            _set(self, lim, _nonneg(f"{p}.{lim}", getattr(self, lim)))
         _choice(f"{p}.pulse_mode", self.pulse_mode, PULSE_MODES)
         w = _positive(f"{p}.pulse_width_us", self.pulse_width_us)
         if w > MAX_PULSE_WIDTH_US:

@@ -154,7 +154,7 @@ def run_demo(out: Path) -> int:
               f"{pos:>10.3f} {ax.config.unit:<4} {ax.state.value}")
 
     written = plot_trace(rec, out / "demo_trace.png", title="openmotion demo: velocity curve",
-                         html=True)
+                         html=True, machine=ctl.config)
     move = scurve(distance=30000, str_vel=0, max_vel=60000, tacc=0.2, tdec=0.2,
                   vs_acc=10000, vs_dec=10000)
     written += plot_profile(move, out / "demo_scurve.png", title="S-curve of step 2",

@@ -23,6 +23,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from .config import MachineConfig
 from .errors import MotionError, check_int
 from .profile.segments import Profile
 from .recording import Recorder
@@ -146,13 +147,15 @@ def _check_arrays(arrays: Mapping[str, Any]) -> tuple[NDArray[Any], int]:
 
 def plot_trace(recorder_arrays: Mapping[str, Any] | Recorder, path: str | Path,
                axes: Sequence[int] | None = None, *, title: str | None = None,
-               html: bool = False) -> list[Path]:
+               html: bool = False, machine: MachineConfig | None = None) -> list[Path]:
     """Velocity curve (velocity vs time) of a recorded trace, with position and I/O lanes.
 
     `recorder_arrays` is `Recorder.arrays()`, `recording.load_trace(...)` or a Recorder;
     `axes` selects axes
     (default all). Velocity is `cmd_vel`, or the gradient of `cmd_pos` when it was not
-    recorded. I/O lanes show each bit of the `io` word that is ever set, and the state code.
+    recorded. I/O lanes show each bit of the `io` word that is ever set (off/on), and the
+    axis state. With `machine` (the recorded machine) axes are named and drawn in their
+    user units (mm, deg), signals by name (X pel, Y org); without it in pulses, "axis 0".
     Returns the paths written.
     """
     if isinstance(recorder_arrays, Recorder):
@@ -177,8 +180,10 @@ def plot_trace(recorder_arrays: Mapping[str, Any] | Recorder, path: str | Path,
     axs = np.atleast_1d(fig.subplots(n_rows, 1, sharex=True, height_ratios=[3, 2, 2][:n_rows]))
     ax_v, ax_p = axs[0], axs[1]
 
+    names, scale, units = _axis_labels(machine, n_axes)
     for a in sel:
         color = f"C{a % 10}"
+        k, u = scale[a], units[a]
         if "cmd_vel" in arr:
             v = arr["cmd_vel"][:, a]
         elif "cmd_pos" in arr and t.size > 1:
@@ -186,30 +191,45 @@ def plot_trace(recorder_arrays: Mapping[str, Any] | Recorder, path: str | Path,
         else:
             v = None
         if v is not None:
-            ax_v.plot(*envelope(t, v), lw=1.2, color=color, label=f"axis {a}")
+            ax_v.plot(*envelope(t, v / k), lw=1.2, color=color, label=f"{names[a]} [{u}/s]")
         if "cmd_pos" in arr:
-            ax_p.plot(*envelope(t, arr["cmd_pos"][:, a]), lw=1.2, color=color,
-                      label=f"axis {a} command")
+            ax_p.plot(*envelope(t, arr["cmd_pos"][:, a] / k), lw=1.2, color=color,
+                      label=f"{names[a]} command [{u}]")
         if "fb_pos" in arr:
-            ax_p.plot(*envelope(t, arr["fb_pos"][:, a]), lw=0.9, ls="--", color=color,
-                      alpha=0.7, label=f"axis {a} feedback")
-    ax_v.set_ylabel("velocity [pulse/s]")
-    ax_p.set_ylabel("position [pulse]")
+            ax_p.plot(*envelope(t, arr["fb_pos"][:, a] / k), lw=0.9, ls="--", color=color,
+                      alpha=0.7, label=f"{names[a]} feedback [{u}]")
+    one = len({units[a] for a in sel}) == 1
+    ax_v.set_ylabel(f"velocity [{units[sel[0]]}/s]" if one else "velocity [unit/s]")
+    ax_p.set_ylabel(f"position [{units[sel[0]]}]" if one else "position [unit]")
     for ax in (ax_v, ax_p):
         ax.grid(True, alpha=0.3)
         if ax.lines:
             ax.legend(loc="upper right", fontsize="small")
 
     if has_io:
-        _io_lanes(axs[2], t, arr, sel)
+        _io_lanes(axs[2], t, arr, sel, names)
     axs[-1].set_xlabel("time [s]")
     fig.suptitle(title)
     return _write(fig, p, html, title)
 
 
+def _axis_labels(machine: MachineConfig | None, n: int
+                 ) -> tuple[list[str], list[float], list[str]]:
+    """(names, pulses per unit, unit names) of the recorded axes."""
+    if machine is None or len(machine.axes) != n:
+        return [f"axis {a}" for a in range(n)], [1.0] * n, ["pulse"] * n
+    unit = {"degree": "deg"}
+    return ([a.name.upper() for a in machine.axes], [a.pulses_per_unit for a in machine.axes],
+            [unit.get(a.unit, a.unit) for a in machine.axes])
+
+
 def _io_lanes(ax: Any, t: NDArray[Any], arr: Mapping[str, NDArray[Any]],
-              sel: list[int]) -> None:
-    """Digital lanes: one per set bit of each axis's io word, then the state codes."""
+              sel: list[int], names: list[str]) -> None:
+    """Digital lanes: one per set bit of each axis's io word (off/on), then the states."""
+    from .control.controller import IO_BITS, STATE_CODES
+
+    signal = {bit: sig for sig, bit in IO_BITS}
+    state_name = {code: st.value for st, code in STATE_CODES.items()}
     labels: list[str] = []
     lane = 0
     if "io" in arr:
@@ -222,14 +242,22 @@ def _io_lanes(ax: Any, t: NDArray[Any], arr: Mapping[str, NDArray[Any]],
                 if used >> b & 1:
                     bit = (word >> b) & 1
                     ax.step(*envelope(t, lane + 0.8 * bit), where="post", lw=1.0)
-                    labels.append(f"ax{a} io{b}")
+                    labels.append(f"{names[a]} {signal.get(b, f'bit {b}')} (off/on)")
                     lane += 1
     if "state" in arr:
         for a in sel:
-            s = arr["state"][:, a]
-            top = max(int(np.max(np.abs(s))) if s.size else 1, 1)
-            ax.step(*envelope(t, lane + 0.8 * s / top), where="post", lw=1.0, color="k")
-            labels.append(f"ax{a} state/{top}")
+            s = arr["state"][:, a].astype(int)
+            # one lane per axis: the state as a bar that changes height with each state,
+            # its name written where it begins
+            codes = sorted(set(s.tolist()))
+            rank = {c: i for i, c in enumerate(codes)}
+            h = np.array([rank[c] for c in s]) / max(len(codes) - 1, 1)
+            ax.step(*envelope(t, lane + 0.8 * h), where="post", lw=1.0, color="k")
+            starts = np.nonzero(np.diff(s, prepend=s[0] - 1))[0] if s.size else []
+            for i in starts[:12]:
+                ax.text(t[i], lane + 0.8 * h[i] + 0.05, state_name.get(int(s[i]), str(s[i])),
+                        fontsize="x-small")
+            labels.append(f"{names[a]} state")
             lane += 1
     ax.set_yticks(np.arange(lane) + 0.4, labels)
     ax.set_ylim(-0.3, max(lane, 1) + 0.1)

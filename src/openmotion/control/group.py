@@ -32,7 +32,7 @@ from ..path import Arc, Arc3D, Line
 from ..profile.pcl import MoveSpec
 from ..units import AxisUnits
 from . import pathrun
-from .group_checks import unit_scales
+from .group_checks import unit_names, unit_scales
 from .group_settings import PERIOD_PULSES_DEFAULT, PERIOD_PULSES_MAX, GroupSettings
 from .groupdue import group_due
 from .groupexec import (
@@ -149,6 +149,7 @@ class Group(GroupSettings):
         self.axes: tuple[Axis, ...] = tuple(ax)
         self._k = k_units                       # signed pulses per logical unit, per axis
         self._ppu = np.abs(k_units)
+        self._unit_names = unit_names(controller, ax, units)  # messages in the user's units
         self._queue: deque[_Cmd] = deque()
         self._pre: dict[int, tuple[Any, ...]] = {}  # corners blended ahead (groupexec)
         self._pre_tail: tuple[int, Any] | None = None
@@ -177,7 +178,9 @@ class Group(GroupSettings):
         if acc_time is not None:
             self.set_acc_time(acc_time)
         self._vmax_pps = np.array([a.max_speed for a in ax], dtype=float)
-        self._amax_pps = np.full(len(ax), math.inf)
+        # the machine file's per-axis acceleration limit (0: none) caps every command
+        self._amax_pps = np.array([a.config.max_accel * a.config.pulses_per_unit
+                                   if a.config.max_accel > 0.0 else math.inf for a in ax])
         self._period_pulses = np.full(len(ax), PERIOD_PULSES_DEFAULT)
         self._period_pulse_acc = np.full(len(ax), PERIOD_PULSES_DEFAULT)
         self._update_caps()
@@ -185,6 +188,10 @@ class Group(GroupSettings):
         self._ptp_ratio = 10.0
         self._path_jerk = 0.0   # 0: T-curve path speed; > 0: S-curve with this path jerk
         self._path_sfactor = 0.0  # > 0: S-curve sized from the ramp times (MCCL)
+        jmax = [a.config.max_jerk * a.config.pulses_per_unit / k
+                for a, k in zip(ax, self._ppu, strict=True) if a.config.max_jerk > 0.0]
+        if jmax:  # the machine file's jerk limits: S paths whose jerk stays within them
+            self._path_jerk = min(jmax)
         self._str_vel = 0.0     # StrVel of the following path commands (0: from/to rest)
         self._ptp_shapes = ("T",) * len(ax)
         self._ptp_dec_shapes = ("T",) * len(ax)
@@ -364,9 +371,21 @@ class Group(GroupSettings):
         tacc, tdec = self.ptp_times
         for k, a in enumerate(self.axes):
             v = min(a.max_speed, self._vmax[k]) * (ratio or self._ptp_ratio) / 100.0
-            specs.append(MoveSpec(self._ptp_shapes[k], 0.0, v, tacc, tdec, 0.0, 0.0,
-                                  self._ptp_dec_shapes[k]))
+            sa, sd = self._ptp_shapes[k], self._ptp_dec_shapes[k]
+            specs.append(MoveSpec(sa, 0.0, v, self._ramp_time(k, sa, v, tacc),
+                                  self._ramp_time(k, sd, v, tdec), 0.0, 0.0, sd))
         return self._push(_Cmd(-1, "ptp", target=p, specs=tuple(specs)), p)
+
+    def _ramp_time(self, k: int, shape: str, v: float, t: float) -> float:
+        """A PtP ramp time `t` of axis k lengthened, if need be, to keep the axis within
+        its acceleration limit and (S ramps) jerk limit of the machine file: a T ramp
+        peaks at v/t, a pure S ramp at 2v/t with jerk 4v/t^2."""
+        a = self.axes[k].config
+        if a.max_accel > 0.0:
+            t = max(t, (2.0 if shape == "S" else 1.0) * v / (a.max_accel * a.pulses_per_unit))
+        if shape == "S" and a.max_jerk > 0.0:
+            t = max(t, math.sqrt(4.0 * v / (a.max_jerk * a.pulses_per_unit)))
+        return t
 
     @_locked
     def line(self, target: Sequence[float], *, relative: bool = False) -> int:

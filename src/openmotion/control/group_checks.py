@@ -157,15 +157,17 @@ class GroupChecks(GroupEngine):
             need = feed * tan * self._ppu
             k = _first_over(need, vmax * self._ppu)
             if k is not None:
-                raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need {need[k]:g} pps "
-                                            f"at feed {feed:g}, above its maximum pulse speed "
-                                            f"{self._vmax[k]:g} pps")
+                raise GroupError(ERR_SPEED, f"axis {self.names[k]} would need "
+                                            f"{self._in_units(k, need[k], '/s')} at feed "
+                                            f"{feed:g}, above its maximum speed "
+                                            f"{self._in_units(k, self._vmax[k], '/s')}")
             needa = max(accel, decel or 0.0) * tan * self._ppu
             k = _first_over(needa, amax * self._ppu)
             if k is not None:
-                raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need {needa[k]:g} "
-                                            f"pps^2, above its maximum pulse acceleration "
-                                            f"{self._amax[k]:g} pps^2")
+                raise GroupError(ERR_ACCEL, f"axis {self.names[k]} would need "
+                                            f"{self._in_units(k, needa[k], '/s^2')}, above "
+                                            f"its maximum acceleration "
+                                            f"{self._in_units(k, self._amax[k], '/s^2')}")
         return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
                                decel=decel, jerk=jerk, str_vel=sv), end)
 
@@ -183,6 +185,15 @@ class GroupChecks(GroupEngine):
         tj = 0.5 * s * min(ta, td)
         accel, dec = feed / (ta - tj), feed / (td - tj)
         return accel, (None if self._dec_time is None else dec), 2.0 * max(accel, dec) / tj
+
+    def _in_units(self, k: int, pulses: float, per: str) -> str:
+        """A pulse figure of axis k in the group's unit ("12.5 mm/s (25000 pps)"), or in
+        pulses for a group that works in pulses."""
+        unit = getattr(self, "_unit_names", None)
+        p_unit = "pps" if per == "/s" else "pps^2"
+        if not unit or unit[k] == "pulse":
+            return f"{pulses:g} {p_unit}"
+        return f"{pulses / self._ppu[k]:g} {unit[k]}{per} ({pulses:g} {p_unit})"
 
     def _check_str_vel(self, sv: float, feed: float, tan: np.ndarray) -> None:
         """StrVel of a path command: <= its feed, within every axis's maximum speed along
@@ -227,6 +238,17 @@ def unit_scales(controller: Controller, axes: Sequence[Axis],
     else:
         raise MotionError(f"units must be a bool or {len(axes)} AxisUnits, got {units!r}")
     return np.array([u.sign * u.pulses_per_unit for u in au], dtype=float)
+
+
+def unit_names(controller: Controller, axes: Sequence[Axis],
+               units: bool | Sequence[AxisUnits]) -> tuple[str, ...]:
+    """The logical unit of each axis ("pulse" when the group works in pulses), for
+    messages in the user's units."""
+    if units is False:
+        return ("pulse",) * len(axes)
+    if units is True:
+        return tuple(controller.config.axes[a.index].unit for a in axes)
+    return tuple(u.unit for u in units)  # type: ignore[union-attr]
 
 
 def _first_over(need: np.ndarray, cap: np.ndarray) -> int | None:

@@ -50,8 +50,11 @@ class GroupSettings(GroupChecks):
         if f <= 0.0:
             raise GroupError(ERR_SPEED, f"feed must be > 0, got {feed!r}")
         if hasattr(self, "_sys_max") and f > self._sys_max * (1 + 1e-12):
+            names = set(getattr(self, "_unit_names", ("pulse",)))
+            unit = "pps" if names == {"pulse"} else \
+                (f"{names.pop()}/s" if len(names) == 1 else "units/s")
             raise GroupError(ERR_SPEED, f"feed must be <= the system maximum speed "
-                                        f"{self._sys_max:g} pps, got {feed!r}")
+                                        f"{self._sys_max:g} {unit}, got {feed!r}")
         self._feed = f
 
     def set_sys_max_speed(self, speed: float) -> None:

@@ -1,4 +1,4 @@
-"""What a program run did: a summary (text) and an HTML report with embedded SVG figures.
+"""What a program run did: a summary (text) and an interactive HTML report (report_html.py).
 
 The runner keeps one trace sample per controller cycle (time, command index, positions in
 machine units). From it: run time, path length (linear axes), the largest contour error
@@ -10,7 +10,6 @@ deviation from the corner, not from one side), the I/O events and faults.
 
 from __future__ import annotations
 
-import html
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -18,11 +17,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import MotionError
-from ..svgplot import path_chart, step_chart, time_charts
 from . import canon
 
 if TYPE_CHECKING:
-    from .runner import ProgramRunner, RunEvent
+    from .runner import ProgramRunner
 
 
 @dataclass(frozen=True)
@@ -120,61 +118,17 @@ def format_summary(s: RunSummary) -> str:
     return "\n".join(out)
 
 
-def _figures(run: ProgramRunner) -> list[tuple[str, str]]:
-    """The report's figures as inline SVG, drawn at the resolution they are shown at
-    (svgplot.py: never more points than pixels), so any trace is drawn in milliseconds."""
-    t, _, pos = run.trace()
-    figs: list[tuple[str, str]] = []
-    if len(t) >= 2:
-        v = np.gradient(pos, t, axis=0)
-        lin = ~run.scales.rotary
-        speed = np.linalg.norm(v[:, lin], axis=1) * 60.0 if lin.any() else np.zeros(len(t))
-        units = run.machine_units
-        if pos.shape[1] >= 2:
-            figs.append(("Path", path_chart(
-                pos[:, :2], speed, f"{run.letters[0]} ({units})",
-                f"{run.letters[1]} ({units})", f"speed ({units}/min)",
-                "path coloured by speed")))
-        series = [(f"{letter} ({'deg' if run.scales.rotary[k] else units}/s)", v[:, k])
-                  for k, letter in enumerate(run.letters)]
-        figs.append(("Velocity per axis", time_charts(t - run.t_start, series, "time (s)")))
-    io_ev = [e for e in run.events if e.index is not None]
-    if io_ev:
-        lanes = []
-        for n in sorted({e.index for e in io_ev}):
-            ev = [e for e in io_ev if e.index == n]
-            ts = [run.t_start] + [e.t for e in ev] + [max(run.t_end, ev[-1].t)]
-            lv = [0] + [int(bool(e.level)) for e in ev] + [int(bool(ev[-1].level))]
-            lanes.append((f"do{n}", np.array(ts) - run.t_start, np.array(lv, dtype=float)))
-        figs.append(("Outputs", step_chart(lanes, "time (s)")))
-    return figs
-
-
-def _event_rows(events: list[RunEvent], limit: int = 2000) -> str:
-    rows = [f"<tr><td>{e.t:.4f}</td><td>{html.escape(e.kind)}</td><td>{e.line}</td>"
-            f"<td>{html.escape(e.text)}</td></tr>" for e in events[:limit]]
-    if len(events) > limit:
-        rows.append(f"<tr><td colspan=4>... {len(events) - limit} more</td></tr>")
-    return "\n".join(rows)
-
-
-def write_report(run: ProgramRunner, out_dir: str | Path, name: str = "report") -> Path:
-    """Write `<out_dir>/<name>.html` (summary, figures as inline SVG, events); its path."""
+def write_report(run: ProgramRunner, out_dir: str | Path, name: str = "report",
+                 options: str = "") -> Path:
+    """Write `<out_dir>/<name>.html`, the interactive report (report_html.py: summary,
+    plotly figures, events; plotly.min.js beside it); its path. `options`: a line on the
+    machine and run options shown above the summary."""
     if not isinstance(name, str) or not name or "/" in name or "\\" in name:
         raise MotionError(f"name must be a plain file name, got {name!r}")
+    from .report_html import write_html
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     s = summarize(run)
-    title = html.escape(run.file or "program")
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>openmotion run: {title}"
-             "</title><style>body{font-family:sans-serif;margin:2em}table{border-collapse:"
-             "collapse}td,th{border:1px solid #ccc;padding:2px 8px}</style></head><body>",
-             f"<h1>openmotion run: {title}</h1><pre>{html.escape(format_summary(s))}</pre>"]
-    for heading, svg in _figures(run):
-        parts.append(f"<h2>{heading}</h2>{svg}")
-    parts.append("<h2>Events</h2><table><tr><th>t (s)</th><th>kind</th><th>line</th>"
-                 f"<th>what</th></tr>{_event_rows(run.events)}</table></body></html>")
-    path = out / f"{name}.html"
-    path.write_text("\n".join(parts), encoding="utf-8")
-    return path
-
+    err, _ = contour_errors(run)
+    return write_html(run, s, format_summary(s), err, out / f"{name}.html", options)

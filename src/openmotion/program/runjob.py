@@ -84,8 +84,15 @@ def run_job(args: argparse.Namespace) -> int:
     summary = summarize(run)
     print(format_summary(summary))
     bar.status("writing the report ...")
-    report = write_report(run, args.out, path.stem)
+    options = (f"machine '{cfg.name}' ({''.join(run.letters)}), acceleration time "
+               f"{acc_time:g} s, feed override {override:g} %, {args.repeat} pass(es)")
+    report = write_report(run, args.out, path.stem, options)
     print(f"report: {report}")
+    if getattr(args, "report", False):
+        import webbrowser
+
+        if not webbrowser.open(report.resolve().as_uri()):
+            print(f"no web browser found: open {report} yourself", file=sys.stderr)
     if stop.pressed:
         return 130
     return 0 if run.state is RunState.DONE else 1
