@@ -291,9 +291,10 @@ class PathRecorder:
         r = self.runner
         if r is None or self._closed:
             return
-        if r.state not in (RunState.RUNNING, RunState.PAUSED):
-            self._record(t)      # the end point: every firing lies within the samples
-            self._closed = True
+        if r.state not in (RunState.RUNNING, RunState.PAUSED) and not any(
+                self.ctl.axes[i].is_moving for _k, i, _p in self._cols):
+            self._record(t)      # the end point (after an abort: at rest); every firing
+            self._closed = True  # lies within the samples
             return
         self._tick += 1
         if self._tick < self._every:
