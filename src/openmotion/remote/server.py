@@ -93,7 +93,7 @@ class Connection:
 
     def send_soon(self, obj: Any) -> None:
         """Thread-safe: queue a push on this connection's loop."""
-        if not self.closed:
+        if not self.closed and not self.loop.is_closed():
             asyncio.run_coroutine_threadsafe(self.send(obj), self.loop)
 
     # -- subscriptions (called from handler threads) -------------------------------------
