@@ -47,6 +47,7 @@ class ProgramSession:
         self.feed_override = 100.0
         self.single_block = False
         self._preview: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._compiled_at: tuple[float, ...] = ()
         self.path = PathRecorder(ctl)
 
     # ------------------------------------------------------------------ loading
@@ -73,8 +74,12 @@ class ProgramSession:
     def _make_runner(self, text: str, name: str) -> ProgramRunner:
         params = {} if sets_work_offset(text) else work_origin(self.ctl)
         opts = RunOptions(single_block=self.single_block)
+        self._compiled_at = self._positions()
         return ProgramRunner(self.ctl, text, options=opts, file=name,
                              gcode={"parameters": params})
+
+    def _positions(self) -> tuple[float, ...]:
+        return tuple(ax.position for ax in self.ctl.axes)
 
     def _check_idle(self, what: str) -> None:
         r = self.runner
@@ -95,7 +100,9 @@ class ProgramSession:
                           repeat=repeat, acc_time=acc_time)
         if not 1.0 <= feed_override <= 200.0:
             raise MotionError(f"feed_override must be in [1, 200] %, got {feed_override!r}")
-        if r.state is not RunState.READY:   # ran before: compile it again
+        if r.state is not RunState.READY or self._compiled_at != self._positions():
+            # ran before, or the axes moved since the compile: compile again here, outside
+            # the lock (start() would do it under the lock, holding up the cycle)
             r = self._make_runner(self.text, self.file)
         r.options = opts   # run-time settings only: the compiled operations stay valid
         with self.ctl.lock:
@@ -284,9 +291,10 @@ class PathRecorder:
         r = self.runner
         if r is None or self._closed:
             return
-        if r.state not in (RunState.RUNNING, RunState.PAUSED):
-            self._record(t)      # the end point: every firing lies within the samples
-            self._closed = True
+        if r.state not in (RunState.RUNNING, RunState.PAUSED) and not any(
+                self.ctl.axes[i].is_moving for _k, i, _p in self._cols):
+            self._record(t)      # the end point (after an abort: at rest); every firing
+            self._closed = True  # lies within the samples
             return
         self._tick += 1
         if self._tick < self._every:
