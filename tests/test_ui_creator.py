@@ -219,6 +219,8 @@ def test_home_then_move_changes_chart_and_lamps(page):
     assert vel > 30
     csv = page.evaluate("window.openmotion.scopeChart.toCsv()")
     assert csv.startswith("t_s,") and csv.count("\n") > 100
+    field(page, "scope-view", "window").fill("20")     # the move in view for the screenshot
+    page.wait_for_timeout(300)
     shot(page, "scope")
 
 
