@@ -321,3 +321,20 @@ def test_the_page_logic_in_the_browser(page):
     assert first == 0 and last == 1000 and 95 <= n <= 110     # one point per 0.01 of 1.0
     assert out["snap"] == {"axes": {"x": {"command": 1, "io": {"inp": False, "org": False},
                                           "fault": None}}, "estop": True}
+
+
+def test_escape_stops_every_axis_decelerating_and_f1_is_the_estop(page):
+    ready_axis(page, "z")
+    field(page, "op-target", "mode").select_option("velocity")
+    field(page, "op-target", "velocity").fill("5")
+    page.click("#op-play2")
+    wait_status(page, "s.axes.z.velocity > 0", 5)
+    page.keyboard.press("Escape")
+    wait_status(page, "!s.axes.z.moving && s.axes.z.velocity === 0", 5)
+    assert status(page, "s.axes.z.state") == "Standstill"      # a stop, not an ErrorStop
+    page.click("#op-play2")
+    wait_status(page, "s.axes.z.velocity > 0", 5)
+    page.keyboard.press("F1")
+    wait_status(page, "!s.axes.z.moving && s.axes.z.state === 'ErrorStop'", 5)
+    page.click("#estop-reset")
+    wait_status(page, "Object.values(s.axes).every((a) => a.state !== 'ErrorStop')", 5)

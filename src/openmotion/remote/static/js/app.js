@@ -213,13 +213,24 @@ class App extends EventTarget {
     $("#next-axis").addEventListener("click", () => this.nextAxis());
     $("#estop").addEventListener("click", () => this.estop());
     $("#reload-config").addEventListener("click", () => this.reloadConfig());
-    window.addEventListener("keydown", (e) => { if (e.key === "Escape") this.estop(); });
+    // AXIS's keys: F1 = E-stop; Escape = stop (abort the program, every axis decelerates)
+    window.addEventListener("keydown", (e) => {
+      if (e.key === "F1") { e.preventDefault(); this.estop(); } else if (e.key === "Escape") this.stopAll();
+    });
 
     for (const [name, mod] of Object.entries(PAGES)) mod.mount(this, $(`#page-${name}`));
     const route = () => this.show(window.location.hash.slice(1) || "operation");
     window.addEventListener("hashchange", route);
     route();
     this.rpc.connect();
+  }
+
+  stopAll() {
+    const p = this.status && this.status.program;
+    if (p && (p.state === "running" || p.state === "paused")) this.rpc.call("program.abort").catch(() => {});
+    this.rpc.call("axis.stop", {})
+      .then(() => this.log("stop: every axis decelerates"))
+      .catch((err) => this.log(`STOP FAILED: ${err.message}`, true));
   }
 
   estop() {
