@@ -3,6 +3,7 @@
 
 import { Rpc, RpcError, defaultUrl } from "./rpc.js";
 import { $, $$, el } from "./dom.js";
+import { mergeDiff } from "./status.js";
 import * as machine from "./pages/machine.js";
 import * as iface from "./pages/interface.js";
 import * as operation from "./pages/operation.js";
@@ -24,17 +25,6 @@ const COMMANDS = new Set(["interface.set", "home.set", "machine.load", "machine.
   "axis.set_position", "axis.reset_position", "home.start", "jog.start", "jog.step",
   "program.load", "program.run", "program.resume", "program.single_block", "program.feed_override",
   "sim.trip_limit", "sim.alarm", "sim.speed", "scope.configure", "scope.run", "scope.arm"]);
-
-function isObj(v) { return v !== null && typeof v === "object" && !Array.isArray(v); }
-
-/** Merge a status diff into the snapshot (nested objects merge, everything else replaces). */
-export function mergeDiff(into, diff) {
-  for (const [k, v] of Object.entries(diff || {})) {
-    if (isObj(v) && isObj(into[k])) mergeDiff(into[k], v);
-    else into[k] = isObj(v) ? structuredClone(v) : v;
-  }
-  return into;
-}
 
 class App extends EventTarget {
   constructor() {
@@ -241,5 +231,6 @@ class App extends EventTarget {
   }
 }
 
+export { mergeDiff };
 export const app = new App();
 app.start();
