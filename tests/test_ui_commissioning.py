@@ -9,7 +9,7 @@ import pytest
 
 import ui_browser
 from test_ui_creator import field, goto, ready_axis
-from ui_browser import status, wait_status
+from ui_browser import shot, status, wait_status
 
 server = ui_browser.server
 browser = ui_browser.browser
@@ -84,6 +84,7 @@ def test_the_homing_drawing_follows_the_selected_mode(page):
     assert "EZ" in note and "ORG" in note and "home mark" in note
     arrows = page.locator("#home-drawing line[marker-end]").count()
     assert arrows == 4          # three phases and the final move to the mark
+    shot(page, "homing")
     field(page, "home-fields", "mode").select_option("0")
     page.wait_for_function("() => document.querySelector('#home-seq-note').children.length === 1")
     # an invalid speed is refused beside its field, nothing saved

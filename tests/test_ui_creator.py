@@ -186,7 +186,6 @@ def test_home_then_move_changes_chart_and_lamps(page):
     wait_status(page, "s.axes.x.homing.state === 'done' && !s.axes.x.moving"
                 " && s.axes.x.command === 0", 30)
     assert status(page, "s.axes.x.io.org") is True
-    shot(page, "homing")
     goto(page, "operation")
     page.wait_for_selector("#op-play2")
     field(page, "op-target", "mode").select_option("relative")
