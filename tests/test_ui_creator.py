@@ -149,7 +149,7 @@ def test_jog_runs_while_held_and_stops_on_release(page):
     page.mouse.down()
     wait_status(page, "s.axes.x.velocity > 0", 5)
     page.wait_for_timeout(600)   # held longer than the deadman: the confirmations keep it going
-    assert status(page, "s.axes.x.velocity") > 0
+    assert status(page, "s.axes.x.velocity") > 0, page.inner_text("#log")
     page.mouse.up()
     wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
     # keyboard jog: key down moves, key up stops

@@ -50,13 +50,14 @@ export function mount(a, node) {
   jogger = new Jogger({
     start: async (axis, direction, opts) => (await app.call("jog.start", { axis, direction, ...opts })).jog,
     confirm: (jog) => app.rpc.notify("jog.confirm", { jog }),
+    check: (jog) => app.rpc.call("jog.confirm", { jog }, { timeoutMs: 1000 }),
     stop: (jog) => app.call("jog.stop", { jog }),
   }, {
     onState: (active, err) => {
       for (const b of root.querySelectorAll("button.jog")) {
         b.classList.toggle("pressed", Boolean(active) && Number(b.dataset.dir) === active.dir);
       }
-      if (err) serverError(err, [fsJog]);
+      if (err) { serverError(err, [fsJog]); app.log(err.message, true); }
     },
   });
   jogger.opts = () => {
