@@ -240,13 +240,15 @@ def test_a_second_tab_is_told_to_reload_and_sees_the_scope_history(page, browser
     # now the first tab is the stale one: it reloads, then its commands go through
     page.wait_for_selector("#reload-banner:not([hidden])", timeout=5000)
     page.click("#reload-config")
+    page.wait_for_function("() => window.openmotion.configVersion === "
+                           "window.openmotion.status.config_version")
     # the scope history lives on the server: the other tab draws the same samples
     ready_axis(page)
     field(page, "op-target", "mode").select_option("relative")
     field(page, "op-target", "distance").fill("5")
+    before = status(page, "s.axes.x.command")
     page.click("#op-play2")
-    wait_status(page, "s.axes.x.moving", 5)
-    wait_status(page, "!s.axes.x.moving", 10)
+    wait_status(page, f"s.axes.x.command === {before + 5000} && !s.axes.x.moving", 10)
     goto(other, "scope")
     other.wait_for_function("() => (window.openmotion.scopeChart || {t: []}).t.length > 1000",
                             timeout=10000)
