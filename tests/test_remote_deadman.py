@@ -116,3 +116,29 @@ def test_repeat_runs_count_moves_with_the_dwell():
     with pytest.raises(MotionError, match="max_vel"):
         reps.start("x", 1.0, 5.0, 0.1, 0, {"max_vel": -20.0})
     assert not reps.active(0)
+
+
+def test_path_firings_come_once_when_reading_on():
+    from openmotion.remote.programs import ProgramSession
+
+    ctl = Controller()
+    ctl.enable_all()
+    prog = ProgramSession(ctl)
+    ctl.add_cycle_hook(lambda c, t: prog.path.sample(t))
+    prog.load("G21 G90\nG0 X0 Y0\nM62 P0\nG1 F900 X6\nM63 P0\nG1 Y6\nM62 P0\nG1 X0\n"
+              "M63 P0\nM30\n", "laser.ngc")
+    prog.run(feed_override=100.0, single_block=False, optional_stop=False, repeat=1,
+             acc_time=0.05)
+    got, nxt = [], 0
+    for _ in range(400):
+        ctl.advance(0.007)
+        d = prog.path.path(nxt, 10_000)
+        got += d["firings"]
+        nxt = d["next"]
+        if prog.status()["state"] == "done":
+            break
+    assert prog.status()["state"] == "done"
+    got += prog.path.path(nxt, 10_000)["firings"]   # after the end: nothing twice
+    assert [f["level"] for f in got] == [True, False, True, False]
+    assert [round(f["point"][0] - 150.0, 2) for f in got] == [0.0, 6.0, 6.0, 0.0]
+    assert len(prog.path.path(0, 10_000)["firings"]) == 4

@@ -143,3 +143,32 @@ def test_stops_do_not_wait_behind_a_long_command():
                 m.call("axis.reset", axis="x", timeout=0.5)   # a command: it waits
         finally:
             release.set()
+
+
+def test_a_slow_query_does_not_hold_up_the_next_request_on_its_connection():
+    import json
+    import time
+
+    from openmotion.remote.methods import Method
+
+    with served() as (svc, th), client(th) as m:
+        release = threading.Event()
+
+        def slow(ctx, p):
+            p.done()
+            release.wait(20)
+            return {"slow": True}
+
+        th.server.methods = {**th.server.methods, "test.slow": Method(slow, command=False)}
+        m._send(json.dumps({"jsonrpc": "2.0", "id": "s", "method": "test.slow"}))
+        # answered while the slow query still waits, on the same connection
+        assert m.call("server.info", timeout=10)["api"] == 1
+        m.call("axis.servo", axis="x", on=True, timeout=10)
+        jog = m.call("jog.start", axis="x", direction=1, timeout=10)["jog"]
+        assert m.call("jog.confirm", jog=jog, timeout=10)["active"]
+        m.call("jog.stop", jog=jog, timeout=10)
+        release.set()
+        t_end = time.monotonic() + 10
+        while "s" not in m._pending and time.monotonic() < t_end:
+            time.sleep(0.01)
+        assert m._pending["s"][0]["result"] == {"slow": True}

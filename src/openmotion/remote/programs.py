@@ -47,6 +47,7 @@ class ProgramSession:
         self.feed_override = 100.0
         self.single_block = False
         self._preview: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._compiled_at: tuple[float, ...] = ()
         self.path = PathRecorder(ctl)
 
     # ------------------------------------------------------------------ loading
@@ -73,8 +74,12 @@ class ProgramSession:
     def _make_runner(self, text: str, name: str) -> ProgramRunner:
         params = {} if sets_work_offset(text) else work_origin(self.ctl)
         opts = RunOptions(single_block=self.single_block)
+        self._compiled_at = self._positions()
         return ProgramRunner(self.ctl, text, options=opts, file=name,
                              gcode={"parameters": params})
+
+    def _positions(self) -> tuple[float, ...]:
+        return tuple(ax.position for ax in self.ctl.axes)
 
     def _check_idle(self, what: str) -> None:
         r = self.runner
@@ -95,7 +100,9 @@ class ProgramSession:
                           repeat=repeat, acc_time=acc_time)
         if not 1.0 <= feed_override <= 200.0:
             raise MotionError(f"feed_override must be in [1, 200] %, got {feed_override!r}")
-        if r.state is not RunState.READY:   # ran before: compile it again
+        if r.state is not RunState.READY or self._compiled_at != self._positions():
+            # ran before, or the axes moved since the compile: compile again here, outside
+            # the lock (start() would do it under the lock, holding up the cycle)
             r = self._make_runner(self.text, self.file)
         r.options = opts   # run-time settings only: the compiled operations stay valid
         with self.ctl.lock:
@@ -268,24 +275,34 @@ class PathRecorder:
         self._t = np.zeros(PATH_CAPACITY)
         self._p = np.zeros((PATH_CAPACITY, 3))
         self.n = 0
+        self._closed = False
         self._cols: list[tuple[int, int, float]] = []
 
     def start(self, runner: ProgramRunner) -> None:
         self.runner = runner
         self.n = 0
         self._tick = 0
+        self._closed = False
         axes = runner.axis_indices
         self._cols = [(k, axes[runner.letters.index(c)], float(runner.scales.ppu[
             runner.letters.index(c)])) for k, c in enumerate(_XYZ) if c in runner.letters]
 
     def sample(self, t: float) -> None:
         r = self.runner
-        if r is None or r.state not in (RunState.RUNNING, RunState.PAUSED):
+        if r is None or self._closed:
+            return
+        if r.state not in (RunState.RUNNING, RunState.PAUSED) and not any(
+                self.ctl.axes[i].is_moving for _k, i, _p in self._cols):
+            self._record(t)      # the end point (after an abort: at rest); every firing
+            self._closed = True  # lies within the samples
             return
         self._tick += 1
         if self._tick < self._every:
             return
         self._tick = 0
+        self._record(t)
+
+    def _record(self, t: float) -> None:
         i = self.n % PATH_CAPACITY
         self._t[i] = t
         axes = self.ctl.axes
@@ -310,12 +327,19 @@ class PathRecorder:
             sel = np.unique(np.linspace(0, len(t) - 1, max_points).astype(int))
         firings = []
         r = self.runner
-        if r is not None and len(t):
-            t_lo = t[0]
+        if r is not None and n > first:
+            # the firings after the point before `start` up to the last point returned (the
+            # recorder takes a last point when the run ends), so reading on with since=next
+            # gives each firing exactly once
+            t_lo = self._t[(start - 1) % PATH_CAPACITY] if start > first else -np.inf
+            t_hi = t[-1] if len(t) else t_lo
+            all_idx = np.arange(first, n) % PATH_CAPACITY
+            all_t = self._t[all_idx]
             for ev in r.events:
-                if ev.kind == "sync_output" and ev.t >= t_lo:
-                    k = int(np.clip(np.searchsorted(t, ev.t), 0, len(t) - 1))
-                    firings.append({"t": ev.t, "point": np.round(p[k], 6).tolist(),
+                if ev.kind == "sync_output" and t_lo < ev.t <= t_hi:
+                    k = int(np.clip(np.searchsorted(all_t, ev.t), 0, len(all_t) - 1))
+                    firings.append({"t": ev.t,
+                                    "point": np.round(self._p[all_idx[k]], 6).tolist(),
                                     "output": ev.index, "level": ev.level})
         vmax = float(speed.max()) if len(speed) else 0.0
         return {"axes": "".join(r.letters) if r is not None else "", "first": first,

@@ -91,12 +91,6 @@ class Scope:
             raise MotionError(f"divider must be an integer in [1, 1000], got {divider!r}")
         if not 1.0 <= seconds <= 600.0:
             raise MotionError(f"seconds must be in [1, 600], got {seconds!r}")
-        with ctl.lock:   # never between the getters and the write of a cycle's sample
-            self._configure(channels, divider, seconds, trigger)
-
-    def _configure(self, channels: Sequence[str], divider: int, seconds: float,
-                   trigger: Trigger) -> None:
-        ctl = self.ctl
         specs = [self._parse(c) for c in channels]
         if trigger.mode not in TRIGGER_MODES:
             raise MotionError(f"trigger.mode must be one of {', '.join(TRIGGER_MODES)}, "
@@ -112,7 +106,9 @@ class Scope:
         cap = int(min(MAX_SAMPLES, max(2, round(seconds / dt))))
         # raw getters: one per channel, values in pulses / counts / codes
         getters = [self._getter(ax, q) for ax, q in specs]
-        with self._lock:
+        t_buf, buf = np.zeros(cap), np.zeros((cap, len(channels)))   # outside the locks
+        # under the cycle's lock: never between the getters and the write of a sample
+        with ctl.lock, self._lock:
             self.channels = list(channels)
             self._specs = specs
             self._getters = getters
@@ -121,8 +117,7 @@ class Scope:
             self.trigger = trigger
             self.dt = dt
             self.cap = cap
-            self._t = np.zeros(cap)
-            self._buf = np.zeros((cap, len(channels)))
+            self._t, self._buf = t_buf, buf
             self.n = 0
             self._pend_t: list[float] = []
             self._pend: list[list[float]] = []

@@ -58,6 +58,10 @@ MAX_SUBSCRIPTIONS = 16
 WS_HARD_LIMIT = 16 << 20
 BUSY_S = 5.0
 MIN_TOKEN = 16
+#: requests of one connection answered at once (more wait for one to finish)
+MAX_IN_FLIGHT = 64
+#: answered on the event loop itself: the deadman's confirmations and releases
+INLINE = frozenset({"jog.confirm", "jog.stop"})
 
 
 class Connection:
@@ -73,6 +77,7 @@ class Connection:
         self._send_lock = asyncio.Lock()
         self._subs: dict[str, asyncio.Future[Any]] = {}
         self._sub_ids = itertools.count(1)
+        self.tasks: set[asyncio.Task[None]] = set()
         self.closed = False
 
     async def send(self, obj: Any) -> None:
@@ -88,7 +93,7 @@ class Connection:
 
     def send_soon(self, obj: Any) -> None:
         """Thread-safe: queue a push on this connection's loop."""
-        if not self.closed:
+        if not self.closed and not self.loop.is_closed():
             asyncio.run_coroutine_threadsafe(self.send(obj), self.loop)
 
     # -- subscriptions (called from handler threads) -------------------------------------
@@ -253,9 +258,15 @@ class RemoteServer:
                 frame = msg.get("text")
                 if frame is None:
                     frame = msg.get("bytes") or b""
-                out = await self.handle_frame(ctx, frame)
-                if out is not None:
-                    await conn.send(out)
+                # each frame is answered by its own task: a slow query (a long scope read)
+                # never holds up the next frame (a jog confirmation) on this connection;
+                # commands still reach the command thread in arrival order (each task
+                # submits at its first step, tasks start in creation order)
+                task = asyncio.create_task(self._answer(conn, ctx, frame))
+                conn.tasks.add(task)
+                task.add_done_callback(conn.tasks.discard)
+                if len(conn.tasks) >= MAX_IN_FLIGHT:
+                    await asyncio.wait(set(conn.tasks), return_when=asyncio.FIRST_COMPLETED)
         except WebSocketDisconnect:
             pass
         finally:
@@ -265,6 +276,15 @@ class RemoteServer:
                 self.svc.jogs.drop_owner(conn)
             except Exception as exc:  # pragma: no cover - logged, never raised
                 log.error("dropping the jogs of a closed connection failed: %r", exc)
+
+    async def _answer(self, conn: Connection, ctx: Context, frame: str | bytes) -> None:
+        try:
+            out = await self.handle_frame(ctx, frame)
+        except Exception:  # pragma: no cover - handle_frame answers every error itself
+            log.error("frame failed:\n%s", traceback.format_exc())
+            return
+        if out is not None:
+            await conn.send(out)
 
     async def handle_frame(self, ctx: Context, frame: str | bytes) -> Any:
         """The response to one frame (None when it held only notifications)."""
@@ -290,6 +310,8 @@ class RemoteServer:
         if m is None:
             return dumps(error_response(req.id, RpcError(
                 METHOD_NOT_FOUND, f"method {req.method!r} is unknown", {"method": req.method})))
+        if req.method in INLINE:   # tiny and urgent: on the loop, no thread hop
+            return self._run(m.fn, ctx, req, None)
         if m.command:
             queued = time.monotonic()
             fut = asyncio.get_running_loop().run_in_executor(
