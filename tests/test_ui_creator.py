@@ -149,7 +149,7 @@ def test_jog_runs_while_held_and_stops_on_release(page):
     page.mouse.down()
     wait_status(page, "s.axes.x.velocity > 0", 5)
     page.wait_for_timeout(600)   # held longer than the deadman: the confirmations keep it going
-    assert status(page, "s.axes.x.velocity") > 0
+    assert status(page, "s.axes.x.velocity") > 0, page.inner_text("#log")
     page.mouse.up()
     wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
     # keyboard jog: key down moves, key up stops
@@ -186,7 +186,6 @@ def test_home_then_move_changes_chart_and_lamps(page):
     wait_status(page, "s.axes.x.homing.state === 'done' && !s.axes.x.moving"
                 " && s.axes.x.command === 0", 30)
     assert status(page, "s.axes.x.io.org") is True
-    shot(page, "homing")
     goto(page, "operation")
     page.wait_for_selector("#op-play2")
     field(page, "op-target", "mode").select_option("relative")
@@ -219,6 +218,8 @@ def test_home_then_move_changes_chart_and_lamps(page):
     assert vel > 30
     csv = page.evaluate("window.openmotion.scopeChart.toCsv()")
     assert csv.startswith("t_s,") and csv.count("\n") > 100
+    field(page, "scope-view", "window").fill("20")     # the move in view for the screenshot
+    page.wait_for_timeout(300)
     shot(page, "scope")
 
 

@@ -3,6 +3,7 @@
 
 import { Rpc, RpcError, defaultUrl } from "./rpc.js";
 import { $, $$, el } from "./dom.js";
+import { mergeDiff } from "./status.js";
 import * as machine from "./pages/machine.js";
 import * as iface from "./pages/interface.js";
 import * as operation from "./pages/operation.js";
@@ -24,17 +25,6 @@ const COMMANDS = new Set(["interface.set", "home.set", "machine.load", "machine.
   "axis.set_position", "axis.reset_position", "home.start", "jog.start", "jog.step",
   "program.load", "program.run", "program.resume", "program.single_block", "program.feed_override",
   "sim.trip_limit", "sim.alarm", "sim.speed", "scope.configure", "scope.run", "scope.arm"]);
-
-function isObj(v) { return v !== null && typeof v === "object" && !Array.isArray(v); }
-
-/** Merge a status diff into the snapshot (nested objects merge, everything else replaces). */
-export function mergeDiff(into, diff) {
-  for (const [k, v] of Object.entries(diff || {})) {
-    if (isObj(v) && isObj(into[k])) mergeDiff(into[k], v);
-    else into[k] = isObj(v) ? structuredClone(v) : v;
-  }
-  return into;
-}
 
 class App extends EventTarget {
   constructor() {
@@ -213,13 +203,24 @@ class App extends EventTarget {
     $("#next-axis").addEventListener("click", () => this.nextAxis());
     $("#estop").addEventListener("click", () => this.estop());
     $("#reload-config").addEventListener("click", () => this.reloadConfig());
-    window.addEventListener("keydown", (e) => { if (e.key === "Escape") this.estop(); });
+    // AXIS's keys: F1 = E-stop; Escape = stop (abort the program, every axis decelerates)
+    window.addEventListener("keydown", (e) => {
+      if (e.key === "F1") { e.preventDefault(); this.estop(); } else if (e.key === "Escape") this.stopAll();
+    });
 
     for (const [name, mod] of Object.entries(PAGES)) mod.mount(this, $(`#page-${name}`));
     const route = () => this.show(window.location.hash.slice(1) || "operation");
     window.addEventListener("hashchange", route);
     route();
     this.rpc.connect();
+  }
+
+  stopAll() {
+    const p = this.status && this.status.program;
+    if (p && (p.state === "running" || p.state === "paused")) this.rpc.call("program.abort").catch(() => {});
+    this.rpc.call("axis.stop", {})
+      .then(() => this.log("stop: every axis decelerates"))
+      .catch((err) => this.log(`STOP FAILED: ${err.message}`, true));
   }
 
   estop() {
@@ -230,5 +231,6 @@ class App extends EventTarget {
   }
 }
 
+export { mergeDiff };
 export const app = new App();
 app.start();

@@ -3,7 +3,8 @@
 // the confirmations stop); release, key-up, window blur, a hidden tab or a lost connection
 // stop it at once.
 
-export const CONFIRM_MS = 50;
+export const CONFIRM_MS = 25;      // 10x inside the server's 250 ms deadman (a loaded box)
+const ASK_EVERY = 8;               // every 8th confirmation asks whether the jog still runs
 
 export class Jogger {
   /**
@@ -72,9 +73,22 @@ export class Jogger {
       this.api.stop(me.handle, axis).catch(() => {});
       return;
     }
-    this.timer = setInterval(() => {
+    let n = 0;
+    this.timer = setInterval(async () => {
       if (this.active !== me) return;
-      this.api.confirm(me.handle, axis);
+      n += 1;
+      if (n % ASK_EVERY !== 0 || !this.api.check) { this.api.confirm(me.handle, axis); return; }
+      // a jog the server ended (limit ahead, deadman, fault) is released here too, with why
+      try {
+        const r = await this.api.check(me.handle, axis);
+        if (r && r.active === false && this.active === me) {
+          this.active = null;
+          me.stopped = true;
+          clearInterval(this.timer);
+          this.timer = 0;
+          this.onState(null, { message: `jog ended by the controller: ${r.reason || "stopped"}` });
+        }
+      } catch { /* the next confirmation or the lost-connection release handles it */ }
     }, CONFIRM_MS);
   }
 

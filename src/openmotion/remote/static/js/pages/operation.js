@@ -7,6 +7,7 @@ import { FieldSet, serverError } from "../fields.js";
 import { LiveChart } from "../chart.js";
 import { Jogger } from "../jog.js";
 import { panel, Lamps, motionSpecs, compact } from "./common.js";
+import { mergeDiff } from "../status.js";
 
 let app, root, fsTarget, fsMotion, fsRepeat, fsSet, fsJog, lamps, chart, jogger;
 const view = {};
@@ -49,13 +50,14 @@ export function mount(a, node) {
   jogger = new Jogger({
     start: async (axis, direction, opts) => (await app.call("jog.start", { axis, direction, ...opts })).jog,
     confirm: (jog) => app.rpc.notify("jog.confirm", { jog }),
+    check: (jog) => app.rpc.call("jog.confirm", { jog }, { timeoutMs: 1000 }),
     stop: (jog) => app.call("jog.stop", { jog }),
   }, {
     onState: (active, err) => {
       for (const b of root.querySelectorAll("button.jog")) {
         b.classList.toggle("pressed", Boolean(active) && Number(b.dataset.dir) === active.dir);
       }
-      if (err) serverError(err, [fsJog]);
+      if (err) { serverError(err, [fsJog]); app.log(err.message, true); }
     },
   });
   jogger.opts = () => {
@@ -191,8 +193,14 @@ function update() {
 async function act(method, params, sets = [fsTarget, fsMotion]) {
   for (const fs of sets) fs.clearFormError();
   try {
-    const r = await app.call(method, { axis: app.axis, ...params });
-    app.log(`${method} ${app.axis}: ok`);
+    const axis = app.axis;
+    const r = await app.call(method, { axis, ...params });
+    app.log(`${method} ${axis}: ok`);
+    // an AxisStatus answer (servo, reset, set/reset position) is newer than the last push
+    if (r && typeof r === "object" && "state" in r && "command" in r && app.status && app.status.axes && app.status.axes[axis]) {
+      mergeDiff(app.status.axes[axis], r);
+      app.dispatchEvent(new CustomEvent("status"));
+    }
     return r;
   } catch (err) {
     serverError(err, sets, { p1: "position1", p2: "position2", delay_s: "delay_s" });
