@@ -71,7 +71,6 @@ class Axis(AxisEngine):
         self._state = S.DISABLED
         self._fault: str | None = None
         self._powered = False
-        self._servo = config.drive.type in ("servo", "dc_servo")  # axes with SVON
         self._motion: ActiveMotion | None = None
         self._pos = 0.0       # commanded position, raw pulse frame, at controller time
         self._vel = 0.0
@@ -162,7 +161,8 @@ class Axis(AxisEngine):
     # ------------------------------------------------------------------ power and faults
     @_locked
     def enable(self) -> None:
-        """Power the axis (servo on through SVON for servo drives): Disabled -> Standstill.
+        """Power the axis (SVON on: the servo-on / drive-enable output every axis has, as on
+        the HSL card; a stepper driver wires it to its enable input): Disabled -> Standstill.
 
         Refused while the emergency stop is active. Enabling an axis already enabled does
         nothing; an axis in ErrorStop needs `reset()`.
@@ -173,8 +173,7 @@ class Axis(AxisEngine):
             raise MotionError(f"axis {self.name}: emergency stop is active")
         if self._state is not S.DISABLED:
             return
-        if self._servo:
-            self._ctl.hardware.write_output(self.index, "svon", True)
+        self._ctl.hardware.write_output(self.index, "svon", True)
         self._powered = True
         self._state = transition(self._state, S.STANDSTILL, self.name)
         if self._ctl.alarm_active(self.index):
@@ -185,8 +184,7 @@ class Axis(AxisEngine):
         """Power off: any motion stops immediately; SVON off. From ErrorStop the axis stays
         in ErrorStop (PLCopen) until reset."""
         self._kill_motion()
-        if self._servo:
-            self._ctl.hardware.write_output(self.index, "svon", False)
+        self._ctl.hardware.write_output(self.index, "svon", False)
         self._powered = False
         if self._state is not S.ERROR_STOP:
             self._state = transition(self._state, S.DISABLED, self.name)

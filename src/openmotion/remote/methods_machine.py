@@ -125,6 +125,7 @@ def machine_reset(ctx: Context, p: Params) -> dict[str, Any]:
         for ax in ctl.axes:
             if ax.state is AxisState.ERROR_STOP:
                 ax.reset()
+        ctx.svc.estop_reason = None   # the software E-stop latch ends with the reset
         return {"axes": {ax.name: ax.state.value for ax in ctl.axes}}
 
 

