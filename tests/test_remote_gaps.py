@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pytest
 
+from openmotion.remote import RemoteError
 from remote_kit import at_rest, client, served
 
 WAIT = 20.0   # generous: the checks are on states, never on wall-clock figures
@@ -62,3 +63,17 @@ def test_homing_done_arrives_with_the_counters_cleared(machine):
             break
     else:
         raise AssertionError("no push carried homing done")
+
+
+def test_home_get_draws_another_mode_without_applying_it(machine):
+    svc, m = machine
+    saved = m.call("home.get", axis="x")
+    assert saved["config"]["mode"] == 0
+    other = m.call("home.get", axis="x", mode=11)
+    assert other["config"]["mode"] == 11 and other["sequence"] != saved["sequence"]
+    assert other["config"]["max_vel"] == saved["config"]["max_vel"]   # the rest as saved
+    assert m.call("home.get", axis="x")["config"]["mode"] == 0        # nothing applied
+    assert svc.homes["x"].mode == 0
+    with pytest.raises(RemoteError) as e:
+        m.call("home.get", axis="x", mode=99)
+    assert "mode" in e.value.message

@@ -165,17 +165,22 @@ def interface_set(ctx: Context, p: Params) -> dict[str, Any]:
 
 
 # -- homing -------------------------------------------------------------------------------
-def _home(ctx: Context, axis: Any) -> dict[str, Any]:
+def _home(ctx: Context, axis: Any, mode: Any = None) -> dict[str, Any]:
+    """The saved homing settings, or with `mode` the saved ones in that mode (not applied:
+    the page draws a mode's sequence before the user picks it)."""
     ax = ctx.svc.ctl.axis(axis)
     c = ctx.svc.homes[ax.name]
+    if mode is not None:
+        c = homeconf.home_from_user(ax, c, {"mode": mode})
     return {"config": homeconf.home_to_user(ax, c), "sequence": homeconf.sequence(ax, c)}
 
 
 @method("home.get", command=False)
 def home_get(ctx: Context, p: Params) -> dict[str, Any]:
     axis = p.axis()
+    mode = p.raw("mode", None)
     p.done()
-    return {**_home(ctx, axis), "choices": homeconf.choices()}
+    return {**_home(ctx, axis, mode), "choices": homeconf.choices()}
 
 
 @method("home.set")
