@@ -77,3 +77,36 @@ def test_home_get_draws_another_mode_without_applying_it(machine):
     with pytest.raises(RemoteError) as e:
         m.call("home.get", axis="x", mode=99)
     assert "mode" in e.value.message
+
+
+@pytest.mark.parametrize(("method", "params", "quoted"), [
+    ("axis.move", {"kind": "velocity", "velocity": 1e6}, "500 mm/s"),
+    ("axis.move", {"kind": "velocity", "velocity": 1.0, "str_vel": 5.0}, "5 mm/s"),
+    ("axis.move", {"kind": "relative", "distance": 5.0, "max_vel": 1e6}, "500] mm/s"),
+    ("home.set", {"changes": {"max_vel": 1e6}}, "500 mm/s"),
+    ("home.set", {"changes": {"str_vel": 50.0, "max_vel": 40.0}}, "(40 mm/s), got 50 mm/s"),
+])
+def test_refusals_quote_the_users_units(machine, method, params, quoted):
+    svc, m = machine
+    m.call("axis.servo", axis="x", on=True)
+    if method == "home.set":
+        params = {**params, "config_version": m.call("machine.info")["config_version"]}
+    before = m.call("home.get", axis="x")["config"]
+    with pytest.raises(RemoteError) as e:
+        m.call(method, axis="x", **params)
+    assert quoted in e.value.message and "pps" not in e.value.message, e.value.message
+    assert m.call("home.get", axis="x")["config"] == before
+    assert not m.call("status.get")["axes"]["x"]["moving"]
+
+
+def test_change_speed_refusal_in_mm_per_s(machine):
+    svc, m = machine
+    m.call("axis.servo", axis="x", on=True)
+    m.call("axis.move", axis="x", kind="velocity", velocity=10.0)
+    try:
+        with pytest.raises(RemoteError) as e:
+            m.call("axis.change_speed", axis="x", velocity=50.0)
+        assert "speed range 10 mm/s" in e.value.message, e.value.message
+        assert e.value.data["param"] == "velocity"
+    finally:
+        m.call("axis.stop", axis="x", mode="immediate")
