@@ -110,3 +110,50 @@ def test_change_speed_refusal_in_mm_per_s(machine):
         assert e.value.data["param"] == "velocity"
     finally:
         m.call("axis.stop", axis="x", mode="immediate")
+
+
+def test_file_paths_stay_in_the_working_folder(tmp_path):
+    from openmotion.remote.workdir import WorkFolder
+    from remote_kit import machine_file
+
+    work = tmp_path / "work"
+    work.mkdir()
+    outside = tmp_path / "secret.ngc"
+    outside.write_text("G0 X1\nM2\n")
+    (work / "part.ngc").write_text("G0 X1\nM2\n")
+    (work / "link.ngc").symlink_to(outside)
+    mf = machine_file(work)
+    with served(file=mf, workdir=WorkFolder(work.resolve(), True)) as (svc, th), \
+            client(th) as m:
+        assert m.call("program.load", path="part.ngc")["lines"] == 2        # relative
+        assert m.call("program.load", path=str(work / "part.ngc"))["lines"] == 2
+        for bad in (str(outside), "../secret.ngc", "link.ngc", "/etc/passwd"):
+            with pytest.raises(RemoteError) as e:
+                m.call("program.load", path=bad)
+            assert e.value.code == -32000 and "must lie in the working folder" in e.value.message
+            assert e.value.data["param"] == "path"
+        v = m.call("machine.info")["config_version"]
+        with pytest.raises(RemoteError, match="must lie in the working folder"):
+            m.call("machine.save", path=str(tmp_path / "other.toml"))
+        assert not (tmp_path / "other.toml").exists()
+        with pytest.raises(RemoteError, match="must lie in the working folder"):
+            m.call("machine.load", path=str(tmp_path / "other.toml"), config_version=v)
+        assert m.call("machine.save", path="copy.toml")["file"] == str(work.resolve() /
+                                                                      "copy.toml")
+        assert mf.exists()   # the server's own machine file: written without a path
+        assert m.call("machine.save")["file"].endswith("copy.toml")   # the new machine file
+
+
+def test_working_folder_of_the_command_line(tmp_path):
+    from openmotion.errors import MotionError
+    from openmotion.remote.workdir import WorkFolder
+
+    assert not WorkFolder.for_server("127.0.0.1", None, None).restricted
+    wf = WorkFolder.for_server("0.0.0.0", None, str(tmp_path / "m.toml"))
+    assert wf.restricted and wf.folder == tmp_path.resolve()
+    assert WorkFolder.for_server("127.0.0.1", str(tmp_path), None).folder == tmp_path.resolve()
+    with pytest.raises(MotionError, match="--workdir"):
+        WorkFolder.for_server("0.0.0.0", str(tmp_path / "nope"), None)
+    none = WorkFolder.for_server("0.0.0.0", None, None)
+    with pytest.raises(MotionError, match="no working folder"):
+        none.resolve("path", "a.ngc")

@@ -93,7 +93,7 @@ def machine_config(ctx: Context, p: Params) -> dict[str, Any]:
 def machine_save(ctx: Context, p: Params) -> dict[str, Any]:
     path = p.string("path", None)
     p.done()
-    f, side = ctx.svc.save(path)
+    f, side = ctx.svc.save(None if path is None else ctx.svc.workdir.resolve("path", path))
     return {"file": str(f), "sidecar": str(side)}
 
 
@@ -103,7 +103,7 @@ def machine_load(ctx: Context, p: Params) -> dict[str, Any]:
     if not p.has("config_version"):
         p.integer("config_version")   # required here: refused as missing
     p.done()
-    ctx.svc.load(path)
+    ctx.svc.load(str(ctx.svc.workdir.resolve("path", path)))
     return machine_info(ctx)
 
 

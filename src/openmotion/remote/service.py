@@ -42,6 +42,7 @@ from .interface import (
 from .programs import ProgramSession
 from .repeat import RepeatRegistry
 from .scope import Scope, Trigger
+from .workdir import WorkFolder
 
 MAX_SPEED = 20.0
 EVENT_KEEP = 2000
@@ -53,8 +54,9 @@ class MachineService:
     """One simulated machine running in real time (see the module docstring)."""
 
     def __init__(self, config: MachineConfig | None = None, file: str | Path | None = None,
-                 *, speed: float = 1.0) -> None:
+                 *, speed: float = 1.0, workdir: WorkFolder | None = None) -> None:
         self.file: Path | None = None
+        self.workdir = WorkFolder() if workdir is None else workdir   # file-path methods
         if file is not None:
             self.file = Path(file)
             config = load_machine_arg(str(self.file), "--machine")
