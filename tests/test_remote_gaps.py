@@ -26,6 +26,9 @@ def test_software_estop_is_reported_until_reset(machine):
     m.call("machine.estop", reason="test")
     assert m.wait(lambda s: s["estop"] and s["axes"]["x"]["state"] == "ErrorStop", WAIT)
     assert m.call("status.get")["estop"]
+    with pytest.raises(RemoteError, match="latched"):
+        m.call("axis.reset", axis="x")
+    assert m.call("status.get")["axes"]["x"]["state"] == "ErrorStop"
     m.call("machine.reset")
     assert m.wait(lambda s: not s["estop"] and s["axes"]["x"]["state"] != "ErrorStop", WAIT)
 
