@@ -11,13 +11,15 @@ from openmotion.remote import connect
 from openmotion.remote.client import RemoteClient
 from openmotion.remote.server import RemoteServer, ServerThread
 from openmotion.remote.service import MachineService
+from openmotion.remote.workdir import WorkFolder
 
 
 @contextlib.contextmanager
-def served(file: Path | None = None, token: str | None = None, speed: float = 1.0
+def served(file: Path | None = None, token: str | None = None, speed: float = 1.0,
+           workdir: WorkFolder | None = None
            ) -> Iterator[tuple[MachineService, ServerThread]]:
     """A MachineService running in real time behind a server on a free port."""
-    svc = MachineService(file=file, speed=speed)
+    svc = MachineService(file=file, speed=speed, workdir=workdir)
     server = RemoteServer(svc, token=token)
     svc.start()
     th = ServerThread(server).start()

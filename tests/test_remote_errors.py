@@ -139,6 +139,19 @@ def test_token_gates_http_and_websocket():
         assert e.value.code == 401
         with urllib.request.urlopen(th.url + "/health", timeout=10) as r:
             assert r.status == 200
+        # the front end's static assets carry no secrets: served without the token; the
+        # page itself, the API routes and the socket are gated
+        for asset in ("/static/js/app.js", "/static/css/creator.css"):
+            with urllib.request.urlopen(th.url + asset, timeout=10) as r:
+                assert r.status == 200
+        for gated in ("/", "/static/../api/scope.csv", "/static/%2e%2e/api/scope.csv"):
+            with pytest.raises(urllib.error.HTTPError) as e:
+                urllib.request.urlopen(th.url + gated, timeout=10)
+            assert e.value.code in (401, 404), gated
+        req = urllib.request.Request(th.url + "/api/program", data=b"G0 X0\n", method="POST")
+        with pytest.raises(urllib.error.HTTPError) as e:
+            urllib.request.urlopen(req, timeout=10)
+        assert e.value.code == 401
         with urllib.request.urlopen(th.url + f"/api/scope.csv?token={token}",
                                     timeout=10) as r:
             assert r.status == 200

@@ -79,7 +79,6 @@ class Axis(AxisEngine):
         self._state = S.DISABLED
         self._fault: str | None = None
         self._powered = False
-        self._servo = config.drive.type in ("servo", "dc_servo")  # axes with SVON
         self._motion: ActiveMotion | None = None
         self.motion_ended_at: float | None = None  # exact end time of the last motion
         self._pos = 0.0       # commanded position, raw pulse frame, at controller time
@@ -171,7 +170,8 @@ class Axis(AxisEngine):
     # ------------------------------------------------------------------ power and faults
     @_locked
     def enable(self) -> None:
-        """Power the axis (servo on through SVON for servo drives): Disabled -> Standstill.
+        """Power the axis (SVON on: the servo-on / drive-enable output every axis has, as on
+        the HSL card; a stepper driver wires it to its enable input): Disabled -> Standstill.
 
         Refused while the emergency stop is active. Enabling an axis already enabled does
         nothing; an axis in ErrorStop needs `reset()`.
@@ -182,8 +182,7 @@ class Axis(AxisEngine):
             raise MotionError(f"axis {self.name}: emergency stop is active")
         if self._state is not S.DISABLED:
             return
-        if self._servo:
-            self._ctl.hardware.write_output(self.index, "svon", True)
+        self._ctl.hardware.write_output(self.index, "svon", True)
         self._powered = True
         self._state = transition(self._state, S.STANDSTILL, self.name)
         if self._ctl.alarm_active(self.index):
@@ -194,8 +193,7 @@ class Axis(AxisEngine):
         """Power off: any motion stops immediately; SVON off. From ErrorStop the axis stays
         in ErrorStop (PLCopen) until reset."""
         self._kill_motion()
-        if self._servo:
-            self._ctl.hardware.write_output(self.index, "svon", False)
+        self._ctl.hardware.write_output(self.index, "svon", False)
         self._powered = False
         if self._state is not S.ERROR_STOP:
             self._state = transition(self._state, S.DISABLED, self.name)
@@ -276,9 +274,17 @@ class Axis(AxisEngine):
         v = check_finite(name, value)
         v = float(self.units.scale_to_pulses(v)) if units else v
         if abs(v) > self._max_speed * (1.0 + 1e-9):
-            raise MotionError(f"{name} on axis {self.name} must be <= {self._max_speed:g} pps "
+            raise MotionError(f"{name} on axis {self.name} must be <= "
+                              f"{self.speed_text(self._max_speed, units)} "
                               f"(maximum safe speed), got {value!r}")
         return v
+
+    def speed_text(self, pps: float, units: bool) -> str:
+        """A speed for a message in the caller's units: "500000 pps", or with `units=True`
+        "500 mm/s" (the value the caller gave is quoted beside it in the same units)."""
+        if not units:
+            return f"{pps:g} pps"
+        return f"{abs(pps) / self.units.pulses_per_unit:.6g} {self.units.unit}/s"
 
     def _spec(self, shape: str, str_vel: float, max_vel: float, tacc: float,
               tdec: float | None, vs_acc: float, vs_dec: float, units: bool,
@@ -320,15 +326,16 @@ class Axis(AxisEngine):
         """Velocity mode (HSL tv_move / sv_move): ramp from StrVel to `velocity` (signed,
         pps) in `tacc` and hold it until changed or stopped."""
         v = check_finite("velocity", velocity)
+        self.check_speed("velocity", v, units)   # refused in the caller's units
         if units:  # signed: a reversed axis runs the other way in pulses
             v = float(self.units.velocity_to_pps(v))
-        v = self.check_speed("velocity", v, False)
         if v == 0.0:
             raise MotionError("velocity must be non-zero (its sign gives the direction)")
         check_quantity("velocity", abs(v), "pps")
         sv = self.check_speed("str_vel", str_vel, units)
         if abs(v) < sv:
-            raise MotionError(f"velocity must satisfy |velocity| >= str_vel ({sv:g} pps), "
+            raise MotionError(f"velocity must satisfy |velocity| >= str_vel "
+                              f"({self.speed_text(sv, units)}), "
                               f"got {velocity!r}")
         va = self.check_speed("vs_acc", vs_acc, units)
         spec = MoveSpec(shape, sv, abs(v), tacc, tacc, va, va)
@@ -518,7 +525,7 @@ class Axis(AxisEngine):
         limit = self._speed_range if self._speed_range is not None else m.v_range
         if v > limit * (1.0 + 1e-12):
             raise InfeasibleError(
-                f"new_vel must be <= the speed range {limit:g} pps "
+                f"new_vel must be <= the speed range {self.speed_text(limit, units)} "
                 f"(fix_speed_range to allow more), got {new_vel!r}")
         if self.speed_model is not None:
             v = self.speed_model.change(v, limit)
@@ -539,7 +546,10 @@ class Axis(AxisEngine):
         p = check_finite("new_position", new_position)
         p = float(self.units.to_pulses(p)) if units else p
         if not COUNTER_MIN <= p <= COUNTER_MAX:
-            raise MotionError(f"new_position must be in [{COUNTER_MIN}, {COUNTER_MAX}], "
+            lo, hi = (COUNTER_MIN, COUNTER_MAX) if not units else sorted(
+                float(self.units.to_units(c)) for c in (COUNTER_MIN, COUNTER_MAX))
+            raise MotionError(f"new_position must be in [{lo:.10g}, {hi:.10g}]"
+                              f"{' ' + self.units.unit if units else ''}, "
                               f"got {new_position!r}")
         m = self._check_running("change_position")
         if m.kind != "absolute":

@@ -54,9 +54,30 @@ def home_from_user(ax: Axis, old: HomeConfig, changes: Any) -> HomeConfig:
         else:
             kw[k] = v
     for name in ("str_vel", "max_vel"):
-        if name in kw:
-            ax.check_speed(name, kw[name])   # the axis's maximum safe speed
-    return dataclasses.replace(old, **kw)   # HomeConfig checks every field
+        if name in kw:   # the axis's maximum safe speed, refused in the user's units
+            ax.check_speed(name, _num(name, changes[name]), units=True)
+    try:
+        return dataclasses.replace(old, **kw)   # HomeConfig checks every field (pulses)
+    except MotionError as exc:
+        passed = {k: kw.get(k, getattr(old, k)) for k in _PULSE_KEYS}
+        raise MotionError(_in_user_units(str(exc), ax, passed)) from None
+
+
+#: HomeConfig fields held in pulses (speeds in pps): the API gives them in user units.
+_PULSE_KEYS = ("str_vel", "max_vel", "org_offset", "home_offset")
+
+
+def _in_user_units(message: str, ax: Axis, pulses: dict[str, Any]) -> str:
+    """HomeConfig's refusal quotes the pulse values this module passed it: put back the
+    user-unit values they came from (each value quoted as repr, as HomeConfig does)."""
+    ppu, unit = ax.units.pulses_per_unit, ax.units.unit
+    for k, v in pulses.items():
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or v == 0:
+            continue
+        user = float(ax.units.to_units(v)) if k == "home_offset" else v / ppu
+        text = f"{user:.6g} {unit}/s" if k in ("str_vel", "max_vel") else f"{user:.6g} {unit}"
+        message = message.replace(repr(v), text)
+    return message
 
 
 def _num(name: str, v: Any) -> float:

@@ -93,7 +93,7 @@ def machine_config(ctx: Context, p: Params) -> dict[str, Any]:
 def machine_save(ctx: Context, p: Params) -> dict[str, Any]:
     path = p.string("path", None)
     p.done()
-    f, side = ctx.svc.save(path)
+    f, side = ctx.svc.save(None if path is None else ctx.svc.workdir.resolve("path", path))
     return {"file": str(f), "sidecar": str(side)}
 
 
@@ -103,7 +103,7 @@ def machine_load(ctx: Context, p: Params) -> dict[str, Any]:
     if not p.has("config_version"):
         p.integer("config_version")   # required here: refused as missing
     p.done()
-    ctx.svc.load(path)
+    ctx.svc.load(str(ctx.svc.workdir.resolve("path", path)))
     return machine_info(ctx)
 
 
@@ -125,6 +125,7 @@ def machine_reset(ctx: Context, p: Params) -> dict[str, Any]:
         for ax in ctl.axes:
             if ax.state is AxisState.ERROR_STOP:
                 ax.reset()
+        ctx.svc.estop_reason = None   # the software E-stop latch ends with the reset
         return {"axes": {ax.name: ax.state.value for ax in ctl.axes}}
 
 
@@ -164,17 +165,22 @@ def interface_set(ctx: Context, p: Params) -> dict[str, Any]:
 
 
 # -- homing -------------------------------------------------------------------------------
-def _home(ctx: Context, axis: Any) -> dict[str, Any]:
+def _home(ctx: Context, axis: Any, mode: Any = None) -> dict[str, Any]:
+    """The saved homing settings, or with `mode` the saved ones in that mode (not applied:
+    the page draws a mode's sequence before the user picks it)."""
     ax = ctx.svc.ctl.axis(axis)
     c = ctx.svc.homes[ax.name]
+    if mode is not None:
+        c = homeconf.home_from_user(ax, c, {"mode": mode})
     return {"config": homeconf.home_to_user(ax, c), "sequence": homeconf.sequence(ax, c)}
 
 
 @method("home.get", command=False)
 def home_get(ctx: Context, p: Params) -> dict[str, Any]:
     axis = p.axis()
+    mode = p.raw("mode", None)
     p.done()
-    return {**_home(ctx, axis), "choices": homeconf.choices()}
+    return {**_home(ctx, axis, mode), "choices": homeconf.choices()}
 
 
 @method("home.set")

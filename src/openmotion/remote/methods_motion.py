@@ -74,6 +74,9 @@ def axis_reset(ctx: Context, p: Params) -> dict[str, Any]:
     axis = p.axis()
     p.done()
     ax = ctx.svc.ctl.axis(axis)
+    if ctx.svc.estop_reason is not None:   # one axis must not leave a latched E-stop
+        raise MotionError(f"axis {ax.name}: the software E-stop is latched; machine.reset "
+                          "releases it and resets every axis")
     ax.reset()
     return _status(ctx, ax)
 

@@ -22,7 +22,7 @@ def program_load(ctx: Context, p: Params) -> dict[str, Any]:
         raise MotionError("give exactly one of text and path")
     prog = ctx.svc.program   # compiled outside the controller's lock (a big program
     if path is not None:     # takes seconds; the cycle must not wait for it)
-        return prog.load_path(path)
+        return prog.load_path(str(ctx.svc.workdir.resolve("path", path)))
     return prog.load(text, name or "program.ngc")
 
 

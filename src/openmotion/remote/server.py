@@ -355,7 +355,9 @@ def _float_arg(request: HttpRequest, name: str) -> float | None:
 
 
 class _TokenGate:
-    """ASGI middleware: every request but /health must carry the token."""
+    """ASGI middleware: every request must carry the token but /health and the front end's
+    static assets under /static/ (shipped in the package, no secrets: the page can load its
+    styles and modules with plain URLs). `/`, every API route and the WebSocket stay gated."""
 
     def __init__(self, app: Any, token: str | None) -> None:
         self.app = app
@@ -372,7 +374,7 @@ class _TokenGate:
         return hmac.compare_digest(given.encode(), self.token.encode())
 
     async def __call__(self, scope: dict[str, Any], receive: Any, send: Any) -> None:
-        if scope["type"] in ("http", "websocket") and scope.get("path") != "/health" \
+        if scope["type"] in ("http", "websocket") and not _open_path(scope) \
                 and not self._ok(scope):
             if scope["type"] == "http":
                 body = json.dumps({"error": "missing or wrong token"}).encode()
@@ -384,6 +386,15 @@ class _TokenGate:
                 await send({"type": "websocket.close", "code": 1008})
             return
         await self.app(scope, receive, send)
+
+
+def _open_path(scope: dict[str, Any]) -> bool:
+    """/health, or a GET of a static asset (no `..` segment: nothing outside /static/)."""
+    path = scope.get("path", "")
+    if path == "/health":
+        return True
+    return scope["type"] == "http" and scope.get("method") in ("GET", "HEAD") and \
+        path.startswith("/static/") and ".." not in path.split("/")
 
 
 # -- running it ---------------------------------------------------------------------------

@@ -42,6 +42,7 @@ from .interface import (
 from .programs import ProgramSession
 from .repeat import RepeatRegistry
 from .scope import Scope, Trigger
+from .workdir import WorkFolder
 
 MAX_SPEED = 20.0
 EVENT_KEEP = 2000
@@ -53,8 +54,9 @@ class MachineService:
     """One simulated machine running in real time (see the module docstring)."""
 
     def __init__(self, config: MachineConfig | None = None, file: str | Path | None = None,
-                 *, speed: float = 1.0) -> None:
+                 *, speed: float = 1.0, workdir: WorkFolder | None = None) -> None:
         self.file: Path | None = None
+        self.workdir = WorkFolder() if workdir is None else workdir   # file-path methods
         if file is not None:
             self.file = Path(file)
             config = load_machine_arg(str(self.file), "--machine")
@@ -79,6 +81,7 @@ class MachineService:
         ctl = Controller(config)
         self.ctl = ctl
         self.config = config
+        self.estop_reason: str | None = None   # software E-stop latched until machine.reset
         for ax in ctl.axes:
             apply_responses(ctl, ax.index, self.responses[ax.name])
         self.homes: dict[str, HomeConfig] = {}
@@ -353,7 +356,8 @@ class MachineService:
 
     # ------------------------------------------------------------------ stops
     def estop(self, reason: str) -> None:
-        """Software E-stop: jogs, repeats and the program end, every axis stops at once."""
+        """Software E-stop: jogs, repeats and the program end, every axis stops at once.
+        Latched (status `estop`) until `machine.reset`, like a pressed EMG button."""
         with self.ctl.lock:
             self.jogs.stop_all("emergency stop")
             self.repeats.stop_all("emergency stop")
@@ -363,6 +367,7 @@ class MachineService:
                     with contextlib.suppress(MotionError):
                         h.abort()
             self.ctl.emergency_stop(reason)
+            self.estop_reason = reason
 
     def stop_axis(self, axis: Any | None, immediate: bool, tdec: float | None) -> None:
         with self.ctl.lock:

@@ -61,7 +61,8 @@ def snapshot(svc: MachineService, fields: tuple[str, ...] = FIELDS) -> dict[str,
         if "cycles" in fields:
             out["cycles"] = ctl.cycles
         if "estop" in fields:
-            out["estop"] = bool(ctl.estop_active)
+            # the EMG input or the latched software E-stop (machine.estop until reset)
+            out["estop"] = bool(ctl.estop_active) or svc.estop_reason is not None
         if "config_version" in fields:
             out["config_version"] = svc.config_version
         if "speed" in fields:

@@ -21,6 +21,9 @@ def add_parser(sub: argparse._SubParsersAction, formatter: type) -> None:
     u.add_argument("--host", default="127.0.0.1",
                    help="bind address; any other than 127.0.0.1 needs --token")
     u.add_argument("--token", help="shared secret every request must carry (>= 16 chars)")
+    u.add_argument("--workdir", help="the only folder whose files program.load / "
+                   "machine.load / machine.save may use (default with --host: the machine "
+                   "file's folder; on 127.0.0.1 without it: any path)")
     u.add_argument("--speed", type=float, default=1.0,
                    help="simulation speed: 1 = real time, up to 20 = faster")
     u.set_defaults(handler=cmd_ui)
@@ -29,11 +32,13 @@ def add_parser(sub: argparse._SubParsersAction, formatter: type) -> None:
 def cmd_ui(args: argparse.Namespace) -> int:
     from .server import RemoteServer, ServerThread, check_bind
     from .service import MachineService
+    from .workdir import WorkFolder
 
     if isinstance(args.port, bool) or not 0 <= args.port <= 65535:
         raise MotionError(f"--port must be in [0, 65535], got {args.port!r}")
     check_bind(args.host, args.token)
-    svc = MachineService(file=args.machine, speed=args.speed)
+    workdir = WorkFolder.for_server(args.host, args.workdir, args.machine)
+    svc = MachineService(file=args.machine, speed=args.speed, workdir=workdir)
     server = RemoteServer(svc, token=args.token)
     svc.start()
     thread = ServerThread(server, args.host, args.port)

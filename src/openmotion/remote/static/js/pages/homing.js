@@ -138,25 +138,20 @@ async function start() {
   try { await app.call("home.start", { axis }); } catch (err) { serverError(err, [fs]); }
 }
 
-/** Selecting a mode applies it at once (as Motion Creator's home dialog does): the server
- * describes the phases of the mode in use, and the drawing shows them. */
+/** Selecting a mode draws its sequence at once (`home.get {mode}`: nothing applied; Save
+ * applies it with the other fields). */
 async function applyMode() {
-  const raw = fs.raw();
   const v = fs.values(["mode"]);
   if (!v || String(v.mode) === String(loaded.mode)) { redraw(); return; }
   if (!seqCache.has(String(v.mode))) {
     try {
-      const res = await app.call("home.set", { axis, changes: { mode: v.mode } });
-      if (res.config_version !== undefined) app.configVersion = res.config_version;
-      loaded = { ...loaded, mode: res.config.mode };
-      seqCache.set(String(res.config.mode), res.sequence || []);
-      savedNote.textContent = `mode ${res.config.mode} applied${res.saved ? `, saved to ${res.saved}` : ""}`;
+      const res = await app.call("home.get", { axis, mode: v.mode });
+      seqCache.set(String(v.mode), res.sequence || []);
     } catch (err) {
       serverError(err, [fs]);
       return;
     }
   }
-  fs.set("direction", raw.direction);
   redraw();
 }
 

@@ -186,7 +186,7 @@ function update() {
   view.homing.textContent = h.state && h.state !== "idle" ? `homing: ${h.state}${h.phase ? " · " + h.phase : ""}${h.reason ? " · " + h.reason : ""}` : "";
   if (!view.servoBusy) view.servo.checked = Boolean(s.servo);
   view.reset.disabled = s.state !== "ErrorStop";
-  lamps.update({ ...(s.io || {}), svon: s.servo });   // SVON = the servo-on output axis.servo sets
+  lamps.update(s.io || {});   // SVON: the servo-on output (io.svon, set by axis.servo)
   if (chart && app.status && typeof app.status.time === "number") chart.append([app.status.time], [[s.velocity], [s.position]]);
 }
 

@@ -112,7 +112,7 @@ function update() {
   for (const [name, lamps] of lampsByAxis) {
     const a = s.axes && s.axes[name];
     if (!a) continue;
-    lamps.update({ ...(a.io || {}), svon: a.servo });
+    lamps.update(a.io || {});
     for (const [sig] of SIGNALS) {
       const b = document.getElementById(`sim-${name}-${sig}`);
       if (b && b.dataset.active === "true" && a.io && a.io[sig] === false && sig !== "org") b.title = "switch put under the axis (logic may invert the lamp)";
