@@ -44,7 +44,7 @@ KNOWN_STATE = frozenset((
     "motion_prev", "cycle", "polar_inc", "comp", "saved_states", "blend", "coord", "tools",
     "selected_tool", "tool", "spindle_on", "spindle_cw", "speed", "mist", "flood", "ended",
     "flow_request", "letters", "g92", "off", "work", "rot", "rotated", "tool_offset", "line",
-    "per_rev", "css", "retract_old_z", "diameter_mode"))
+    "per_rev", "css", "retract_old_z", "diameter_mode", "wait_request"))
 
 
 class _Defer(Exception):
@@ -240,6 +240,8 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
         running = modal.execute(b, general)
         if modal.flow_request is not None:
             raise _Defer("M98/M99")
+        if modal.wait_request is not None:  # G38.x / M66: the interpreter answers it
+            raise _Defer("probe or input wait")
         if general and not comp.side and not comp.queue:
             # cutter compensation edits the moves it queued (indices into this list):
             # they leave only once it is off

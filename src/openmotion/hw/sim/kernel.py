@@ -58,12 +58,14 @@ if _k is not None:
 
 
 def usable(axes: list[SimAxis]) -> bool:
-    """True when the kernel models every axis (steppers, nothing armed, no pitch table)."""
+    """True when the kernel models every axis (steppers, nothing armed, no pitch table, only
+    the axis's own input switches: a probe's hidden switches feed a board input through
+    the machine's edge filters, which only the Python path applies)."""
     if _k is None:
         return False
     for ax in axes:
         if (type(ax.plant) is not StepperPlant or ax.armed or ax.trans.pitch.e
-                or len(ax.switches) > _MAXSW):
+                or len(ax.switches) > _MAXSW or not _BIT.keys() >= ax.switches.keys()):
             return False
     return True
 
