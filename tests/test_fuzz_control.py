@@ -4,8 +4,6 @@ in-position control."""
 
 from __future__ import annotations
 
-import pytest
-
 from fuzzkit import Entry, examples, run_entries
 from openmotion.control import jog
 from openmotion.control.compare import (
@@ -89,7 +87,8 @@ AXES = [
 
 GROUPS = [
     Entry("Group", lambda w, **kw: Group(w.ctl, **kw),
-          dict(axes=["x", "y"], feed=10_000.0, acc_time=0.1, queue_size=16, units=False)),
+          dict(axes=["z", "u"], feed=10_000.0, acc_time=0.1, queue_size=16, units=False),
+          aliases={"axes": ("axes", "axis")}),
     Entry("Group.line", group_call("line"), dict(target=[1000.0, 500.0], relative=False)),
     Entry("Group.ptp", group_call("ptp"), dict(target=[1000.0, 500.0], relative=True)),
     Entry("Group.arc", group_call("arc"),
@@ -239,9 +238,6 @@ def test_fuzz_axes(fuzz_long: bool) -> None:
 
 
 def test_fuzz_groups(fuzz_long: bool) -> None:
-    if not fuzz_long:  # open in issue #12: see docs/ranges.md, "Fuzz status"
-        pytest.skip("after the round-2 merge this family ran a pytest worker out of memory "
-                    "(an accepted huge path); run with --fuzz-long while it is fixed")
     _run(GROUPS, fuzz_long, 700)
 
 
