@@ -234,20 +234,20 @@ def _run(entries, fuzz_long, normal):
 
 
 def test_fuzz_axes(fuzz_long: bool) -> None:
-    _run(AXES, fuzz_long, 500)
+    _run(AXES, fuzz_long, 300)
 
 
 def test_fuzz_groups(fuzz_long: bool) -> None:
-    _run(GROUPS, fuzz_long, 700)
+    _run(GROUPS, fuzz_long, 400)
 
 
 def test_fuzz_jog_homing_latch(fuzz_long: bool) -> None:
-    _run(JOG_HOME_LATCH, fuzz_long, 500)
+    _run(JOG_HOME_LATCH, fuzz_long, 300)
 
 
 def test_fuzz_compare_pso(fuzz_long: bool) -> None:
-    _run(COMPARE, fuzz_long, 700)
+    _run(COMPARE, fuzz_long, 400)
 
 
 def test_fuzz_compensation_servo(fuzz_long: bool) -> None:
-    _run(COMP_SERVO, fuzz_long, 500)
+    _run(COMP_SERVO, fuzz_long, 300)

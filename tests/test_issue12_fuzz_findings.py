@@ -222,3 +222,12 @@ def test_a_refused_group_command_leaves_the_tail_as_it_was(centre):
     assert g._tail is None
     _motion_error(lambda: g.arc(centre, [1000.0, 0.0]), "centre")
     assert g._tail is None
+
+
+@pytest.mark.parametrize("kw", [dict(start=-6.954724257381864e188), dict(end=1e300),
+                                dict(start=-(2.0**41))])
+def test_every_distance_window_lies_within_the_position_range(kw):
+    from openmotion.control.compare import Toggle, VectorSource, every_distance
+
+    _motion_error(lambda: every_distance(VectorSource((0, 1)), 100.0, Toggle(2), **kw),
+                  next(iter(kw)))
