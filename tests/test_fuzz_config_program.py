@@ -72,7 +72,7 @@ ENTRIES = [
 
 
 def test_fuzz_config_units_program(fuzz_long: bool) -> None:
-    stats = run_entries(ENTRIES, examples(fuzz_long, 600), cycles=0.0)
+    stats = run_entries(ENTRIES, examples(fuzz_long, 500), cycles=0.0)
     print(stats.report())
     assert stats.clean, stats.report()
 
@@ -87,7 +87,7 @@ _WORDS = st.sampled_from(["G0", "G1", "G2", "G3", "G4", "G90", "G91", "G20", "G2
 
 def test_fuzz_gcode_lines(fuzz_long: bool) -> None:
     """Mutated G-code: only GCodeError/MotionError, never a crash, always in bounded work."""
-    n = examples(fuzz_long, 400)
+    n = examples(fuzz_long, 300)
     bad: list[str] = []
     count = [0]
     opts = GCodeOptions(axes={"X": 0, "Y": 1, "Z": 2}, max_blocks=20_000,

@@ -238,7 +238,7 @@ def test_fuzz_axes(fuzz_long: bool) -> None:
 
 
 def test_fuzz_groups(fuzz_long: bool) -> None:
-    _run(GROUPS, fuzz_long, 400)
+    _run(GROUPS, fuzz_long, 300)
 
 
 def test_fuzz_jog_homing_latch(fuzz_long: bool) -> None:
@@ -246,7 +246,7 @@ def test_fuzz_jog_homing_latch(fuzz_long: bool) -> None:
 
 
 def test_fuzz_compare_pso(fuzz_long: bool) -> None:
-    _run(COMPARE, fuzz_long, 400)
+    _run(COMPARE, fuzz_long, 300)
 
 
 def test_fuzz_compensation_servo(fuzz_long: bool) -> None:
