@@ -66,14 +66,16 @@ MOVE = dict(max_vel=20_000.0, str_vel=100.0, tacc=0.05, tdec=None, shape="S", vs
             vs_dec=0.0, units=False)
 
 AXES = [
-    Entry("Axis.move_relative", axis_call("move_relative"), dict(distance=5000.0, **MOVE)),
-    Entry("Axis.move_absolute", axis_call("move_absolute"), dict(position=5000.0, **MOVE)),
+    Entry("Axis.move_relative", axis_call("move_relative"), dict(distance=5000.0, **MOVE),
+          aliases={"units": ("units", "max_vel")}),
+    Entry("Axis.move_absolute", axis_call("move_absolute"), dict(position=5000.0, **MOVE),
+          aliases={"units": ("units", "max_vel")}),
     Entry("Axis.move_velocity", axis_call("move_velocity"),
           dict(velocity=5000.0, str_vel=100.0, tacc=0.05, shape="T", vs_acc=0.0,
                units=False), aliases={"units": ("units", "velocity")}),
     Entry("Axis.move_jerk_limited", axis_call("move_jerk_limited"),
           dict(distance=5000.0, v_max=2e4, a_max=2e5, j_max=2e7, d_max=None, absolute=False,
-               units=False)),
+               units=False), aliases={"units": ("units", "v_max")}),
     Entry("Axis.fix_speed_range", axis_call("fix_speed_range"),
           dict(max_vel=10_000.0, units=False)),
     Entry("Axis.set_move_ratio", axis_call("set_move_ratio"), dict(ratio=2.0)),
@@ -153,7 +155,8 @@ COMPARE = [
     Entry("SetLevel", lambda w, **kw: SetLevel(**kw), dict(output=0, level=True)),
     Entry("LevelJob", lambda w, **kw: engine(w).add(LevelJob(**kw)),
           dict(source=AxisSource(0), levels=[100.0, 200.0], action=Toggle(0), direction=1,
-               repeat=False, after_final=None, monotonic=True, name="j")),
+               repeat=False, after_final=None, monotonic=True, name="j"),
+          aliases={"direction": ("direction", "levels")}),
     Entry("WindowJob", lambda w, **kw: engine(w).add(WindowJob(**kw)),
           dict(axes=(0, 1), points=[[100.0, 0.0]], maxerr=5.0, action=Toggle(1),
                kind="dpos", name="w")),
@@ -192,7 +195,8 @@ COMP_SERVO = [
           lambda w, **kw: comp(w).suppress_vibration(**kw), dict(t1=0.01, t2=0.02)),
     Entry("Compensation.set_pitch_table", lambda w, **kw: comp(w).set_pitch_table(**kw),
           dict(interval=1000, home_index=0, forward=[0, 1, 2], backward=None, stroke=None),
-          aliases={"interval": ("interval", "table covers")}),
+          aliases={"interval": ("interval", "table covers"),
+                   "home_index": ("home_index", "home point")}),
     Entry("PitchCompTable.make", lambda w, **kw: PitchCompTable.make(**kw),
           dict(interval=1000, home_index=1, forward=[0, 1, 2], backward=[0, 1, 1]),
           aliases={"interval": ("interval", "home point")}),
@@ -214,7 +218,7 @@ COMP_SERVO = [
     Entry("InPositionControl.set_check_time",
           lambda w, **kw: inpos(w).set_check_time(**kw), dict(axis="y", seconds=0.01)),
     Entry("InPositionControl.enable", lambda w, **kw: inpos(w).enable(**kw),
-          dict(axes=["x"])),
+          dict(axes=["x"]), aliases={"axes": ("axes", "axis")}),
 ]
 
 

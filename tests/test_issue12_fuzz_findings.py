@@ -231,3 +231,12 @@ def test_every_distance_window_lies_within_the_position_range(kw):
 
     _motion_error(lambda: every_distance(VectorSource((0, 1)), 100.0, Toggle(2), **kw),
                   next(iter(kw)))
+
+
+@pytest.mark.parametrize("value", [np.array([1.0, 2.0]), np.array(["mm"]), ["mm"]])
+def test_choice_arguments_refuse_arrays(value):
+    from openmotion.control.homing import HomeConfig
+    from openmotion.program import GCodeOptions
+
+    _motion_error(lambda: GCodeOptions(axes={"X": 0}, machine_units=value), "machine_units")
+    _motion_error(lambda: HomeConfig(mode=value), "mode")

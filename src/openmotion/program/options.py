@@ -99,7 +99,7 @@ class GCodeOptions:
                 raise MotionError(f"n_axes must be an integer >= {n} (highest mapped axis + 1)"
                                   f", got {self.n_axes!r}")
             n = self.n_axes
-        if self.machine_units not in ("mm", "inch"):
+        if not isinstance(self.machine_units, str) or self.machine_units not in ("mm", "inch"):
             raise MotionError(f"machine_units must be 'mm' or 'inch', got "
                               f"{self.machine_units!r}")
         if self.start is not None and (isinstance(self.start, (str, bytes, Mapping))
