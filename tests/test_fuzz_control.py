@@ -4,8 +4,6 @@ in-position control."""
 
 from __future__ import annotations
 
-import pytest
-
 from fuzzkit import Entry, examples, run_entries
 from openmotion.control import jog
 from openmotion.control.compare import (
@@ -68,14 +66,16 @@ MOVE = dict(max_vel=20_000.0, str_vel=100.0, tacc=0.05, tdec=None, shape="S", vs
             vs_dec=0.0, units=False)
 
 AXES = [
-    Entry("Axis.move_relative", axis_call("move_relative"), dict(distance=5000.0, **MOVE)),
-    Entry("Axis.move_absolute", axis_call("move_absolute"), dict(position=5000.0, **MOVE)),
+    Entry("Axis.move_relative", axis_call("move_relative"), dict(distance=5000.0, **MOVE),
+          aliases={"units": ("units", "max_vel")}),
+    Entry("Axis.move_absolute", axis_call("move_absolute"), dict(position=5000.0, **MOVE),
+          aliases={"units": ("units", "max_vel")}),
     Entry("Axis.move_velocity", axis_call("move_velocity"),
           dict(velocity=5000.0, str_vel=100.0, tacc=0.05, shape="T", vs_acc=0.0,
                units=False), aliases={"units": ("units", "velocity")}),
     Entry("Axis.move_jerk_limited", axis_call("move_jerk_limited"),
           dict(distance=5000.0, v_max=2e4, a_max=2e5, j_max=2e7, d_max=None, absolute=False,
-               units=False)),
+               units=False), aliases={"units": ("units", "v_max")}),
     Entry("Axis.fix_speed_range", axis_call("fix_speed_range"),
           dict(max_vel=10_000.0, units=False)),
     Entry("Axis.set_move_ratio", axis_call("set_move_ratio"), dict(ratio=2.0)),
@@ -89,7 +89,8 @@ AXES = [
 
 GROUPS = [
     Entry("Group", lambda w, **kw: Group(w.ctl, **kw),
-          dict(axes=["x", "y"], feed=10_000.0, acc_time=0.1, queue_size=16, units=False)),
+          dict(axes=["z", "u"], feed=10_000.0, acc_time=0.1, queue_size=16, units=False),
+          aliases={"axes": ("axes", "axis")}),
     Entry("Group.line", group_call("line"), dict(target=[1000.0, 500.0], relative=False)),
     Entry("Group.ptp", group_call("ptp"), dict(target=[1000.0, 500.0], relative=True)),
     Entry("Group.arc", group_call("arc"),
@@ -154,7 +155,8 @@ COMPARE = [
     Entry("SetLevel", lambda w, **kw: SetLevel(**kw), dict(output=0, level=True)),
     Entry("LevelJob", lambda w, **kw: engine(w).add(LevelJob(**kw)),
           dict(source=AxisSource(0), levels=[100.0, 200.0], action=Toggle(0), direction=1,
-               repeat=False, after_final=None, monotonic=True, name="j")),
+               repeat=False, after_final=None, monotonic=True, name="j"),
+          aliases={"direction": ("direction", "levels")}),
     Entry("WindowJob", lambda w, **kw: engine(w).add(WindowJob(**kw)),
           dict(axes=(0, 1), points=[[100.0, 0.0]], maxerr=5.0, action=Toggle(1),
                kind="dpos", name="w")),
@@ -193,7 +195,8 @@ COMP_SERVO = [
           lambda w, **kw: comp(w).suppress_vibration(**kw), dict(t1=0.01, t2=0.02)),
     Entry("Compensation.set_pitch_table", lambda w, **kw: comp(w).set_pitch_table(**kw),
           dict(interval=1000, home_index=0, forward=[0, 1, 2], backward=None, stroke=None),
-          aliases={"interval": ("interval", "table covers")}),
+          aliases={"interval": ("interval", "table covers"),
+                   "home_index": ("home_index", "home point")}),
     Entry("PitchCompTable.make", lambda w, **kw: PitchCompTable.make(**kw),
           dict(interval=1000, home_index=1, forward=[0, 1, 2], backward=[0, 1, 1]),
           aliases={"interval": ("interval", "home point")}),
@@ -215,7 +218,7 @@ COMP_SERVO = [
     Entry("InPositionControl.set_check_time",
           lambda w, **kw: inpos(w).set_check_time(**kw), dict(axis="y", seconds=0.01)),
     Entry("InPositionControl.enable", lambda w, **kw: inpos(w).enable(**kw),
-          dict(axes=["x"])),
+          dict(axes=["x"]), aliases={"axes": ("axes", "axis")}),
 ]
 
 
@@ -235,23 +238,20 @@ def _run(entries, fuzz_long, normal):
 
 
 def test_fuzz_axes(fuzz_long: bool) -> None:
-    _run(AXES, fuzz_long, 500)
+    _run(AXES, fuzz_long, 300)
 
 
 def test_fuzz_groups(fuzz_long: bool) -> None:
-    if not fuzz_long:  # open in issue #12: see docs/ranges.md, "Fuzz status"
-        pytest.skip("after the round-2 merge this family ran a pytest worker out of memory "
-                    "(an accepted huge path); run with --fuzz-long while it is fixed")
-    _run(GROUPS, fuzz_long, 700)
+    _run(GROUPS, fuzz_long, 300)
 
 
 def test_fuzz_jog_homing_latch(fuzz_long: bool) -> None:
-    _run(JOG_HOME_LATCH, fuzz_long, 500)
+    _run(JOG_HOME_LATCH, fuzz_long, 300)
 
 
 def test_fuzz_compare_pso(fuzz_long: bool) -> None:
-    _run(COMPARE, fuzz_long, 700)
+    _run(COMPARE, fuzz_long, 300)
 
 
 def test_fuzz_compensation_servo(fuzz_long: bool) -> None:
-    _run(COMP_SERVO, fuzz_long, 500)
+    _run(COMP_SERVO, fuzz_long, 300)

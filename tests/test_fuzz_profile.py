@@ -64,6 +64,6 @@ ENTRIES = [
 
 
 def test_fuzz_profile(fuzz_long: bool) -> None:
-    stats = run_entries(ENTRIES, examples(fuzz_long, 1500), cycles=0.0)
+    stats = run_entries(ENTRIES, examples(fuzz_long, 500), cycles=0.0)
     print(stats.report())
     assert stats.clean, stats.report()

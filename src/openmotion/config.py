@@ -304,7 +304,9 @@ class AxisConfig:
         if max_pps > MAX_PULSE_RATE:
             raise MotionError(
                 f"{p}.max_speed must be <= {MAX_PULSE_RATE / self.pulses_per_unit:g} "
-                f"{self.unit}/s (pulse output limit {MAX_PULSE_RATE:g} pps), "
+                f"{self.unit}/s (pulse output limit {MAX_PULSE_RATE:g} pps at "
+                f"{self.pulses_per_unit:g} pulses/{self.unit} from pulses_per_rev="
+                f"{self.pulses_per_rev!r}, lead={self.lead!r}, gear_ratio={self.gear_ratio!r}), "
                 f"got {self.max_speed!r}")
         for lim in ("max_accel", "max_jerk"):
             _set(self, lim, _nonneg(f"{p}.{lim}", getattr(self, lim)))

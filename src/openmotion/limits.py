@@ -39,6 +39,10 @@ class Range:
 
 #: Largest position or distance, pulses: float64 keeps 2^-12 pulse resolution below 2^40.
 PULSES_MAX = float(2**40)
+#: Longest path element (line, arc, helix), pulses of its axes: a full circle through any
+#: two representable points fits (2*pi*2*sqrt(2)*2^40 < 2^45), and the path coordinate s
+#: keeps 2^-7 pulse resolution (an arc's angle s*sweep/length errs by at most length*2^-53).
+PATH_LENGTH_MAX = float(2**45)
 #: Velocity, pulses/s: 1 pulse in 11.6 days up to 1 Gpps (hardware tops out near 10 Mpps).
 PPS_MIN, PPS_MAX = 1e-6, 1e9
 #: Acceleration, pulses/s^2.

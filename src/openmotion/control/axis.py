@@ -579,6 +579,19 @@ class Axis(AxisEngine):
         self._replace(m, profile, m.spec, None, kind="stop")
         self._state = transition(self._state, S.STOPPING, self.name)
 
+    def _stop_along(self, tail: Profile) -> None:
+        """Decelerating stop that follows `tail` (command-counter frame, time 0 = now, ends
+        at rest) instead of the axis's own deceleration: a group stopping along its path
+        when one of its axes is stopped. The axis is STOPPING (or stays in ErrorStop)."""
+        m = self._motion
+        if m is None:
+            return
+        shifted = tail.shifted(-self.counters._cmd_off)
+        self._replace(m, m.profile.splice(self._ctl.time - m.t_start, shifted), m.spec, None,
+                      kind="stop")
+        if self._state is not S.ERROR_STOP:
+            self._state = transition(self._state, S.STOPPING, self.name)
+
     @_locked
     def stop_immediately(self) -> None:
         """Immediate stop (HSL emg_stop): the pulse output stops at once, at any state."""

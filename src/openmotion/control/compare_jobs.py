@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import MotionError, check_finite, check_positive, show
-from ..limits import as_array
+from ..limits import as_array, check_pulses
 from .compare_math import crossings_after, first_crossing, first_inside
 
 if TYPE_CHECKING:
@@ -329,10 +329,10 @@ def every_distance(source: VectorSource, interval: float, action: Action, *,
     """Fire every `interval` of path length, from `start` (default `interval`) up to `end`
     (default endless): the enable window [start, end] is in the source's VECTOR_MOVED."""
     iv = check_positive("interval", interval)
-    s = iv if start is None else check_finite("start", start)
+    s = iv if start is None else check_pulses("start", start)
     count = None
     if end is not None:
-        e = check_finite("end", end)
+        e = check_pulses("end", end)
         if e < s:
             what = "start" if start is not None else "start (default: interval)"
             raise MotionError(f"end must be >= {what}, got start={s!r} (interval={iv!r}), "

@@ -176,7 +176,10 @@ class Group(GroupSettings):
         self._sys_max = float(max(a.max_speed / k for a, k in zip(ax, self._ppu, strict=True)))
         self.set_feed(feed)
         if acc_time is not None:
-            self.set_acc_time(acc_time)
+            try:
+                self.set_acc_time(acc_time)
+            except MotionError as e:  # set_acc_time names its own argument, `seconds`
+                raise MotionError(f"acc_time: {e}") from None
         self._vmax_pps = np.array([a.max_speed for a in ax], dtype=float)
         # the machine file's per-axis acceleration limit (0: none) caps every command
         self._amax_pps = np.array([a.config.max_accel * a.config.pulses_per_unit
@@ -418,9 +421,8 @@ class Group(GroupSettings):
                direction: str = "CCW", relative: bool = False) -> int:
         """Full circle around `centre` (MCC_CircleXY), back to the start."""
         start = self._start_point()
-        return self.arc(centre, start, plane=plane, direction=direction, relative=False) \
-            if not relative else self.arc(np.asarray(centre, float) + start[list(plane)],
-                                          start, plane=plane, direction=direction)
+        c = self._point2("centre", centre, start if relative else None, plane)
+        return self.arc(c, start, plane=plane, direction=direction, relative=False)
 
     @_locked
     def helix(self, centre: Sequence[float], end: Sequence[float], **kw: Any) -> int:

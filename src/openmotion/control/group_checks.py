@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import MotionError, show
-from ..limits import PULSES_MAX, as_array
+from ..limits import PATH_LENGTH_MAX, PULSES_MAX, as_array
 from ..path.extent import element_extent
 from ..path.geometry import PathElement
 from ..units import AxisUnits
@@ -57,10 +57,7 @@ class GroupChecks(GroupEngine):
     _refuse: bool
 
     def _axis_values(self, name: str, values: Sequence[float]) -> np.ndarray:
-        try:
-            arr = np.array(values, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise MotionError(f"{name} must be {len(self.axes)} numbers") from None
+        arr = as_array(name, values, None).reshape(-1)
         if arr.size != len(self.axes) or np.any(np.isnan(arr)) or np.any(arr <= 0.0):
             raise MotionError(f"{name} must be {len(self.axes)} numbers > 0, got {values!r}")
         return arr
@@ -80,11 +77,13 @@ class GroupChecks(GroupEngine):
                 raise GroupError(ERR_AXIS_BUSY, f"axis {a.name} is moving outside the group")
 
     def _start_point(self) -> np.ndarray:
+        """Where the next command starts: the queue's tail, or where the axes are (while
+        abort() is still stopping: where it stops). Read only: a refused command leaves
+        the tail as it was; `_push` moves it."""
         self._check_accepting()
         if self._tail is None or (self._run is None and not self._queue
                                   and self._held is None):
-            # while abort() is still stopping, the next command starts where it stops
-            self._tail = self._units_of(self._stop_point()) if self._aborting \
+            return self._units_of(self._stop_point()) if self._aborting \
                 and self._run is not None else self.position
         return self._tail.copy()
 
@@ -146,7 +145,20 @@ class GroupChecks(GroupEngine):
                 raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the - "
                                             f"soft limit {lim.nlimit!r} (reaches {plo[i]:.6g})")
 
+    def _check_length(self, el: PathElement) -> None:
+        """Refuse a path element longer than PATH_LENGTH_MAX pulses (docs/ranges.md): its
+        path coordinate would lose pulse resolution, and its run would never end."""
+        length = float(el.length) * float(np.max(np.abs(self._ppu)))
+        if not length <= PATH_LENGTH_MAX:
+            turns = getattr(el, "turns", None)
+            what = f"arc of radius {el.radius:.6g} with turns={turns}" \
+                if turns is not None and hasattr(el, "radius") else type(el).__name__.lower()
+            raise GroupError(ERR_ARGUMENT, f"path length must be <= 2^45 = "
+                                           f"{PATH_LENGTH_MAX:.6g} pulses, got {length:.6g} "
+                                           f"(the {what})")
+
     def _push_path(self, el: PathElement, end: np.ndarray) -> int:
+        self._check_length(el)
         self._check_soft_limits(el)
         feed, sv = self._feed, self._str_vel
         tan = el.max_abs_tangent

@@ -6,12 +6,12 @@ running motion: group.py)."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from ..errors import MotionError, check_finite, check_nonnegative
+from ..limits import check_quantity
 from .group_checks import GroupChecks
 from .groupexec import ERR_ARGUMENT, ERR_SPEED, GroupError
 
@@ -46,9 +46,10 @@ class GroupSettings(GroupChecks):
     def set_feed(self, feed: float) -> None:
         """MCC_SetFeedSpeed: vector speed (pps, or user units/s) of the following path
         commands."""
-        f = check_finite("feed", feed)
-        if f <= 0.0:
-            raise GroupError(ERR_SPEED, f"feed must be > 0, got {feed!r}")
+        try:
+            f = check_quantity("feed", feed, "pps")
+        except MotionError as e:
+            raise GroupError(ERR_SPEED, str(e)) from None
         if hasattr(self, "_sys_max") and f > self._sys_max * (1 + 1e-12):
             names = set(getattr(self, "_unit_names", ("pulse",)))
             unit = "pps" if names == {"pulse"} else \
@@ -59,17 +60,12 @@ class GroupSettings(GroupChecks):
 
     def set_sys_max_speed(self, speed: float) -> None:
         """MCC_SetSysMaxSpeed: the largest feed accepted (pps, or user units/s)."""
-        v = check_finite("speed", speed)
-        if v <= 0.0:
-            raise MotionError(f"speed must be > 0, got {speed!r}")
-        self._sys_max = v
+        self._sys_max = check_quantity("speed", speed, "pps")
 
     def set_acc_time(self, seconds: float) -> None:
         """Time to accelerate from rest to the feed (MCC_SetAccStep x interpolation time)
         of the following commands; the deceleration follows it until set_dec_time."""
-        t = check_finite("seconds", seconds)
-        if t <= 0.0:
-            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        t = check_quantity("seconds", seconds, "seconds")
         self._acc_time = t
 
     def set_dec_time(self, seconds: float) -> None:
@@ -77,9 +73,7 @@ class GroupSettings(GroupChecks):
         of the following commands: path commands brake at feed / seconds (the look-ahead's
         backward pass, holds, aborts, a lower override), point-to-point axes with this
         Tdec. Until it is called the deceleration follows set_acc_time."""
-        t = check_finite("seconds", seconds)
-        if t <= 0.0:
-            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        t = check_quantity("seconds", seconds, "seconds")
         self._dec_time = t
 
     @property
@@ -198,9 +192,9 @@ class GroupSettings(GroupChecks):
             self._path_jerk = 0.0
             self._path_sfactor = s
             return
-        j = check_finite("jerk", jerk) if jerk is not None else math.nan
-        if not j > 0.0:
-            raise MotionError(f"jerk must be a finite number > 0 for shape 'S', got {jerk!r}")
+        if jerk is None:
+            raise MotionError("jerk must be a number > 0 (pps^3) for shape 'S', got None")
+        j = check_quantity("jerk", jerk, "pps3")
         self._path_jerk = j
         self._path_sfactor = 0.0
 
@@ -210,9 +204,10 @@ class GroupSettings(GroupChecks):
         vector speed, and ends at it with a jump to rest. Checked when a command is queued:
         <= its feed and StrVel*|u_i| <= each axis's maximum speed (GroupError ERR_SPEED).
         T and S paths (an S path: jump to StrVel, then an S acceleration from a = 0)."""
-        v = check_finite("speed", speed)
-        if v < 0.0:
-            raise GroupError(ERR_ARGUMENT, f"speed (StrVel) must be >= 0, got {speed!r}")
+        try:
+            v = check_quantity("speed", speed, "pps", zero=True)
+        except MotionError as e:
+            raise GroupError(ERR_ARGUMENT, f"StrVel: {e}") from None
         self._str_vel = v
 
     def set_ptp_speed(self, ratio: float, *, shape: str | None = None) -> None:
@@ -244,17 +239,13 @@ class GroupSettings(GroupChecks):
     def set_ptp_acc_time(self, seconds: float) -> None:
         """MCC_SetPtPAccStep x T: acceleration time of point-to-point axes (default: the
         path commands' set_acc_time)."""
-        t = check_finite("seconds", seconds)
-        if t <= 0.0:
-            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        t = check_quantity("seconds", seconds, "seconds")
         self._ptp_acc_time = t
 
     def set_ptp_dec_time(self, seconds: float) -> None:
         """MCC_SetPtPDecStep x T: deceleration time of point-to-point axes (default: the
         PtP acceleration time)."""
-        t = check_finite("seconds", seconds)
-        if t <= 0.0:
-            raise MotionError(f"seconds must be > 0, got {seconds!r}")
+        t = check_quantity("seconds", seconds, "seconds")
         self._ptp_dec_time = t
 
     @property

@@ -685,12 +685,35 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         if motion is None:
             self._fault(ERR_AXIS_STATE, f"axis {axis.name}: stopped outside the group")
             return
-        with self._commanding():  # a decelerating stop: the others decelerate too
-            for a in self.axes:
-                if a is not axis and a.motion is not None and a.motion.kind != "stop":
-                    a.stop()
+        # a decelerating stop: every axis decelerates along the path (a path's own stop,
+        # as hold() does), so an arc stays on its arc; a point-to-point move has no path
+        if self._run.kind != "path" or not self._path_stop():
+            with self._commanding():
+                for a in self.axes:
+                    if a is not axis and a.motion is not None and a.motion.kind != "stop":
+                        a.stop()
         self._fault(ERR_AXIS_STATE, f"axis {axis.name}: stopped outside the group",
                     stop=False)
+
+    def _path_stop(self) -> bool:
+        """Replace every axis's motion from now by the running path's stop to rest (the
+        hold re-plan), each as a "stop" motion of that axis; False (nothing changed) when
+        the path cannot be stopped along itself (a plan starting later, a planner error)."""
+        r = self._run
+        assert r is not None and r.plan is not None
+        t = self._ctl.time
+        if t < r.plan.t0 or t >= r.plan.t_end:
+            return False
+        try:
+            plan = pathrun.replan(r.plan, t, limits=r.plan.limits, hold=True)
+            profiles = self._pulse_profiles(px.axis_profiles(
+                plan.chain, plan.sprof, self._ctl.period, self.position))
+        except (MotionError, ArithmeticError, ValueError):
+            return False
+        with self._commanding():
+            for a, p in zip(self.axes, profiles, strict=True):
+                a._stop_along(p)
+        return True
 
     def _on_axis_fault(self, axis: Axis, reason: str) -> None:
         """Controller fault hook: a group axis went to ErrorStop."""
@@ -699,7 +722,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             # the motion hook reacted first (the fault stopped the axis): name the fault
             self._foreign = None
             self._error, self._error_msg = code, f"axis {axis.name}: {reason}"
-            self._stop_axes()
+            if axis.motion is None:  # an immediate fault stop; a decelerating one keeps
+                self._stop_axes()    # the path stop the motion hook installed
             return
         if axis in self.axes and not self._dry and self._state in (
                 GroupState.MOVING, GroupState.HOLDING, GroupState.HELD):

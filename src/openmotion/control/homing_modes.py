@@ -174,7 +174,7 @@ class HomeConfig:
     def __post_init__(self) -> None:
         m = self.mode
         if not (isinstance(m, int) and not isinstance(m, bool) and m in HSL_MODES) and \
-                m not in tuple(f"mccl_{k}" for k in MCCL_TYPES):
+                not (isinstance(m, str) and m in tuple(f"mccl_{k}" for k in MCCL_TYPES)):
             raise MotionError(f"mode must be 0..12 or mccl_normal/mccl_home_only/"
                               f"mccl_index_only, got {m!r}")
         if not isinstance(self.direction, int) or isinstance(self.direction, bool) \

@@ -162,12 +162,15 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
     if lead > 0.0:
         b.segment(lead, 0.0, accel=0.0, label="dwell")
     last = len(ds) - 1
+    # a stall is a piece crawling at a speed rounding left (> 1e6 s at under 1e-6 of the
+    # curve's peak); a long piece at a real speed is a long path (2^45 pulses at a low feed)
+    crawl = 2e-6 * float(v.max(initial=0.0))
     for k in range(len(ds)):
         if ds[k] <= 0.0:
             continue
         a = dv2[k] / (2.0 * ds[k])
         vm = v[k] + v[k + 1]
-        if vm <= 0.0 or 2.0 * ds[k] / vm > 1e6:
+        if vm <= 0.0 or (2.0 * ds[k] / vm > 1e6 and vm < crawl):
             if ds[k] <= 1e-9 * max(1.0, s_end):  # a sliver left by rounding: step over it
                 continue
             raise InfeasibleError("path speed curve stalls at rest before its end")

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import MotionError, check_finite, check_nonnegative, check_positive
+from ..limits import COUNT_MAX
 from .geometry import (
     Array,
     Direction,
@@ -37,6 +38,9 @@ from .geometry import (
     snap_ends,
     vnorm,
 )
+
+#: Smallest arc radius (path units): below it the tangent and curvature lose all precision.
+RADIUS_MIN = 1e-9
 
 TWO_PI = 2.0 * math.pi
 #: Default end-point tolerance, relative to the radius.
@@ -281,16 +285,19 @@ class Arc(_ArcQueries):
         i, j = _plane_axes(self.plane, n)
         direction = parse_direction(self.direction)
         if isinstance(self.turns, bool) or not isinstance(self.turns, (int, np.integer)) \
-                or self.turns < 0:
-            raise MotionError(f"turns must be an integer >= 0, got {self.turns!r}")
+                or not 0 <= self.turns <= COUNT_MAX:
+            raise MotionError(f"turns must be an integer with 0 <= n <= {COUNT_MAX}, "
+                              f"got {self.turns!r}")
         tol = check_nonnegative("tol", self.tol)
         cp = centre_in if centre_in.size == 2 else centre_in[[i, j]]
         centre = start.copy()
         centre[[i, j]] = cp
         rs = start[[i, j]] - cp
         radius = math.hypot(rs[0], rs[1])
-        if radius == 0.0:
-            raise MotionError("centre must differ from start in the plane (radius > 0)")
+        if not radius >= RADIUS_MIN:
+            raise MotionError(f"centre must differ from start in the plane (radius > 0, at "
+                              f"least {RADIUS_MIN:g}: a smaller circle is a point), got "
+                              f"radius {radius:g}")
         re = end[[i, j]] - cp
         miss = abs(math.hypot(re[0], re[1]) - radius)
         if miss > tol * radius:

@@ -132,7 +132,7 @@ class ConvertOptions:
         r = self.rapid_ratio
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0.0 < r <= 1.0:
             raise MotionError(f"rapid_ratio must be in (0, 1], got {r!r}")
-        if self.feed_mode not in ("uniform", "exact"):
+        if not isinstance(self.feed_mode, str) or self.feed_mode not in ("uniform", "exact"):
             raise MotionError(f"feed_mode must be 'uniform' or 'exact', got {self.feed_mode!r}")
         c = self.chord_tol
         if isinstance(c, bool) or not isinstance(c, (int, float)) or not c > 0.0 \

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..errors import MotionError, check_finite, check_int
+from ..errors import MotionError, check_finite, check_int, show
 from .parser import MAX_PARAMETER
 from .source import MAX_LINE_LENGTH, MAX_PROGRAM_BYTES
 
@@ -102,9 +102,14 @@ class GCodeOptions:
                 raise MotionError(f"n_axes must be an integer >= {n} (highest mapped axis + 1)"
                                   f", got {self.n_axes!r}")
             n = self.n_axes
-        if self.machine_units not in ("mm", "inch"):
+        if not isinstance(self.machine_units, str) or self.machine_units not in ("mm", "inch"):
             raise MotionError(f"machine_units must be 'mm' or 'inch', got "
                               f"{self.machine_units!r}")
+        if self.start is not None and (isinstance(self.start, (str, bytes, Mapping))
+                                       or not isinstance(self.start, Iterable)
+                                       or getattr(self.start, "ndim", 1) != 1):
+            raise MotionError(f"start must be a sequence of {n} numbers (one per machine "
+                              f"axis) or None, got {show(self.start)}")
         start = tuple(0.0 for _ in range(n)) if self.start is None else tuple(
             check_finite(f"start[{k}]", v) for k, v in enumerate(self.start))
         if len(start) != n:
@@ -138,6 +143,10 @@ class GCodeOptions:
                                       f" = {lim!r}")
                 out.append((lo, hi))
             limits = tuple(out)
+        for name in ("parameters", "tool_lengths"):
+            if not isinstance(getattr(self, name), Mapping):
+                raise MotionError(f"{name} must be a mapping number -> value, got "
+                                  f"{show(getattr(self, name))}")
         for key, v in self.parameters.items():
             if isinstance(key, bool) or not isinstance(key, int) \
                     or not 1 <= key <= MAX_PARAMETER:
@@ -160,7 +169,8 @@ class GCodeOptions:
         for name in ("block_delete", "keep_comments"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False, got {getattr(self, name)!r}")
-        if isinstance(self.subroutine_path, (str, bytes)) or not all(
+        if isinstance(self.subroutine_path, (str, bytes)) or not isinstance(
+                self.subroutine_path, Iterable) or not all(
                 isinstance(d, (str, os.PathLike)) for d in self.subroutine_path):
             raise MotionError(f"subroutine_path must be a sequence of folder names, got "
                               f"{self.subroutine_path!r}")
@@ -180,7 +190,10 @@ class GCodeOptions:
         if table is None:
             tools: dict[int, Tool] = {}
         elif isinstance(table, (str, os.PathLike)):
-            tools = read_tool_table(table)
+            try:
+                tools = read_tool_table(table)
+            except MotionError as e:  # the file's own message, said to be the tool table
+                raise MotionError(f"tool_table: {e}") from None
         elif isinstance(table, Mapping):
             tools = {}
             for key, t in table.items():

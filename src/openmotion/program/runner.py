@@ -35,6 +35,7 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Mapping, Sequence
@@ -44,7 +45,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import MotionError
+from ..errors import MotionError, show
 from ..units import AxisUnits
 from . import canon
 from .convert import ConvertOptions, Op, Scales, convert
@@ -179,6 +180,23 @@ class _Pass:
     pc: int = 0
 
 
+def _gcode_fields(gcode: object) -> dict[str, object]:
+    """The runner's `gcode` argument: GCodeOptions fields by name, minus those the
+    runner sets itself (their values are checked when the options are built)."""
+    if gcode is None:
+        return {}
+    if not isinstance(gcode, Mapping):
+        raise MotionError(f"gcode must be a mapping of GCodeOptions fields, got {show(gcode)}")
+    names = {f.name for f in dataclasses.fields(GCodeOptions)}
+    for key in gcode:
+        if key in ("axes", "n_axes", "start", "machine_units"):
+            raise MotionError(f"gcode must not set {key!r} (the runner sets it)")
+        if key not in names:
+            raise MotionError(f"gcode: {key!r} is not a GCodeOptions field "
+                              f"({', '.join(sorted(names))})")
+    return dict(gcode)
+
+
 class ProgramRunner:
     """A G-code program (text, a pathlib path, or canonical commands) bound to a controller.
 
@@ -208,10 +226,11 @@ class ProgramRunner:
                      if k not in "ABC" and u.unit in ("mm", "inch")}
         self.machine_units = "inch" if lin_units == {"inch"} else "mm"
         self.scales = Scales.build(units, self.letters, self.machine_units)
-        self._gextra = dict(gcode or {})
-        for bad in ("axes", "n_axes", "start", "machine_units"):
-            if bad in self._gextra:
-                raise MotionError(f"gcode must not set {bad!r} (the runner sets it)")
+        self._gextra = _gcode_fields(gcode)
+        if not isinstance(file, (str, os.PathLike)):
+            raise MotionError(f"file must be a file name (str or path) for messages, got "
+                              f"{show(file)}")
+        file = os.fspath(file)
         self._gextra.setdefault("n_outputs", ctl.config.digital_outputs)
         self._gextra.setdefault("n_inputs", ctl.config.digital_inputs)
         self._gextra.setdefault("n_analog_inputs", 0)  # no analog inputs in the hardware
@@ -288,9 +307,12 @@ class ProgramRunner:
 
     def _goptions(self, start_pulses: np.ndarray) -> GCodeOptions:
         start = tuple(float(x) for x in start_pulses / self.scales.ppu)
-        return GCodeOptions(axes={k: n for n, k in enumerate(self.letters)},
-                            n_axes=len(self.letters), machine_units=self.machine_units,
-                            start=start, **self._gextra)  # type: ignore[arg-type]
+        try:
+            return GCodeOptions(axes={k: n for n, k in enumerate(self.letters)},
+                                n_axes=len(self.letters), machine_units=self.machine_units,
+                                start=start, **self._gextra)  # type: ignore[arg-type]
+        except MotionError as e:  # a gcode= field (or the soft limits made of the axes')
+            raise MotionError(f"gcode options: {e}") from None
 
     def _compile(self, start: np.ndarray) -> _Pass:
         cmds = self._commands

@@ -107,7 +107,7 @@ TABLE: tuple[Entry, ...] = (
     _e("HSL_M_set_feedback_src", "motion I/O", note="1 EA/EB, 0 output pulses"),
     _e("HSL_M_Set_Servo", "motion I/O"),
     _e("HSL_M_set_servo", "motion I/O", note="5.3 spelling"),
-    _e("HSL_M_get_io_status", "motion I/O", note="bits of seed-facts 2.4"),
+    _e("HSL_M_get_io_status", "motion I/O", note="bits of manual notes 2.4"),
     # counters
     _e("HSL_M_get_position", "counters"),
     _e("HSL_M_set_position", "counters"),
@@ -130,7 +130,7 @@ TABLE: tuple[Entry, ...] = (
     _e("HSL_M_disable_soft_limit", "comparators", _H),
     _e("HSL_M_error_counter_check", "comparators", note="Table 4-8 name"),
     _e("HSL_M_set_error_counter_check", "comparators"),
-    _e("HSL_M_set_general_comparator", "comparators", note="codes of seed-facts 2.5"),
+    _e("HSL_M_set_general_comparator", "comparators", note="codes of manual notes 2.5"),
     _e("HSL_M_set_trigger_comparator", "comparators", order=_M, note="axes 0, 1 of a module"),
     _e("HSL_M_set_trigger_type", "comparators"),
     _e("HSL_M_build_compare_function", "comparators", order=_M),
