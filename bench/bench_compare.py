@@ -16,7 +16,7 @@ import numpy as np
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.compare import (
+from openmotion.control.trigger.compare import (
     AxisSource,
     CompareEngine,
     LevelJob,

@@ -34,8 +34,8 @@ import time
 import numpy as np
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
-from openmotion.control.pathexec import contour_error
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.groups.pathexec import contour_error
 from openmotion.path import Line
 
 try:

@@ -24,7 +24,7 @@ import sys
 import textwrap
 import time
 
-from openmotion.control.clock import RealtimePacer
+from openmotion.control.core.clock import RealtimePacer
 from openmotion.remote.server import RemoteServer, ServerThread
 from openmotion.remote.service import MachineService
 

@@ -3,7 +3,7 @@
 N blended 0.05 mm segments on a wavy line at 40 mm/s (the stream of bench_stream.py,
 without its 1024-command feeder burst: a cycle hook pushes at most 3 commands per cycle,
 the queue kept at 256), run with `Controller.start_realtime()` at 1 ms, twice: with the
-join worker (control/groupjoin.py) and with every join forced into the cycle (the old
+join worker (control/groups/groupjoin.py) and with every join forced into the cycle (the old
 behaviour). Per run it prints the joins done each way, the path rests (0: it never stopped
 inside), the end error, and the cycle statistics (`Controller.cycle_stats`) without the
 first cycles (the first chain's start is planned in the cycle either way).
@@ -21,8 +21,8 @@ import numpy as np
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.clock import CycleStats, pacer_baseline
-from openmotion.control.group import Group, GroupState
+from openmotion.control.core.clock import CycleStats, pacer_baseline
+from openmotion.control.groups.group import Group, GroupState
 
 SKIP = 30  # first cycles left out of the figures (the first chain starts there)
 

@@ -8,7 +8,7 @@ pieces and the stepper pipeline in C).
 1, 4, 16 and 63 moving axes (ideal steppers on the default machine's X axis template, 1 ms
 cycle, every axis doing back-to-back T/S moves for the whole run, each restarted as soon
 as it is done) and 4 enabled idle axes; recorder off and on; each cycle by cycle
-(`virtual_jumps = False`, the reference) and jumping (control/jump.py). The driver loop is
+(`virtual_jumps = False`, the reference) and jumping (control/core/jump.py). The driver loop is
 the same both ways: `run_until(any axis done, event_driven=True)`, then new moves. Figures
 are CPU time (time.process_time), so they hold on a loaded machine. Prints the goals of
 issue 13 beside them, and the recorder's extra cost. Then two jobs, cycle by cycle and
@@ -28,8 +28,8 @@ from dataclasses import replace
 
 from openmotion.config import MachineConfig, default_machine
 from openmotion.control import Controller
-from openmotion.control import motion as _motion
-from openmotion.control.homing import HomeConfig, home_search
+from openmotion.control.core import motion as _motion
+from openmotion.control.home.homing import HomeConfig, home_search
 from openmotion.program.runner import ProgramRunner
 
 #: issue 13's goals (virtual s per CPU s)

@@ -37,7 +37,7 @@ import numpy as np
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 
 FEED = 40.0          # mm/s (F2400)
 TOL = 0.005          # blend tolerance, mm

@@ -11,8 +11,8 @@ import dataclasses
 
 from openmotion.config import DriveConfig, default_machine
 from openmotion.control import Controller
-from openmotion.control.compensation import Compensation
-from openmotion.control.inposition import InPositionControl
+from openmotion.control.guard.inposition import InPositionControl
+from openmotion.control.loops.compensation import Compensation
 
 SCREW_ERR = (0.0, 3.0, 7.5, 12.0, 9.0, 4.0, -2.0, -6.5, -3.0, 1.0, 5.0)  # per revolution
 BACKLASH = 30

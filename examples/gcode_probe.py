@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from openmotion.control.controller import Controller
+from openmotion.control.core.controller import Controller
 from openmotion.hw.sim.probe import SimProbe
 from openmotion.program import ProgramRunner, RunOptions, RunState
 

@@ -14,7 +14,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from openmotion.config_toml import load_machine
-from openmotion.control.controller import Controller
+from openmotion.control.core.controller import Controller
 from openmotion.hw.sim.spindle import spindle_axis
 from openmotion.program import ProgramRunner, RunOptions, RunState
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 
 V, A = 100_000.0, 1e6  # per-axis limits, pps and pps^2
 

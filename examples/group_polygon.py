@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
-from openmotion.control.pathexec import contour_error
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.groups.pathexec import contour_error
 from openmotion.path import Line
 
 V, A = 100_000.0, 1e6  # per-axis limits, pps and pps^2

@@ -18,8 +18,8 @@ import math
 import numpy as np
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
-from openmotion.control.pathexec import contour_error
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.groups.pathexec import contour_error
 from openmotion.path import Arc, Line
 
 VMAX, AMAX = 50_000.0, 500_000.0

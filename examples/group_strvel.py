@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 
 
 def run(str_vel: float, jerk: float | None = None) -> dict:

@@ -10,9 +10,9 @@ from pathlib import Path
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.compare import CompareEngine, Pulse, VectorSource, every_distance
-from openmotion.control.compare_io import plot_firings
-from openmotion.control.group import Group
+from openmotion.control.groups.group import Group
+from openmotion.control.trigger.compare import CompareEngine, Pulse, VectorSource, every_distance
+from openmotion.control.trigger.compare_io import plot_firings
 
 MM = 1000.0  # pulses per mm
 

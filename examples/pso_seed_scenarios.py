@@ -17,10 +17,10 @@ import numpy as np
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.compare import CompareEngine
-from openmotion.control.compare_io import plot_firings
-from openmotion.control.hsl_trigger import HslTrigger
-from openmotion.control.pso import ZPso
+from openmotion.control.trigger.compare import CompareEngine
+from openmotion.control.trigger.compare_io import plot_firings
+from openmotion.control.trigger.hsl_trigger import HslTrigger
+from openmotion.control.trigger.pso import ZPso
 from openmotion.profile.jerk import jerk_limited
 from openmotion.profile.segments import Profile, State
 

@@ -10,7 +10,7 @@ Run: python examples/pulse_accuracy.py
 from __future__ import annotations
 
 from openmotion.control import Controller, pulse_accuracy
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 from openmotion.path import Arc, Line
 
 R = 2_000.0

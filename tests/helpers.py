@@ -12,8 +12,8 @@ import numpy as np
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
-from openmotion.control.safety import Safety
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.guard.safety import Safety
 from openmotion.hw.interface import Hardware
 from openmotion.profile.jerk import jerk_limited
 from openmotion.profile.segments import Profile, State

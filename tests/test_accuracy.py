@@ -1,4 +1,4 @@
-"""Pulse accuracy: the simulator's pulse record, control.accuracy, and the exact distance
+"""Pulse accuracy: the simulator's pulse record, control.groups.accuracy, and the exact distance
 to arcs that contour_error uses. Group runs on lines and arcs are in test_group_blend."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import pytest
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller, count_accuracy, pulse_accuracy
-from openmotion.control import pathexec as px
+from openmotion.control.groups import pathexec as px
 from openmotion.errors import MotionError
 from openmotion.hw.interface import AxisCommand
 from openmotion.hw.sim import SimMachine

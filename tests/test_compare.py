@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from helpers import free_axes, start_line
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.compare import (
+from openmotion.control.trigger.compare import (
     AxisSource,
     CompareEngine,
     LevelJob,
@@ -23,7 +23,7 @@ from openmotion.control.compare import (
     VectorSource,
     WindowJob,
 )
-from openmotion.control.compare_io import plot_firings
+from openmotion.control.trigger.compare_io import plot_firings
 from openmotion.errors import MotionError
 from openmotion.profile.jerk import jerk_limited
 from openmotion.profile.segments import ProfileBuilder

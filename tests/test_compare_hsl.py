@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from helpers import free_axes
-from openmotion.control.compare import CompareEngine
-from openmotion.control.hsl_trigger import HslTrigger
+from openmotion.control.trigger.compare import CompareEngine
+from openmotion.control.trigger.hsl_trigger import HslTrigger
 from openmotion.errors import MotionError
 
 

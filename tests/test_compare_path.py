@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from helpers import free_axes
-from openmotion.control.compare import CompareEngine, Pulse, VectorSource, every_distance
-from openmotion.control.group import Group
+from openmotion.control.groups.group import Group
+from openmotion.control.trigger.compare import CompareEngine, Pulse, VectorSource, every_distance
 from openmotion.errors import MotionError
 
 MM = 1000.0  # pulses per mm of the default axis (10000 ppr, 10 mm lead)

@@ -5,7 +5,7 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from openmotion.control.compare_roots import level_events
+from openmotion.control.trigger.compare_roots import level_events
 from openmotion.history import MotionHistory
 from openmotion.profile.segments import ProfileBuilder
 

@@ -10,9 +10,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from openmotion.control import compare_math as cm
-from openmotion.control import compare_roots as cr
-from openmotion.control.compare_math import Track
+from openmotion.control.trigger import compare_math as cm
+from openmotion.control.trigger import compare_roots as cr
+from openmotion.control.trigger.compare_math import Track
 from openmotion.crossings import velocity_roots
 from openmotion.history import MotionHistory
 from openmotion.profile.segments import ProfileBuilder

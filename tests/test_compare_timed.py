@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 from helpers import free_axes
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.compare import (
+from openmotion.control.groups.group import Group
+from openmotion.control.trigger.compare import (
     AxisSource,
     CompareEngine,
     LevelJob,
@@ -20,9 +21,8 @@ from openmotion.control.compare import (
     Toggle,
     VectorSource,
 )
-from openmotion.control.group import Group
-from openmotion.control.hsl_trigger import HslTrigger
-from openmotion.control.pso import ZPso
+from openmotion.control.trigger.hsl_trigger import HslTrigger
+from openmotion.control.trigger.pso import ZPso
 from openmotion.errors import MotionError
 from openmotion.hw.interface import TimedOutputHardware
 from openmotion.hw.sim import SimMachine
@@ -242,7 +242,7 @@ def test_sub_cycle_speed_pwm_integrates_to_the_path_length():
 # ----------------------------------------------------------------------------- edge stops
 def edge_stop_machine():
     from openmotion.config import DriveConfig, SwitchConfig
-    from openmotion.control.safety import Safety
+    from openmotion.control.guard.safety import Safety
 
     ax = AxisConfig(name="x", lead=10.0, max_speed=500.0, drive=DriveConfig(type="ideal_stepper"),
                     pel=SwitchConfig(position=20_000.0, width=5000.0),

@@ -1,4 +1,4 @@
-"""Backlash, vibration suppression and pitch-error compensation (control.compensation)."""
+"""Backlash, vibration suppression and pitch-error compensation (control.loops.compensation)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 
 from openmotion.config import DriveConfig, default_machine
 from openmotion.control import Controller
-from openmotion.control.axis import Axis
-from openmotion.control.compensation import (
+from openmotion.control.core.axis import Axis
+from openmotion.control.loops.compensation import (
     BACKLASH_COMPENSATING,
     Compensation,
     PitchCompTable,

@@ -4,8 +4,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from openmotion.control.counters import CLOCK_HZ, COUNTER_MAX, COUNTER_MIN, Counters, wrap28
-from openmotion.control.states import TRANSITIONS, AxisState, can_transition, transition
+from openmotion.control.core.counters import CLOCK_HZ, COUNTER_MAX, COUNTER_MIN, Counters, wrap28
+from openmotion.control.core.states import TRANSITIONS, AxisState, can_transition, transition
 from openmotion.errors import MotionError
 
 

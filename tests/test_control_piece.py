@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from longrun import size
-from openmotion.control.motion import ActiveMotion
+from openmotion.control.core.motion import ActiveMotion
 from openmotion.profile.pcl import MoveSpec
 from openmotion.profile.velocity import velocity_move
 

@@ -3,7 +3,7 @@
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.events import EventLog, classify_fault
+from openmotion.control.core.events import EventLog, classify_fault
 from openmotion.errors import MotionError
 
 
@@ -77,9 +77,9 @@ def test_classify_fault():
 
 
 def test_latch_and_home_completion_are_events():
-    from openmotion.control.homing import Homing
-    from openmotion.control.homing_modes import HomeConfig
-    from openmotion.control.latch import Latch
+    from openmotion.control.home.homing import Homing
+    from openmotion.control.home.homing_modes import HomeConfig
+    from openmotion.control.home.latch import Latch
 
     ctl = _ctl()
     latch = Latch(ctl)

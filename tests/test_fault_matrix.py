@@ -29,11 +29,11 @@ import pytest
 
 from openmotion.config import AxisConfig, DriveConfig, LoopConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.compare import AxisSource, CompareEngine, LevelJob, Pulse
-from openmotion.control.group import Group, GroupState
-from openmotion.control.homing import Homing
-from openmotion.control.homing_modes import HomeConfig
-from openmotion.control.jog import jog_conti
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.home.homing import Homing
+from openmotion.control.home.homing_modes import HomeConfig
+from openmotion.control.manual.jog import jog_conti
+from openmotion.control.trigger.compare import AxisSource, CompareEngine, LevelJob, Pulse
 from openmotion.errors import MotionError
 from openmotion.program.runner import ProgramRunner
 

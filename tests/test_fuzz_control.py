@@ -5,8 +5,14 @@ in-position control."""
 from __future__ import annotations
 
 from fuzzkit import Entry, examples, run_entries
-from openmotion.control import jog
-from openmotion.control.compare import (
+from openmotion.control.groups.group import Group
+from openmotion.control.guard.inposition import InPositionControl
+from openmotion.control.home.homing import HomeConfig, Homing
+from openmotion.control.home.latch import Latch, TouchProbe
+from openmotion.control.loops.compensation import Compensation, PitchCompTable
+from openmotion.control.loops.servo import PIDFF, FollowingErrorMonitor, LeadFilter
+from openmotion.control.manual import jog
+from openmotion.control.trigger.compare import (
     AxisSource,
     CompareEngine,
     LevelJob,
@@ -17,13 +23,7 @@ from openmotion.control.compare import (
     WindowJob,
     every_distance,
 )
-from openmotion.control.compensation import Compensation, PitchCompTable
-from openmotion.control.group import Group
-from openmotion.control.homing import HomeConfig, Homing
-from openmotion.control.inposition import InPositionControl
-from openmotion.control.latch import Latch, TouchProbe
-from openmotion.control.pso import ZPso
-from openmotion.control.servo import PIDFF, FollowingErrorMonitor, LeadFilter
+from openmotion.control.trigger.pso import ZPso
 
 
 def _ax(w, **kw):

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from openmotion.control.controller import Controller
+from openmotion.control.core.controller import Controller
 from openmotion.errors import MotionError
 from openmotion.hw.sim.probe import SimProbe
 from openmotion.program import (
@@ -121,12 +121,12 @@ def _ctl():
 
 
 def test_sim_probe_edge_is_exact_and_latches_every_axis():
-    from openmotion.control.latch import TouchProbe
+    from openmotion.control.home.latch import TouchProbe
 
     ctl, probe = _ctl()
     probe.place([{0: (3000.0, 9000.0), 2: (-INF, -5000.0)}])  # a block: X 3..9 mm
     # continuous: a single-mode TouchProbe detaches inside the controller's hook loop,
-    # which skips the next hook on that edge (noted for control/latch.py)
+    # which skips the next hook on that edge (noted for control/home/latch.py)
     tps = [TouchProbe(ctl, a, "di0", mode="continuous") for a in (0, 2)]
     z = ctl.axes[2]
     z.move_absolute(-8000, max_vel=20000)  # beside the block: no contact

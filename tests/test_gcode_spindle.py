@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from openmotion.config import default_machine
-from openmotion.control.controller import Controller
-from openmotion.control.states import AxisState
+from openmotion.control.core.controller import Controller
+from openmotion.control.core.states import AxisState
 from openmotion.errors import MotionError
 from openmotion.hw.sim.spindle import spindle_axis
 from openmotion.program import ProgramRunner, RunOptions, RunState, compile_text

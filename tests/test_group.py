@@ -10,8 +10,8 @@ import pytest
 
 from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
-from openmotion.control.axis import AxisState
-from openmotion.control.group import (
+from openmotion.control.core.axis import AxisState
+from openmotion.control.groups.group import (
     ERR_ARC,
     ERR_ARGUMENT,
     ERR_AXIS_BUSY,
@@ -342,7 +342,7 @@ def test_limit_switch_stops_all_axes_of_the_group():
 
 
 def test_limit_with_safety_attached_stops_the_group_through_the_fault_hook():
-    safety_mod = pytest.importorskip("openmotion.control.safety")
+    safety_mod = pytest.importorskip("openmotion.control.guard.safety")
     ctl, g = make()
     assert safety_mod.Safety.of(ctl) is not None  # attached by default
     ctl.hardware.scenario.place_switch(0, "pel", 6000.0, 1000.0)

@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 from helpers import finish_group, table_without_mel
 from longrun import size
 from openmotion.control import Controller, pulse_accuracy
-from openmotion.control import pathexec as px
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups import pathexec as px
+from openmotion.control.groups.group import Group, GroupState
 from openmotion.path import Arc, Line, plan_speeds
 
 VMAX = 50_000.0

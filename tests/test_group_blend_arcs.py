@@ -9,8 +9,8 @@ import pytest
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
-from openmotion.control.pathexec import contour_error
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.groups.pathexec import contour_error
 from openmotion.path import Arc, Line
 from openmotion.program.report import contour_errors
 from openmotion.program.runner import ProgramRunner, RunState

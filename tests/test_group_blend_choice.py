@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 
 V, A = 100_000.0, 1_000_000.0  # per-axis limits, pps and pps^2 (100 mm/s at 1000 p/mm)
 

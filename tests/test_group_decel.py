@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from helpers import finish_group, table_without_mel
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 from openmotion.errors import MotionError
 from openmotion.path import Line, plan_speeds
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from helpers import finish_group, free_axes
-from openmotion.control.group import Group
+from openmotion.control.groups.group import Group
 from openmotion.errors import MotionError
 
 

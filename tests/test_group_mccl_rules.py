@@ -13,8 +13,7 @@ from hypothesis import strategies as st
 
 from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
-from openmotion.control.compensation import PitchCompTable
-from openmotion.control.group import (
+from openmotion.control.groups.group import (
     ERR_SPEED,
     PERIOD_PULSES_DEFAULT,
     PERIOD_PULSES_MAX,
@@ -22,8 +21,9 @@ from openmotion.control.group import (
     GroupError,
     GroupState,
 )
-from openmotion.control.homing_modes import HomeConfig
-from openmotion.control.softlimits import working_interval
+from openmotion.control.guard.softlimits import working_interval
+from openmotion.control.home.homing_modes import HomeConfig
+from openmotion.control.loops.compensation import PitchCompTable
 from openmotion.errors import MotionError
 
 

@@ -14,8 +14,8 @@ import math
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
-from openmotion.control.states import AxisState
+from openmotion.control.core.states import AxisState
+from openmotion.control.groups.group import Group, GroupState
 
 R = 20_000.0
 

@@ -10,8 +10,8 @@ import pytest
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control import groupexec as gx
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups import groupexec as gx
+from openmotion.control.groups.group import Group, GroupState
 
 
 def _stream(n: int) -> tuple[Controller, Group, dict[str, int]]:

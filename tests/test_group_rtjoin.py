@@ -1,4 +1,4 @@
-"""Joins planned off the real-time cycle (control/groupjoin.py): a streamed program in
+"""Joins planned off the real-time cycle (control/groups/groupjoin.py): a streamed program in
 real-time mode ends exactly, never rests inside, keeps its limits, and its join re-plans
 run on the worker thread; hold, override and abort while a join is in flight keep the
 queue and the path consistent; a late or failing worker falls back to joins in the cycle.
@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 from openmotion.config import AxisConfig, MachineConfig
-from openmotion.control import Controller, groupjoin, pathrun
-from openmotion.control.group import Group, GroupState
+from openmotion.control import Controller
+from openmotion.control.groups import groupjoin, pathrun
+from openmotion.control.groups.group import Group, GroupState
 
 FEED, ACC_TIME, PPU = 40.0, 0.05, 1000.0  # mm/s, s, pulses/mm (lead 10 mm, 10000 ppr)
 N = 300

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 from openmotion.errors import MotionError
 from openmotion.path.smoothing import fir_smooth, jerk_window
 from openmotion.profile.segments import ProfileBuilder

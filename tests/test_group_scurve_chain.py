@@ -10,8 +10,8 @@ import pytest
 
 from longrun import size
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
-from openmotion.control.pathexec import contour_error
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.groups.pathexec import contour_error
 from openmotion.path import Arc, Line, plan_speeds, speed_caps, tangential_accels
 
 VMAX, AMAX = 50_000.0, 500_000.0       # per-axis pulse speed and acceleration limits
@@ -556,14 +556,14 @@ def test_higher_acceleration_next_to_a_short_move_keeps_its_jerk():
 
 # ------------------------------------------------------------------ the guard itself
 def _limits(feed: float = FEED, accel: float = 400_000.0):
-    from openmotion.control.pathexec import Limits
+    from openmotion.control.groups.pathexec import Limits
     return Limits(feed, accel, np.array([VMAX, VMAX]), np.array([AMAX, AMAX]))
 
 
 def test_guard_zone_is_half_a_window_of_the_cap():
     """A line into an arc of cap c: the line's last c*tj/2 runs at c (and at the arc's
     tangential acceleration), the rest at the feed; the arc keeps its own cap."""
-    from openmotion.control.pathexec import guarded
+    from openmotion.control.groups.pathexec import guarded
     tj = 0.04
     arc = Arc([10_000, 0], [10_000, 1_000], [11_000, 1_000], direction="CCW")
     els = [Line([0, 0], [10_000, 0]), arc]
@@ -583,7 +583,7 @@ def test_guard_zone_is_half_a_window_of_the_cap():
 def test_guard_does_not_cross_an_exact_stop():
     """An exact-stop corner (junction speed 0) is a barrier: neither side is slowed for the
     other, and no element gets a 0 feed (which used to crash the join)."""
-    from openmotion.control.pathexec import guarded
+    from openmotion.control.groups.pathexec import guarded
     els = [Line([0, 0], [10_000, 0]), Line([10_000, 0], [10_000, 10_000])]
     out, feeds, _ = guarded(els, [FEED, 10_000.0], [400_000.0, 400_000.0], _limits(), 0.04)
     assert len(out) == 2 and feeds == [FEED, 10_000.0]

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from helpers import finish_group, table_without_mel
-from openmotion.control.group import Group
+from openmotion.control.groups.group import Group
 from openmotion.errors import MotionError
 
 FEED, ACC_T = 20_000.0, 0.05  # pps, s

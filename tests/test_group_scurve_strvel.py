@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from helpers import finish_group, table_without_mel
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 from openmotion.errors import MotionError
 from openmotion.path.smoothing import fir_smooth
 from openmotion.profile.pcl import scurve

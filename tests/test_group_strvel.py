@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.group import ERR_SPEED, Group, GroupError, GroupState
+from openmotion.control.groups.group import ERR_SPEED, Group, GroupError, GroupState
 from openmotion.errors import MotionError
 from openmotion.profile.pcl import trapezoid
 

@@ -8,7 +8,7 @@ import pytest
 
 from helpers import finish_group, table_without_mel
 from openmotion.control import Controller
-from openmotion.control.group import ERR_SPEED, Group, GroupError
+from openmotion.control.groups.group import ERR_SPEED, Group, GroupError
 from openmotion.errors import MotionError
 from openmotion.units import AxisUnits
 

@@ -26,7 +26,7 @@ from openmotion.compat.hctl1100_step import (
     plot_step_responses,
     step_response,
 )
-from openmotion.control.servo import LeadFilter
+from openmotion.control.loops.servo import LeadFilter
 from openmotion.errors import MotionError
 from openmotion.hw.sim.dcmotor import DCMotor
 

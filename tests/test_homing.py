@@ -12,9 +12,9 @@ from hypothesis import strategies as st
 
 from openmotion.config import AxisConfig, MachineConfig, default_machine
 from openmotion.control import AxisState, Controller
-from openmotion.control.homing import HomeConfig, Homing, escape_home, home_move, home_search
-from openmotion.control.homing_sequence import HomeSequence
-from openmotion.control.safety import Safety
+from openmotion.control.guard.safety import Safety
+from openmotion.control.home.homing import HomeConfig, Homing, escape_home, home_move, home_search
+from openmotion.control.home.homing_sequence import HomeSequence
 from openmotion.errors import MotionError
 
 S = AxisState

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from openmotion.control import AxisState, Controller
-from openmotion.control.homing import HomeConfig, Homing
-from openmotion.control.safety import Safety
+from openmotion.control.guard.safety import Safety
+from openmotion.control.home.homing import HomeConfig, Homing
 from openmotion.errors import MotionError
 
 

@@ -16,7 +16,7 @@ from openmotion.compat.hsl import HslLibrary, HslSim
 from openmotion.compat.hsl import errors as E
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.config_network import ModuleConfig, NetworkConfig
-from openmotion.control.network import GET_U32
+from openmotion.control.cards.network import GET_U32
 from openmotion.profile.onthefly import change_speed
 
 
@@ -372,7 +372,7 @@ def test_scan_time_examples():
     hsl = library(1)
     assert hsl.HSL_get_scan_time(0) == pytest.approx(243.2e-6)
     assert library(2).HSL_get_scan_time(0) == pytest.approx(243.2e-6)
-    from openmotion.control.network import NetworkTiming
+    from openmotion.control.cards.network import NetworkTiming
 
     half = HslLibrary.simulated(1, timing=NetworkTiming(duplex="half"))
     half.HSL_initial(0)

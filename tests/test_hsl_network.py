@@ -18,7 +18,7 @@ from openmotion.config_network import (
     default_module,
     loads_network,
 )
-from openmotion.control import network as N
+from openmotion.control.cards import network as N
 from openmotion.errors import MotionError
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / "hsl"

@@ -1,4 +1,4 @@
-"""The PCL6045 speed-range model (control.speed_range): register grid, ramp-time range,
+"""The PCL6045 speed-range model (control.cards.speed_range): register grid, ramp-time range,
 moves slowed or refused exactly as the range allows; axes without it stay exact."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from helpers import free_axes
-from openmotion.control.speed_range import (
+from openmotion.control.cards.speed_range import (
     MAX_RANGE_PPS,
     SpeedRange,
     attach_speed_model,

@@ -1,4 +1,4 @@
-"""In-position control (control.inposition, MCCL 2.10.2)."""
+"""In-position control (control.guard.inposition, MCCL 2.10.2)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import pytest
 
 from openmotion.config import DriveConfig, default_machine
 from openmotion.control import Controller
-from openmotion.control.inposition import INPOS_TIMEOUT, NO_ERROR, InPositionControl
-from openmotion.control.states import AxisState, MotionDone
+from openmotion.control.core.states import AxisState, MotionDone
+from openmotion.control.guard.inposition import INPOS_TIMEOUT, NO_ERROR, InPositionControl
 from openmotion.errors import MotionError
 
 

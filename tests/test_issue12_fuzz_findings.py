@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupError
+from openmotion.control.groups.group import Group, GroupError
 from openmotion.path import Arc
 from openmotion.path.extent import element_extent
 
@@ -227,7 +227,7 @@ def test_a_refused_group_command_leaves_the_tail_as_it_was(centre):
 @pytest.mark.parametrize("kw", [dict(start=-6.954724257381864e188), dict(end=1e300),
                                 dict(start=-(2.0**41))])
 def test_every_distance_window_lies_within_the_position_range(kw):
-    from openmotion.control.compare import Toggle, VectorSource, every_distance
+    from openmotion.control.trigger.compare import Toggle, VectorSource, every_distance
 
     _motion_error(lambda: every_distance(VectorSource((0, 1)), 100.0, Toggle(2), **kw),
                   next(iter(kw)))
@@ -235,7 +235,7 @@ def test_every_distance_window_lies_within_the_position_range(kw):
 
 @pytest.mark.parametrize("value", [np.array([1.0, 2.0]), np.array(["mm"]), ["mm"]])
 def test_choice_arguments_refuse_arrays(value):
-    from openmotion.control.homing import HomeConfig
+    from openmotion.control.home.homing import HomeConfig
     from openmotion.program import GCodeOptions
 
     _motion_error(lambda: GCodeOptions(axes={"X": 0}, machine_units=value), "machine_units")

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from helpers import finish_group, free_axes, table_without_mel
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 from openmotion.profile.segments import State
 from openmotion.profile.velocity import ramp_rates, velocity_ramp
 
@@ -246,7 +246,7 @@ def test_4_blend_next_to_a_reversing_arc_does_not_raise():
 
 
 def test_4_a_planner_failure_becomes_a_fault_of_that_group(monkeypatch):
-    from openmotion.control import groupexec
+    from openmotion.control.groups import groupexec
 
     ctl = free_axes(3)
     g = Group(ctl, ["x", "y"], feed=20_000)
@@ -470,7 +470,7 @@ def test_7_a_long_slow_circle_is_planned_in_bounded_windows():
 
 def test_7_windowed_path_ends_exactly_like_a_whole_one():
     """A path longer than a window ends on its target with the same timing."""
-    from openmotion.control import groupexec
+    from openmotion.control.groups import groupexec
 
     ends = []
     for window in (groupexec.PATH_WINDOW_S, 1e9):

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.group import Group
-from openmotion.control.jog import jog_conti, jog_pulse, jog_space, stop_jog
-from openmotion.control.states import AxisState
+from openmotion.control.core.states import AxisState
+from openmotion.control.groups.group import Group
+from openmotion.control.manual.jog import jog_conti, jog_pulse, jog_space, stop_jog
 from openmotion.errors import MotionError
 
 

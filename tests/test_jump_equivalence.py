@@ -1,4 +1,4 @@
-"""Virtual time that jumps gives what cycle-by-cycle execution gives (control/jump.py).
+"""Virtual time that jumps gives what cycle-by-cycle execution gives (control/core/jump.py).
 
 Random scenarios on ideal steppers, stalling steppers with backlash and servo drives
 (moves, velocity moves, speed changes, stops, end limits, E-stop, alarms,
@@ -25,14 +25,14 @@ import pytest
 
 from openmotion.config import MachineConfig, SwitchConfig, default_machine
 from openmotion.control import Controller
-from openmotion.control.group import Group
-from openmotion.control.homing import HomeConfig, home_search
-from openmotion.control.jump import (
+from openmotion.control.core.jump import (
     FIRST_CHUNK,
     FIRST_CHUNK_COMPILED,
     first_cycle_at,
     plan_jump,
 )
+from openmotion.control.groups.group import Group
+from openmotion.control.home.homing import HomeConfig, home_search
 from openmotion.errors import MotionError
 
 AXES = 3
@@ -184,7 +184,7 @@ def apply(ctl: Controller, op: tuple) -> object:
             jobs.append(run)
             run.start()
         elif kind == "compare":
-            from openmotion.control.compare import (
+            from openmotion.control.trigger.compare import (
                 AxisSource,
                 CompareEngine,
                 LevelJob,
@@ -234,8 +234,8 @@ def observe(ctl: Controller) -> tuple:
 
 def _job_view(job: object) -> tuple:
     """What a group, homing, program run or compare engine shows of itself."""
-    from openmotion.control.compare import CompareEngine
-    from openmotion.control.homing import Homing
+    from openmotion.control.home.homing import Homing
+    from openmotion.control.trigger.compare import CompareEngine
     from openmotion.program.runner import ProgramRunner
 
     if isinstance(job, Group):

@@ -1,6 +1,6 @@
 """Jobs jump too: a running group line/arc, a homing sequence, a G-code job and an armed
-compare table cross the cycles between the instants they act (control/groupdue.py,
-Homing._due, ProgramRunner._due, control/compare_due.py), with results identical to the
+compare table cross the cycles between the instants they act (control/groups/groupdue.py,
+Homing._due, ProgramRunner._due, control/trigger/compare_due.py), with results identical to the
 cycle-by-cycle run. Each scenario runs both ways and must jump over most of its cycles."""
 
 from __future__ import annotations
@@ -10,9 +10,16 @@ from collections.abc import Callable
 import numpy as np
 
 from openmotion.control import Controller
-from openmotion.control.compare import AxisSource, CompareEngine, LevelJob, Pulse, Toggle, WindowJob
-from openmotion.control.group import Group
-from openmotion.control.homing import HomeConfig, home_search
+from openmotion.control.groups.group import Group
+from openmotion.control.home.homing import HomeConfig, home_search
+from openmotion.control.trigger.compare import (
+    AxisSource,
+    CompareEngine,
+    LevelJob,
+    Pulse,
+    Toggle,
+    WindowJob,
+)
 from openmotion.program.runner import ProgramRunner
 from test_jump_equivalence import observe
 
@@ -124,7 +131,7 @@ def test_compare_tables_jump():
 
 def test_a_pso_table_with_timer_pulses_stays_identical():
     from helpers import free_axes, start_line
-    from openmotion.control.pso import ZPso
+    from openmotion.control.trigger.pso import ZPso
 
     seed_2d = (0, 0, 50, 50, 100, 100, 50, 150, 0, 200, -50, 150, -100, 100, -50, 50)
     cfg = free_axes(2).config

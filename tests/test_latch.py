@@ -4,7 +4,7 @@ import pytest
 
 from openmotion.config import DriveConfig, default_machine
 from openmotion.control import Controller
-from openmotion.control.latch import Latch, TouchProbe
+from openmotion.control.home.latch import Latch, TouchProbe
 from openmotion.errors import MotionError
 
 

@@ -9,7 +9,7 @@ import pytest
 from helpers import finish_group
 from openmotion.config import AxisConfig, MachineConfig, dumps_machine, loads_machine
 from openmotion.control import Controller
-from openmotion.control.group import Group
+from openmotion.control.groups.group import Group
 from openmotion.errors import MotionError
 
 
@@ -67,7 +67,7 @@ def test_machine_jerk_makes_paths_jerk_limited():
 
 
 def test_refusals_of_a_units_group_speak_the_users_units():
-    from openmotion.control.group import GroupError
+    from openmotion.control.groups.group import GroupError
 
     ctl = Controller(machine(max_accel=2000.0), safety=False)
     ctl.enable_all()

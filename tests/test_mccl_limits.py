@@ -8,7 +8,7 @@ import pytest
 
 from mccl_common import manual_param, open_lib, per_period_pulses, state_of
 from openmotion.compat import mccl_defs as D
-from openmotion.control.group import PERIOD_PULSES_MAX
+from openmotion.control.groups.group import PERIOD_PULSES_MAX
 
 # 10 000 pulses/mm, 546 mm/s (5.46 M pps): fast enough to pass 32768 pulses per 10 ms
 FAST = dict(dwPPR=10000, wRPM=32767)

@@ -11,7 +11,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from openmotion.control import Controller
-from openmotion.control.group import Group, GroupState
+from openmotion.control.groups.group import Group, GroupState
 from openmotion.errors import InfeasibleError, MotionError
 from openmotion.path import Line, acceleration_reversals, blend_corner, corner_speed, plan_speeds
 from openmotion.path.blend import TANGENT_ANGLE

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from openmotion.control.pathexec import contour_error
+from openmotion.control.groups.pathexec import contour_error
 from openmotion.errors import MotionError
 from openmotion.path import Arc, Arc3D, Line, blend_corner
 from openmotion.path.fillet import model_error

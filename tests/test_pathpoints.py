@@ -1,4 +1,4 @@
-"""control/pathpoints.py: a chain's elements evaluated at once give, bit for bit, what each
+"""control/groups/pathpoints.py: a chain's elements evaluated at once give, bit for bit, what each
 element's own point/tangent gives (lines, arcs, helices, 3-D arcs, trimmed elements, and
 element types the table does not know)."""
 
@@ -10,8 +10,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from openmotion.control.pathexec import Trimmed
-from openmotion.control.pathpoints import ElementTable
+from openmotion.control.groups.pathexec import Trimmed
+from openmotion.control.groups.pathpoints import ElementTable
 from openmotion.path import Arc, Arc3D, Line
 
 

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from openmotion.control.planning import position_move
+from openmotion.control.core.planning import position_move
 from openmotion.errors import MotionError
 from openmotion.profile.pcl import MoveSpec
 from openmotion.profile.superpose import deceleration_start, superpose

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from helpers import free_axes, start_line
-from openmotion.control.compare import CompareEngine
-from openmotion.control.pso import ZPso
+from openmotion.control.trigger.compare import CompareEngine
+from openmotion.control.trigger.pso import ZPso
 from openmotion.errors import MotionError
 
 UNITS = 100.0  # seed: UNITS=100

@@ -18,8 +18,14 @@ from hypothesis import strategies as st
 
 from helpers import free_axes
 from openmotion import limits
-from openmotion.control.compare import AxisSource, CompareEngine, LevelJob, Toggle, WindowJob
-from openmotion.control.group import Group
+from openmotion.control.groups.group import Group
+from openmotion.control.trigger.compare import (
+    AxisSource,
+    CompareEngine,
+    LevelJob,
+    Toggle,
+    WindowJob,
+)
 from openmotion.errors import MotionError
 from openmotion.limits import check_quantity
 from openmotion.profile import (

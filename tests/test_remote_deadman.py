@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from openmotion.control import Controller
-from openmotion.control.states import AxisState
+from openmotion.control.core.states import AxisState
 from openmotion.errors import MotionError
 from openmotion.remote.deadman import DEADMAN_S, JogRegistry
 from openmotion.remote.repeat import RepeatRegistry

@@ -1,11 +1,11 @@
-"""The no-op pacer baseline (control/clock.py): OS wake-up lateness measured the way the
+"""The no-op pacer baseline (control/core/clock.py): OS wake-up lateness measured the way the
 real-time cycle is measured."""
 
 from __future__ import annotations
 
 import pytest
 
-from openmotion.control.clock import pacer_baseline
+from openmotion.control.core.clock import pacer_baseline
 from openmotion.errors import MotionError
 
 

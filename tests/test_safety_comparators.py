@@ -7,7 +7,7 @@ import pytest
 from helpers import with_own_safety
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import AxisState, Controller
-from openmotion.control.safety import Safety
+from openmotion.control.guard.safety import Safety
 from openmotion.errors import MotionError
 
 S = AxisState

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig, SwitchConfig
 from openmotion.control import AxisState, Controller
-from openmotion.control.safety import Safety
+from openmotion.control.guard.safety import Safety
 from openmotion.errors import MotionError
 
 PEL, MEL = 20_000.0, -20_000.0

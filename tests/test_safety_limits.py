@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from helpers import with_own_safety
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig, SwitchConfig
 from openmotion.control import AxisState, Controller
-from openmotion.control.safety import IO_STATUS_BITS, Safety, io_status
+from openmotion.control.guard.safety import IO_STATUS_BITS, Safety, io_status
 from openmotion.errors import MotionError
 from openmotion.profile.jerk import jerk_limited
 from openmotion.profile.pcl import MoveSpec

@@ -11,10 +11,10 @@ import pytest
 
 from helpers import table_without_mel
 from openmotion.control import AxisState, Controller
-from openmotion.control.group import ERR_LIMIT, Group, GroupError, GroupState
-from openmotion.control.homing import Homing
-from openmotion.control.homing_modes import HomeConfig
-from openmotion.control.jog import jog_conti
+from openmotion.control.groups.group import ERR_LIMIT, Group, GroupError, GroupState
+from openmotion.control.home.homing import Homing
+from openmotion.control.home.homing_modes import HomeConfig
+from openmotion.control.manual.jog import jog_conti
 
 FEED = 20_000.0
 

@@ -13,8 +13,8 @@ from hypothesis import strategies as st
 from helpers import with_own_safety
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import AxisState, Controller
-from openmotion.control.safety import Safety
-from openmotion.control.softlimits import profile_extent
+from openmotion.control.guard.safety import Safety
+from openmotion.control.guard.softlimits import profile_extent
 from openmotion.errors import MotionError
 from openmotion.profile.jerk import jerk_limited
 from openmotion.profile.segments import ProfileBuilder

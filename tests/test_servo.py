@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from openmotion.control.servo import PIDFF, FollowingErrorMonitor, LeadFilter
+from openmotion.control.loops.servo import PIDFF, FollowingErrorMonitor, LeadFilter
 from openmotion.errors import MotionError
 
 byte = st.integers(0, 255)

@@ -18,7 +18,7 @@ from openmotion.config import (
     loads_machine,
 )
 from openmotion.control import AxisState, Controller
-from openmotion.control.servoloop import FOLLOWING_ERROR, ServoLoop
+from openmotion.control.loops.servoloop import FOLLOWING_ERROR, ServoLoop
 from openmotion.errors import MotionError
 
 TUNED = LoopConfig(a=0xD8, b=0x00, k=0x10, samples_per_cycle=2)

@@ -31,9 +31,10 @@ import numpy as np
 import pytest
 
 from openmotion.config import AxisConfig, MachineConfig
-from openmotion.control import Controller, groupexec
-from openmotion.control.group import Group, GroupState
-from openmotion.control.jog import jog_conti, stop_jog
+from openmotion.control import Controller
+from openmotion.control.groups import groupexec
+from openmotion.control.groups.group import Group, GroupState
+from openmotion.control.manual.jog import jog_conti, stop_jog
 from openmotion.errors import MotionError
 
 PERIOD = 0.001

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from openmotion.control import Controller
-from openmotion.control.compare import CompareEngine, Pulse, WindowJob
+from openmotion.control.trigger.compare import CompareEngine, Pulse, WindowJob
 from openmotion.program.runjob import work_origin
 from openmotion.program.runner import ProgramRunner
 from openmotion.units import AxisUnits

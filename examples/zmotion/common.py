@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from openmotion.compat.zmotion import OFF, ON, ZController
-from openmotion.control.compare_io import plot_firings
-from openmotion.control.compare_scope import plot_scope
+from openmotion.control.trigger.compare_io import plot_firings
+from openmotion.control.trigger.compare_scope import plot_scope
 
 OUT = Path("out") / "zmotion"
 

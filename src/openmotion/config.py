@@ -164,7 +164,7 @@ class DCMotorConfig:
 
 @dataclass(frozen=True)
 class LoopConfig:
-    """A position loop closed in the control layer (control/servoloop.py).
+    """A position loop closed in the control layer (control/loops/servoloop.py).
 
     compensator "lead": the HCTL-1100 filter with zero `a`, pole `b`, gain `k` (0..255), its
     8-bit output MC giving the duty min(|MC|, 100)/100 as on the chip. "pid": PIDFF with

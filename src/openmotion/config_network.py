@@ -74,7 +74,7 @@ class NetworkConfig:
     time_scale: float = 1.0
 
     def __post_init__(self) -> None:
-        from openmotion.control.network import NetworkTiming
+        from openmotion.control.cards.network import NetworkTiming
 
         NetworkTiming(self.rate, self.duplex, scale=self.time_scale)  # validates the three
         mods = tuple(self.modules)

@@ -226,7 +226,7 @@ def _axis_labels(machine: MachineConfig | None, n: int
 def _io_lanes(ax: Any, t: NDArray[Any], arr: Mapping[str, NDArray[Any]],
               sel: list[int], names: list[str]) -> None:
     """Digital lanes: one per set bit of each axis's io word (off/on), then the states."""
-    from .control.controller import IO_BITS, STATE_CODES
+    from .control.core.controller import IO_BITS, STATE_CODES
 
     signal = {bit: sig for sig, bit in IO_BITS}
     state_name = {code: st.value for st, code in STATE_CODES.items()}

@@ -25,7 +25,7 @@ from typing import Protocol
 
 import numpy as np
 
-from openmotion.control.servo import LeadFilter
+from openmotion.control.loops.servo import LeadFilter
 from openmotion.errors import MotionError, check_nonnegative, check_positive
 
 from . import hctl1100_regs as R

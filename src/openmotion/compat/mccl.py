@@ -21,14 +21,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from openmotion.control import group as G
-from openmotion.control.compensation import Compensation, PitchCompTable
-from openmotion.control.homing_modes import HomeConfig
-from openmotion.control.homing_sequence import HomeSequence
-from openmotion.control.inposition import INPOS_TIMEOUT
-from openmotion.control.jog import MAX_JOG_PULSES
-from openmotion.control.softlimits import working_interval
-from openmotion.control.states import AxisState
+from openmotion.control.core.states import AxisState
+from openmotion.control.groups import group as G
+from openmotion.control.guard.inposition import INPOS_TIMEOUT
+from openmotion.control.guard.softlimits import working_interval
+from openmotion.control.home.homing_modes import HomeConfig
+from openmotion.control.home.homing_sequence import HomeSequence
+from openmotion.control.loops.compensation import Compensation, PitchCompTable
+from openmotion.control.manual.jog import MAX_JOG_PULSES
 from openmotion.errors import check_nonnegative
 
 from . import mccl_defs as D

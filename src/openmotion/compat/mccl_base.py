@@ -18,19 +18,19 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.control import group as G
-from openmotion.control.group import Group, GroupError
-from openmotion.control.inposition import InPositionControl
-from openmotion.control.softlimits import working_interval
+from openmotion.control.groups import group as G
+from openmotion.control.groups.group import Group, GroupError
+from openmotion.control.guard.inposition import InPositionControl
+from openmotion.control.guard.softlimits import working_interval
 from openmotion.errors import MotionError
 from openmotion.units import AxisUnits
 
 from . import mccl_defs as D
 
 if TYPE_CHECKING:
-    from openmotion.control.axis import Axis
-    from openmotion.control.compensation import Compensation
-    from openmotion.control.homing_sequence import HomeSequence
+    from openmotion.control.core.axis import Axis
+    from openmotion.control.home.homing_sequence import HomeSequence
+    from openmotion.control.loops.compensation import Compensation
 
 F = TypeVar("F", bound=Callable[..., Any])
 

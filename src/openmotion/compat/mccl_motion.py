@@ -1,5 +1,5 @@
 """MCC_* system, configuration, coordinate, motion, speed and status functions (manual
-2.4-2.6). Each maps onto the core (`control.group.Group`, `control.softlimits`); the
+2.4-2.6). Each maps onto the core (`control.groups.group.Group`, `control.guard.softlimits`); the
 facade only converts arguments (six x..w values, mm or inch, steps of the interpolation
 time) and return codes."""
 
@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from openmotion.control import group as G
+from openmotion.control.groups import group as G
 
 from . import mccl_defs as D
 from .mccl_base import GroupSlot, Refused, _api, _int, _num
@@ -107,7 +107,7 @@ class MCCLMotion(MCCLSpeed):
             self._n_cards = 0
             raise
         self.controller, self._period, self._groups = ctl, n / 1000.0, groups
-        from openmotion.control.inposition import InPositionControl
+        from openmotion.control.guard.inposition import InPositionControl
 
         self._inpos = InPositionControl(ctl)
         for gs in groups.values():
@@ -416,7 +416,7 @@ def _check_mach(p: D.SYS_MACH_PARAM) -> None:
     for name in ("dfPitch", "dfGearRatio"):
         if _num(name, getattr(p, name)) <= 0.0:
             raise Refused(D.PARAMETER_ERR, f"{name} must be > 0, got {getattr(p, name)!r}")
-    from openmotion.control.softlimits import working_interval
+    from openmotion.control.guard.softlimits import working_interval
     from openmotion.errors import MotionError
 
     try:

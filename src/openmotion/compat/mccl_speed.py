@@ -1,6 +1,6 @@
 """MCC_* speed, acceleration, profile shape, blending and override functions (manual
 2.6.2-2.6.4): feed, PtP ratio, acc/dec steps, maximum pulse speed and acceleration, T/S
-types. The values go to the core group's settings (control/group_settings.py)."""
+types. The values go to the core group's settings (control/groups/group_settings.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from openmotion.control import group as G
+from openmotion.control.groups import group as G
 
 from . import mccl_defs as D
 from .mccl_base import GroupSlot, MCCLBase, Refused, _api, _int, _num

@@ -16,8 +16,8 @@ The article's subroutines read almost word for word:
 
 Mapping onto the core (the facade keeps the settings and forwards; every rule lives in the
 core): TABLE / BASE / UNITS / ATYPE / VECTOR_MOVED / HW_PSWITCH2 / HW_TIMER go to
-`control.pso.ZPso` on a `CompareEngine`; MOVE / MOVEABS are linear interpolations of a
-`control.group.Group` over the BASE axes (`pso.base_axes`: a BASE list shorter than the
+`control.trigger.pso.ZPso` on a `CompareEngine`; MOVE / MOVEABS are linear interpolations of a
+`control.groups.group.Group` over the BASE axes (`pso.base_axes`: a BASE list shorter than the
 move is extended by the following axes) in units of UNITS pulses, at the main axis's SPEED
 (vector speed), ACCEL, DECEL, with SRAMP as an S-curve whose jerk is ACCEL / SRAMP and MERGE
 as blending (corners rounded within one pulse of the main axis, so a PSO window around a
@@ -38,11 +38,18 @@ from functools import wraps
 from typing import Any, TypeVar
 
 from ..config import AxisConfig, MachineConfig
-from ..control.compare import CompareEngine
-from ..control.compare_scope import Scope
-from ..control.controller import Controller
-from ..control.group import ERR_AXIS_BUSY, ERR_GROUP, ERR_STATE, Group, GroupError, GroupState
-from ..control.pso import ZPso, base_axes
+from ..control.core.controller import Controller
+from ..control.groups.group import (
+    ERR_AXIS_BUSY,
+    ERR_GROUP,
+    ERR_STATE,
+    Group,
+    GroupError,
+    GroupState,
+)
+from ..control.trigger.compare import CompareEngine
+from ..control.trigger.compare_scope import Scope
+from ..control.trigger.pso import ZPso, base_axes
 from ..errors import MotionError, check_finite, check_positive
 from ..profile.sramp import ramp_spec
 from ..units import AxisUnits
@@ -258,7 +265,7 @@ class ZController:
     # ------------------------------------------------------------------ PSO
     @_command("HW_PSWITCH2")
     def HW_PSWITCH2(self, mode: int, *params: float) -> int | None:  # noqa: N802
-        """HW_PSWITCH2(mode, ...) on the BASE axes (control.pso.ZPso.hw_pswitch2)."""
+        """HW_PSWITCH2(mode, ...) on the BASE axes (control.trigger.pso.ZPso.hw_pswitch2)."""
         return self.pso.hw_pswitch2(mode, *params)
 
     @_command("HW_PSWITCH2")

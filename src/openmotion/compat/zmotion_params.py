@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
-from ..control.pso import base_axes
+from ..control.trigger.pso import base_axes
 from ..errors import MotionError
 
 #: Error codes of refused commands (ours: the article lists none).

@@ -1,13 +1,30 @@
 """The controller runtime: clock and cycle loop, axes (PLCopen states, HSL counters),
 single-axis motion execution. Public positions are pulses; see Axis for unit-aware calls."""
 
-from .accuracy import PulseAccuracy, count_accuracy, pulse_accuracy
-from .axis import Axis
-from .clock import CycleStats
-from .compare import CompareEngine
-from .compare_io import EventLog as CompareLog
-from .compare_io import plot_firings
-from .compare_jobs import (
+from .core.axis import Axis
+from .core.clock import CycleStats
+from .core.controller import Controller, register_attachment, set_default_hardware
+from .core.counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
+from .core.events import EventLog, MotionEvent
+from .core.motion import ActiveMotion
+from .core.states import AxisState, MotionDone
+from .groups.accuracy import PulseAccuracy, count_accuracy, pulse_accuracy
+from .groups.group import Group
+from .groups.groupexec import GroupError, GroupState
+from .guard.inposition import INPOS_TIMEOUT, InPositionControl
+from .guard.safety import IO_STATUS_BITS, Safety, StopRecord, io_status
+from .home.homing import Homing, escape_home, home_move, home_search
+from .home.homing_modes import HomeConfig, HomeStatus
+from .home.homing_sequence import HomeSequence
+from .home.latch import Latch, LatchData, TouchProbe
+from .loops.compensation import BACKLASH_COMPENSATING, Compensation, PitchCompTable
+from .loops.servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
+from .loops.servoloop import ServoLoop, attach_servo_loops
+from .manual.jog import jog_conti, jog_pulse, jog_space, stop_jog
+from .trigger.compare import CompareEngine
+from .trigger.compare_io import EventLog as CompareLog
+from .trigger.compare_io import plot_firings
+from .trigger.compare_jobs import (
     AxisSource,
     LevelJob,
     LevelSeq,
@@ -18,25 +35,8 @@ from .compare_jobs import (
     WindowJob,
     every_distance,
 )
-from .compensation import BACKLASH_COMPENSATING, Compensation, PitchCompTable
-from .controller import Controller, register_attachment, set_default_hardware
-from .counters import COUNTER_MAX, COUNTER_MIN, Counters, wrap28
-from .events import EventLog, MotionEvent
-from .group import Group
-from .groupexec import GroupError, GroupState
-from .homing import Homing, escape_home, home_move, home_search
-from .homing_modes import HomeConfig, HomeStatus
-from .homing_sequence import HomeSequence
-from .hsl_trigger import HslTrigger
-from .inposition import INPOS_TIMEOUT, InPositionControl
-from .jog import jog_conti, jog_pulse, jog_space, stop_jog
-from .latch import Latch, LatchData, TouchProbe
-from .motion import ActiveMotion
-from .pso import PulseTimer, ZPso
-from .safety import IO_STATUS_BITS, Safety, StopRecord, io_status
-from .servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
-from .servoloop import ServoLoop, attach_servo_loops
-from .states import AxisState, MotionDone
+from .trigger.hsl_trigger import HslTrigger
+from .trigger.pso import PulseTimer, ZPso
 
 
 # -- composition: the core (controller) imports no capability and no back end; this

@@ -15,7 +15,7 @@ timed cubic pieces per axis (a whole stretch of a profile, planned ahead), which
 by itself over many cycles (`run_cycles`), reporting back only what the control layer must
 act on: the cycle in which input edges happened (with the edges, at their exact times) and
 the axes whose queue ran empty. The control layer then skips the cycles in between
-(virtual time jumps, control/jump.py); back ends without it get one command per cycle.
+(virtual time jumps, control/core/jump.py); back ends without it get one command per cycle.
 
 Signal levels crossing this boundary are *electrical* (True = contact closed / line
 active-high as wired). Logic (normally open / closed, active high / low) is applied by the
@@ -40,7 +40,7 @@ class AxisCommand:
 
     Positions are in command pulses (float); the pulse output is the command rounded to
     the nearest count (pulse k leaves at k - 1/2 going up, k + 1/2 going down; a back end
-    that counts otherwise sets `half_pulse = False`, see control/pulserule.py).
+    that counts otherwise sets `half_pulse = False`, see control/home/pulserule.py).
     """
 
     t0: float
@@ -118,7 +118,7 @@ class EdgeStopHardware(Protocol):
     """Optional extension: the pulse output stops by itself at an input edge, at the edge's
     exact time, as a PCL6045 does at EL/EMG/ALM (HSL-4XMO 3.3, 4.8) - not one cycle later.
 
-    The control layer arms it (control/safety.py) and, when an immediate stop follows an
+    The control layer arms it (control/guard/safety.py) and, when an immediate stop follows an
     edge, asks `stop_time` whether the hardware already cut the pulses there, so that its
     command position and history end at the same instant.
     """

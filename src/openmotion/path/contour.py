@@ -22,7 +22,7 @@ def contour_error(points: np.ndarray, elements: Sequence[PathElement],
     nearest of points every `step` of arc length, a local search (33 points over one step)
     and three Gauss-Newton rounds find the foot point, and the distance is taken to the
     tangent line there (the foot's residual enters as kappa*ds**2/2). Checks recorded runs
-    against the programmed path (issue 4, accuracy; control.accuracy for pulse counts).
+    against the programmed path (issue 4, accuracy; control.groups.accuracy for pulse counts).
     """
     pts = np.asarray(points, dtype=float)
     best = np.full(len(pts), np.inf)

@@ -26,7 +26,7 @@ from ..errors import MotionError
 from .options import AXIS_LETTERS
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
     from .runner import ProgramRunner
 
 KINDS = ("line", "rapid")

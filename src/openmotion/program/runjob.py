@@ -194,7 +194,7 @@ def _drive(ctl, run: ProgramRunner, stop: _CtrlC, realtime: bool, bar: RunProgre
 
 def _settle(ctl, run: ProgramRunner, realtime: bool, limit: float = 120.0) -> None:
     """After abort(): let the group decelerate to rest (at most `limit` s machine time)."""
-    from ..control.group import GroupState
+    from ..control.groups.group import GroupState
 
     def at_rest() -> bool:
         return run.group is None or run.group.state in (GroupState.IDLE, GroupState.ERROR)

@@ -61,9 +61,9 @@ from .spindle import OrientMove, SpindleDrive, SyncMove
 from .syncout import SyncedOutputs
 
 if TYPE_CHECKING:
-    from ..control.compare import CompareEngine
-    from ..control.controller import Controller
-    from ..control.group import Group
+    from ..control.core.controller import Controller
+    from ..control.groups.group import Group
+    from ..control.trigger.compare import CompareEngine
     from ..hw.interface import InputEdge
 
 
@@ -209,7 +209,7 @@ class ProgramRunner:
                  *, axes: Mapping[str, int | str] | None = None,
                  options: RunOptions | None = None, gcode: Mapping[str, object] | None = None,
                  file: str = "", compare: CompareEngine | None = None) -> None:
-        from ..control.compare import CompareEngine
+        from ..control.trigger.compare import CompareEngine
 
         if compare is not None and (not isinstance(compare, CompareEngine)
                                     or compare.ctl is not ctl):
@@ -351,7 +351,7 @@ class ProgramRunner:
     # ------------------------------------------------------------------ control
     def start(self) -> None:
         """Open the group (the program's axes) and start streaming; returns at once."""
-        from ..control.group import Group
+        from ..control.groups.group import Group
 
         if self.state is not RunState.READY:
             raise MotionError(f"start needs a ready runner (state {self.state.value})")
@@ -388,7 +388,7 @@ class ProgramRunner:
 
     def resume(self) -> None:
         """Continue a paused program (after pause(), M0/M1 or a single-block stop)."""
-        from ..control.group import GroupState
+        from ..control.groups.group import GroupState
 
         if self.state is not RunState.PAUSED:
             raise MotionError(f"resume needs a paused program (state {self.state.value})")
@@ -451,7 +451,7 @@ class ProgramRunner:
 
     # ------------------------------------------------------------------ execution
     def _hold(self) -> None:
-        from ..control.group import GroupState
+        from ..control.groups.group import GroupState
 
         g = self.group
         assert g is not None
@@ -492,14 +492,14 @@ class ProgramRunner:
                 self._ctl.add_cycle_hook(self._close_when_idle, due=self._close_due)
 
     def _close_due(self, ctl: Controller) -> float:
-        from ..control.group import GroupState
+        from ..control.groups.group import GroupState
 
         g = self.group
         return -math.inf if g is not None and g.state in (GroupState.IDLE,
                                                           GroupState.ERROR) else math.inf
 
     def _close_when_idle(self, ctl: Controller, t: float) -> None:
-        from ..control.group import GroupState
+        from ..control.groups.group import GroupState
 
         g = self.group
         if g is not None and g.state in (GroupState.IDLE, GroupState.ERROR):
@@ -507,7 +507,7 @@ class ProgramRunner:
             ctl.remove_cycle_hook(self._close_when_idle)
 
     def _idle(self) -> bool:
-        from ..control.group import GroupState
+        from ..control.groups.group import GroupState
 
         g = self.group
         assert g is not None
@@ -518,7 +518,7 @@ class ProgramRunner:
         when the group is in error, an M62/M63 is armed (it watches the command index) or
         `_feed` has work; otherwise the group's own hook acts first and this one follows
         in the same cycle, so never. The crossed cycles' trace comes from `_on_jump`."""
-        from ..control.group import GroupState
+        from ..control.groups.group import GroupState
 
         g = self.group
         assert g is not None
@@ -562,7 +562,7 @@ class ProgramRunner:
             self._trace_p.append([row[i] for i in idx])
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
-        from ..control.group import GroupError, GroupState
+        from ..control.groups.group import GroupError, GroupState
 
         g = self.group
         assert g is not None

@@ -17,8 +17,8 @@ from .runwait import InputWait, ProbeMove
 from .spindle import OrientMove, SyncMove
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
-    from ..control.group import Group
+    from ..control.core.controller import Controller
+    from ..control.groups.group import Group
     from ..hw.interface import InputEdge
     from .runner import ProgramRunner
 

@@ -1,7 +1,7 @@
 """The runner's side of G38.x and M66: a probe move watched on the probe input, and a wait
 on a digital input, each ending in the result the interpreter continues with.
 
-`ProbeMove`: an edge hook on the probe input captures every program axis (control.latch's
+`ProbeMove`: an edge hook on the probe input captures every program axis (control.home.latch's
 `capture`, as a touch probe does) at the edge into the state the move seeks (contact for
 G38.2/G38.3, contact lost for G38.4/G38.5): each axis's exact command position at the
 edge's exact time. The runner then stops the group along its path (decelerating) and, at
@@ -20,13 +20,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..control.latch import LatchData, capture
+from ..control.home.latch import LatchData, capture
 from ..errors import MotionError
 from ..hw.interface import InputEdge
 from .probing import InputResult, Probe, ProbeResult, WaitInput
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
 
 
 class ProbeMove:

@@ -26,16 +26,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..control.group import GroupState
-from ..control.latch import capture
-from ..control.states import AxisState
+from ..control.core.states import AxisState
+from ..control.groups.group import GroupState
+from ..control.home.latch import capture
 from ..errors import MotionError
 from . import canon
 from .orient import Orient
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
-    from ..control.group import Group
+    from ..control.core.controller import Controller
+    from ..control.groups.group import Group
     from ..hw.interface import InputEdge
 
 #: Speed of an M19 positioning move, revolutions per minute.

@@ -2,7 +2,7 @@
 
 An M62/M63 read by the runner waits (`pending`) until the next line/arc is queued; it is
 then bound to that move (`bind`). While the move before it runs, a compare-engine window job
-(control/compare.py, `WindowJob` on the command positions of the program's axes) is armed on
+(control/trigger/compare.py, `WindowJob` on the command positions of the program's axes) is armed on
 the corner where the bound move starts, +-1e-6 pulse, or +-the blend tolerance in pulses
 with G64 P (`set_blend`); the engine switches the output at the exact crossing time, inside
 the cycle (timed hardware). A move that starts from rest starts on a cycle boundary and the
@@ -21,8 +21,8 @@ import numpy as np
 from .convert import Op
 
 if TYPE_CHECKING:
-    from ..control.compare import CompareEngine
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
+    from ..control.trigger.compare import CompareEngine
 
 
 @dataclass
@@ -102,14 +102,14 @@ class SyncedOutputs:
                 self._arm_window(a)
 
     def _engine(self) -> CompareEngine:
-        from ..control.compare import CompareEngine
+        from ..control.trigger.compare import CompareEngine
 
         if self._compare is None:
             self._compare = CompareEngine(self._ctl)
         return self._compare
 
     def _arm_window(self, a: _Armed) -> None:
-        from ..control.compare import SetLevel, WindowJob
+        from ..control.trigger.compare import SetLevel, WindowJob
 
         eng = self._engine()
         n = a.op.index

@@ -1,6 +1,6 @@
 """Deadman jogs: a continuous jog runs only while its client keeps confirming it.
 
-`JogRegistry.start` begins a continuous jog (control.jog.jog_conti: it also stops at the end
+`JogRegistry.start` begins a continuous jog (control.manual.jog.jog_conti: it also stops at the end
 limit ahead) and returns an id. The client confirms the id at least every CONFIRM_MS; the
 registry's `check`, run inside the control cycle, stops a jog whose last confirmation is
 older than DEADMAN_S of wall clock, so neither a stalled network nor a stalled server event
@@ -15,12 +15,12 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..control.jog import jog_conti
-from ..control.states import AxisState
+from ..control.core.states import AxisState
+from ..control.manual.jog import jog_conti
 from ..errors import MotionError
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
 
 CONFIRM_MS = 100
 DEADMAN_S = 0.25

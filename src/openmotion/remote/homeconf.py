@@ -1,4 +1,4 @@
-"""Homing settings in the API's user units <-> control.homing_modes.HomeConfig (pulses).
+"""Homing settings in the API's user units <-> control.home.homing_modes.HomeConfig (pulses).
 
 The API shows speeds in user units/s and offsets in user units; HomeConfig holds pps and
 pulses. `home_from_user` builds (and so validates) a HomeConfig; `home_to_user` is its
@@ -10,11 +10,11 @@ from __future__ import annotations
 import dataclasses
 from typing import TYPE_CHECKING, Any
 
-from ..control.homing_modes import EL_STOPS, FINALS, HSL_MODES, MCCL_TYPES, HomeConfig
+from ..control.home.homing_modes import EL_STOPS, FINALS, HSL_MODES, MCCL_TYPES, HomeConfig
 from ..errors import MotionError
 
 if TYPE_CHECKING:
-    from ..control.axis import Axis
+    from ..control.core.axis import Axis
 
 USER_KEYS = ("mode", "direction", "str_vel", "max_vel", "tacc", "tdec", "ez_count",
              "org_offset", "home_offset", "final", "el_stop", "auto_search", "timeout_s")

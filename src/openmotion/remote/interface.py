@@ -1,6 +1,6 @@
 """Interface I/O settings of an axis (Motion Creator "I/O configuration"), as the API sees
 them: machine-file fields (signal logic, pulse and encoder modes, inversions, move ratio)
-plus the responses (EL / ALM stop modes, ERC, SD, INP, RDY) that live in control.safety.
+plus the responses (EL / ALM stop modes, ERC, SD, INP, RDY) that live in control.guard.safety.
 
 `split_changes` checks a partial change against the rules and splits it into a new
 AxisConfig (validated by the config dataclass itself) and new responses; `apply_responses`
@@ -23,7 +23,7 @@ from ..config import ENCODER_MODES, LOGIC_SIGNALS, PULSE_MODES, SIGNAL_LOGIC, Ax
 from ..errors import MotionError
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
 
 CONFIG_FIELDS = ("pulse_mode", "pulse_width_us", "encoder_mode", "invert_a", "invert_b",
                  "invert_z", "swap_ab", "reverse", "move_ratio")

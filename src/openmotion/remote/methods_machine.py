@@ -9,7 +9,7 @@ from typing import Any
 
 from .. import __version__
 from ..config import dumps_machine
-from ..control.states import AxisState
+from ..control.core.states import AxisState
 from ..errors import MotionError
 from . import homeconf, interface
 from .deadman import CONFIRM_MS, DEADMAN_S

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..control.jog import jog_space
-from ..control.states import AxisState
+from ..control.core.states import AxisState
+from ..control.manual.jog import jog_space
 from ..errors import MotionError
 from .methods import Context, method, renamed
 from .protocol import Params

@@ -26,7 +26,7 @@ from ..program.runjob import sets_work_offset, work_origin
 from ..program.runner import ProgramRunner, RunOptions, RunState
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
 
 MAX_TEXT_BYTES = 1 << 20
 MAX_FILE_BYTES = 64 << 20

@@ -11,11 +11,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ..control.states import AxisState
+from ..control.core.states import AxisState
 from ..errors import MotionError
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
 
 MAX_DELAY_S = 60.0
 

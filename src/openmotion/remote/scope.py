@@ -23,12 +23,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..control.controller import STATE_CODES
-from ..control.safety import IO_STATUS_BITS, io_status
+from ..control.core.controller import STATE_CODES
+from ..control.guard.safety import IO_STATUS_BITS, io_status
 from ..errors import MotionError
 
 if TYPE_CHECKING:
-    from ..control.controller import Controller
+    from ..control.core.controller import Controller
 
 QUANTITIES = ("command", "feedback", "velocity", "acceleration", "error", "state")
 LAMPS = ("alm", "pel", "mel", "org", "ez", "inp", "sd", "rdy", "erc", "emg", "ltc", "svon")

@@ -20,11 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from ..config import MachineConfig, default_machine, dumps_machine
-from ..control.clock import RealtimePacer
-from ..control.controller import Controller
-from ..control.homing import Homing
-from ..control.homing_modes import HomeConfig
-from ..control.states import AxisState
+from ..control.core.clock import RealtimePacer
+from ..control.core.controller import Controller
+from ..control.core.states import AxisState
+from ..control.home.homing import Homing
+from ..control.home.homing_modes import HomeConfig
 from ..errors import MotionError
 from ..program.runjob import load_machine_arg
 from .deadman import JogRegistry

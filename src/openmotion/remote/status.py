@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ..control.safety import IO_STATUS_BITS, io_status
+from ..control.guard.safety import IO_STATUS_BITS, io_status
 
 if TYPE_CHECKING:
     from .service import MachineService

@@ -36,14 +36,14 @@ from .errors import (
 )
 
 if TYPE_CHECKING:
-    from ...control.axis import Axis
-    from ...control.compensation import Compensation
-    from ...control.controller import Controller
-    from ...control.group import Group
-    from ...control.homing import Homing
-    from ...control.hsl_trigger import HslTrigger
-    from ...control.latch import Latch
-    from ...control.network import Network
+    from ...control.cards.network import Network
+    from ...control.core.axis import Axis
+    from ...control.core.controller import Controller
+    from ...control.groups.group import Group
+    from ...control.home.homing import Homing
+    from ...control.home.latch import Latch
+    from ...control.loops.compensation import Compensation
+    from ...control.trigger.hsl_trigger import HslTrigger
 
 F = TypeVar("F", bound=Callable[..., Any])
 AXES_PER_MODULE = 4
@@ -102,7 +102,7 @@ class HslBase:
     """State and addressing shared by the function groups (see HslLibrary)."""
 
     def __init__(self, network: Network, card: int = 0) -> None:
-        from ...control.network import Network
+        from ...control.cards.network import Network
 
         if not isinstance(network, Network):
             raise MotionError(f"network must be a Network, got {type(network).__name__}")

@@ -14,14 +14,14 @@ import math
 from dataclasses import replace
 from typing import Any
 
-from ...control.compare import CompareEngine
-from ...control.compensation import Compensation
-from ...control.homing import escape_home, home_move, home_search
-from ...control.homing_modes import HomeConfig
-from ...control.hsl_trigger import HslTrigger
-from ...control.latch import Latch
-from ...control.network import GET_U16, GET_U32, SET_U16, SET_U32, SHORT, SIMPLE
-from ...control.safety import Safety
+from ...control.cards.network import GET_U16, GET_U32, SET_U16, SET_U32, SHORT, SIMPLE
+from ...control.guard.safety import Safety
+from ...control.home.homing import escape_home, home_move, home_search
+from ...control.home.homing_modes import HomeConfig
+from ...control.home.latch import Latch
+from ...control.loops.compensation import Compensation
+from ...control.trigger.compare import CompareEngine
+from ...control.trigger.hsl_trigger import HslTrigger
 from ...errors import check_finite, check_int
 from .base import HslBase, Module, hsl_call
 from .errors import (

@@ -19,7 +19,7 @@ import os
 from typing import Any
 
 from ...config_network import ModuleConfig, NetworkConfig, default_module, load_network
-from ...control.network import GET_U16, Network, NetworkTiming, network_from_config
+from ...control.cards.network import GET_U16, Network, NetworkTiming, network_from_config
 from ...errors import MotionError
 from .base import AXES_PER_MODULE, hsl_call
 from .errors import ERR_AxisBusy, ERR_InvalidCard, ERR_InvalidParameter, Refusal, error_message

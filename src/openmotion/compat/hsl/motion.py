@@ -1,8 +1,8 @@
 """HSL motion functions: single-axis moves, speed and position changes, interpolation.
 
-Single-axis functions map one to one onto `Axis` (control.axis); the PCL6045 speed range
-(control.speed_range) is attached to every axis of a network built from a config.
-Interpolation runs on a `Group` (control.group) of the named axes of one module: vector
+Single-axis functions map one to one onto `Axis` (control.core.axis); the PCL6045 speed range
+(control.cards.speed_range) is attached to every axis of a network built from a config.
+Interpolation runs on a `Group` (control.groups.group) of the named axes of one module: vector
 StrVel / MaxVel, acceleration (MaxVel - StrVel) / Tacc and deceleration (MaxVel - StrVel) /
 Tdec, S-curve jerk from VSacc as the PCL6045 defines it (profile.pcl). Circular moves
 without Tacc run at MaxVel from start to end (StrVel = MaxVel): the seed's
@@ -16,9 +16,9 @@ from collections.abc import Callable
 from functools import partial
 from typing import Any
 
-from ...control.group import Group, GroupState
-from ...control.network import GET_U16, GET_U32, ONE_AXIS, SET_U16, SET_U32, SHORT, TWO_AXIS
-from ...control.speed_range import on_range, verify_speed
+from ...control.cards.network import GET_U16, GET_U32, ONE_AXIS, SET_U16, SET_U32, SHORT, TWO_AXIS
+from ...control.cards.speed_range import on_range, verify_speed
+from ...control.groups.group import Group, GroupState
 from ...errors import check_distance, check_finite
 from ...profile.pcl import MoveSpec
 from .base import HslBase, Module, hsl_call

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from ...errors import MotionError, check_finite, check_int
 
 if TYPE_CHECKING:
-    from ...control.controller import Controller
+    from ...control.core.controller import Controller
     from .library import HslLibrary
 
 AXES_PER_MODULE = 4

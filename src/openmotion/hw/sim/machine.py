@@ -411,7 +411,7 @@ class SimMachine:
     @property
     def half_pulse(self) -> bool:
         """True (the default) when the generators count by the half-pulse rule (see
-        `set_half_pulse`); the control layer reads it (control.pulserule) to rebuild counts
+        `set_half_pulse`); the control layer reads it (control.home.pulserule) to rebuild counts
         at edge times the same way."""
         return self._axes[0].gen.half == 0.5 if self._axes else True
 

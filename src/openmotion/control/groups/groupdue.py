@@ -1,0 +1,121 @@
+"""When a group's cycle hook may next act (Controller.add_cycle_hook(..., due=...)).
+
+`GroupEngine._cycle_step` acts on a few instants only: a queued command becoming due
+(the group idle or the running command ended), the end of a delay, the renewal of a path
+window, the cycle in which the running chain has less than its reach ahead (a join), and
+the pre-blending of queued corners. Between them a running line or arc needs nothing from
+Python, so virtual time may jump (control/core/jump.py). `group_due` returns the earliest of
+those instants; -inf ("every cycle") wherever the answer is not cheap and sure: a join
+in flight (real time), pre-blending still to do, a group axis in ErrorStop or standing on
+a limit switch (the limit check depends on the velocity's sign cycle by cycle).
+
+The join instant is found on the very cycle grid the hook sees, by evaluating the plan's
+`remaining(t)` at the cycle ends ahead (cached while the plan and the queue head stay
+the same), so the cycle found is the one the cycle-by-cycle run joins in.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import TYPE_CHECKING, Any
+
+from ..core.states import AxisState
+
+if TYPE_CHECKING:
+    from ..core.controller import Controller
+
+#: How many cycle ends ahead one due call looks for the join cycle (then it asks again).
+JOIN_HORIZON = 4096
+
+
+def group_due(g: Any, ctl: Controller) -> float:
+    """Earliest time the group's `_on_cycle` may act (see the module docstring)."""
+    from .groupexec import PATH_WINDOW_S, GroupState
+
+    state = g._state
+    if state is GroupState.ERROR:
+        return math.inf
+    if g._job is not None:
+        return -math.inf
+    r = g._run
+    due = math.inf
+    if r is not None:
+        if not g._dry and _faults_pending(g, ctl):
+            return -math.inf
+        if r.window_end is not None:
+            due = min(due, r.window_end - 0.5 * PATH_WINDOW_S)
+        if r.kind == "delay" and g._queue:
+            due = min(due, r.t_until - ctl.period)
+        due = min(due, r.t_end - 1e-12)
+    elif state in (GroupState.MOVING, GroupState.IDLE):
+        return -math.inf if g._queue or state is GroupState.MOVING else due
+    if g._queue:
+        if _preblend_pending(g):
+            return -math.inf
+        due = min(due, _join_due(g, ctl))
+    return due
+
+
+def _faults_pending(g: Any, ctl: Controller) -> bool:
+    """A group axis in ErrorStop, or on an end limit (checked every cycle then)."""
+    for a in g.axes:
+        if a.state is AxisState.ERROR_STOP:
+            return True
+        if ctl.input_active(a.index, "pel") or ctl.input_active(a.index, "mel"):
+            return True
+    return False
+
+
+def _preblend_pending(g: Any) -> bool:
+    """Whether `_preblend` would change anything this cycle (see groupexec)."""
+    from .groupexec import PREBLEND_AHEAD, PREBLEND_PER_CYCLE, GroupState
+
+    r, q, pre = g._run, g._queue, g._pre
+    if r is None or r.plan is None or not q or not (g._blend and g._blend_tol > 0.0) \
+            or g._state is not GroupState.MOVING:
+        return bool(pre)
+    prev = r.plan.chain.elements[-1]
+    head = pre.get(q[0].index)
+    i = 0
+    if head is not None and head[0] is prev and g._pre_tail is not None:
+        tail, _ = g._pre_tail
+        i = tail - q[0].index + 1
+        if not (0 < i <= len(q) and q[i - 1].index == tail):
+            i = 0
+    if i == 0 and pre:
+        return True
+    end = min(len(q), i + PREBLEND_PER_CYCLE, PREBLEND_AHEAD)
+    for c in itertools.islice(q, i, end):
+        return bool(g._joins(r.plan.tj, c, r.plan.limits.str_vel))
+    return False
+
+
+def _join_due(g: Any, ctl: Controller) -> float:
+    """The end time of the first cycle ahead in which `_join_queued` joins (or a later
+    cycle end to ask again; inf when it cannot join the running chain)."""
+    from .groupexec import GroupState
+
+    r = g._run
+    if r is None or r.plan is None or g._state is not GroupState.MOVING:
+        return math.inf
+    plan = r.plan
+    q0 = g._queue[0]
+    if not g._joins(plan.tj, q0, plan.limits.str_vel):
+        return math.inf
+    reach = max(g._reach(q0, plan.tj), g._reach(r.cmds[-1], plan.tj))
+    origin, period, n = ctl._t_origin, ctl.period, ctl.cycles
+    key = (q0.index, reach)
+    cache = g.__dict__.get("_join_due_cache")
+    k = n + 1
+    if cache is not None and cache[0] is plan and cache[1] == key:
+        k = max(k, cache[2])  # the cycles before it were checked: no join there
+    last = n + JOIN_HORIZON
+    while k <= last:
+        t = origin + k * period
+        if t >= plan.t0 and plan.remaining(t) < reach:
+            g._join_due_cache = (plan, key, k)
+            return t
+        k += 1
+    g._join_due_cache = (plan, key, k)
+    return origin + last * period

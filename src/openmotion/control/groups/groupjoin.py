@@ -1,0 +1,189 @@
+"""Joins planned off the real-time cycle: a worker thread re-plans, a later cycle installs.
+
+In real-time mode a join (the running chain re-planned with the next queued commands, a
+few hundred elements) takes several cycles of work. Instead of doing it inside one cycle,
+`_join_async` picks a future cycle boundary t_j = t + K periods (K from `JOIN_LEAD`),
+takes the commands off the queue and starts a worker thread that builds the join options,
+re-plans the running plan from t_j (`pathrun.replan` is a pure function of the immutable
+plan) and builds the axis profiles from the group position the running profiles reach at
+t_j. At the hook of cycle t_j, `_poll_join` installs the result exactly as `_launch` does
+when the running plan is still the same object, the settings are unchanged and the worker
+has finished; otherwise (late, failed, or the plan changed by a hold, an override, a
+continue) the commands go back to the queue front; abort and faults drop them
+(`_drop_join`). After `MAX_MISSES` misses in a row the next join is synchronous.
+
+The worker reads only immutable values or copies taken before it starts: the plan, the
+commands, the limits, the pre-blend cache (a copy), the blend settings (compared again at
+install). Virtual time never uses it: joins there stay synchronous and bit for bit as they
+were.
+"""
+
+from __future__ import annotations
+
+import math
+import queue
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ...errors import InfeasibleError, MotionError
+from . import pathaxes, pathrun
+
+if TYPE_CHECKING:
+    from ...profile.segments import Profile
+
+#: Lead time of a join planned off the cycle (s): the worker has this long to finish.
+JOIN_LEAD = 0.025
+#: Misses in a row (late, failed, or the plan changed) before a join is done in the cycle.
+MAX_MISSES = 2
+
+
+def lead_cycles(period: float) -> int:
+    """K: cycles between the decision to join and the cycle that installs it (>= 2)."""
+    return max(2, math.ceil(JOIN_LEAD / period - 1e-9))
+
+
+@dataclass
+class _Job:
+    """One join in flight: what it was planned against, and the worker's result."""
+
+    plan: pathrun.PathPlan        # the running plan (compared by identity at install)
+    run: Any                      # the running _Run
+    new: list[Any]                # the commands taken off the queue
+    t_j: float                    # the cycle boundary the join starts at
+    key: tuple                    # the settings it was planned with
+    work: Callable[[], None] | None = None
+    done: threading.Event = field(default_factory=threading.Event)
+    result: tuple[pathrun.PathPlan, list[Profile]] | None = None
+    error: BaseException | None = None
+
+
+class AsyncJoin:
+    """The real-time join worker of `GroupEngine` (see the module doc)."""
+
+    _job: _Job | None = None
+    _last_job: _Job | None = None
+    _jobs: queue.SimpleQueue | None = None   # the worker's input (None: no worker yet)
+    _join_misses: int = 0
+    async_joins: int = 0     # joins installed from the worker (for tests and figures)
+    sync_joins: int = 0      # joins done in the cycle in real-time mode (fallbacks)
+
+    def _join_key(self) -> tuple:
+        """Everything besides the plan and the commands a join's result depends on."""
+        # the blend key holds the blend and corner settings and the axis caps
+        return (self._blend_key(), self._override, self._sys_max,  # type: ignore[attr-defined]
+                self._cruise_ratio)  # type: ignore[attr-defined]
+
+    def _lead_cycles(self) -> int:
+        return lead_cycles(self._ctl.period)  # type: ignore[attr-defined]
+
+    def _use_worker(self, plan: pathrun.PathPlan) -> bool:
+        """Whether a due join goes to the worker (real-time mode) or is done in the cycle:
+        virtual time, dry run, after MAX_MISSES misses in a row, a chain that ends before
+        the worker's cycle, or the worker still busy with a late job (waiting for it
+        would let the chain brake for its end)."""
+        ctl = self._ctl  # type: ignore[attr-defined]
+        if not ctl.realtime or self._dry:  # type: ignore[attr-defined]
+            return False
+        if self._join_misses >= MAX_MISSES:
+            self._join_misses = 0
+            return False
+        if plan.t_end <= ctl.time + (self._lead_cycles() + 1) * ctl.period:
+            return False
+        return self._last_job is None or self._last_job.done.is_set()
+
+    def _join_async(self, r: Any, new: list[Any]) -> None:
+        """Start the worker on a join of `new` to the running chain at t + K cycles."""
+        ctl = self._ctl  # type: ignore[attr-defined]
+        plan = r.plan
+        t_j = ctl._t_origin + (ctl._n + lead_cycles(ctl.period)) * ctl.period
+        u = t_j - r.t0
+        starts = np.array([p.state_at(min(max(u, 0.0), p.duration)).p for p in r.profiles])
+        starts = self._units_of(starts)  # type: ignore[attr-defined]
+        lim0 = self._limits(plan.chain, plan.limits.str_vel)  # type: ignore[attr-defined]
+        pre = dict(self._pre)  # type: ignore[attr-defined]
+        have = plan.remaining(t_j)
+        job = _Job(plan, r, new, t_j, self._join_key())
+        k = self._k.copy()  # type: ignore[attr-defined]
+
+        def work() -> None:
+            try:
+                for chain in self._join_options(plan, have, new, pre):  # type: ignore[attr-defined]
+                    lim = replace(lim0, accel=float(np.max(chain.accels))) \
+                        if chain.accels is not None else lim0
+                    try:
+                        p2 = pathrun.replan(plan, t_j, chain=chain, limits=lim)
+                    except InfeasibleError:
+                        continue
+                    prof = pathaxes.axis_profiles(p2.chain, p2.sprof, ctl.period, starts)
+                    if not np.all(k == 1.0):
+                        prof = [pathaxes.scaled(p, float(s)) for p, s in zip(prof, k,
+                                                                              strict=True)]
+                    job.result = (p2, prof)
+                    return
+            except BaseException as exc:  # reported at install: the join is a miss
+                job.error = exc
+            finally:
+                job.done.set()
+
+        job.work = work
+        if self._jobs is None:  # one worker per group, started once: a thread start
+            # per join would hand the new thread the GIL in the middle of the cycle
+            self._jobs = queue.SimpleQueue()
+            threading.Thread(target=_serve, args=(self._jobs,), name="openmotion-join",
+                             daemon=True).start()
+        self._job = self._last_job = job
+        self._jobs.put(job)
+
+    def _poll_join(self, t: float) -> bool:
+        """Each cycle while a join is in flight: install it at its cycle, or give it up
+        when the plan changed. True while the join still owns the queue's front."""
+        job = self._job
+        if job is None:
+            return False
+        r = self._run  # type: ignore[attr-defined]
+        same = (r is job.run and r.plan is job.plan and self._join_key() == job.key
+                and self._state.value == "moving")  # type: ignore[attr-defined]
+        if same and t < job.t_j - 0.5 * self._ctl.period:  # type: ignore[attr-defined]
+            return True
+        self._job = None
+        if same and job.done.is_set() and job.result is not None \
+                and t < job.t_j + 0.5 * self._ctl.period:  # type: ignore[attr-defined]
+            p2, profiles = job.result
+            for c in job.new:
+                self._pre.pop(c.index, None)  # type: ignore[attr-defined]
+            try:
+                self._install(p2, profiles, [*r.cmds, *job.new], t)  # type: ignore[attr-defined]
+            except MotionError as err:  # refused by an axis (safety): stop the group
+                self._fault(getattr(err, "code", -4), f"join refused: {err}")  # type: ignore[attr-defined]
+                return True
+            self._join_misses = 0
+            self.async_joins += 1
+            return True
+        if same:  # late or failed (a changed plan is nobody's miss)
+            self._join_misses += 1
+        self._queue.extendleft(reversed(job.new))  # type: ignore[attr-defined]
+        return False
+
+    def _drop_join(self) -> None:
+        """Abort, fault, close: forget a join in flight with its commands."""
+        self._job = None
+
+    def _stop_join_worker(self) -> None:
+        """Close: end the worker thread (after the job it runs, if any)."""
+        self._job = None
+        if self._jobs is not None:
+            self._jobs.put(None)
+            self._jobs = None
+
+
+def _serve(jobs: queue.SimpleQueue) -> None:
+    """The worker thread: run the jobs one at a time until a None arrives."""
+    while True:
+        job = jobs.get()
+        if job is None:
+            return
+        job.work()

@@ -1,0 +1,131 @@
+"""Per-axis profiles of a path: the cubic Hermite knots an axis follows along a chain.
+
+Step 3 of pathexec.py (see its module doc): knots every interpolation period plus every
+break of s(t) and every element boundary s(t) crosses; positions from the elements, velocities
+tangent*ds/dt; on lines acceleration and jerk from s(t) exactly; the last knot is the chain's
+end point bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ...profile.segments import Profile, State
+
+if TYPE_CHECKING:
+    from .pathexec import Chain
+
+
+def axis_profiles(chain: Chain, sp: Profile, period: float,
+                  starts: Sequence[float]) -> list[Profile]:
+    """Per-axis Profiles (positions in the element frame plus nothing else) following
+    chain.point(s(t)); see the module doc. `starts` are the axis positions at t = 0 (the
+    first knot uses them, so a replacement starts exactly where the axis is)."""
+    dur = sp.duration
+    n = int(math.floor(dur / period + 1e-9))
+    grid = np.arange(n + 1) * period
+    brk = np.union1d(sp.t0, [dur])
+    # the instants s(t) crosses an element boundary are knots too (a smoothed S path's
+    # breaks are not there): an interval then never straddles a change of curvature, which
+    # the cubic would smear into an acceleration overshoot
+    cross = _crossings(sp, chain.cum[1:-1])
+    brk = np.union1d(brk, cross[~_near(cross, brk, 1e-6 * period)]) if len(cross) else brk
+    # grid knots closer than 1e-6 period to a break of s(t) are dropped: a tiny interval
+    # would make the Hermite coefficients (divided by h**2, h**3) lose all precision
+    near = _near(grid, brk, 1e-6 * period)
+    t = np.union1d(grid[(grid < dur) & ~near], brk)
+    smp = sp.sample(t)
+    s = np.clip(smp.p, sp.start.p, sp.end.p)
+    sd = smp.v
+    sd[-1] = _end_speed(sp)  # the speed just before the end (a StrVel end jumps from it)
+    s[-1] = sp.end.p
+    dim = chain.elements[0].dim
+    if len(t) < 2:  # nothing left to move: hold the start
+        p0 = np.array(chain.elements[-1].end if sp.end.p >= chain.length else starts,
+                      dtype=float)
+        return [Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), 0.0,
+                        State(float(x), 0.0, 0.0), State(float(x), 0.0, 0.0), (),
+                        np.zeros(0)) for x in p0]
+    n_el = len(chain.elements)
+    cum = chain.cum
+    table = chain.table  # every element's parameters as arrays (pathpoints.py)
+    lens = table.lengths
+    # positions per knot (continuous: consecutive elements join bit for bit)
+    k = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, n_el - 1)
+    pos = table.point(k, np.clip(s - cum[k], 0.0, lens[k]))
+    pos[0] = starts
+    if s[-1] >= chain.length:
+        pos[-1] = chain.elements[-1].end
+    # velocities per interval, from the element the interval lies on: at a corner taken at
+    # speed (junction deviation) the velocity jumps between two intervals, not inside one
+    s_mid = sp.sample(0.5 * (t[:-1] + t[1:])).p
+    km = np.clip(np.searchsorted(cum, s_mid, side="right") - 1, 0, n_el - 1)
+    v0 = table.tangent(km, np.clip(s[:-1] - cum[km], 0.0, lens[km])) * sd[:-1][:, None]
+    v1 = table.tangent(km, np.clip(s[1:] - cum[km], 0.0, lens[km])) * sd[1:][:, None]
+    h = np.diff(t)[:, None]
+    dp = np.diff(pos, axis=0)
+    a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
+    jj = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
+    # on a line the axis motion is u*s(t) exactly: take a and j from s(t), not the fit
+    ss = sp.sample(t[:-1])
+    straight = table.curvature[km] == 0.0
+    if np.any(straight):
+        u = table.line_tangents(km[straight])
+        a0[straight] = ss.a[straight][:, None] * u
+        jj[straight] = ss.j[straight][:, None] * u
+    out = []
+    dts = np.diff(t)
+    labels = ("path",) * len(dts)
+    for i in range(dim):
+        out.append(Profile(
+            t0=t[:-1].copy(), p0=pos[:-1, i].copy(), v0=v0[:, i].copy(), a0=a0[:, i].copy(),
+            j=jj[:, i].copy(), duration=float(dur),
+            start=State(float(pos[0, i]), float(v0[0, i]) if sp.start.v else 0.0, 0.0),
+            end=State(float(pos[-1, i]), 0.0, 0.0), labels=labels, dt=dts.copy()))
+    return out
+
+
+def _crossings(sp: Profile, levels: np.ndarray) -> np.ndarray:
+    """Times at which a non-decreasing s(t) reaches each of `levels` inside its range
+    (vectorised bisection in the segment that holds the level)."""
+    lv = levels[(levels > sp.start.p) & (levels < sp.end.p)]
+    n = sp.n_segments
+    if not len(lv) or not n:
+        return np.zeros(0)
+    k = np.clip(np.searchsorted(sp.p0, lv, side="right") - 1, 0, n - 1)
+    dts = sp.dt if sp.dt is not None else np.diff(np.append(sp.t0, sp.duration))
+    lo, hi = np.zeros(len(lv)), np.asarray(dts, dtype=float)[k].copy()
+    p0, v0, a0, j = sp.p0[k], sp.v0[k], sp.a0[k], sp.j[k]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        below = p0 + mid * (v0 + mid * (a0 / 2.0 + mid * j / 6.0)) < lv
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return np.unique(sp.t0[k] + hi)
+
+
+def _end_speed(sp: Profile) -> float:
+    """Path speed just before the end of s(t): 0 for a stop at rest (within the rounding of
+    the last segment), else the speed a StrVel end jumps to rest from."""
+    if not sp.n_segments or sp.end.v != 0.0:
+        return float(sp.end.v)
+    dt = float(sp.dt[-1]) if sp.dt is not None else sp.duration - float(sp.t0[-1])
+    v = float(sp.v0[-1] + dt * (sp.a0[-1] + dt * sp.j[-1] / 2.0))
+    return v if v > 1e-9 * max(1.0, float(np.max(np.abs(sp.v0)))) else 0.0
+
+
+def scaled(p: Profile, k: float) -> Profile:
+    """The profile with every position, velocity, acceleration and jerk times k (a change
+    of units; k < 0 also mirrors it)."""
+    return Profile(p.t0, p.p0 * k, p.v0 * k, p.a0 * k, p.j * k, p.duration,
+                   State(p.start.p * k, p.start.v * k, p.start.a * k),
+                   State(p.end.p * k, p.end.v * k, p.end.a * k), p.labels, p.dt)
+
+
+def _near(grid: np.ndarray, brk: np.ndarray, tol: float) -> np.ndarray:
+    """Which grid values lie within tol of a value of the sorted array brk."""
+    k = np.clip(np.searchsorted(brk, grid), 1, len(brk) - 1)
+    return np.minimum(np.abs(grid - brk[k - 1]), np.abs(grid - brk[k])) <= tol

@@ -1,0 +1,521 @@
+"""Compare engine: position-compare triggers located exactly on the analytic motion.
+
+(Jobs, sources and actions live in compare_jobs.py and are re-exported here; the solvers
+in compare_math.py / compare_roots.py; outputs and the event log in compare_io.py.)
+
+Attached to a Controller through a cycle hook. At the end of each cycle [t0, t1] it takes
+the motion just executed from the MotionHistory and finds, for every active job, every
+trigger in (t0, t1] at its exact time (architecture.md "Events are located exactly").
+
+On hardware with timed outputs (hw.interface.TimedOutputHardware, e.g. the simulator) the
+jobs on command positions (DPOS axes, vector distance) run earlier, in the controller's
+pre-advance hook: the commanded motion of (t0, t1] is in the history before the hardware
+executes it, so their output edges are handed to the hardware with `write_output_at` and
+land on the physical line at their exact times (compare_io.OutputLine.send). MPOS jobs
+need the encoder at t1 and stay after the cycle (their edges reach the line at the cycle
+end). The event log is the same either way.
+
+- sources: `AxisSource(axis, "dpos")` = command position in the command-counter frame;
+  `AxisSource(axis, "mpos")` = feedback position in the feedback-counter frame (see
+  `feedback model` below); `VectorSource(axes, scale)` = accumulated path length of the
+  axes (ZMotion VECTOR_MOVED) in pulses, or in user units with `scale` pulses per unit;
+- jobs: `LevelJob` compares against a sequence of values one at a time, the "Value block"
+  of HSL-4XMO 4.12 / the HW_PSWITCH2 buffer (a value fires once, then the next is loaded, so
+  nothing fires twice when the axis reverses); `repeat=True` keeps one value armed (the
+  single-value trigger comparator). `WindowJob` compares 2-D/3-D points with a +-maxerr
+  window per axis (ZMotion modes 25/26/35/36), in table order;
+- actions on a hit: `Toggle`, `Pulse`, `SetLevel`, or a pulse timer (pso.PulseTimer); each
+  drives an `OutputLine` (exact edges) and every hit goes to the `EventLog`.
+
+Feedback model (MPOS): the Hardware boundary reports the encoder only at cycle ends, so
+between them the feedback is modelled as move_ratio * command(t) + e(t), with the following
+error e(t) linear between its values at the cycle ends. For a stepper that keeps step this
+is exactly the encoder; for a servo the error is the part interpolated, and it changes far
+more slowly than the position.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import MotionError, check_finite, check_int, check_positive
+from .compare_due import engine_due
+from .compare_io import EventLog, OutputLine
+from .compare_jobs import (
+    SOURCE_KINDS,
+    Action,
+    AxisSource,
+    CompareJob,
+    LevelJob,
+    LevelSeq,
+    Pulse,
+    SetLevel,
+    Source,
+    Toggle,
+    VectorSource,
+    WindowJob,
+    every_distance,
+)
+from .compare_math import (
+    Track,
+    VectorCycle,
+    affine_track,
+    history_track,
+    positions,
+    track_range,
+)
+
+if TYPE_CHECKING:
+    from ..core.controller import Controller
+
+__all__ = [
+    "SOURCE_KINDS", "Action", "AxisSource", "CompareEngine", "CompareJob", "LevelJob",
+    "LevelSeq", "Pulse", "SetLevel", "Source", "SpeedPwm", "Toggle", "VectorSource", "WindowJob",
+    "every_distance",
+]
+
+Array = NDArray[np.float64]
+
+
+class SpeedPwm:
+    """Duty-cycle output following the path speed (see CompareEngine.add_speed_pwm)."""
+
+    def __init__(self, source: VectorSource, output: int, full_speed: float,
+                 per_cycle: int = 1) -> None:
+        self.source = source
+        self.output = output
+        self.full_speed = full_speed
+        self.per_cycle = per_cycle
+        self.duties: list[tuple[float, float]] = []  # (PWM period start, duty) for plots/tests
+
+    def apply(self, line: OutputLine, vc: VectorCycle, s0: float, t0: float,
+              t1: float) -> None:
+        """PWM periods of (t0, t1] (per_cycle equal ones), each with the duty of the mean
+        path speed over that period: its length increment / (period * full_speed)."""
+        n = self.per_cycle
+        tb = [t0 + (t1 - t0) * k / n for k in range(n)] + [t1]
+        s = [s0] + [vc.at(t) for t in tb[1:-1]] + [vc.end]
+        for k in range(n):
+            a, period = tb[k], tb[k + 1] - tb[k]
+            duty = min(max((s[k + 1] - s[k]) / (period * self.full_speed), 0.0), 1.0)
+            self.duties.append((a, duty))
+            line.set(a, duty > 0.0)
+            if 0.0 < duty < 1.0:
+                line.set(a + duty * period, False)
+
+
+# ---------------------------------------------------------------------------- engine
+class CompareEngine:
+    """Runs compare jobs on a Controller every cycle (see module docstring).
+
+    buffer_size: total points all jobs may hold; outputs: output numbers able to compare
+    (default every general output of the machine).
+    """
+
+    def __init__(self, controller: Controller, *, buffer_size: int = 100_000,
+                 outputs: Sequence[int] | None = None) -> None:
+        if not isinstance(buffer_size, int) or buffer_size < 1:
+            raise MotionError(f"buffer_size must be an int >= 1, got {buffer_size!r}")
+        self.ctl = controller
+        self.buffer_size = buffer_size
+        n_do = controller.config.digital_outputs
+        caps = range(n_do) if outputs is None else outputs
+        if isinstance(caps, (str, bytes)) or not hasattr(caps, "__iter__"):
+            raise MotionError(f"outputs must be a sequence of output numbers, "
+                              f"got {outputs!r}")
+        for o in caps:
+            if not isinstance(o, int) or isinstance(o, bool) or not 0 <= o < n_do:
+                raise MotionError(f"outputs must be output numbers in [0, {n_do - 1}], "
+                                  f"got {o!r}")
+        self.capable = frozenset(caps)
+        self.log = EventLog(len(controller.axes))
+        self._jobs: dict[int, CompareJob] = {}
+        self._next_id = 0
+        self._lines: dict[int, OutputLine] = {}
+        self._vectors: dict[VectorSource, float] = {}
+        self._mpos_err: dict[int, float] = {}
+        self._pwms: list[SpeedPwm] = []
+        self._t_last = controller.time
+        self._tracks: dict[AxisSource, Track] = {}
+        self._ranges = {}
+        self._vcycles: dict[VectorSource, VectorCycle] = {}
+        self._mpos_e1: dict[int, float] = {}
+        self._win = (self._t_last, self._t_last)
+        from ...hw.interface import TimedOutputHardware
+
+        #: DPOS/vector jobs run before the hardware advances; edges go out at exact times
+        self.timed = isinstance(controller.hardware, TimedOutputHardware)
+        self._t_pre = self._t_last
+        self._pre_rows: list[tuple[float, int, int, float, int, int]] = []
+        self._pre_pos: list[Array] = []
+        self._plan: list[tuple[float, ...]] | None = None  # records planned (rollback)
+        controller.add_cycle_hook(self._on_cycle, due=self._due)
+        if self.timed:
+            controller.add_pre_advance_hook(self._pre_advance, due=self._due)
+
+    def detach(self) -> None:
+        """Stop running (the jobs stay as they are)."""
+        self.ctl.remove_cycle_hook(self._on_cycle)
+        self.ctl.remove_pre_advance_hook(self._pre_advance)
+
+    # ------------------------------------------------------------------ outputs
+    def check_output(self, number: int) -> int:
+        if isinstance(number, bool) or not isinstance(number, int) or number not in self.capable:
+            raise MotionError(f"output must be a compare-capable output "
+                              f"{sorted(self.capable)}, got {number!r}")
+        return number
+
+    def output(self, number: int) -> OutputLine:
+        """The exact waveform of output `do<number>` (created at its current level)."""
+        line = self._lines.get(number) if isinstance(number, int) else None
+        if line is None:
+            self.check_output(number)
+            line = OutputLine(number, False)
+            line.attach(self.ctl.hardware)
+            self._lines[number] = line
+        return line
+
+    # ------------------------------------------------------------------ jobs
+    @property
+    def jobs(self) -> dict[int, CompareJob]:
+        return dict(self._jobs)
+
+    def buffer_free(self) -> int:
+        """Points the buffer can still take (ZMotion ?HW_PSWITCH2)."""
+        return self.buffer_size - sum(j.buffer_use for j in self._jobs.values())
+
+    def add(self, job: CompareJob) -> int:
+        """Validate and arm `job` from now; returns its id. Nothing changes on refusal."""
+        if not isinstance(job, CompareJob):
+            raise MotionError(f"job must be a CompareJob, got {type(job).__name__}")
+        if job.id >= 0:
+            raise MotionError("job was already added")
+        self.check_output(job.action.output)
+        n_axes = len(self.ctl.axes)
+        axes = (job.axes if isinstance(job, WindowJob) else
+                job.source.axes if isinstance(job.source, VectorSource)  # type: ignore[attr-defined]
+                else (job.source.axis,))  # type: ignore[attr-defined]
+        for a in axes:
+            if isinstance(a, bool) or not isinstance(a, int) or not 0 <= a < n_axes:
+                raise MotionError(f"axis must be in [0, {n_axes - 1}], got {a!r}")
+        if isinstance(job, LevelJob):
+            src = job.source
+            if isinstance(src, AxisSource) and src.kind not in SOURCE_KINDS:
+                raise MotionError(f"kind must be one of {SOURCE_KINDS}, got {src.kind!r}")
+            if isinstance(src, VectorSource) and (
+                    len(src.axes) == 0 or len(set(src.axes)) != len(src.axes)
+                    or (src.scale is not None and (len(src.scale) != len(src.axes)
+                                                   or not all(math.isfinite(s) and s > 0
+                                                              for s in src.scale)))):
+                raise MotionError("vector source needs distinct axes and a positive scale "
+                                  "per axis")
+        with self.ctl.lock:  # the cycle may run on the real-time thread
+            return self._add(job, axes)
+
+    def _add(self, job: CompareJob, axes: Sequence[int]) -> int:
+        if job.buffer_use > self.buffer_free():
+            raise MotionError(f"table too long: {job.buffer_use} points, buffer has "
+                              f"{self.buffer_free()} free of {self.buffer_size}")
+        if isinstance(job, LevelJob) and isinstance(job.source, VectorSource):
+            self.track_vector(job.source)
+        kinds = [job.kind] if isinstance(job, WindowJob) else [getattr(job.source, "kind", "")]
+        if "mpos" in kinds:
+            for a in axes:
+                self._start_mpos(a)
+        job.id = self._next_id
+        self._next_id += 1
+        job.t_armed = self.ctl.time
+        job.arm(self)
+        self._jobs[job.id] = job
+        return job.id
+
+    def remove(self, job_id: int) -> None:
+        """Stop a job and drop its unfired points (HW_PSWITCH2(2) for one job)."""
+        with self.ctl.lock:
+            job = self._jobs.pop(job_id, None)
+            if job is not None:
+                job.active = False
+
+    def clear(self) -> None:
+        for k in list(self._jobs):
+            self.remove(k)
+
+    def job(self, job_id: int) -> CompareJob:
+        try:
+            return self._jobs[job_id]
+        except KeyError:
+            raise MotionError(f"no active compare job {job_id!r}") from None
+
+    # ------------------------------------------------------------------ vector distance
+    def track_vector(self, source: VectorSource) -> None:
+        """Start accumulating `source`'s path length (from 0) if not already."""
+        self._vectors.setdefault(source, 0.0)
+
+    def vector_moved(self, source: VectorSource) -> float:
+        """Path length accumulated so far (ZMotion VECTOR_MOVED)."""
+        self.track_vector(source)
+        return self._vectors[source]
+
+    def set_vector_moved(self, source: VectorSource, value: float = 0.0) -> None:
+        """VECTOR_MOVED = value (clear it before a job, as the seed says)."""
+        if not isinstance(source, VectorSource):
+            raise MotionError(f"source must be a VectorSource, got {type(source).__name__}")
+        self._vectors[source] = check_finite("value", value)
+
+    # ------------------------------------------------------------------ speed-following PWM
+    def add_speed_pwm(self, source: VectorSource, output: int, full_speed: float, *,
+                      per_cycle: int = 1) -> SpeedPwm:
+        """Laser-power-style output: a PWM of `per_cycle` periods per control cycle on
+        `output` whose duty follows the path speed of `source` (duty = mean speed over the
+        PWM period / full_speed, capped at 1). On timed hardware the duty is that of the
+        period itself (the coming motion is known) and the edges are exact; otherwise the
+        periods of a cycle are computed after it, so they come out one cycle late."""
+        if not isinstance(source, VectorSource):
+            raise MotionError(f"source must be a VectorSource, got {source!r}")
+        self.check_output(output)
+        check_int("per_cycle", per_cycle, 1, 1000)
+        pwm = SpeedPwm(source, output, check_positive("full_speed", full_speed), per_cycle)
+        self.track_vector(source)
+        self.output(output)
+        self._pwms.append(pwm)
+        return pwm
+
+    def remove_speed_pwm(self, pwm: SpeedPwm) -> None:
+        if pwm in self._pwms:
+            self._pwms.remove(pwm)
+            self.output(pwm.output).set(self.ctl.time, False)
+
+    # ------------------------------------------------------------------ per-cycle data
+    def _cmd_offset(self, axis: int) -> float:
+        return -self.ctl.axes[axis].counters.pulses_from_command(0.0)
+
+    def _mpos_error(self, axis: int) -> float:
+        """Following error in feedback counts at the current time."""
+        ctr = self.ctl.axes[axis].counters
+        h = self.ctl.history.position_at(axis, self.ctl.time)
+        return ctr.feedback_unwrapped() - ctr.move_ratio * (h + self._cmd_offset(axis))
+
+    def _start_mpos(self, axis: int) -> None:
+        if axis not in self._mpos_err:
+            self._mpos_err[axis] = self._mpos_error(axis)
+
+    def track(self, src: AxisSource) -> Track:
+        """The source's track over this cycle (cached per cycle)."""
+        tr = self._tracks.get(src)
+        if tr is None:
+            ta, t1 = self._win
+            h = history_track(self.ctl.history, src.axis, ta, t1)
+            off = self._cmd_offset(src.axis)
+            if src.kind == "dpos":
+                tr = affine_track(h, 1.0, off)
+            else:
+                r = self.ctl.axes[src.axis].counters.move_ratio
+                e0 = self._mpos_err[src.axis]
+                e1 = self._mpos_e1[src.axis]
+                tr = affine_track(h, r, r * off, e0, (e1 - e0) / (t1 - ta), ta)
+            self._tracks[src] = tr
+        return tr
+
+    def track_range(self, src: AxisSource) -> tuple[float, float]:
+        """(min, max) of the source over this cycle (cached per cycle)."""
+        r = self._ranges.get(src)
+        if r is None:
+            r = self._ranges[src] = track_range(self.track(src), *self._win)
+        return r
+
+    def reachable(self, src: AxisSource, level: float) -> bool:
+        """Can the source touch `level` in this cycle? (skips the exact solver if not)"""
+        lo, hi = self.track_range(src)
+        slack = 1e-9 * (abs(level) + 1.0)
+        return lo - slack <= level <= hi + slack
+
+    def vector_cycle(self, src: VectorSource) -> VectorCycle:
+        vc = self._vcycles.get(src)
+        if vc is None:
+            ta, t1 = self._win
+            tracks = [history_track(self.ctl.history, a, ta, t1) for a in src.axes]
+            vc = VectorCycle(tracks, src.weights, ta, t1, self._vectors[src])
+            self._vcycles[src] = vc
+        return vc
+
+    # ------------------------------------------------------------------ the cycle
+    def _begin(self, ta: float, t1: float) -> None:
+        self._win = (ta, t1)
+        self._tracks = {}
+        self._ranges: dict[AxisSource, tuple[float, float]] = {}
+        self._vcycles = {}
+
+    def _scan(self, pre: bool | None, ta: float, t1: float
+              ) -> list[tuple[float, int, int, float, int, int]]:
+        """Run the jobs (pre True: command-position ones, False: MPOS ones, None: all)."""
+        rows: list[tuple[float, int, int, float, int, int]] = []
+        for job in list(self._jobs.values()):
+            if not job.active or (pre is not None and _on_command(job) != pre):
+                continue
+            for tf, idx, val in job.scan(self, ta, t1):
+                state = job.action.apply(self, tf, job.hits)
+                job.hits += 1
+                rows.append((tf, job.id, idx, val, job.action.output, int(state)))
+            if job.done:
+                self._jobs.pop(job.id, None)
+                job.active = False
+        return rows
+
+    def _positions(self, rows: list[tuple[float, int, int, float, int, int]]) -> Array:
+        times = np.array([r[0] for r in rows])
+        return np.column_stack([positions(self.track(AxisSource(a)), times)
+                                for a in range(len(self.ctl.axes))])
+
+    def _vectors_end(self, ta: float, t1: float) -> None:
+        """Speed PWMs over (ta, t1], then every VECTOR_MOVED to its value at t1."""
+        for pwm in self._pwms:
+            s0 = self._vectors[pwm.source]
+            vc = self.vector_cycle(pwm.source)
+            if self.timed:
+                pwm.apply(self.output(pwm.output), vc, s0, ta, t1)
+            else:  # the cycle already ran: its PWM periods are played in the next one
+                d = t1 - ta
+                pwm.apply(self.output(pwm.output), _Shifted(vc, d), s0, t1, t1 + d)
+        for src in self._vectors:
+            self._vectors[src] = self.vector_cycle(src).end
+
+    # A stop the hardware makes by itself at an input edge (hw.interface.EdgeStopHardware)
+    # or a re-plan from an edge time changes (t0, t1] after the pre-advance scan. The
+    # history record in force at the end of the cycle is kept; if it changed after the cycle,
+    # the scan's effects (job state, waveforms, vector lengths, PWM duties, log rows) are
+    # undone and the scan is run again on the motion as executed. Edges already handed to
+    # the hardware cannot be taken back: the line is corrected at the cycle end.
+    def _snapshot(self, ta: float, t1: float) -> None:
+        if not (self._jobs or self._pwms or self._vectors):
+            self._plan = None
+            return
+        axes: set[int] = set()
+        for j in self._jobs.values():
+            src = getattr(j, "source", None)
+            axes.update(j.axes if isinstance(j, WindowJob) else
+                        src.axes if isinstance(src, VectorSource) else (src.axis,))
+        for v in self._vectors:
+            axes.update(v.axes)
+        self._plan_axes = sorted(axes)
+        self._plan = [self._last_record(a, t1) for a in self._plan_axes]
+        timers = {id(x): x for x in (_timer_of(j.action) for j in self._jobs.values())
+                  if x is not None}
+        self._snap = (
+            dict(self._jobs),
+            {k: (j.index, j.hits, j.active) for k, j in self._jobs.items()},
+            {k: (x.busy_until, x.overruns, x.ignored) for k, x in timers.items()}, timers,
+            {n_: ln.snapshot(ta) for n_, ln in self._lines.items()},
+            dict(self._vectors), [len(p.duties) for p in self._pwms])
+
+    def _last_record(self, axis: int, t1: float) -> tuple[float, ...]:
+        """The history record in force just before t1 (a re-plan or cut inside the cycle
+        starts a new one there; a motion starting exactly at t1 does not count)."""
+        return self.ctl.history.record_at(axis, math.nextafter(t1, -math.inf)) or ()
+
+    def _moved_off_plan(self) -> bool:
+        if self._plan is None:
+            return False
+        t1 = self._win[1]
+        return any(self._last_record(a, t1) != rec
+                   for a, rec in zip(self._plan_axes, self._plan, strict=True))
+
+    def _rollback(self, ta: float) -> None:
+        jobs, state, tstate, timers, lines, vectors, duties = self._snap
+        for k, (idx, hits, active) in state.items():
+            j = jobs[k]
+            if k in self._jobs or j.done:  # not removed by the user meanwhile
+                j.index, j.hits, j.active = idx, hits, active
+                if active:
+                    self._jobs[k] = j
+        for k, (busy, over, ign) in tstate.items():
+            timers[k].busy_until, timers[k].overruns, timers[k].ignored = busy, over, ign
+        for n_, snap in lines.items():
+            self._lines[n_].restore(ta, snap)
+        self._vectors.update(vectors)
+        for p, n_ in zip(self._pwms, duties, strict=False):
+            del p.duties[n_:]
+        self._pre_rows, self._pre_pos = [], []
+
+    def _due(self, ctl: Controller) -> float:
+        """When a hook of the engine may next act (control/trigger/compare_due.py)."""
+        return engine_due(self)
+
+    def _pre_advance(self, ctl: Controller, t0: float, t1: float) -> None:
+        """Timed hardware, before it runs (t0, t1]: command-position jobs, exact edges."""
+        ta = max(self._t_pre, t0)  # (after a jump: the cycles crossed had nothing to do)
+        self._t_pre = t1
+        if t1 <= ta:
+            return
+        self._begin(ta, t1)
+        self._snapshot(ta, t1)
+        rows = self._scan(True, ta, t1)
+        if rows:
+            self._pre_rows.extend(rows)
+            self._pre_pos.extend(self._positions(rows))
+        self._vectors_end(ta, t1)
+        hw = ctl.hardware
+        for line in self._lines.values():
+            line.send(hw, ta, t1)
+
+    def _on_cycle(self, ctl: Controller, t1: float) -> None:
+        # after a jump the window starts at the previous cycle end, as cycle by cycle
+        ta = max(self._t_last, ctl._t_origin + (ctl.cycles - 1) * ctl.period)
+        self._t_last = t1
+        if t1 <= ta:
+            return
+        # (a jump's landing cycle had no pre-advance scan: nothing to redo)
+        replan = self.timed and self._t_pre == t1 and self._moved_off_plan()
+        self._begin(ta, t1)
+        if replan:  # redo the command-position jobs on the motion as executed
+            self._rollback(ta)
+            rows = self._scan(True, ta, t1)
+            self._vectors_end(ta, t1)
+        else:
+            rows = []
+        self._mpos_e1 = {a: self._mpos_error(a) for a in self._mpos_err}
+        rows += self._scan(False if self.timed else None, ta, t1)
+        if not self.timed:
+            self._vectors_end(ta, t1)
+        self._mpos_err.update(self._mpos_e1)
+        pos = list(self._positions(rows)) if rows else []
+        if self._pre_rows:
+            rows = self._pre_rows + rows
+            pos = self._pre_pos + pos
+            self._pre_rows, self._pre_pos = [], []
+        if rows:
+            order = sorted(range(len(rows)), key=lambda k: rows[k][0])
+            self.log.add([rows[k] for k in order], np.array([pos[k] for k in order]))
+        hw = ctl.hardware
+        keep = t1 - ctl.history.window_s  # waveforms are kept as long as the motion history
+        for line in self._lines.values():
+            line.flush(hw, ta, t1)
+            line.forget_before(keep)
+
+
+def _timer_of(action: Action) -> Any:
+    """The pulse timer an action drives (itself, or a trigger's `timer`), or None."""
+    tm = getattr(action, "timer", action)
+    return tm if hasattr(tm, "busy_until") else None
+
+
+def _on_command(job: CompareJob) -> bool:
+    """Does the job compare command positions only (DPOS axes or vector distance)?"""
+    if isinstance(job, WindowJob):
+        return job.kind == "dpos"
+    src = getattr(job, "source", None)
+    return isinstance(src, VectorSource) or getattr(src, "kind", "dpos") == "dpos"
+
+
+class _Shifted:
+    """A VectorCycle read `d` seconds later (the PWM of a cycle played in the next one)."""
+
+    def __init__(self, vc: VectorCycle, d: float) -> None:
+        self.vc, self.d, self.end = vc, d, vc.end
+
+    def at(self, t: float) -> float:
+        return self.vc.at(t - self.d)
