@@ -77,7 +77,7 @@ AXES = [
           dict(distance=5000.0, v_max=2e4, a_max=2e5, j_max=2e7, d_max=None, absolute=False,
                units=False), aliases={"units": ("units", "v_max")}),
     Entry("Axis.fix_speed_range", axis_call("fix_speed_range"),
-          dict(max_vel=10_000.0, units=False)),
+          dict(max_vel=10_000.0, units=False), aliases={"units": ("units", "max_vel")}),
     Entry("Axis.set_move_ratio", axis_call("set_move_ratio"), dict(ratio=2.0)),
     Entry("Axis.set_inp", axis_call("set_inp"), dict(enabled=True)),
     Entry("Axis.stop", axis_call("stop"), dict(tdec=0.1)),
