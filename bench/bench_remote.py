@@ -88,11 +88,9 @@ def arm(svc: TimedService, url: str, seconds: float, with_client: bool
     return median_cpu, wall1.mean_busy if n else 0.0, pushes, proc_share - rt_share
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=4.0)
-    ap.add_argument("--rounds", type=int, default=3)
-    args = ap.parse_args()
+def start_busy_machine() -> tuple[TimedService, ServerThread]:
+    """The served machine both UI benchmarks measure: every axis repeating a move, the scope
+    recording 8 channels, the server up (settled for 1 s)."""
     svc = TimedService()
     server = RemoteServer(svc)
     svc.start()
@@ -105,6 +103,15 @@ def main() -> int:
                          ("command", "velocity", "acceleration", "error")], 1, 30.0,
                         svc.scope.trigger)
     time.sleep(1.0)
+    return svc, th
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=4.0)
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args()
+    svc, th = start_busy_machine()
     results: dict[str, list[tuple[float, float, int, float]]] = {"idle": [], "client": []}
     try:
         for _ in range(args.rounds):

@@ -21,8 +21,7 @@ import textwrap
 import time
 from pathlib import Path
 
-from bench_remote import GOAL, TimedService
-from openmotion.remote.server import RemoteServer, ServerThread
+from bench_remote import GOAL, TimedService, start_busy_machine
 
 CHROMIUM = "/usr/bin/chromium"
 
@@ -69,18 +68,7 @@ def main() -> int:
     if not Path(CHROMIUM).exists():
         print(f"bench_ui: {CHROMIUM} is missing (apt-get install chromium)")
         return 1
-    svc = TimedService()
-    server = RemoteServer(svc)
-    svc.start()
-    th = ServerThread(server).start()
-    for ax in svc.ctl.axes:
-        ax.enable()
-        svc.repeats.start(ax.index, 1.0, 20.0 if ax.config.unit != "degree" else 90.0,
-                          0.05, 0, {"max_vel": ax.config.max_speed * 0.2, "tacc": 0.05})
-    svc.scope.configure([f"{a}.{q}" for a in ("x", "y") for q in
-                         ("command", "velocity", "acceleration", "error")], 1, 30.0,
-                        svc.scope.trigger)
-    time.sleep(1.0)
+    svc, th = start_busy_machine()
     rows: dict[str, list[tuple[float, str]]] = {"idle": [], "browser": []}
     try:
         for _ in range(args.rounds):
