@@ -225,20 +225,20 @@ def test_a_second_tab_is_told_to_reload_and_sees_the_scope_history(page, browser
     width.fill("3" if width.input_value() != "3" else "4")
     page.click("#if-save")
     page.wait_for_selector("#if-saved:has-text('applied'), #if-saved:has-text('saved to')")
-    other.wait_for_selector("#reload-banner:not([hidden])", timeout=5000)
+    other.wait_for_selector("#reload-banner:not([hidden])", timeout=20_000)
     w2 = field(other, "if-pulse", "pulse_width_us")
     w2.fill("9")
     other.click("#if-save")
-    other.wait_for_selector("#if-error:has-text('reload')", timeout=5000)
+    other.wait_for_selector("#if-error:has-text('reload')", timeout=20_000)
     other.click("#reload-config")
     other.wait_for_selector("#reload-banner[hidden]", state="attached")
     other.wait_for_timeout(500)
     field(other, "if-pulse", "pulse_width_us").fill("9")
     other.click("#if-save")
     other.wait_for_selector("#if-saved:has-text('applied'), #if-saved:has-text('saved to')",
-                            timeout=5000)
+                            timeout=20_000)
     # now the first tab is the stale one: it reloads, then its commands go through
-    page.wait_for_selector("#reload-banner:not([hidden])", timeout=5000)
+    page.wait_for_selector("#reload-banner:not([hidden])", timeout=20_000)
     page.click("#reload-config")
     page.wait_for_function("() => window.openmotion.configVersion === "
                            "window.openmotion.status.config_version")
@@ -283,7 +283,7 @@ def test_scope_pause_freezes_the_recording_and_run_resumes_it(page):
     assert page.evaluate("window.openmotion.scopeChart.t.length") == n
     page.click("#scope-run")
     page.wait_for_selector("#log:has-text('running')")
-    page.wait_for_function(f"() => window.openmotion.scopeChart.t.length > {n}", timeout=5000)
+    page.wait_for_function(f"() => window.openmotion.scopeChart.t.length > {n}", timeout=20_000)
 
 
 def test_the_page_logic_in_the_browser(page):
