@@ -94,114 +94,175 @@ def _switch_bits(name: str, switches: dict) -> int:
     return bits
 
 
-def run_quiet(axes: list[SimAxis], queues: list[PieceQueue], origin: float, period: float,
-              start: int, stop: int, now: float, limit: float,
+class KernelState:
+    """The kernel's arrays over all axes, kept between calls: built from the `SimAxis`
+    objects once (`__init__`), run by `run_quiet` call after call, and written back into
+    the objects only when Python needs them (`write_back`; SimMachine decides when). So a
+    landing of a virtual-time jump costs no per-axis packing or copying."""
+
+    __slots__ = ("ad", "ai", "sd", "si", "names", "recording", "_wake", "_wake_key",
+                 "_readback")
+
+    def __init__(self, axes: list[SimAxis]) -> None:
+        n = len(axes)
+        ad = np.zeros((n, _ND))
+        ai = np.zeros((n, _NI), dtype=np.int64)
+        sd = np.zeros((n, _MAXSW, _NSD))
+        si = np.zeros((n, _MAXSW, _NSI), dtype=np.int64)
+        adl: list[tuple] = []
+        ail: list[list] = []
+        self.names: list[list[str]] = []
+        for x, ax in enumerate(axes):
+            g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
+            c = g.cubic
+            adl.append((c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
+                        tr.backlash, tr.z, ax.y, dec.upp))
+            fwd = [*dec.fwd_pre, 0, 0, 0, 0][:5]
+            bwd = [*dec.bwd_pre, 0, 0, 0, 0][:5]
+            sws = ax.switches
+            nm = list(sws)
+            self.names.append(nm)
+            base = level_bits(ax)
+            for s, name in enumerate(nm):
+                sw = sws[name]
+                if type(sw) is IndexSwitch:
+                    sd[x, s] = (1.0, sw.period, sw.width, 0.0)
+                else:
+                    sd[x, s] = (0.0, sw.lo, sw.hi, sw.hyst)
+                bits = _switch_bits(name, sws)
+                if sw.active:
+                    base ^= bits
+                si[x, s] = (sw.active, 0, bits)
+            ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
+                        dec.count, dec.period, len(sws), dec.turn[1], dec.turn[-1],
+                        *fwd, *bwd, 0, 0, 0, g.record is not None, base])
+        if n:
+            ad[:] = adl
+            ai[:] = ail
+        self.ad, self.ai, self.sd, self.si = ad, ai, sd, si
+        self.recording = any(ax.gen.record is not None for ax in axes)  # pulse records
+        self._wake_key: object = ()  # no wake set computed yet
+        self._wake = np.zeros((n, _MAXSW), dtype=np.int64)
+        self._readback: tuple[list[int], list[int], list[int]] | None = None
+
+    def set_wake(self, axes: list[SimAxis], wake: Collection[str] | None) -> None:
+        """Mark the switches whose edges end a kernel run (computed once per wake set)."""
+        key = None if wake is None else frozenset(wake)
+        if key != self._wake_key or (key is None) != (self._wake_key is None):
+            for x, nm in enumerate(self.names):
+                sws = axes[x].switches
+                for s, name in enumerate(nm):
+                    self._wake[x, s] = _wakes(name, sws, key)
+            self._wake_key = key
+        self.si[:, :, 1] = self._wake
+
+    def readback(self, x: int) -> tuple[int, int, int]:
+        """(pulse count, decoded count, input level bits) of axis x now."""
+        rb = self._readback
+        if rb is None:
+            ai, si = self.ai, self.si
+            flips = np.bitwise_xor.reduce(si[:, :, 0] * si[:, :, 2], axis=1)
+            rb = self._readback = (ai[:, I_COUNT].tolist(), ai[:, I_DCOUNT].tolist(),
+                                   (ai[:, I_LEVELS] ^ flips).tolist())
+        return rb[0][x], rb[1][x], rb[2][x]
+
+    def at_rest(self, t: float) -> bool:
+        """Every generator holds its command's end at time t (te <= t)."""
+        return bool((self.ad[:, D_TE] <= t).all())
+
+    def write_back(self, axes: list[SimAxis]) -> None:
+        """Put the arrays' state into the axis objects (the kernel's arrays stay valid)."""
+        adl, ail, sil = self.ad.tolist(), self.ai.tolist(), self.si.tolist()
+        for x, ax in enumerate(axes):
+            d, i = adl[x], ail[x]
+            g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
+            g.cubic = Cubic(d[D_P0], d[D_V0], d[D_A0], d[D_J])
+            g.tc, g.te = d[D_TC], d[D_TE]
+            g.count = i[I_COUNT]
+            plant.lost = i[I_LOST]
+            tr.z = d[D_Z]
+            ax.y = d[D_Y]
+            dec.q, dec.last_dir, dec.count = i[I_Q], i[I_LASTDIR], i[I_DCOUNT]
+            for s, name in enumerate(self.names[x]):
+                ax.switches[name].active = bool(sil[x][s][0])
+            ax.stop_time = None
+            ax.record = []
+            ax.run_start = (tr.z, (dec.q, dec.last_dir, dec.count))
+
+
+def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin: float,
+              period: float, start: int, stop: int, now: float, limit: float,
               wake: Collection[str] | None, trace: bool = False
               ) -> tuple[int, float, np.ndarray | None]:
-    """Run cycles start+1 .. at most stop in the kernel; returns (cycle reached, time,
-    trace): with `trace`, an int64 array [cycles run, axis, 3] of the pulse count, decoded
-    count and input levels (`level_bits`) at the end of each cycle.
+    """Run cycles start+1 .. at most stop in the kernel on the arrays of `ks`; returns
+    (cycle reached, time, trace): with `trace`, an int64 array [cycles run, axis, 3] of the
+    pulse count, decoded count and input levels (`level_bits`) at the end of each cycle.
 
     Stops before the first cycle ending at or after `limit` or with an edge on a `wake`
-    signal; the state of every axis (and the pieces started) is written back."""
+    signal. The pieces started leave their queues; the axis state stays in `ks` (with
+    pulse recording on, it and the record are written back into the axes at once)."""
     n = len(axes)
-    adl: list[tuple] = []
-    ail: list[list] = []
-    sdl: list[list[tuple]] = []
-    sil: list[list[tuple]] = []
+    ks.set_wake(axes, wake)
+    ai = ks.ai
+    ai[:, I_PBEGIN:I_CURSOR + 1] = 0
     blocks: list[np.ndarray] = []
+    used: list[int] = []
     total = 0
-    names: list[list[str]] = []
-    recording = False
-    pad_d = [(0.0, 0.0, 0.0, 0.0)] * _MAXSW
-    pad_i = [(0, 0, 0)] * _MAXSW
-    for x, ax in enumerate(axes):
-        g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
-        c = g.cubic
-        adl.append((c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
-                    tr.backlash, tr.z, ax.y, dec.upp))
-        block = queues[x].remaining()
-        begin = total
-        total += len(block)
-        blocks.append(block)
-        fwd = [*dec.fwd_pre, 0, 0, 0, 0][:5]
-        bwd = [*dec.bwd_pre, 0, 0, 0, 0][:5]
-        rec = g.record is not None
-        recording = recording or rec
-        ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
-                    dec.count, dec.period, len(ax.switches), dec.turn[1], dec.turn[-1],
-                    *fwd, *bwd, begin, total, begin, rec])
-        sws = ax.switches
-        nm = list(sws)
-        names.append(nm)
-        rd, ri = [], []
-        base = level_bits(ax) if trace else 0
-        for name in nm:
-            sw = sws[name]
-            if type(sw) is IndexSwitch:
-                rd.append((1.0, sw.period, sw.width, 0.0))
-            else:
-                rd.append((0.0, sw.lo, sw.hi, sw.hyst))
-            bits = _switch_bits(name, sws)
-            if sw.active:
-                base ^= bits
-            ri.append((sw.active, _wakes(name, sws, wake), bits))
-        ail[-1].append(base)
-        sdl.append(rd + pad_d[len(rd):])
-        sil.append(ri + pad_i[len(ri):])
-    ad = np.array(adl, dtype=float)
-    ai = np.array(ail, dtype=np.int64)
-    sd = np.array(sdl, dtype=float)
-    si = np.array(sil, dtype=np.int64)
-    pieces = np.concatenate(blocks) if total else _NO_PIECES
+    for x, q in enumerate(queues):
+        if len(q):
+            block = q.remaining()
+            ai[x, I_PBEGIN] = ai[x, I_CURSOR] = total
+            total += len(block)
+            ai[x, I_PEND] = total
+            blocks.append(block)
+            used.append(x)
+    recording = ks.recording
+    if not total:
+        pieces = _NO_PIECES
+    elif len(blocks) == 1 and blocks[0].flags.writeable:
+        pieces = blocks[0]  # the queue's own block (the kernel only reads it)
+    else:
+        pieces = np.concatenate(blocks)
     popt = np.zeros(len(pieces)) if recording else _NONE
     cap = (stop - start) * n * 8 + 16 if recording else 0
     rows = np.zeros((cap, _NREC)) if cap else _NONE
     tr = np.zeros((stop - start, n, 3), dtype=np.int64) if trace else _NO_TRACE
-    k, t, used = _k.run(ad, ai, sd, si, pieces, popt, rows, tr, float(origin), float(period),
-                        int(start), int(stop), float(now), float(limit))
+    k, t, nrows = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, float(origin),
+                         float(period), int(start), int(stop), float(now), float(limit))
     if k == start:
         return k, now, tr[:0] if trace else None
-    _write_back(axes, queues, ad, ai, si, pieces, popt, rows[:used], names)
+    ks._readback = None
+    if used:
+        begin = ai[used, I_PBEGIN].tolist()
+        cursor = ai[used, I_CURSOR].tolist()
+        for x, b, c in zip(used, begin, cursor, strict=True):
+            if c > b:
+                queues[x].consume(c - b)
+        if recording:
+            _record_commands(axes, used, begin, cursor, pieces, popt)
+    if recording:
+        ks.write_back(axes)
+        _record_stretches(axes, rows[:nrows])
     return k, t, tr[:k - start] if trace else None
 
 
-def _write_back(axes: list[SimAxis], queues: list[PieceQueue], ad: np.ndarray,
-                ai: np.ndarray, si: np.ndarray, pieces: np.ndarray, popt: np.ndarray,
-                rows: np.ndarray, names: list[list[str]]) -> None:
-    adl, ail, sil = ad.tolist(), ai.tolist(), si.tolist()
-    recording = any(ax.gen.record is not None for ax in axes)
-    pcl = pieces.tolist() if recording else []
-    ptl = popt.tolist() if recording else []
-    per_axis: list[list[list[float]]] = [[] for _ in axes]
-    for r in rows.tolist():
-        per_axis[int(r[0])].append(r)
-    for x, ax in enumerate(axes):
-        d, i = adl[x], ail[x]
-        g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
-        begin, cursor = i[I_PBEGIN], i[I_CURSOR]
-        rec = g.record
-        if cursor > begin:
-            queues[x].consume(cursor - begin)
-            if rec is not None:
-                for m in range(begin, cursor):
-                    t0, dt, p0, v0, a0, j = pcl[m]
-                    rec.command(ptl[m], Cubic(p0, v0, a0, j), t0, t0 + dt)
-            g.cubic = Cubic(d[D_P0], d[D_V0], d[D_A0], d[D_J])
-            g.tc, g.te = d[D_TC], d[D_TE]
-        g.count = i[I_COUNT]
-        plant.lost = i[I_LOST]
-        tr.z = d[D_Z]
-        ax.y = d[D_Y]
-        dec.q, dec.last_dir, dec.count = i[I_Q], i[I_LASTDIR], i[I_DCOUNT]
-        for s, name in enumerate(names[x]):
-            ax.switches[name].active = bool(sil[x][s][0])
+def _record_commands(axes: list[SimAxis], used: list[int], begin: list[int],
+                     cursor: list[int], pieces: np.ndarray, popt: np.ndarray) -> None:
+    """The pieces the kernel started, into the pulse records (as `set_command` does)."""
+    pcl, ptl = pieces.tolist(), popt.tolist()
+    for x, b, c in zip(used, begin, cursor, strict=True):
+        rec = axes[x].gen.record
         if rec is not None:
-            half = g.half
-            for r in per_axis[x]:
-                _, kind, t0, t1, tc, p0, v0, a0, j, dr, c0, c1 = r
-                cub = Cubic(p0, v0, a0, j) if kind else None
-                rec.add(Stretch(t0, t1, cub, tc, int(dr), int(c0), int(c1)), half)
-        ax.stop_time = None
-        ax.record = []
-        ax.run_start = (tr.z, (dec.q, dec.last_dir, dec.count))
+            for m in range(b, c):
+                t0, dt, p0, v0, a0, j = pcl[m]
+                rec.command(ptl[m], Cubic(p0, v0, a0, j), t0, t0 + dt)
+
+
+def _record_stretches(axes: list[SimAxis], rows: np.ndarray) -> None:
+    """The kernel's pulse-record rows, into the axes' pulse records."""
+    for r in rows.tolist():
+        _, kind, t0, t1, tc, p0, v0, a0, j, dr, c0, c1 = r
+        g = axes[int(r[0])].gen
+        if g.record is not None:
+            cub = Cubic(p0, v0, a0, j) if kind else None
+            g.record.add(Stretch(t0, t1, cub, tc, int(dr), int(c0), int(c1)), g.half)

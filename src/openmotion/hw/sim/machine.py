@@ -68,7 +68,11 @@ class SimMachine:
             if not isinstance(n, int) or n < 0:
                 raise MotionError(f"{name} must be an int >= 0, got {n!r}")
         self.config = config
-        self._axes = [SimAxis(i, a, wiring.get(i)) for i, a in enumerate(config.axes)]
+        self._ax = [SimAxis(i, a, wiring.get(i)) for i, a in enumerate(config.axes)]
+        # the compiled kernel's arrays (hw/sim/kernel.py), kept between runs while nothing
+        # but the kernel changes the axes; `_stale`: they are newer than the axis objects
+        self._ks: kernel.KernelState | None = None
+        self._stale = False
         self._t = 0.0
         self._emg_active = False
         self._emg_armed: bool | None = None  # level at which EMG cuts every axis's pulses
@@ -80,17 +84,42 @@ class SimMachine:
         self._timed = TimedOutputs()  # do<n> writes at exact times (write_output_at)
         self.output_record = OutputRecord()  # every output edge at its exact time
         self.scenario = Scenario(self)
-        self._queues = [PieceQueue() for _ in self._axes]  # QueuedHardware
+        self._queues = [PieceQueue() for _ in self._ax]  # QueuedHardware
         #: run quiet cycles of `run_cycles` in the compiled kernel (hw/sim/kernel.py) when
         #: it is built and models every axis; False: every cycle in Python (the reference)
         self.native = True
         # inputs derived from axis positions (probe.py): raw edges -> board edges
         self._edge_filters: list[Callable[[list], list]] = []
 
+    # -- the axes' state: kernel arrays or objects ----------------------------------------------
+    def _objects(self) -> list[SimAxis]:
+        """The axis objects with their state current (the kernel's arrays written back if
+        they are newer), for reading."""
+        if self._stale:
+            assert self._ks is not None
+            self._ks.write_back(self._ax)
+            self._stale = False
+        return self._ax
+
+    @property
+    def _axes(self) -> list[SimAxis]:
+        """The axis objects, current and free to change: the kernel's arrays are dropped
+        (rebuilt from the objects before the next kernel run). Every Python path of the
+        machine goes through here, so the kernel never runs on an outdated copy."""
+        axes = self._objects()
+        self._ks = None
+        return axes
+
+    def _index(self, axis: int) -> int:
+        """`axis` checked (MotionError), without touching the axes' state."""
+        if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._ax):
+            raise MotionError(f"axis must be an int in 0..{len(self._ax) - 1}, got {axis!r}")
+        return axis
+
     # -- Hardware protocol --------------------------------------------------------------------
     @property
     def n_axes(self) -> int:
-        return len(self._axes)
+        return len(self._ax)
 
     @property
     def time(self) -> float:
@@ -121,15 +150,15 @@ class SimMachine:
         """Append timed pieces (AxisCommands or a PieceBlock of arrays) to the queue of
         `axis` (hw.interface.QueuedHardware); each becomes the pulse generator's command at
         its t0, as `command` would make it."""
-        self._queues[self._axis(axis).index].extend(pieces, self._t)
+        self._queues[self._index(axis)].extend(pieces, self._t)
 
     def clear_queue(self, axis: int) -> None:
         """Drop the pieces of `axis` not started yet."""
-        self._queues[self._axis(axis).index].clear()
+        self._queues[self._index(axis)].clear()
 
     def queued(self, axis: int) -> int:
         """Pieces of `axis` not started yet."""
-        return len(self._queues[self._axis(axis).index])
+        return len(self._queues[self._index(axis)])
 
     def run_cycles(self, origin: float, period: float, start: int, stop: int,
                    wake: Collection[str] | None = None, trace: bool = False) -> QueueRun:
@@ -165,10 +194,15 @@ class SimMachine:
                 if edges or k >= stop:
                     break
             first = False
-            if self.native and not hold and not self._pending and kernel.usable(self._axes):
-                k, self._t, tr = kernel.run_quiet(self._axes, queues, origin, period, k,
+            ks = self._kernel_state() if self.native and not hold and not self._pending \
+                else None
+            if ks is not None:
+                k0 = k
+                k, self._t, tr = kernel.run_quiet(ks, self._ax, queues, origin, period, k,
                                                   stop, self._t, self._next_action(), wake,
                                                   trace)
+                if k > k0 and not ks.recording:
+                    self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
                 if k >= stop:
@@ -184,9 +218,17 @@ class SimMachine:
         drained = tuple(i for i, q in enumerate(queues) if had[i] and not q)
         tr = None
         if trace:
-            tr = np.concatenate(rows) if rows else np.zeros((0, len(self._axes), 3),
+            tr = np.concatenate(rows) if rows else np.zeros((0, len(self._ax), 3),
                                                             dtype=np.int64)
         return QueueRun(k, edges, drained, tr)
+
+    def _kernel_state(self) -> kernel.KernelState | None:
+        """The kernel's arrays (built from the axes if dropped), or None when the kernel
+        does not model this machine."""
+        ks = self._ks
+        if ks is None and kernel.usable(self._ax):  # not stale: the objects are current
+            ks = self._ks = kernel.KernelState(self._ax)
+        return ks
 
     def _trace_row(self) -> np.ndarray:
         """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""
@@ -205,7 +247,9 @@ class SimMachine:
         if self._pending:
             return False
         t = self._t
-        for ax, q in zip(self._axes, self._queues, strict=True):
+        if self._ks is not None:  # steppers only (kernel.usable)
+            return not any(len(q) for q in self._queues) and self._ks.at_rest(t)
+        for ax, q in zip(self._ax, self._queues, strict=True):
             if ax.is_servo or ax.is_dc or ax.gen.te > t or len(q):
                 return False
         return True
@@ -280,7 +324,11 @@ class SimMachine:
         return edges
 
     def read_axis(self, axis: int) -> AxisReadback:
-        ax = self._axis(axis)
+        if self._ks is not None:  # the kernel's arrays are current (objects maybe not)
+            pulses, enc, bits = self._ks.readback(self._index(axis))
+            return AxisReadback(pulses, enc, {sig: bool(bits >> i & 1)
+                                              for i, sig in enumerate(AXIS_INPUTS)})
+        ax = self._objects()[self._index(axis)]
         return AxisReadback(ax.gen.count, ax.decoder.count,
                             dict(zip(AXIS_INPUTS, ax.levels(), strict=True)))
 
@@ -319,7 +367,7 @@ class SimMachine:
         if axis is None:
             self._board_index(signal, "do", len(self._do))
         else:
-            self._axis(axis)
+            self._index(axis)
             if signal not in AXIS_OUTPUTS:
                 raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, "
                                   f"got {signal!r}")
@@ -378,7 +426,7 @@ class SimMachine:
 
     def stop_time(self, axis: int) -> float | None:
         """When an armed stop cut the pulses of `axis` in the last advance, else None."""
-        return self._axis(axis).stop_time
+        return self._view(axis).stop_time
 
     # -- extras for tests and tools ---------------------------------------------------------
     def read_output(self, axis: int | None, signal: str) -> bool:
@@ -392,28 +440,28 @@ class SimMachine:
 
     def steps_lost(self, axis: int) -> int:
         """Pulses the stepper of `axis` has lost (stalls + injected losses); 0 for a servo."""
-        p = self._axis(axis).plant
+        p = self._view(axis).plant
         return p.lost if isinstance(p, StepperPlant) else 0
 
     def motor_position(self, axis: int) -> float:
         """Motor position (command pulses) at the current time."""
-        ax = self._axis(axis)
+        ax = self._view(axis)
         return ax.plant.motor(ax.gen)
 
     def load_position(self, axis: int) -> float:
         """Position seen by encoder and switches (after backlash and pitch error)."""
-        return self._axis(axis).y
+        return self._view(axis).y
 
     def command_position(self, axis: int) -> float:
         """Commanded (float) position at the current time."""
-        return self._axis(axis).gen.pos(self._t)
+        return self._view(axis).gen.pos(self._t)
 
     @property
     def half_pulse(self) -> bool:
         """True (the default) when the generators count by the half-pulse rule (see
         `set_half_pulse`); the control layer reads it (control.home.pulserule) to rebuild counts
         at edge times the same way."""
-        return self._axes[0].gen.half == 0.5 if self._axes else True
+        return self._ax[0].gen.half == 0.5 if self._ax else True
 
     def set_half_pulse(self, on: bool = True) -> None:
         """Pulse rule of every axis's generator from now on.
@@ -448,7 +496,7 @@ class SimMachine:
         """What `axis` emitted since `record_pulses()`: `pulses()` gives every pulse's exact
         time and the count after it, `command_at(times)` the commanded position.
         MotionError if not recording or if the record filled its capacity."""
-        rec = self._axis(axis).gen.record
+        rec = self._view(axis).gen.record
         if rec is None:
             raise MotionError("pulse_record needs record_pulses() first")
         if not rec.complete:
@@ -458,9 +506,12 @@ class SimMachine:
 
     # -- internals ----------------------------------------------------------------------------
     def _axis(self, axis: int) -> SimAxis:
-        if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._axes):
-            raise MotionError(f"axis must be an int in 0..{len(self._axes) - 1}, got {axis!r}")
-        return self._axes[axis]
+        """Axis `axis` (checked), free to change (see `_axes`)."""
+        return self._axes[self._index(axis)]
+
+    def _view(self, axis: int) -> SimAxis:
+        """Axis `axis` (checked), current, for reading only."""
+        return self._objects()[self._index(axis)]
 
     @staticmethod
     def _board_index(signal: str, prefix: str, n: int) -> int:
