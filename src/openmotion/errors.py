@@ -32,6 +32,9 @@ def show(value: object, limit: int = 60) -> str:
 
 def is_real(value: object) -> bool:
     """A real number: int, float, Fraction, numpy scalars; not bool, str, Decimal, arrays."""
+    t = type(value)
+    if t is float or t is int:  # the common case, without the ABC check
+        return True
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
@@ -42,6 +45,10 @@ def check_finite(name: str, value: float, *, strict: bool = False) -> float:
     (even of one element) are refused, so a typing slip fails here and not deep in a
     planner. `strict` accepts only Python int and float (values read from files).
     """
+    if type(value) is float:  # the common case (NaN and infinities fail below)
+        if value - value == 0.0:
+            return value
+        raise MotionError(f"{name} must be finite, got {show(value)}")
     if strict and (isinstance(value, bool) or not isinstance(value, (int, float))):
         raise MotionError(f"{name} must be a real number, got {show(value)}")
     if not is_real(value):

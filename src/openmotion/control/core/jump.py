@@ -66,6 +66,22 @@ def first_cycle_at(ctl: Controller, t: float) -> int:
     return k
 
 
+def end_cycle(ctl: Controller, m: _motion.ActiveMotion) -> int:
+    """first_cycle_at(ctl, m.t_end) for a move: the grid cycle is kept on the motion (it
+    never changes), so a landing does not search it again for every axis still moving."""
+    t = m.t_end
+    if t <= ctl._time:
+        return ctl._n
+    origin, period = ctl._t_origin, ctl.period
+    c = m._end_cycle
+    if c is None or c[0] != origin or c[1] != period or c[2] < ctl._n:
+        k = first_cycle_at(ctl, t)
+        if k == ctl._n:  # clamped by the present: not the grid cycle itself, don't keep
+            return k
+        m._end_cycle = c = (origin, period, k)
+    return c[2]
+
+
 _QUEUED: dict[type, bool] = {}
 
 
@@ -102,7 +118,7 @@ def plan_jump(ctl: Controller, cycles: int) -> int:
             return nxt
         m = ax._motion
         if m is not None and m.kind != "velocity":
-            land = min(land, first_cycle_at(ctl, m.t_end))
+            land = min(land, end_cycle(ctl, m))
             if land <= nxt:
                 return nxt
     dues = ctl._cycle_dues
@@ -145,13 +161,10 @@ def jump(ctl: Controller, land: int) -> None:
     while True:
         stop = min(land, n + chunk)
         ends = []
-        t1 = origin + np.arange(n + 1, stop + 1) * period  # cycle ends, as `step` has them
         for ax in movers:
             m = ax._motion
             assert m is not None
-            rows, p1v1 = m.pieces(t0, origin, period, n, stop - n)
-            if m.kind != "velocity":  # a move settles at its end: velocity 0 from t_end on
-                p1v1[t1 >= m.t_end, 1] = 0.0
+            rows, p1v1 = _ahead(ctl, m, t0, n, stop)
             try:
                 hw.queue_pieces(ax.index, PieceBlock(rows))
             except BaseException:
@@ -177,6 +190,35 @@ def jump(ctl: Controller, land: int) -> None:
         if k < stop:
             hw.clear_queue(ax.index)
     ctl._finish_cycle(k, run.edges)
+
+
+def _ahead(ctl: Controller, m: _motion.ActiveMotion, t0: float, n: int, stop: int
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces (rows) and end states (p1, v1) of `m` for cycles n+1 .. stop, the first
+    starting at t0. With the compiled pieces they are computed ahead, up to the cycle the
+    motion ends in (at most MAX_CHUNK cycles on), and kept on the motion, so the next
+    jumps reuse them: a landing costs no new pieces for the axes still moving. A motion
+    never changes once made, and every cycle's piece depends only on it and the cycle
+    grid, so the rows are the very ones computed at the landing."""
+    origin, period = ctl._t_origin, ctl.period
+    cache = m._ahead
+    if cache is not None:
+        c_origin, c_period, c_n, rows, ends = cache
+        i = n - c_n
+        if (c_origin == origin and c_period == period and 0 <= i < len(rows)
+                and stop - c_n <= len(rows) and rows[i, 0] == t0):
+            return rows[i:stop - c_n], ends[i:stop - c_n]
+    upto = stop
+    velocity = m.kind == "velocity"
+    k_end = 0 if velocity else end_cycle(ctl, m)
+    if _motion._kernel is not None:
+        upto = max(stop, n + min(FIRST_CHUNK_COMPILED if velocity else k_end - n, MAX_CHUNK))
+    rows, ends = m.pieces(t0, origin, period, n, upto - n)
+    if not velocity:  # a move settles at its end: velocity 0 from the cycle ending at or
+        # after t_end on (the cycle ends rise with k, so that is a tail of the rows)
+        ends[max(k_end, n + 1) - n - 1:, 1] = 0.0
+    m._ahead = (origin, period, n, rows, ends)
+    return rows[:stop - n], ends[:stop - n]
 
 
 def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,

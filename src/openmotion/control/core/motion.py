@@ -18,6 +18,7 @@ forward, so the hot path does no numpy calls and no searching.
 
 from __future__ import annotations
 
+import math
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
 
@@ -58,6 +59,10 @@ class ActiveMotion:
     _k: int = field(init=False, default=0, repr=False)
     _seg_array: np.ndarray | None = field(init=False, default=None, repr=False)
     _left_end: float = field(init=False, default=0.0, repr=False)
+    # pieces computed ahead by a virtual-time jump (control/core/jump.py `_ahead`)
+    _ahead: tuple | None = field(init=False, default=None, repr=False)
+    _done_at: tuple[float, int] = field(init=False, default=(math.nan, 0), repr=False)
+    _end_cycle: tuple[float, float, int] | None = field(init=False, default=None, repr=False)
 
     def __post_init__(self) -> None:
         if not self.v_range and self.spec is not None:
@@ -181,6 +186,14 @@ class ActiveMotion:
 
     def done_code(self, t: float) -> int:
         """HSL motion_done code while this motion runs (seed-facts 2.5)."""
+        at, code = self._done_at
+        if at == t:  # polled again at the same time (a motion never changes)
+            return code
+        code = self._done_code(t)
+        self._done_at = (t, code)
+        return code
+
+    def _done_code(self, t: float) -> int:
         _, v, a = self.state(t)
         speed = abs(v)
         tol = 1e-9 * max(1.0, speed)

@@ -85,6 +85,17 @@ def level_bits(ax: SimAxis) -> int:
     return word
 
 
+_LEVEL_DICTS: dict[int, dict[str, bool]] = {}
+
+
+def level_dict(bits: int) -> dict[str, bool]:
+    """The input levels of a `level_bits` word as AxisReadback.inputs (a new dict)."""
+    d = _LEVEL_DICTS.get(bits)
+    if d is None:
+        d = _LEVEL_DICTS[bits] = {sig: bool(bits >> i & 1) for i, sig in enumerate(AXIS_INPUTS)}
+    return d.copy()
+
+
 def _switch_bits(name: str, switches: dict) -> int:
     """The input-level bits a switch flips when it toggles (SD is also LTC when no LTC
     switch is placed)."""

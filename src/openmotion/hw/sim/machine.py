@@ -112,6 +112,8 @@ class SimMachine:
 
     def _index(self, axis: int) -> int:
         """`axis` checked (MotionError), without touching the axes' state."""
+        if type(axis) is int and 0 <= axis < len(self._ax):
+            return axis
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._ax):
             raise MotionError(f"axis must be an int in 0..{len(self._ax) - 1}, got {axis!r}")
         return axis
@@ -326,8 +328,7 @@ class SimMachine:
     def read_axis(self, axis: int) -> AxisReadback:
         if self._ks is not None:  # the kernel's arrays are current (objects maybe not)
             pulses, enc, bits = self._ks.readback(self._index(axis))
-            return AxisReadback(pulses, enc, {sig: bool(bits >> i & 1)
-                                              for i, sig in enumerate(AXIS_INPUTS)})
+            return AxisReadback(pulses, enc, kernel.level_dict(bits))
         ax = self._objects()[self._index(axis)]
         return AxisReadback(ax.gen.count, ax.decoder.count,
                             dict(zip(AXIS_INPUTS, ax.levels(), strict=True)))

@@ -24,6 +24,7 @@ except ImportError:  # pragma: no cover - depends on the build
     _kernel = None
 
 _FIELDS = ("t0", "dt", "p0", "v0", "a0", "j")
+_F8 = np.dtype(np.float64)
 #: Slack on "starts after the piece before ends" (s): t0 + dt of one cycle's piece may be
 #: one rounding step past the next cycle's start.
 TIME_SLACK = 1e-9
@@ -46,7 +47,17 @@ class PieceQueue:
     def extend(self, pieces: Sequence[AxisCommand] | PieceBlock, now: float) -> None:
         """Check every piece (MotionError naming it and the rule; nothing queued then),
         then append them all."""
-        start = max(self.end, now)
+        start = self.end if self.end > now else now
+        if type(pieces) is PieceBlock:  # the planner's chunks: checked in one C call
+            rows = pieces.rows
+            if (_kernel is not None and type(rows) is np.ndarray and rows.dtype == _F8
+                    and rows.ndim == 2 and rows.shape[1] == 6 and rows.flags.c_contiguous
+                    and len(rows) and _kernel.check_rows(rows, start, TIME_SLACK) < 0):
+                self._blocks.append(rows)
+                self._n += len(rows)
+                last = rows[-1].tolist()
+                self.end = last[0] + last[1]
+                return
         if isinstance(pieces, PieceBlock):
             rows = _block_rows(pieces, start, now)
         elif isinstance(pieces, AxisCommand) or not isinstance(pieces, Sequence):
