@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 from openmotion.config import MachineConfig, SwitchConfig, default_machine
 from openmotion.control import Controller
 from openmotion.errors import MotionError
-from openmotion.hw.interface import PieceBlock
+from openmotion.hw.interface import AxisCommand, PieceBlock
 from openmotion.hw.sim import SimMachine
 from openmotion.hw.sim import kernel as simkernel
 
@@ -190,6 +190,59 @@ def test_run_cycles_in_the_kernel_is_the_python_path(seed):
             k = r.cycle
         runs.append((trace, pulses(hw) if record else None))
     assert simkernel.usable(SimMachine(cfg)._axes)
+    assert runs[0] == runs[1]
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_the_state_kept_in_the_kernels_arrays_reads_and_writes_back_as_python(seed):
+    """Runs in a row keep the axes' state in the kernel's arrays (nothing written back):
+    read_axis, queued and stop_time read from them, and the first Python access (a
+    scenario action, a command, an output, a readout of the objects) writes them back
+    first; the result is the Python path's at every step."""
+    rng = np.random.default_rng(seed)
+    n_axes = int(rng.integers(1, 4))
+    cfg, half_off = machine(rng, n_axes)
+    period = 0.001
+    cycles = int(rng.integers(20, 150))
+    plans = [random_pieces(rng, cycles, period, 0.0) for _ in range(n_axes)]
+    stops = sorted({int(k) for k in rng.integers(1, cycles, size=int(rng.integers(1, 6)))})
+    touch = [str(rng.choice(["none", "read", "command", "output", "loss", "half"]))
+             for _ in stops]
+    wake = frozenset(s for s in ("pel", "mel", "org") if rng.random() < 0.5)
+    runs = []
+    for native in (False, True):
+        hw = SimMachine(cfg)
+        hw.native = native
+        if half_off:
+            hw.set_half_pulse(False)
+        for i, rows in enumerate(plans):
+            hw.queue_pieces(i, PieceBlock(rows))
+        seen = []
+        k = 0
+        for stop, what in [*zip(stops, touch, strict=True), (cycles, "none")]:
+            while k < stop:
+                r = hw.run_cycles(0.0, period, k, stop, wake)
+                k = r.cycle
+                seen.append((k, [(bits([e.time]), e.axis, e.signal, e.level, e.encoders)
+                                 for e in r.edges]))
+                seen.append([(rb.pulses_out, rb.encoder, rb.inputs) for rb in
+                             (hw.read_axis(i) for i in range(n_axes))])
+                seen.append([(hw.queued(i), hw.stop_time(i)) for i in range(n_axes)])
+            if what == "read":
+                seen.append(state(hw))
+            elif what == "command":  # a cycle-by-cycle command replaces the queue's
+                hw.clear_queue(0)
+                p = float(hw.read_axis(0).pulses_out)
+                hw.command(0, AxisCommand(hw.time, period, p, 1000.0, 0.0, 0.0))
+            elif what == "output":
+                hw.write_output(0, "svon", True)
+            elif what == "loss":
+                hw.scenario.inject_step_loss(0, 3, at=hw.time + period / 2)
+            elif what == "half":
+                hw.set_half_pulse(True)
+        seen.append(state(hw))
+        runs.append(seen)
     assert runs[0] == runs[1]
 
 

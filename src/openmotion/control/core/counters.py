@@ -23,7 +23,9 @@ error and the general counter's "command" source show the *planned* position.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+
+import numpy as np
 
 from ...errors import MotionError, check_finite
 from ...limits import check_quantity
@@ -158,6 +160,15 @@ class Counters:
         """The feedback counter for raw hardware totals (ints or int arrays): what
         `update(pulses_out, encoder, t)` then `feedback` gives (jumps record with it)."""
         return wrap28((pulses_out if self._fb_internal else encoder) + self._fb_off)
+
+    @staticmethod
+    def feedback_of(counters: Sequence[Counters], pulses_out: np.ndarray,
+                    encoder: np.ndarray) -> np.ndarray:
+        """`feedback_from` of many axes at once: column i of the (m, n) int arrays
+        `pulses_out` and `encoder` belongs to counters[i] (the recorder in jumps)."""
+        internal = np.array([c._fb_internal for c in counters], dtype=bool)
+        off = np.array([c._fb_off for c in counters], dtype=np.int64)
+        return wrap28(np.where(internal, pulses_out, encoder) + off)
 
     def set_feedback(self, value: int) -> None:
         self._fresh()

@@ -40,6 +40,7 @@ import numpy as np
 
 from ...hw.interface import AXIS_INPUTS, PieceBlock, QueuedHardware
 from . import motion as _motion
+from .counters import Counters
 
 if TYPE_CHECKING:
     from .controller import Controller
@@ -226,7 +227,7 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     """Record cycles n+1 .. n+len(trace) that a jump crossed: the rows `Controller._record`
     writes cycle by cycle, from the back end's readback at each cycle end (`trace`) and the
     end states of the movers' pieces (`ends`); nothing else changes in those cycles."""
-    from .controller import IO_BITS, STATE_CODES  # the controller imports this module
+    from .controller import STATE_CODES  # the controller imports this module
 
     m = len(trace)
     if not m:
@@ -235,26 +236,48 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
     pos = np.empty((m, len(axes)))
     vel = np.empty((m, len(axes)))
-    for ax in axes:
-        pos[:, ax.index] = ax.position
-        vel[:, ax.index] = ax.velocity
-    for ax, p1v1 in zip(movers, ends, strict=True):
-        pos[:, ax.index] = p1v1[:m, 0] + ax.counters._cmd_off
-        vel[:, ax.index] = p1v1[:m, 1]
-    fb = np.stack([ax.counters.feedback_from(trace[:, ax.index, 0], trace[:, ax.index, 1])
-                   for ax in axes], axis=1)
+    pos[:] = [ax.position for ax in axes]
+    vel[:] = [ax.velocity for ax in axes]
+    if movers:
+        idx = [ax.index for ax in movers]
+        pv = np.stack([e[:m] for e in ends], axis=1)  # (m, movers, 2)
+        pos[:, idx] = pv[:, :, 0] + np.array([ax.counters._cmd_off for ax in movers])
+        vel[:, idx] = pv[:, :, 1]
+    fb = Counters.feedback_of([ax.counters for ax in axes], trace[:, :, 0], trace[:, :, 1])
     # logical levels: the electrical ones flipped where the contact is normally closed
-    nc = np.array([sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if sig in ctl._nc[i])
-                   for i in range(len(axes))], dtype=np.int64)
-    logical = trace[:, :, 2] ^ nc
-    io = np.zeros((m, len(axes)), dtype=np.int64)
-    for sig, bit in IO_BITS:
-        io |= ((logical >> AXIS_INPUTS.index(sig)) & 1) << bit
+    io = _io_table()[trace[:, :, 2] ^ _nc_words(ctl)]
     if ctl._estop:
         io |= 1 << 6
     state = np.broadcast_to(np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int64),
                             (m, len(axes)))
     ctl.recorder.record_block(t, cmd_pos=pos, fb_pos=fb, cmd_vel=vel, state=state, io=io)
+
+
+_IO_TABLE: list[np.ndarray] = []
+
+
+def _io_table() -> np.ndarray:
+    """The io word (Controller._record's, IO_BITS) of every logical input-level word
+    (bit k = AXIS_INPUTS[k]), so a block of levels converts in one lookup."""
+    if not _IO_TABLE:
+        from .controller import IO_BITS  # the controller imports this module
+        words = np.arange(1 << len(AXIS_INPUTS), dtype=np.int64)
+        io = np.zeros_like(words)
+        for sig, bit in IO_BITS:
+            io |= ((words >> AXIS_INPUTS.index(sig)) & 1) << bit
+        _IO_TABLE.append(io)
+    return _IO_TABLE[0]
+
+
+def _nc_words(ctl: Controller) -> np.ndarray:
+    """Per axis, the input-level bits (bit k = AXIS_INPUTS[k]) whose contact is normally
+    closed (the controller's contact table never changes after construction)."""
+    cached = getattr(ctl, "_jump_nc_words", None)
+    if cached is None or cached[0] is not ctl._nc:
+        words = np.array([sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if sig in nc)
+                          for nc in ctl._nc], dtype=np.int64)
+        cached = ctl._jump_nc_words = (ctl._nc, words)
+    return cached[1]
 
 
 def _observe(ctl: Controller, n: int, last: int, movers: list,
