@@ -192,7 +192,10 @@ class MotionHistory:
         t_end = t_abs + profile.duration
         if n:
             ts = t_abs + profile.t0
-            keep = np.diff(ts, append=t_end) > MIN_RECORD_S
+            gaps = np.empty(n)  # np.diff(ts, append=t_end), without its generic machinery
+            np.subtract(ts[1:], ts[:-1], out=gaps[:-1])
+            gaps[-1] = t_end - ts[-1]
+            keep = gaps > MIN_RECORD_S
             if not keep.all():  # drop zero-length and sub-nanosecond segments
                 idx = np.flatnonzero(keep)
                 ts = ts[idx]

@@ -168,8 +168,7 @@ class ActiveMotion:
         if _kernel is not None:
             if self._seg_array is None:
                 pr = self.profile
-                self._seg_array = np.ascontiguousarray(
-                    np.stack([pr.t0, pr.p0, pr.v0, pr.a0, pr.j]), dtype=float)
+                self._seg_array = np.array([pr.t0, pr.p0, pr.v0, pr.a0, pr.j], dtype=float)
                 self._left_end = self._left(pr.duration)[1] if self._t0 else 0.0
             end = self.profile.end
             _kernel.pieces(self._seg_array, self.t_start, self.profile.duration, end.p, end.v,
