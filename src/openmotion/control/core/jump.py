@@ -19,7 +19,9 @@ some edge hook acts on (`add_edge_hook(..., signals=...)`; edges no hook acts on
 encoder index pulses with nobody latching them, are dropped), and
 finishes that landing cycle exactly as `Controller.step` finishes a cycle. The cycles in
 between are the ones that would have been no-ops, so counters, events, histories and
-outputs are identical (tests/test_jump_equivalence.py runs both ways). Jump observers
+outputs are identical (tests/test_jump_equivalence.py runs both ways). A motion's pieces
+are computed ahead to its end and kept on it (`_ahead`), so a landing re-queues rows
+already made for the axes still moving. Jump observers
 (`Controller.add_jump_observer`) get the command positions of the crossed cycles, so a
 per-cycle record (the program runner's trace) stays complete.
 
