@@ -218,15 +218,19 @@ def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], or
     ai[:, I_PBEGIN:I_CURSOR + 1] = 0
     blocks: list[np.ndarray] = []
     used: list[int] = []
+    begin: list[int] = []
     total = 0
     for x, q in enumerate(queues):
         if len(q):
             block = q.remaining()
-            ai[x, I_PBEGIN] = ai[x, I_CURSOR] = total
-            total += len(block)
-            ai[x, I_PEND] = total
-            blocks.append(block)
             used.append(x)
+            begin.append(total)
+            total += len(block)
+            blocks.append(block)
+    if used:  # each axis's rows: [begin, end) of the pieces array, cursor at begin
+        ai[used, I_PBEGIN] = begin
+        ai[used, I_CURSOR] = begin
+        ai[used, I_PEND] = [*begin[1:], total]
     recording = ks.recording
     if not total:
         pieces = _NO_PIECES
@@ -244,7 +248,6 @@ def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], or
         return k, now, tr[:0] if trace else None
     ks._readback = None
     if used:
-        begin = ai[used, I_PBEGIN].tolist()
         cursor = ai[used, I_CURSOR].tolist()
         for x, b, c in zip(used, begin, cursor, strict=True):
             if c > b:
