@@ -47,6 +47,9 @@ class CycleStats:
     overruns = cycles that ended after the next cycle was due; late = cycles started after
     their whole slot had passed (run in catch-up, never skipped); behind = the most slots
     the pacer was behind at once; errors = cycles that raised (counted over the whole run).
+    With the compiled executor (control/core/realtime.py, executor "compiled"): work = the
+    Python work between cycles (landing, feeding the pieces ahead), python_cycles = cycles
+    stepped in Python because nothing could be jumped (the fallback).
     """
 
     cycles: int
@@ -61,6 +64,11 @@ class CycleStats:
     late: int = 0
     behind: int = 0
     errors: int = 0
+    mean_work: float = 0.0
+    p99_work: float = 0.0
+    max_work: float = 0.0
+    python_cycles: int = 0
+    executor: str = "python"
 
 
 class RealtimePacer:
@@ -159,6 +167,7 @@ class RealtimePacer:
             late=self._late_cycles,
             behind=self._behind,
             errors=self._errors,
+            python_cycles=self._n,
         )
 
 

@@ -155,9 +155,10 @@ class SimMachine:
         edges: list[InputEdge] = []
         rows: list[np.ndarray] = []
         first = True
+        paced = kernel.pacing()  # real time: every cycle at its wall-clock slot
         while k < stop:
             hold = self._holding()
-            if not first and hold:
+            if not first and hold and not paced:
                 k0 = k
                 k, edges = self._skip_idle(origin, period, k, stop)
                 if trace and k > k0:
@@ -165,14 +166,17 @@ class SimMachine:
                 if edges or k >= stop:
                     break
             first = False
-            if self.native and not hold and not self._pending and kernel.usable(self._axes):
+            if self.native and (not hold or paced) and not self._pending \
+                    and kernel.usable(self._axes):
                 k, self._t, tr = kernel.run_quiet(self._axes, queues, origin, period, k,
                                                   stop, self._t, self._next_action(), wake,
                                                   trace)
                 if tr is not None and len(tr):
                     rows.append(tr)
-                if k >= stop:
+                if k >= stop or (paced and kernel.interrupted()):
                     break
+            if paced:
+                kernel.wait_slot(k + 1)
             k += 1
             edges = self.advance(origin + k * period)
             if trace:
@@ -187,6 +191,12 @@ class SimMachine:
             tr = np.concatenate(rows) if rows else np.zeros((0, len(self._axes), 3),
                                                             dtype=np.int64)
         return QueueRun(k, edges, drained, tr)
+
+    def paced_cycles(self) -> bool:
+        """True when `run_cycles` runs every cycle in compiled code (the kernel models
+        every axis), so a real-time pacing context (control/core/realtime.py) can pace
+        each cycle to the wall clock without Python; False: real time steps in Python."""
+        return self.native and kernel.usable(self._axes)
 
     def _trace_row(self) -> np.ndarray:
         """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""
