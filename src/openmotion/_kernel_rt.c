@@ -94,8 +94,10 @@ static void extend_last(RtCtx *c, double t)
     set_end(c, i, st[RT_LASTK], st[RT_LASTSTART], t, st[RT_LASTOVER] != 0.0);
 }
 
-/* sleep until `due` (absolute, CLOCK_MONOTONIC s) in steps of at most 0.2 ms, watching the
- * stop flag (and, when `interruptible`, the lock waiters); 1 when woken by them */
+/* sleep until `due` (absolute, CLOCK_MONOTONIC s) in steps of at most 1 ms, watching the
+ * stop flag (and, when `interruptible`, the lock waiters); 1 when woken by them. A waiter
+ * is seen within a period; inside a cycle's wait it is one absolute sleep, as a plain
+ * pacer's. */
 static int wait_until(RtCtx *c, double due, int interruptible)
 {
     for (;;) {
@@ -104,7 +106,7 @@ static int wait_until(RtCtx *c, double due, int interruptible)
             return 1;
         double t = now_s();
         if (t >= due) return 0;
-        double target = due - t > 2e-4 ? t + 2e-4 : due;
+        double target = due - t > 1e-3 ? t + 1e-3 : due;
         struct timespec ts;
         ts.tv_sec = (time_t)floor(target);
         ts.tv_nsec = (long)((target - floor(target)) * 1e9);
