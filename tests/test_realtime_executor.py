@@ -194,3 +194,26 @@ def test_the_python_pacer_is_still_there_on_request():
     _realtime_run(ctl, 100)
     s = ctl.cycle_stats()
     assert s.executor == "python" and s.python_cycles == s.cycles == ctl.cycles
+
+
+def test_a_failure_inside_a_compiled_run_faults_and_real_time_goes_on():
+    ctl = Controller(_machine())
+    ctl.enable_all()
+    hw = ctl.hardware
+    real = hw.run_cycles
+    calls = [0]
+
+    def failing(*a, **k):  # noqa: ANN002, ANN003, ANN202
+        calls[0] += 1
+        if calls[0] == 1:
+            raise RuntimeError("back end failed")
+        return real(*a, **k)
+
+    hw.run_cycles = failing
+    ctl.axis("z").move_relative(50_000, max_vel=40_000, tacc=0.05)
+    _realtime_run(ctl, 100)
+    z = ctl.axis("z")
+    assert z.fault is not None and "cycle error" in z.fault
+    assert ctl.cycle_errors == 1 and ctl.cycle_stats().errors == 1
+    assert [e.kind for e in ctl.events.events()].count("cycle_error") == 1
+    assert hw.queued(2) == 0  # nothing half-queued stays behind

@@ -180,28 +180,30 @@ class RealtimeExecutor:
                 st[RT_INTERRUPTED] = 0.0
                 with ctl._lock:
                     n1 = ctl._n + 1
-                    land = plan_jump(ctl, horizon) if self._compiled() else n1
-                    if land > n1:
-                        self.compiled_runs += 1
-                        self._guarded(ctx, land, n1)
-                    elif not k.rt_wait(*ctx, n1):
+                    if not (self._compiled() and self._guarded(ctx, horizon, n1)) \
+                            and not k.rt_wait(*ctx, n1):
                         self.python_cycles += 1
                         ctl.step()
                     k.rt_close(*ctx)  # a landing cycle's reactions count in its busy time
-                if st[RT_BURSTS] > bursts:
-                    bursts = st[RT_BURSTS]
-                    if self._on_overrun is not None:
-                        self._on_overrun(int(st[RT_OVERRUNS]), int(st[RT_BEHIND]))
+                    if st[RT_BURSTS] > bursts:
+                        bursts = st[RT_BURSTS]
+                        if self._on_overrun is not None:
+                            self._on_overrun(int(st[RT_OVERRUNS]), int(st[RT_BEHIND]))
                 if st[RT_INTERRUPTED] or st[RT_WAITERS] > 0:
                     k.rt_yield(*ctx)  # another thread waits for the lock: let it in
         except BaseException as exc:  # surfaced by stop_realtime, never silently dropped
             self.error = exc
 
-    def _guarded(self, ctx: tuple, land: int, n1: int) -> None:
-        """A compiled run up to cycle `land`: nothing escapes it (as
+    def _guarded(self, ctx: tuple, horizon: int, n1: int) -> bool:
+        """A compiled run to the cycle where the jump lands (at most `horizon` ahead);
+        False when the next cycle must run on its own. Nothing escapes it (as
         `Controller._run_cycles`)."""
         ctl = self._ctl
         try:
+            land = plan_jump(ctl, horizon)
+            if land <= n1:
+                return False
+            self.compiled_runs += 1
             _kernel.rt_paced(*ctx, jump, (ctl, land))  # type: ignore[union-attr]
         except Exception as err:  # the cycle must go on: safety reactions run in it
             self._errors += 1
@@ -209,6 +211,7 @@ class RealtimeExecutor:
                 with contextlib.suppress(Exception):
                     ctl.hardware.clear_queue(ax.index)  # type: ignore[attr-defined]
             ctl._cycle_failed(max(n1, ctl._n + 1), err)
+        return True
 
     def stats(self) -> CycleStats:
         st = self.st
