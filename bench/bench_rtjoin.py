@@ -17,8 +17,8 @@ Per run: cycles, busy p50/p99/max (the cycle itself: compiled, or the Python pat
 landing's reactions), start lateness p99 (jitter: OS wake-up plus any Python work that
 overflowed the gap), Python work between cycles p99/max (landing, feeding the pieces
 ahead; compiled executor only), overruns (cycles that ended after the next slot began),
-cycles stepped in Python. Compare the lateness with the no-op rows: what exceeds them is
-the controller's.
+cycles stepped in Python, compiled runs (each ends in a landing: Python's work). Compare
+the lateness with the no-op rows: what exceeds them is the controller's.
 
     python bench/bench_rtjoin.py [N] [seconds]     (defaults 1000, 2)
 """
@@ -54,10 +54,13 @@ def busy_samples(ctl: Controller) -> np.ndarray:
     return p._busy[:n]
 
 
-def show(name: str, mode: str, s: CycleStats, busy: np.ndarray | None = None) -> None:
+def show(name: str, mode: str, s: CycleStats, busy: np.ndarray | None = None,
+         runs: int | None = None) -> None:
     p50 = float(np.percentile(busy, 50)) * 1e6 if busy is not None and len(busy) else 0.0
     work = (f"work p99 {s.p99_work * 1e6:5.0f} max {s.max_work * 1e6:6.0f} us; "
             if s.executor == "compiled" else "")
+    if runs is not None:
+        work += f"compiled runs {runs}; "
     print(f"{name:11s} {mode:8s} cycles {s.cycles:6d}: busy p50 {p50:6.1f} p99 "
           f"{s.p99_busy * 1e6:7.1f} max {s.max_busy * 1e6:7.0f} us; jitter p99 "
           f"{s.p99_jitter * 1e6:6.0f} us; {work}overruns {s.overruns}; py cycles "
@@ -170,8 +173,9 @@ def main() -> None:
     for name, case in cases:
         for compiled in (False, True):
             ctl = case(compiled)
+            p = ctl._pacer
             show(name, "compiled" if compiled else "python", ctl.cycle_stats(),
-                 busy_samples(ctl))
+                 busy_samples(ctl), p.compiled_runs if compiled else None)
 
 
 if __name__ == "__main__":
