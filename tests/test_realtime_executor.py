@@ -48,7 +48,10 @@ def _setup(ctl: Controller, scenario: str) -> None:
     ctl.axis("y").move_relative(-7_000, max_vel=30_000, tacc=0.02, str_vel=500.0)
     ctl.axis("z").move_relative(12_345, max_vel=50_000, tacc=0.1)
     ctl.axis("u").move_velocity(-4_000, tacc=0.03)
-    if scenario == "estop":
+    if scenario == "recorder":  # the recorder rows of the crossed cycles come from C
+        ctl.start_recording(capacity=700)
+        hw.scenario.press_estop(at=0.4567)
+    elif scenario == "estop":
         hw.scenario.press_estop(at=0.317)
     else:
         hw.scenario.inject_step_loss(2, 17, at=0.2113)
@@ -65,7 +68,10 @@ def _observe(ctl: Controller) -> tuple:
                        .tolist()) for i in range(len(ctl.axes)))
     pulses = tuple(tuple(map(tuple, (t.tolist(), c.tolist())))
                    for t, c in (hw.pulse_record(i).pulses() for i in range(len(ctl.axes))))
-    return ctl.time, ctl.cycles, axes, events, tuple(ctl.safety.stops), hist, pulses
+    rec = ctl.recorder
+    rows = None if rec is None else (len(rec), rec.total, tuple(
+        (k, v.tobytes()) for k, v in rec.arrays().items()))
+    return ctl.time, ctl.cycles, axes, events, tuple(ctl.safety.stops), hist, pulses, rows
 
 
 def _realtime_run(ctl: Controller, cycles: int) -> None:
@@ -76,7 +82,7 @@ def _realtime_run(ctl: Controller, cycles: int) -> None:
     assert ctl.cycles >= cycles, "the real-time run did not get there in time"
 
 
-@pytest.mark.parametrize("scenario", ["estop", "limit"])
+@pytest.mark.parametrize("scenario", ["estop", "limit", "recorder"])
 def test_a_realtime_run_gives_the_virtual_time_result(scenario):
     rt = Controller(_machine())
     _setup(rt, scenario)
