@@ -16,7 +16,9 @@ Cases (wall clock; each run twice, "python" then "compiled"):
 Per run: cycles, busy p50/p99/max (the cycle itself: compiled, or the Python path, with a
 landing's reactions), start lateness p99 (jitter: OS wake-up plus any Python work that
 overflowed the gap), Python work between cycles p99/max (landing, feeding the pieces
-ahead; compiled executor only), overruns (cycles that ended after the next slot began),
+ahead; compiled executor only), overruns (cycles that ended after the next slot began;
+"own": those the controller's busy time plus its work before the next cycle caused alone,
+the OS's lateness left out - wall time, so CPU starvation inside a cycle still counts),
 cycles stepped in Python, compiled runs (each ends in a landing: Python's work). Compare
 the lateness with the no-op rows: what exceeds them is the controller's.
 
@@ -63,8 +65,8 @@ def show(name: str, mode: str, s: CycleStats, busy: np.ndarray | None = None,
         work += f"compiled runs {runs}; "
     print(f"{name:11s} {mode:8s} cycles {s.cycles:6d}: busy p50 {p50:6.1f} p99 "
           f"{s.p99_busy * 1e6:7.1f} max {s.max_busy * 1e6:7.0f} us; jitter p99 "
-          f"{s.p99_jitter * 1e6:6.0f} us; {work}overruns {s.overruns}; py cycles "
-          f"{s.python_cycles}")
+          f"{s.p99_jitter * 1e6:6.0f} us; {work}overruns {s.overruns} (own {s.own_overruns}); "
+          f"py cycles {s.python_cycles}")
 
 
 def compiled_noop(seconds: float) -> CycleStats:

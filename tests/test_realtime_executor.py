@@ -109,6 +109,7 @@ def test_stats_count_every_cycle_once():
     assert s.python_cycles < s.cycles
     assert s.p99_busy <= s.max_busy and s.p99_work <= s.max_work
     assert 0 <= s.overruns <= s.cycles and s.errors == 0
+    assert 0 <= s.own_overruns <= s.cycles
     samples = ctl._pacer.samples()
     assert len(samples["busy"]) == s.cycles
     assert np.all(samples["late"] >= 0.0) and np.all(samples["busy"] >= 0.0)

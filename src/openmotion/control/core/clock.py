@@ -49,7 +49,9 @@ class CycleStats:
     the pacer was behind at once; errors = cycles that raised (counted over the whole run).
     With the compiled executor (control/core/realtime.py, executor "compiled"): work = the
     Python work between cycles (landing, feeding the pieces ahead), python_cycles = cycles
-    stepped in Python because nothing could be jumped (the fallback).
+    stepped in Python because nothing could be jumped (the fallback). own_overruns = cycles
+    whose own busy time plus the Python work before the next one exceeded the period: the
+    overruns the controller causes by itself, with the OS's wake-up lateness left out.
     """
 
     cycles: int
@@ -69,6 +71,7 @@ class CycleStats:
     max_work: float = 0.0
     python_cycles: int = 0
     executor: str = "python"
+    own_overruns: int = 0
 
 
 class RealtimePacer:
@@ -168,6 +171,7 @@ class RealtimePacer:
             behind=self._behind,
             errors=self._errors,
             python_cycles=self._n,
+            own_overruns=int(np.count_nonzero(busy > self._period)),
         )
 
 

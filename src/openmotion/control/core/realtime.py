@@ -240,6 +240,7 @@ class RealtimeExecutor:
             max_work=float(work.max()),
             python_cycles=self.python_cycles,
             executor="compiled",
+            own_overruns=_own_overruns(self.samples(), self._period),
         )
 
     def samples(self) -> dict[str, np.ndarray]:
@@ -250,3 +251,14 @@ class RealtimeExecutor:
         order = np.arange(count - n, count) % _WINDOW
         return {"busy": self._busy[order].copy(), "late": self._late[order].copy(),
                 "work": self._work[order].copy()}
+
+
+def _own_overruns(rings: dict[str, np.ndarray], period: float) -> int:
+    """Cycles whose busy time plus the Python work before the next cycle exceeded the
+    period: the controller alone would have made the next cycle late."""
+    busy, work = rings["busy"], rings["work"]
+    if not len(busy):
+        return 0
+    own = busy.copy()
+    own[:-1] += work[1:]
+    return int(np.count_nonzero(own > period))
