@@ -49,11 +49,7 @@ GCODE = "G21 G90 G17\nG0 X0 Y0 Z0 A0\n" + "".join(
 
 
 def busy_samples(ctl: Controller) -> np.ndarray:
-    p = ctl._pacer
-    if isinstance(p, realtime.RealtimeExecutor):
-        return p.samples()["busy"]
-    n = min(p._n, len(p._busy))
-    return p._busy[:n]
+    return ctl.cycle_samples()["busy"]
 
 
 def show(name: str, mode: str, s: CycleStats, busy: np.ndarray | None = None,

@@ -110,7 +110,7 @@ def test_stats_count_every_cycle_once():
     assert s.p99_busy <= s.max_busy and s.p99_work <= s.max_work
     assert 0 <= s.overruns <= s.cycles and s.errors == 0
     assert 0 <= s.own_overruns <= s.cycles
-    samples = ctl._pacer.samples()
+    samples = ctl.cycle_samples()
     assert len(samples["busy"]) == s.cycles
     assert np.all(samples["late"] >= 0.0) and np.all(samples["busy"] >= 0.0)
 
@@ -201,6 +201,7 @@ def test_the_python_pacer_is_still_there_on_request():
     _realtime_run(ctl, 100)
     s = ctl.cycle_stats()
     assert s.executor == "python" and s.python_cycles == s.cycles == ctl.cycles
+    assert len(ctl.cycle_samples()["busy"]) == s.cycles
 
 
 def test_a_failure_inside_a_compiled_run_faults_and_real_time_goes_on():

@@ -150,6 +150,10 @@ class RealtimePacer:
         except BaseException as exc:  # surfaced by stop()/stats, never silently dropped
             self.error = exc
 
+    def samples(self) -> dict[str, np.ndarray]:
+        """The per-cycle rings in cycle order (s): busy and late (start lateness)."""
+        return {"busy": _ring(self._busy, self._n), "late": _ring(self._late, self._n)}
+
     def stats(self) -> CycleStats:
         n = min(self._n, _STATS_WINDOW)
         if n == 0:
@@ -173,6 +177,12 @@ class RealtimePacer:
             python_cycles=self._n,
             own_overruns=int(np.count_nonzero(busy > self._period)),
         )
+
+
+def _ring(buf: np.ndarray, count: int) -> np.ndarray:
+    """A stats ring's last min(count, len) values in the order they were written."""
+    n = min(count, len(buf))
+    return buf[np.arange(count - n, count) % len(buf)].copy()
 
 
 def pacer_baseline(period: float, seconds: float) -> CycleStats:

@@ -627,6 +627,12 @@ class Controller:
         cycles run in catch-up, the most slots behind, cycles that raised)."""
         return self._pacer.stats()
 
+    def cycle_samples(self) -> dict[str, Any]:
+        """The real-time statistics per cycle, in cycle order (seconds; the last 65536
+        cycles): "busy", "late" (start lateness), and with the compiled executor "work"
+        (Python between the cycles); numpy arrays."""
+        return self._pacer.samples()
+
     def _overran(self, count: int, behind: int) -> None:
         """Real-time pacer: a burst of overruns began; record an `overrun` event."""
         events = getattr(self, "events", None)
