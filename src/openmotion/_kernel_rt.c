@@ -25,7 +25,7 @@
 
 enum { RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START,
        RT_LASTEND, RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST,
-       RT_INTERRUPTED, RT_LASTK, RT_LASTSTART, RT_LASTOVER, RT_NFIELDS };
+       RT_INTERRUPTED, RT_LASTK, RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_NFIELDS };
 
 typedef struct {
     double *st, *busy, *late, *work;
@@ -43,13 +43,13 @@ static double now_s(void)
 
 static inline double vread(double *p) { return *(volatile double *)p; }
 
-/* cycle k (started at `start`) ends at t: its busy time, an overrun when it ends after the
- * next slot began (counted once per cycle: `over` says it was counted already) */
-static void set_end(RtCtx *c, Py_ssize_t i, double k, double start, double t, int over)
+/* cycle k ends at t after `busy` seconds of work: an overrun when it ends after the next
+ * slot began (counted once per cycle: `over` says it was counted already) */
+static void set_end(RtCtx *c, Py_ssize_t i, double k, double busy, double t, int over)
 {
     double *st = c->st, period = st[RT_PERIOD];
     double next = st[RT_WALL0] + (k + 1.0) * period;
-    c->busy[i] = t - start;
+    c->busy[i] = busy;
     if (t > next) {
         if (!over) {
             st[RT_OVERRUNS] += 1.0;
@@ -81,17 +81,20 @@ static void close_pending(RtCtx *c, double t)
     st[RT_PENDING] = -1.0;
     st[RT_LASTK] = k;
     st[RT_LASTSTART] = start;
-    set_end(c, i, k, start, t, 0);
+    st[RT_EXTEND] = 1.0;
+    set_end(c, i, k, t - start, t, 0);
 }
 
 /* the Python work that finishes the last ended cycle (a landing: write-back, the
- * reactions of its hooks) belongs to it: extend its busy time to t */
+ * reactions of its hooks) belongs to it: add the time since RT_LASTEND to its busy time
+ * (only until the next cycle begins: RT_EXTEND) */
 static void extend_last(RtCtx *c, double t)
 {
     double *st = c->st;
-    if (st[RT_COUNT] < 1.0) return;
+    if (st[RT_COUNT] < 1.0 || st[RT_EXTEND] == 0.0) return;
     Py_ssize_t i = (Py_ssize_t)((long long)(st[RT_COUNT] - 1.0) % (long long)c->cap);
-    set_end(c, i, st[RT_LASTK], st[RT_LASTSTART], t, st[RT_LASTOVER] != 0.0);
+    set_end(c, i, st[RT_LASTK], c->busy[i] + (t - st[RT_LASTEND]), t,
+            st[RT_LASTOVER] != 0.0);
 }
 
 /* sleep until `due` (absolute, CLOCK_MONOTONIC s) in steps of at most 1 ms, watching the
@@ -124,9 +127,13 @@ static int begin(RtCtx *c, long long k, int interruptible)
     close_pending(c, t);
     double work = st[RT_LASTEND] > 0.0 ? t - st[RT_LASTEND] : 0.0;
     if (wait_until(c, st[RT_WALL0] + (double)k * st[RT_PERIOD], interruptible)) {
+        /* no cycle begins: the landing work that follows still belongs to the last
+         * cycle, the time spent here (planning, the wait) does not */
         st[RT_INTERRUPTED] = 1.0;
+        st[RT_LASTEND] = now_s();
         return 1;
     }
+    st[RT_EXTEND] = 0.0;
     c->work[(Py_ssize_t)((long long)st[RT_COUNT] % (long long)c->cap)] = work;
     st[RT_PENDING] = (double)k;
     st[RT_START] = now_s();

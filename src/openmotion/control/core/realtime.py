@@ -64,7 +64,7 @@ _WINDOW = 65536
 # st fields, as in _kernel_rt.c (the C side checks the array's length)
 (RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START, RT_LASTEND,
  RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST, RT_INTERRUPTED, RT_LASTK,
- RT_LASTSTART, RT_LASTOVER, RT_NFIELDS) = range(18)
+ RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_NFIELDS) = range(19)
 
 AVAILABLE = _kernel is not None and hasattr(_kernel, "rt_paced")
 
