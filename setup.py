@@ -10,6 +10,7 @@ from setuptools import Extension, setup
 flags = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off", "-fno-fast-math"]
 
 setup(ext_modules=[Extension("openmotion._kernel",
-                             ["src/openmotion/_kernel.c", "src/openmotion/_kernel_stepper.c"],
+                             ["src/openmotion/_kernel.c", "src/openmotion/_kernel_stepper.c",
+                              "src/openmotion/_kernel_rt.c"],
                              depends=["src/openmotion/_kernel.h"],
                              extra_compile_args=flags)])

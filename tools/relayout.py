@@ -68,7 +68,7 @@ MAPPING: dict[str, str] = {
     # core
     "axis": "core", "axisexec": "core", "clock": "core", "controller": "core",
     "counters": "core", "events": "core", "jump": "core", "motion": "core",
-    "planning": "core", "states": "core",
+    "planning": "core", "realtime": "core", "states": "core",
     # safety reactions
     "safety": "guard", "softlimits": "guard", "comparators": "guard", "inposition": "guard",
     # servo and compensation

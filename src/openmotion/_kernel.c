@@ -143,6 +143,13 @@ static PyMethodDef methods[] = {
     {"check_rows", check_rows, METH_VARARGS, check_rows_doc},
     {"run", kernel_run, METH_VARARGS, kernel_run_doc},
     {"pieces", pieces, METH_VARARGS, pieces_doc},
+    {"rt_paced", rt_paced, METH_VARARGS, rt_paced_doc},
+    {"rt_wait", rt_wait, METH_VARARGS, rt_wait_doc},
+    {"rt_close", rt_close, METH_VARARGS, rt_close_doc},
+    {"rt_poll", rt_poll, METH_NOARGS, rt_poll_doc},
+    {"rt_now", rt_now, METH_NOARGS, rt_now_doc},
+    {"rt_slot", rt_slot, METH_VARARGS, rt_slot_doc},
+    {"rt_yield", rt_yield, METH_VARARGS, rt_yield_doc},
     {NULL, NULL, 0, NULL},
 };
 

@@ -357,6 +357,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
     Py_BEGIN_ALLOW_THREADS
     while (k < stop) {
         double t = origin + (double)(k + 1) * period;
+        if (rt_before_cycle(k + 1)) break; /* real time: its slot (_kernel_rt.c) */
         if (t >= limit) break;
         memcpy(save_d, AD, sizeof(double) * n * ND);
         memcpy(save_i, AI, sizeof(int64_t) * n * NI);
@@ -408,6 +409,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
                 tr[x * 3 + 2] = levels;
             }
         }
+        rt_after_cycle(k + 1);
         k++;
     }
     Py_END_ALLOW_THREADS

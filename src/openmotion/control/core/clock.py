@@ -47,6 +47,11 @@ class CycleStats:
     overruns = cycles that ended after the next cycle was due; late = cycles started after
     their whole slot had passed (run in catch-up, never skipped); behind = the most slots
     the pacer was behind at once; errors = cycles that raised (counted over the whole run).
+    With the compiled executor (control/core/realtime.py, executor "compiled"): work = the
+    Python work between cycles (landing, feeding the pieces ahead), python_cycles = cycles
+    stepped in Python because nothing could be jumped (the fallback). own_overruns = cycles
+    whose own busy time plus the Python work before the next one exceeded the period: the
+    overruns the controller causes by itself, with the OS's wake-up lateness left out.
     """
 
     cycles: int
@@ -61,6 +66,12 @@ class CycleStats:
     late: int = 0
     behind: int = 0
     errors: int = 0
+    mean_work: float = 0.0
+    p99_work: float = 0.0
+    max_work: float = 0.0
+    python_cycles: int = 0
+    executor: str = "python"
+    own_overruns: int = 0
 
 
 class RealtimePacer:
@@ -139,6 +150,10 @@ class RealtimePacer:
         except BaseException as exc:  # surfaced by stop()/stats, never silently dropped
             self.error = exc
 
+    def samples(self) -> dict[str, np.ndarray]:
+        """The per-cycle rings in cycle order (s): busy and late (start lateness)."""
+        return {"busy": _ring(self._busy, self._n), "late": _ring(self._late, self._n)}
+
     def stats(self) -> CycleStats:
         n = min(self._n, _STATS_WINDOW)
         if n == 0:
@@ -159,7 +174,15 @@ class RealtimePacer:
             late=self._late_cycles,
             behind=self._behind,
             errors=self._errors,
+            python_cycles=self._n,
+            own_overruns=int(np.count_nonzero(busy > self._period)),
         )
+
+
+def _ring(buf: np.ndarray, count: int) -> np.ndarray:
+    """A stats ring's last min(count, len) values in the order they were written."""
+    n = min(count, len(buf))
+    return buf[np.arange(count - n, count) % len(buf)].copy()
 
 
 def pacer_baseline(period: float, seconds: float) -> CycleStats:

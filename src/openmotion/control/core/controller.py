@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-import threading
 from collections.abc import Callable, Collection, Sequence
 from typing import Any
 
@@ -35,6 +34,8 @@ from .clock import CycleStats, RealtimePacer, check_period
 from .events import EventLog
 from .jump import jump, plan_jump
 from .motion import ActiveMotion
+from .realtime import AVAILABLE as _COMPILED_RT
+from .realtime import HandoverLock, RealtimeExecutor
 from .states import AxisState
 
 #: Recorder state channel numbering (the order of AxisState).
@@ -121,7 +122,7 @@ class Controller:
                               f"{len(config.axes)}")
         self.config = config
         self.hardware = hardware
-        self._lock = threading.RLock()
+        self._lock = HandoverLock()
         self._t_origin = float(hardware.time)
         self._n = 0
         self._time = self._t_origin
@@ -155,7 +156,11 @@ class Controller:
                      if ax.signal_logic(s) == "nc"} for ax in config.axes]
         self._emg_nc = any(ax.signal_logic("emg") == "nc" for ax in config.axes)
         self.recorder: Any = None
-        self._pacer = RealtimePacer(self.step, self.period, self._overran)
+        #: real time on the compiled executor (control/core/realtime.py) when it is built;
+        #: False: every cycle stepped in Python by RealtimePacer (the reference)
+        self.compiled_realtime = _COMPILED_RT
+        self._pacer: RealtimePacer | RealtimeExecutor = RealtimePacer(
+            self.step, self.period, self._overran)
         self._rb_cycle = [-1] * len(self.axes)
         self._estop = self._emg_level_active(hardware.read_input("emg"))
         self.events = EventLog(self)  # faults, limits, latches, home completion, compare
@@ -204,7 +209,7 @@ class Controller:
         return not self._emg_nc
 
     @property
-    def lock(self) -> threading.RLock:
+    def lock(self) -> HandoverLock:
         """The re-entrant lock every cycle runs under: hold it to read or change several
         pieces of controller state as one step from another thread."""
         return self._lock
@@ -591,7 +596,18 @@ class Controller:
 
     # ------------------------------------------------------------------ real time
     def start_realtime(self) -> Controller:
-        """Pace the cycle to the wall clock on a thread; returns self (a context manager)."""
+        """Pace the cycle to the wall clock on a thread; returns self (a context manager).
+
+        With the compiled executor (`compiled_realtime`, on when the extension is built) the
+        cycles virtual time would jump over run in C at their slots, Python only where it
+        must act (control/core/realtime.py); otherwise every cycle is a `step` in Python."""
+        if self._pacer.running:
+            raise MotionError("real-time mode is already running")
+        if self.compiled_realtime and _COMPILED_RT:
+            if not isinstance(self._pacer, RealtimeExecutor):
+                self._pacer = RealtimeExecutor(self, self._overran)
+        elif not isinstance(self._pacer, RealtimePacer):
+            self._pacer = RealtimePacer(self.step, self.period, self._overran)
         self._pacer.start()
         return self
 
@@ -610,6 +626,12 @@ class Controller:
         """Statistics of the real-time cycles (busy and jitter mean/p99/max, overruns, late
         cycles run in catch-up, the most slots behind, cycles that raised)."""
         return self._pacer.stats()
+
+    def cycle_samples(self) -> dict[str, Any]:
+        """The real-time statistics per cycle, in cycle order (seconds; the last 65536
+        cycles): "busy", "late" (start lateness), and with the compiled executor "work"
+        (Python between the cycles); numpy arrays."""
+        return self._pacer.samples()
 
     def _overran(self, count: int, behind: int) -> None:
         """Real-time pacer: a burst of overruns began; record an `overrun` event."""

@@ -177,6 +177,10 @@ def jump(ctl: Controller, land: int) -> None:
             ends.append(p1v1)
         rec = ctl.recorder
         run = hw.run_cycles(origin, period, n, stop, wake, trace=rec is not None)
+        if run.cycle == ctl._n:  # real time: returned before its first cycle (realtime.py)
+            for ax in movers:
+                hw.clear_queue(ax.index)
+            return
         last = run.cycle < stop or run.edges or stop >= land
         if rec is not None:  # the landing cycle is recorded by _finish_cycle
             record_trace(ctl, movers, ends, n, run.trace[:run.cycle - n - (1 if last else 0)])

@@ -5,9 +5,10 @@
 window, the cycle in which the running chain has less than its reach ahead (a join), and
 the pre-blending of queued corners. Between them a running line or arc needs nothing from
 Python, so virtual time may jump (control/core/jump.py). `group_due` returns the earliest of
-those instants; -inf ("every cycle") wherever the answer is not cheap and sure: a join
-in flight (real time), pre-blending still to do, a group axis in ErrorStop or standing on
-a limit switch (the limit check depends on the velocity's sign cycle by cycle).
+those instants (a join in flight, real time: its install cycle); -inf ("every cycle")
+wherever the answer is not cheap and sure: pre-blending still to do, a group axis in
+ErrorStop or standing on a limit switch (the limit check depends on the velocity's sign
+cycle by cycle).
 
 The join instant is found on the very cycle grid the hook sees, by evaluating the plan's
 `remaining(t)` at the cycle ends ahead (cached while the plan and the queue head stay
@@ -37,7 +38,7 @@ def group_due(g: Any, ctl: Controller) -> float:
     if state is GroupState.ERROR:
         return math.inf
     if g._job is not None:
-        return -math.inf
+        return _in_flight_due(g, ctl)
     r = g._run
     due = math.inf
     if r is not None:
@@ -54,6 +55,23 @@ def group_due(g: Any, ctl: Controller) -> float:
         if _preblend_pending(g):
             return -math.inf
         due = min(due, _join_due(g, ctl))
+    return due
+
+
+def _in_flight_due(g: Any, ctl: Controller) -> float:
+    """A join in flight (real time, groupjoin.py): `_poll_join` acts at its install cycle,
+    or when the plan or the settings changed (only a command or a hook changes them, and
+    either lands a cycle); before that `_cycle_step` only checks faults and renews the
+    path window."""
+    from .groupexec import PATH_WINDOW_S, GroupState
+
+    r = g._run
+    if r is None or g._state is not GroupState.MOVING or (
+            not g._dry and _faults_pending(g, ctl)):
+        return -math.inf
+    due = g._job.t_j - 0.5 * ctl.period
+    if r.window_end is not None:
+        due = min(due, r.window_end - 0.5 * PATH_WINDOW_S)
     return due
 
 

@@ -11,10 +11,16 @@ that axis goes to ErrorStop ("in-position timeout") and the queued commands are 
 
 `queue(fn)` holds commands: each runs only when every axis is done and in position, so the
 next queued command waits for the previous one to settle (MCCL's consecutive commands).
+
+The cycle hook declares when it acts (`_due`), so virtual time jumps while in-position
+control is attached: at once when a held axis was released or a queued command can start,
+at a check time's end, else not before a motion change (a move's end lands a jump; an axis
+waiting for in-position keeps every cycle running anyway).
 """
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
@@ -49,7 +55,7 @@ class InPositionControl:
         #: The MotionError a queued command raised (the queue was dropped), else None.
         self.failure: MotionError | None = None
         self._gates = [self._make_gate(i) for i in range(n)]
-        controller.add_cycle_hook(self._on_cycle)
+        controller.add_cycle_hook(self._on_cycle, due=self._due)
 
     # ------------------------------------------------------------------ settings
     def set_tolerance(self, axis: int | str, tolerance: float, *, units: bool = False) -> None:
@@ -159,6 +165,20 @@ class InPositionControl:
                 self._since[i] = self._ctl.time
             return MotionDone.WAITING_INP
         return gate
+
+    def _due(self, ctl: Controller) -> float:
+        """The earliest time `_on_cycle` acts (Controller.add_cycle_hook's `due`)."""
+        due = math.inf
+        for ax in ctl.axes:
+            since = self._since[ax.index]
+            if since is None:
+                continue
+            if ax.motion is not None or not ax.is_moving:
+                return -math.inf
+            due = min(due, since + self._check[ax.index] - 1e-9)  # early is safe
+        if not self._error and self._queue and all(a.motion_done == 0 for a in ctl.axes):
+            return -math.inf
+        return due
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         for ax in ctl.axes:

@@ -9,10 +9,16 @@
 
 All three refuse an axis that belongs to an open group (jog the group's axes through the
 group's own commands) or that is not at standstill. Speeds ramp in `tacc` seconds (T-curve).
+
+The continuous jog's watch declares when it acts (`_due`), so virtual time jumps while a
+jog runs: it acts at once when a watched limit is already active or a jog ended, else not
+before the next PEL/MEL edge (a no-op edge hook declares those signals, so such an edge
+always lands a jump and the watch runs in that very cycle) or motion change.
 """
 
 from __future__ import annotations
 
+import math
 import weakref
 from typing import TYPE_CHECKING
 
@@ -96,7 +102,8 @@ def jog_conti(ctl: Controller, axis: int | str, direction: int, ratio: float, *,
     jogs = _JOGS.get(ctl)
     if jogs is None:  # one permanent hook per controller: hooks are never removed mid-cycle
         jogs = _JOGS[ctl] = {}
-        ctl.add_cycle_hook(_watch)
+        ctl.add_edge_hook(_limit_edge, signals=("pel", "mel"))
+        ctl.add_cycle_hook(_watch, due=_due)
     jogs[ax.index] = (ax, "pel" if sign > 0 else "mel")
 
 
@@ -113,6 +120,21 @@ def _watch(ctl: Controller, t: float) -> None:
         elif ctl.input_active(ax.index, signal):
             ax.stop()
             del jogs[idx]
+
+
+def _due(ctl: Controller) -> float:
+    """When `_watch` next acts: now when a watched jog ended or its limit ahead is active,
+    else not before an edge or a motion change (math.inf)."""
+    for ax, signal in _JOGS.get(ctl, {}).values():
+        if ax.motion is None or ax.state is not AxisState.CONTINUOUS_MOTION \
+                or ctl.input_active(ax.index, signal):
+            return -math.inf
+    return math.inf
+
+
+def _limit_edge(ctl: Controller, edge: object) -> None:
+    """Nothing to do in the edge itself: registered with signals PEL/MEL so a limit edge
+    ends a virtual-time jump and `_watch` sees the limit in that cycle."""
 
 
 def stop_jog(ctl: Controller, axis: int | str) -> None:

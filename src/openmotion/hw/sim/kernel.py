@@ -70,6 +70,25 @@ def usable(axes: list[SimAxis]) -> bool:
     return True
 
 
+def pacing() -> bool:
+    """True inside a real-time pacing context bound to this thread (`_kernel.rt_paced`,
+    control/core/realtime.py): every cycle waits for its wall-clock slot."""
+    return _k is not None and _k.rt_poll() is not None
+
+
+def interrupted() -> bool:
+    """In a pacing context: the last kernel run returned at a cycle boundary because
+    another thread waits for the controller's lock or the executor stops."""
+    return bool(_k.rt_poll()) if _k is not None else False
+
+
+def wait_slot(k: int) -> None:
+    """In a pacing context: wait for cycle k's slot before the Python path runs it (a
+    no-op when k is already the cycle in progress)."""
+    if _k is not None:
+        _k.rt_slot(int(k))
+
+
 def _wakes(name: str, switches: dict, wake: Collection[str] | None) -> bool:
     if wake is None or name in wake:
         return True

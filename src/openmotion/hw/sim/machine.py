@@ -186,9 +186,10 @@ class SimMachine:
         edges: list[InputEdge] = []
         rows: list[np.ndarray] = []
         first = True
+        paced = kernel.pacing()  # real time: every cycle at its wall-clock slot
         while k < stop:
             hold = self._holding()
-            if not first and hold:
+            if not first and hold and not paced:
                 k0 = k
                 k, edges = self._skip_idle(origin, period, k, stop)
                 if trace and k > k0:
@@ -196,8 +197,8 @@ class SimMachine:
                 if edges or k >= stop:
                     break
             first = False
-            ks = self._kernel_state() if self.native and not hold and not self._pending \
-                else None
+            ks = self._kernel_state() if self.native and (not hold or paced) \
+                and not self._pending else None
             if ks is not None:
                 k0 = k
                 k, self._t, tr = kernel.run_quiet(ks, self._ax, queues, origin, period, k,
@@ -207,8 +208,10 @@ class SimMachine:
                     self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
-                if k >= stop:
+                if k >= stop or (paced and kernel.interrupted()):
                     break
+            if paced:
+                kernel.wait_slot(k + 1)
             k += 1
             edges = self.advance(origin + k * period)
             if trace:
@@ -231,6 +234,12 @@ class SimMachine:
         if ks is None and kernel.usable(self._ax):  # not stale: the objects are current
             ks = self._ks = kernel.KernelState(self._ax)
         return ks
+
+    def paced_cycles(self) -> bool:
+        """True when `run_cycles` runs every cycle in compiled code (the kernel models
+        every axis), so a real-time pacing context (control/core/realtime.py) can pace
+        each cycle to the wall clock without Python; False: real time steps in Python."""
+        return self.native and kernel.usable(self._objects())
 
     def _trace_row(self) -> np.ndarray:
         """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""

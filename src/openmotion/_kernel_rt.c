@@ -1,0 +1,296 @@
+/* Real-time pacing of the compiled cycles (openmotion._kernel, control/core/realtime.py).
+ *
+ * The real-time executor (a Python thread) binds a pacing context to its own thread with
+ * `rt_paced(st, busy, late, work, fn, args)` and calls fn(*args) - a virtual-time jump -
+ * inside it. Every cycle the compiled stepper loop (_kernel_stepper.c) then runs on that
+ * thread calls `rt_before_cycle(k)`, which sleeps (GIL released, the kernel runs without
+ * it) until cycle k's slot on the wall clock, and `rt_after_cycle(k)`, which records the
+ * cycle's busy time. `rt_before_cycle` returns 1 instead of waiting when another thread
+ * waits for the controller's lock or the executor is asked to stop (st[RT_WAITERS],
+ * st[RT_STOPPING]): the kernel then returns at that cycle boundary and the Python side
+ * lands there, so a command from another thread takes effect at the next cycle, as with
+ * a cycle stepped in Python. A cycle the Python path runs (an edge to report, a landing)
+ * stays "pending" from its slot until `rt_close` (or the next cycle) ends it, so its
+ * busy time includes the Python work. Cycle k's slot starts at st[RT_WALL0] + k * period
+ * (CLOCK_MONOTONIC seconds); a late cycle is never skipped (catch-up, as RealtimePacer).
+ *
+ * The context lives in float64 numpy arrays owned by the executor: st[RT_NFIELDS], the
+ * rings busy/late/work (same length): per cycle the busy time, the start lateness, and the
+ * Python work done between the previous cycle's end and the wait for this one (landing
+ * and feeding the piece queue ahead).
+ */
+#include "_kernel.h"
+#include <time.h>
+#include <errno.h>
+
+enum { RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START,
+       RT_LASTEND, RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST,
+       RT_INTERRUPTED, RT_LASTK, RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_NFIELDS };
+
+typedef struct {
+    double *st, *busy, *late, *work;
+    Py_ssize_t cap;
+} RtCtx;
+
+static _Thread_local RtCtx *rt_cur = NULL;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static inline double vread(double *p) { return *(volatile double *)p; }
+
+/* cycle k ends at t after `busy` seconds of work: an overrun when it ends after the next
+ * slot began (counted once per cycle: `over` says it was counted already) */
+static void set_end(RtCtx *c, Py_ssize_t i, double k, double busy, double t, int over)
+{
+    double *st = c->st, period = st[RT_PERIOD];
+    double next = st[RT_WALL0] + (k + 1.0) * period;
+    c->busy[i] = busy;
+    if (t > next) {
+        if (!over) {
+            st[RT_OVERRUNS] += 1.0;
+            if (st[RT_INBURST] == 0.0) st[RT_BURSTS] += 1.0;
+        }
+        double behind = floor((t - next) / period) + 1.0;
+        if (behind > st[RT_BEHIND]) st[RT_BEHIND] = behind;
+        st[RT_INBURST] = 1.0;
+        st[RT_LASTOVER] = 1.0;
+    } else if (!over) {
+        st[RT_INBURST] = 0.0;
+        st[RT_LASTOVER] = 0.0;
+    }
+    st[RT_LASTEND] = t;
+}
+
+/* end the pending cycle at time t: its lateness, busy time, overrun counts */
+static void close_pending(RtCtx *c, double t)
+{
+    double *st = c->st;
+    if (st[RT_PENDING] < 0.0) return;
+    double k = st[RT_PENDING], period = st[RT_PERIOD];
+    double due = st[RT_WALL0] + k * period;
+    Py_ssize_t i = (Py_ssize_t)((long long)st[RT_COUNT] % (long long)c->cap);
+    double start = st[RT_START];
+    c->late[i] = start - due;
+    if (start - due >= period) st[RT_LATECYC] += 1.0;
+    st[RT_COUNT] += 1.0;
+    st[RT_PENDING] = -1.0;
+    st[RT_LASTK] = k;
+    st[RT_LASTSTART] = start;
+    st[RT_EXTEND] = 1.0;
+    set_end(c, i, k, t - start, t, 0);
+}
+
+/* the Python work that finishes the last ended cycle (a landing: write-back, the
+ * reactions of its hooks) belongs to it: add the time since RT_LASTEND to its busy time
+ * (only until the next cycle begins: RT_EXTEND) */
+static void extend_last(RtCtx *c, double t)
+{
+    double *st = c->st;
+    if (st[RT_COUNT] < 1.0 || st[RT_EXTEND] == 0.0) return;
+    Py_ssize_t i = (Py_ssize_t)((long long)(st[RT_COUNT] - 1.0) % (long long)c->cap);
+    set_end(c, i, st[RT_LASTK], c->busy[i] + (t - st[RT_LASTEND]), t,
+            st[RT_LASTOVER] != 0.0);
+}
+
+/* sleep until `due` (absolute, CLOCK_MONOTONIC s) in steps of at most 1 ms, watching the
+ * stop flag (and, when `interruptible`, the lock waiters); 1 when woken by them. A waiter
+ * is seen within a period; inside a cycle's wait it is one absolute sleep, as a plain
+ * pacer's. */
+static int wait_until(RtCtx *c, double due, int interruptible)
+{
+    for (;;) {
+        if (vread(&c->st[RT_STOPPING]) != 0.0
+                || (interruptible && vread(&c->st[RT_WAITERS]) > 0.0))
+            return 1;
+        double t = now_s();
+        if (t >= due) return 0;
+        double target = due - t > 1e-3 ? t + 1e-3 : due;
+        struct timespec ts;
+        ts.tv_sec = (time_t)floor(target);
+        ts.tv_nsec = (long)((target - floor(target)) * 1e9);
+        if (ts.tv_nsec >= 1000000000L) { ts.tv_sec++; ts.tv_nsec -= 1000000000L; }
+        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {}
+    }
+}
+
+/* start cycle k at its slot: the work since the last cycle ended is recorded with it */
+static int begin(RtCtx *c, long long k, int interruptible)
+{
+    double *st = c->st;
+    if (st[RT_PENDING] == (double)k) return 0; /* already in progress (begun by the kernel) */
+    double t = now_s();
+    close_pending(c, t);
+    double work = st[RT_LASTEND] > 0.0 ? t - st[RT_LASTEND] : 0.0;
+    if (wait_until(c, st[RT_WALL0] + (double)k * st[RT_PERIOD], interruptible)) {
+        /* no cycle begins: the landing work that follows still belongs to the last
+         * cycle, the time spent here (planning, the wait) does not */
+        st[RT_INTERRUPTED] = 1.0;
+        st[RT_LASTEND] = now_s();
+        return 1;
+    }
+    st[RT_EXTEND] = 0.0;
+    c->work[(Py_ssize_t)((long long)st[RT_COUNT] % (long long)c->cap)] = work;
+    st[RT_PENDING] = (double)k;
+    st[RT_START] = now_s();
+    return 0;
+}
+
+int rt_before_cycle(long long k)
+{
+    RtCtx *c = rt_cur;
+    return c == NULL ? 0 : begin(c, k, 1);
+}
+
+void rt_after_cycle(long long k)
+{
+    RtCtx *c = rt_cur;
+    (void)k;
+    if (c != NULL) close_pending(c, now_s());
+}
+
+static int get_ctx(PyObject *const *o, Buf *bufs, RtCtx *c)
+{
+    static const char *names[4] = {"st", "busy", "late", "work"};
+    for (int k = 0; k < 4; k++)
+        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) return -1;
+    if (bufs[0].b.len != 8 * RT_NFIELDS || bufs[1].b.len == 0
+            || bufs[2].b.len != bufs[1].b.len || bufs[3].b.len != bufs[1].b.len) {
+        PyErr_SetString(PyExc_ValueError, "rt: context arrays have the wrong sizes");
+        return -1;
+    }
+    c->st = bufs[0].b.buf;
+    c->busy = bufs[1].b.buf;
+    c->late = bufs[2].b.buf;
+    c->work = bufs[3].b.buf;
+    c->cap = bufs[1].b.len / 8;
+    return 0;
+}
+
+const char rt_paced_doc[] =
+"rt_paced(st, busy, late, work, fn, args) -> fn(*args)\n\n"
+"Call fn(*args) with the pacing context bound to this thread: every compiled cycle run\n"
+"inside waits for its slot on the wall clock and records its busy time.";
+
+PyObject *rt_paced(PyObject *self, PyObject *args)
+{
+    PyObject *o[4], *fn, *fargs;
+    if (!PyArg_ParseTuple(args, "OOOOOO!", &o[0], &o[1], &o[2], &o[3], &fn, &PyTuple_Type,
+                          &fargs))
+        return NULL;
+    Buf bufs[4];
+    memset(bufs, 0, sizeof bufs);
+    RtCtx c;
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    RtCtx *outer = rt_cur;
+    rt_cur = &c;
+    PyObject *res = PyObject_Call(fn, fargs, NULL);
+    rt_cur = outer;
+    release(bufs, 4);
+    return res;
+}
+
+const char rt_wait_doc[] =
+"rt_wait(st, busy, late, work, k) -> True when interrupted instead\n\n"
+"End the pending cycle, then sleep (GIL released) until cycle k's slot and make k the\n"
+"pending cycle (a cycle the Python path runs; `rt_close` ends it). Returns True without\n"
+"beginning k when the executor stops or another thread waits for the lock.";
+
+PyObject *rt_wait(PyObject *self, PyObject *args)
+{
+    PyObject *o[4];
+    long long k;
+    if (!PyArg_ParseTuple(args, "OOOOL", &o[0], &o[1], &o[2], &o[3], &k)) return NULL;
+    Buf bufs[4];
+    memset(bufs, 0, sizeof bufs);
+    RtCtx c;
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    int stopped;
+    Py_BEGIN_ALLOW_THREADS
+    stopped = begin(&c, k, 1);
+    Py_END_ALLOW_THREADS
+    release(bufs, 4);
+    return PyBool_FromLong(stopped);
+}
+
+const char rt_close_doc[] =
+"rt_close(st, busy, late, work)\n\nEnd the pending cycle now, or, with none pending,\n"
+"extend the last ended cycle's busy time to now (the Python work that landed it).";
+
+PyObject *rt_close(PyObject *self, PyObject *args)
+{
+    PyObject *o[4];
+    if (!PyArg_ParseTuple(args, "OOOO", &o[0], &o[1], &o[2], &o[3])) return NULL;
+    Buf bufs[4];
+    memset(bufs, 0, sizeof bufs);
+    RtCtx c;
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    if (c.st[RT_PENDING] >= 0.0) close_pending(&c, now_s());
+    else extend_last(&c, now_s());
+    release(bufs, 4);
+    Py_RETURN_NONE;
+}
+
+const char rt_now_doc[] = "rt_now() -> the pacing clock (CLOCK_MONOTONIC) in seconds";
+
+PyObject *rt_now(PyObject *self, PyObject *args)
+{
+    return PyFloat_FromDouble(now_s());
+}
+
+const char rt_poll_doc[] =
+"rt_poll() -> None when no pacing context is bound to this thread, else whether a cycle\n"
+"wait was interrupted (st[RT_INTERRUPTED]; the executor clears it)";
+
+PyObject *rt_poll(PyObject *self, PyObject *args)
+{
+    RtCtx *c = rt_cur;
+    if (c == NULL) Py_RETURN_NONE;
+    return PyBool_FromLong(c->st[RT_INTERRUPTED] != 0.0);
+}
+
+const char rt_slot_doc[] =
+"rt_slot(k)\n\nIn a bound pacing context: begin cycle k at its slot (GIL released while\n"
+"waiting) before the Python path runs it; nothing when k is already in progress or no\n"
+"context is bound.";
+
+PyObject *rt_slot(PyObject *self, PyObject *args)
+{
+    long long k;
+    if (!PyArg_ParseTuple(args, "L", &k)) return NULL;
+    RtCtx *c = rt_cur;
+    if (c != NULL && c->st[RT_PENDING] != (double)k) {
+        Py_BEGIN_ALLOW_THREADS
+        begin(c, k, 0);
+        Py_END_ALLOW_THREADS
+    }
+    Py_RETURN_NONE;
+}
+
+const char rt_yield_doc[] =
+"rt_yield(st, busy, late, work)\n\nSleep (GIL released) while another thread waits for\n"
+"the controller's lock (st[RT_WAITERS] > 0), so it gets the lock; at most 20 ms.";
+
+PyObject *rt_yield(PyObject *self, PyObject *args)
+{
+    PyObject *o[4];
+    if (!PyArg_ParseTuple(args, "OOOO", &o[0], &o[1], &o[2], &o[3])) return NULL;
+    Buf bufs[4];
+    memset(bufs, 0, sizeof bufs);
+    RtCtx c;
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    Py_BEGIN_ALLOW_THREADS
+    double end = now_s() + 0.02;
+    while (vread(&c.st[RT_WAITERS]) > 0.0 && vread(&c.st[RT_STOPPING]) == 0.0
+           && now_s() < end) {
+        struct timespec ts = {0, 20000};
+        nanosleep(&ts, NULL);
+    }
+    Py_END_ALLOW_THREADS
+    release(bufs, 4);
+    Py_RETURN_NONE;
+}

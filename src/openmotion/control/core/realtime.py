@@ -1,0 +1,264 @@
+"""Real-time mode on the compiled executor: cycles paced to the wall clock without Python.
+
+`RealtimeExecutor` runs the controller against the wall clock on one thread. Whenever
+virtual time could jump (control/core/jump.py: nothing needs the control layer in the
+coming cycles), it feeds the back end the pieces of the next cycles (at most `HORIZON_S`
+ahead) and lets it run them inside a pacing context (`openmotion._kernel.rt_paced`,
+src/openmotion/_kernel_rt.c): the compiled cycle loop waits for each cycle's slot on the
+wall clock with the GIL released and records its busy time, so no Python thread (the
+join worker, a UI, the caller) can delay a cycle. Python is woken only where it must act,
+exactly where a jump lands in virtual time: a reported input edge (its cycle runs on the
+Python path and the reactions land at that cycle's end), a motion end, a hook's due time,
+the end of the fed horizon, or another thread waiting for `Controller.lock` (a command:
+the run returns at the next cycle boundary, the command gets the lock, the next cycle
+sees it - as when stepping). When a jump is not possible (a per-cycle hook, a servo loop
+closed in Python, a back end the compiled loop cannot serve: servo/DC plants, pitch
+tables, armed stops) the cycle runs in Python (`Controller.step`) at its slot: the
+fallback, counted in `CycleStats.python_cycles`.
+
+Because a real-time run takes the same jumps as virtual time (same pieces, same landing
+cycles), it gives the same counters, events and histories as the virtual-time run of the
+same commands (tests/test_realtime.py).
+
+Statistics, per cycle (rings of 65536 cycles): `late` (start against the slot: the OS
+wake-up, or Python work that overran the gap), `busy` (the cycle itself: compiled, or the
+Python path, plus the reactions of a landing cycle), `work` (Python between the cycles:
+landing, planning and feeding the next pieces; it delays nothing unless it overflows the
+gap, which then shows as lateness). `clock.pacer_baseline` measures a no-op pacer the
+same way, the OS part of the lateness.
+
+While a compiled run is in progress, the controller's Python state (time, positions) is
+that of the run's start (at most `HORIZON_S` old); take `Controller.lock` for current
+values (that ends the run at the next cycle boundary).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import sys
+import threading
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ...errors import MotionError
+from .clock import CycleStats
+from .jump import jump, plan_jump
+
+try:  # the compiled inner loops (setup.py builds them)
+    from openmotion import _kernel
+except ImportError:  # pragma: no cover - depends on the build
+    _kernel = None
+
+if TYPE_CHECKING:
+    from .controller import Controller
+
+#: Compiled cycles fed ahead per run (s); a run lands at the latest after this long.
+HORIZON_S = 0.2
+#: Interpreter switch interval while real time runs (s): the executor thread gets the GIL
+#: back this soon for the Python work between cycles (CPython's default is 5 ms).
+SWITCH_INTERVAL_S = 0.0005
+_WINDOW = 65536
+# st fields, as in _kernel_rt.c (the C side checks the array's length)
+(RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START, RT_LASTEND,
+ RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST, RT_INTERRUPTED, RT_LASTK,
+ RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_NFIELDS) = range(19)
+
+AVAILABLE = _kernel is not None and hasattr(_kernel, "rt_paced")
+
+
+class HandoverLock:
+    """The controller's re-entrant lock. A thread that has to wait for it is counted in
+    `st[RT_WAITERS]`, the real-time executor's context, so a compiled run in progress
+    returns at the next cycle boundary and hands the lock over."""
+
+    __slots__ = ("_lock", "_count", "_waiting", "st")
+
+    def __init__(self) -> None:
+        self._lock = threading.RLock()
+        self._count = threading.Lock()
+        self._waiting = 0
+        self.st = np.zeros(RT_NFIELDS)
+
+    def acquire(self, blocking: bool = True, timeout: float = -1) -> bool:
+        if self._lock.acquire(False):
+            return True
+        if not blocking:
+            return False
+        with self._count:
+            self._waiting += 1
+            self.st[RT_WAITERS] = self._waiting
+        try:
+            return self._lock.acquire(True, timeout)
+        finally:
+            with self._count:
+                self._waiting -= 1
+                self.st[RT_WAITERS] = self._waiting
+
+    def release(self) -> None:
+        self._lock.release()
+
+    def __enter__(self) -> bool:
+        return self.acquire()
+
+    def __exit__(self, *exc: object) -> None:
+        self._lock.release()
+
+
+class RealtimeExecutor:
+    """Real time for one controller: compiled cycles paced in C where virtual time would
+    jump, `Controller.step` at its slot otherwise (see the module docstring)."""
+
+    def __init__(self, ctl: Controller, on_overrun: Callable[[int, int], None] | None = None
+                 ) -> None:
+        if not AVAILABLE:
+            raise MotionError("the compiled real-time executor is not built "
+                              "(python setup.py build_ext --inplace)")
+        self._ctl = ctl
+        self._period = ctl.period
+        self._on_overrun = on_overrun
+        self.st = ctl._lock.st
+        self._busy = np.zeros(_WINDOW)
+        self._late = np.zeros(_WINDOW)
+        self._work = np.zeros(_WINDOW)
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+        self._errors = 0
+        self.python_cycles = 0
+        self.compiled_runs = 0
+        self.error: BaseException | None = None
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self) -> None:
+        if self.running:
+            raise MotionError("real-time mode is already running")
+        st = self.st
+        waiting = st[RT_WAITERS]
+        st[:] = 0.0
+        st[RT_WAITERS] = waiting
+        st[RT_PENDING] = -1.0
+        st[RT_PERIOD] = self._period
+        self._stop.clear()
+        self.error = None
+        self._errors = 0
+        self.python_cycles = 0
+        self.compiled_runs = 0
+        self._switch = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch, SWITCH_INTERVAL_S))
+        self._thread = threading.Thread(target=self._run, name="openmotion-rt", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self.st[RT_STOPPING] = 1.0
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+            sys.setswitchinterval(self._switch)
+
+    def _compiled(self) -> bool:
+        paced = getattr(self._ctl.hardware, "paced_cycles", None)
+        return paced is not None and bool(paced())
+
+    def _run(self) -> None:
+        ctl = self._ctl
+        k = _kernel
+        assert k is not None
+        ctx = (self.st, self._busy, self._late, self._work)
+        st = self.st
+        horizon = max(2, math.ceil(HORIZON_S / self._period - 1e-9))
+        # cycle n + 1 is due now; cycle j's slot starts at wall0 + j * period
+        st[RT_WALL0] = k.rt_now() - (ctl._n + 1) * self._period
+        bursts = 0.0
+        try:
+            while not self._stop.is_set():
+                st[RT_INTERRUPTED] = 0.0
+                with ctl._lock:
+                    n1 = ctl._n + 1
+                    if not (self._compiled() and self._guarded(ctx, horizon, n1)) \
+                            and not k.rt_wait(*ctx, n1):
+                        self.python_cycles += 1
+                        ctl.step()
+                    k.rt_close(*ctx)  # a landing cycle's reactions count in its busy time
+                    if st[RT_BURSTS] > bursts:
+                        bursts = st[RT_BURSTS]
+                        if self._on_overrun is not None:
+                            self._on_overrun(int(st[RT_OVERRUNS]), int(st[RT_BEHIND]))
+                if st[RT_INTERRUPTED] or st[RT_WAITERS] > 0:
+                    k.rt_yield(*ctx)  # another thread waits for the lock: let it in
+        except BaseException as exc:  # surfaced by stop_realtime, never silently dropped
+            self.error = exc
+
+    def _guarded(self, ctx: tuple, horizon: int, n1: int) -> bool:
+        """A compiled run to the cycle where the jump lands (at most `horizon` ahead);
+        False when the next cycle must run on its own. Nothing escapes it (as
+        `Controller._run_cycles`)."""
+        ctl = self._ctl
+        try:
+            land = plan_jump(ctl, horizon)
+            if land <= n1:
+                return False
+            self.compiled_runs += 1
+            _kernel.rt_paced(*ctx, jump, (ctl, land))  # type: ignore[union-attr]
+        except Exception as err:  # the cycle must go on: safety reactions run in it
+            self._errors += 1
+            for ax in ctl.axes:  # nothing half-queued stays behind
+                with contextlib.suppress(Exception):
+                    ctl.hardware.clear_queue(ax.index)  # type: ignore[attr-defined]
+            ctl._cycle_failed(max(n1, ctl._n + 1), err)
+        return True
+
+    def stats(self) -> CycleStats:
+        st = self.st
+        count = int(st[RT_COUNT])
+        n = min(count, _WINDOW)
+        if n == 0:
+            return CycleStats(0, self._period, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0,
+                              0, 0, self._errors,
+                              executor="compiled")
+        busy, late, work = self._busy[:n], self._late[:n], self._work[:n]
+        return CycleStats(
+            cycles=count,
+            period=self._period,
+            mean_busy=float(busy.mean()),
+            p99_busy=float(np.percentile(busy, 99)),
+            max_busy=float(busy.max()),
+            mean_jitter=float(late.mean()),
+            p99_jitter=float(np.percentile(late, 99)),
+            max_jitter=float(late.max()),
+            overruns=int(st[RT_OVERRUNS]),
+            late=int(st[RT_LATECYC]),
+            behind=int(st[RT_BEHIND]),
+            errors=self._errors,
+            mean_work=float(work.mean()),
+            p99_work=float(np.percentile(work, 99)),
+            max_work=float(work.max()),
+            python_cycles=self.python_cycles,
+            executor="compiled",
+            own_overruns=_own_overruns(self.samples(), self._period),
+        )
+
+    def samples(self) -> dict[str, np.ndarray]:
+        """The per-cycle rings in cycle order (seconds): busy, late, work (the last
+        65536 cycles at most)."""
+        count = int(self.st[RT_COUNT])
+        n = min(count, _WINDOW)
+        order = np.arange(count - n, count) % _WINDOW
+        return {"busy": self._busy[order].copy(), "late": self._late[order].copy(),
+                "work": self._work[order].copy()}
+
+
+def _own_overruns(rings: dict[str, np.ndarray], period: float) -> int:
+    """Cycles whose busy time plus the Python work before the next cycle exceeded the
+    period: the controller alone would have made the next cycle late."""
+    busy, work = rings["busy"], rings["work"]
+    if not len(busy):
+        return 0
+    own = busy.copy()
+    own[:-1] += work[1:]
+    return int(np.count_nonzero(own > period))
