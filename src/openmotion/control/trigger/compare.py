@@ -357,10 +357,21 @@ class CompareEngine:
         for job in list(self._jobs.values()):
             if not job.active or (pre is not None and _on_command(job) != pre):
                 continue
-            for tf, idx, val in job.scan(self, ta, t1):
-                state = job.action.apply(self, tf, job.hits)
-                job.hits += 1
-                rows.append((tf, job.id, idx, val, job.action.output, int(state)))
+            hits = job.scan(self, ta, t1)
+            if hits:
+                act = job.action
+                many = getattr(act, "apply_many", None)
+                if many is not None:  # the job's firings of this cycle in one call
+                    states = many(self, [h[0] for h in hits], job.hits)
+                    job.hits += len(hits)
+                else:
+                    states = []
+                    for h in hits:
+                        states.append(act.apply(self, h[0], job.hits))
+                        job.hits += 1
+                out, jid = act.output, job.id
+                rows.extend([(tf, jid, idx, val, out, int(st))
+                             for (tf, idx, val), st in zip(hits, states, strict=True)])
             if job.done:
                 self._jobs.pop(job.id, None)
                 job.active = False

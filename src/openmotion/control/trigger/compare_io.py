@@ -24,6 +24,7 @@ from __future__ import annotations
 import bisect
 import csv
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -31,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import MotionError
+from . import compare_math as _cm
 
 if TYPE_CHECKING:
     from ...hw.interface import Hardware
@@ -74,25 +76,16 @@ class OutputLine:
 
     def set(self, t: float, level: bool) -> None:
         """Drive the level from time t on (until the next later edge, if one is scheduled)."""
-        k = bisect.bisect_right(self._t, t)
-        before = self._lv[k - 1] if k else self.initial
-        after_same = k < len(self._t) and self._lv[k] == level
-        if before == level and not after_same:
-            return
-        if self.timed and t <= self._sent_until:
-            self._late.append(t)
-        self._t.insert(k, t)
-        self._lv.insert(k, level)
-        self._merge(k)
+        self.set_many((t,), (level,))
 
-    def _merge(self, k: int) -> None:
-        # drop an edge that no longer changes the level (after an insertion at k)
-        for i in (k + 1, k):
-            if 0 <= i < len(self._t):
-                prev = self._lv[i - 1] if i else self.initial
-                if self._lv[i] == prev:
-                    del self._t[i]
-                    del self._lv[i]
+    def set_many(self, times: Sequence[float], levels: Sequence[bool]) -> None:
+        """`set(times[i], levels[i])` for each i in order, in one compiled call: an edge is
+        inserted after those at equal times, and an edge that no longer changes the level
+        (the one it replaces or repeats) is dropped. A set at or before what was already
+        handed to timed hardware is "late" (flush corrects the physical line)."""
+        sent = self._sent_until if self.timed else -math.inf
+        _cm._solvers().line_set(self._t, self._lv, bool(self.initial), times, levels, sent,
+                                self._late)
 
     def snapshot(self, t: float) -> tuple[bool, list[float], list[bool]]:
         """The waveform from time t on (to undo a cycle's edits with `restore`)."""
@@ -140,9 +133,14 @@ class OutputLine:
                 hw.write_output_at(t_r, None, self.signal, bool(lvl0))  # type: ignore[attr-defined]
             else:
                 hw.write_output(None, self.signal, bool(lvl0))
-        for k in range(a, b):
-            hw.write_output_at(self._t[k], None, self.signal,  # type: ignore[attr-defined]
-                               bool(self._lv[k]))
+        if b > a:
+            bulk = getattr(hw, "write_outputs_at", None)
+            if bulk is not None:  # one call for the cycle's edges
+                bulk(self._t[a:b], None, self.signal, self._lv[a:b])
+            else:
+                for k in range(a, b):
+                    hw.write_output_at(self._t[k], None, self.signal,  # type: ignore[attr-defined]
+                                       bool(self._lv[k]))
         self._sent = list(zip(self._t[a:b], self._lv[a:b], strict=True))
         self._written = self.level_at(t1)
         self._sent_until = t1
