@@ -203,6 +203,13 @@ def window_scan(tracks, ranges, points, maxerr, index, t, t1):  # noqa: ANN001, 
     return out
 
 
+def positions(tracks, times, out) -> None:  # noqa: ANN001
+    """Every track's position at each time into out[i, k] (compare_math.positions)."""
+    for i, x in enumerate(times):
+        for k, tr in enumerate(tracks):
+            out[i, k] = _position(_lists(tr), float(x))
+
+
 # ---------------------------------------------------------------------------- path length
 def set_gauss(x, w) -> None:  # noqa: ANN001
     _GL_PAIRS[:] = list(zip(list(map(float, x)), list(map(float, w)), strict=True))

@@ -433,6 +433,56 @@ done:
     return res;
 }
 
+PyDoc_STRVAR(positions_doc,
+"positions(tracks, times, out)\n\n"
+"out[i, k] = position of track k at times[i] (compare_math.positions, every track at\n"
+"once); out: a writable C-contiguous float64 (len(times), len(tracks)) array.");
+
+static PyObject *positions_py(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o, *t_o, *out_o;
+    if (!PyArg_ParseTuple(args, "OOO", &tr_o, &t_o, &out_o)) return NULL;
+    PyObject *trs = PySequence_Fast(tr_o, "tracks must be a sequence of tracks");
+    if (trs == NULL) return NULL;
+    PyObject *res = NULL, *ts = NULL;
+    double *x = NULL;
+    Py_buffer ob;
+    int have_out = 0;
+    Py_ssize_t na = PySequence_Fast_GET_SIZE(trs);
+    ts = PySequence_Fast(t_o, "times must be a sequence");
+    if (ts == NULL) goto done;
+    if (PyObject_GetBuffer(out_o, &ob, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0)
+        goto done;
+    have_out = 1;
+    Py_ssize_t m = PySequence_Fast_GET_SIZE(ts);
+    size_t fl = ob.format ? strlen(ob.format) : 0;
+    if (ob.itemsize != 8 || fl == 0 || ob.format[fl - 1] != 'd' || ob.len != 8 * m * na) {
+        PyErr_SetString(PyExc_ValueError, "out must be float64[len(times), len(tracks)]");
+        goto done;
+    }
+    x = malloc((size_t)(m > 0 ? m : 1) * sizeof(double));
+    if (x == NULL) { PyErr_NoMemory(); goto done; }
+    for (Py_ssize_t i = 0; i < m; i++) {
+        x[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(ts, i));
+        if (x[i] == -1.0 && PyErr_Occurred()) goto done;
+    }
+    double *out = ob.buf;
+    for (Py_ssize_t k = 0; k < na; k++) {  /* one track at a time: any number of axes */
+        Trk T;
+        TrkBuf tb;
+        if (get_track(PySequence_Fast_GET_ITEM(trs, k), &T, &tb) < 0) goto done;
+        for (Py_ssize_t i = 0; i < m; i++) out[i * na + k] = position(&T, x[i]);
+        release_track(&tb);
+    }
+    res = Py_NewRef(Py_None);
+done:
+    free(x);
+    if (have_out) PyBuffer_Release(&ob);
+    Py_XDECREF(ts);
+    Py_DECREF(trs);
+    return res;
+}
+
 /* ------------------------------------------------------------------ levels */
 /* The value list of a LevelJob: an array, or start + k * step (LevelSeq); `n` values,
  * then `after` if has_after. */
@@ -926,6 +976,7 @@ static PyMethodDef methods[] = {
     {"track_range", track_range_py, METH_VARARGS, track_range_doc},
     {"first_inside", first_inside_py, METH_VARARGS, first_inside_doc},
     {"window_scan", window_scan, METH_VARARGS, window_scan_doc},
+    {"positions", positions_py, METH_VARARGS, positions_doc},
     {"set_gauss", set_gauss, METH_VARARGS, set_gauss_doc},
     {"gl", gl_py, METH_VARARGS, gl_doc},
     {"adaptive", adaptive_py, METH_VARARGS, adaptive_doc},

@@ -107,6 +107,8 @@ class OutputLine:
 
     def forget_before(self, t: float) -> None:
         """Drop edges before t (bounded memory); the level at t becomes the start level."""
+        if not self._t or self._t[0] >= t:
+            return
         k = bisect.bisect_left(self._t, t)
         if k:
             self.initial = self._lv[k - 1]
@@ -150,6 +152,8 @@ class OutputLine:
     def flush(self, hw: Hardware, t0: float, t1: float) -> None:
         """Write the physical line for the cycle (t0, t1] (see module docstring)."""
         if self.timed:
+            if not self._late:  # nothing was added for times already handed over
+                return
             late = any(t0 <= t <= t1 for t in self._late)
             self._late.clear()
             if not late:
@@ -183,19 +187,25 @@ class EventLog:
     def __init__(self, n_axes: int) -> None:
         self.n_axes = n_axes
         self._rows: list[tuple[float, int, int, float, int, int]] = []
-        self._pos: list[Array] = []
+        self._pos: list[Array] = []  # blocks of rows (k x n_axes), as added
 
     def __len__(self) -> int:
         return len(self._rows)
 
     def add(self, rows: list[tuple[float, int, int, float, int, int]], pos: Array) -> None:
         """Append firings (rows as FIELDS) with their positions (len(rows) x n_axes)."""
+        p = np.asarray(pos, dtype=np.float64).reshape(len(rows), self.n_axes)
         self._rows.extend(rows)
-        self._pos.extend(pos)
+        self._pos.append(p)
 
     def clear(self) -> None:
         self._rows.clear()
         self._pos.clear()
+
+    def _positions(self) -> Array:
+        if len(self._pos) > 1:  # join the blocks once
+            self._pos[:] = [np.concatenate(self._pos)]
+        return self._pos[0] if self._pos else np.empty((0, self.n_axes))
 
     def arrays(self) -> dict[str, NDArray]:
         """Columns: time, job, index, value, output, state (-1 none), positions (n x axes)."""
@@ -208,7 +218,7 @@ class EventLog:
             "value": np.array(cols[3], dtype=np.float64),
             "output": np.array(cols[4], dtype=np.int64),
             "state": np.array(cols[5], dtype=np.int64),
-            "positions": np.array(self._pos, dtype=np.float64).reshape(n, self.n_axes),
+            "positions": self._positions().copy(),
         }
 
     def for_job(self, job: int) -> dict[str, NDArray]:
@@ -233,7 +243,7 @@ class EventLog:
         with p.open("w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow([*self.FIELDS, *(f"pos{i}" for i in range(self.n_axes))])
-            for row, pos in zip(self._rows, self._pos, strict=True):
+            for row, pos in zip(self._rows, self._positions(), strict=True):
                 t, job, idx, val, out, st = row
                 w.writerow([repr(t), job, idx, repr(val), out, st, *(repr(float(x)) for x in pos)])
         return p

@@ -340,18 +340,25 @@ class SimMachine:
                               f"times and {len(levels)} levels")
         if not all(map(math.isfinite, times)):
             raise MotionError(f"times must be finite, got {list(times)!r}")
-        if times and min(times) < self._t:
-            raise MotionError(f"t must be >= the current time {self._t!r}, got {min(times)!r}")
-        if not all(isinstance(lv, bool) for lv in levels):
+        if not times:
+            return
+        first = min(times)
+        if first < self._t:
+            raise MotionError(f"t must be >= the current time {self._t!r}, got {first!r}")
+        if not set(map(type, levels)) <= {bool}:
             raise MotionError(f"levels must be bools, got {list(levels)!r}")
         if axis is None:
             self._board_index(signal, "do", len(self._do))
-            now, push = self._t, self._timed.push
-            for t, lv in zip(times, levels, strict=True):
+            now = self._t
+            if first != now:
+                self._timed.push_many(list(times), None, signal, list(levels))
+                return
+            for t, lv in zip(times, levels, strict=True):  # those at `now` go out at once
                 if t == now:
                     self.write_output(None, signal, lv)
-                else:
-                    push(t, None, signal, lv)
+            later = [k for k, t in enumerate(times) if t != now]
+            self._timed.push_many([times[k] for k in later], None, signal,
+                                  [levels[k] for k in later])
             return
         for t, lv in zip(times, levels, strict=True):
             self.write_output_at(t, axis, signal, lv)
