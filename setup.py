@@ -1,5 +1,6 @@
-"""Build of the compiled inner loops (openmotion._kernel, src/openmotion/_kernel*.c); the rest is
-declared in pyproject.toml. Plain C against the CPython API: no build tool beyond setuptools.
+"""Build of the compiled inner loops (openmotion._kernel, src/openmotion/_kernel*.c, and
+openmotion._compare, src/openmotion/_kernel_compare.c: the compare engine's solvers); the rest
+is declared in pyproject.toml. Plain C against the CPython API: no build tool beyond setuptools.
 -ffp-contract=off keeps the compiler from fusing a*b+c, so the kernel's floats are
 bit-identical to the Python path's."""
 
@@ -13,4 +14,6 @@ setup(ext_modules=[Extension("openmotion._kernel",
                              ["src/openmotion/_kernel.c", "src/openmotion/_kernel_stepper.c",
                               "src/openmotion/_kernel_rt.c"],
                              depends=["src/openmotion/_kernel.h"],
+                             extra_compile_args=flags),
+                   Extension("openmotion._compare", ["src/openmotion/_kernel_compare.c"],
                              extra_compile_args=flags)])

@@ -1,6 +1,6 @@
-"""The compare engine's plain-float solvers (compare_roots._refine, compare_math.
-first_inside) give the very floats of the earlier versions, kept here as oracles: the
-speed-up changed no event time (issue 13, bench/bench_compare.py)."""
+"""The compare engine's solvers (the plain-float _refine of tests/compare_oracle.py, the
+compiled compare_math.first_inside) give the very floats of the earlier versions, kept
+here as oracles: the speed-ups changed no event time (issue 13, bench/bench_compare.py)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import compare_oracle as cr
 from openmotion.control.trigger import compare_math as cm
-from openmotion.control.trigger import compare_roots as cr
 from openmotion.control.trigger.compare_math import Track
 from openmotion.crossings import velocity_roots
 from openmotion.history import MotionHistory
@@ -53,8 +53,7 @@ def first_inside_oracle(tracks, centre, maxerr, t, t1, ranges=None):  # noqa: AN
         for lvl in (c - maxerr, c + maxerr):
             if not lo_k - slack <= lvl <= hi_k + slack:
                 continue
-            cands.append(np.array(cr.level_events(tr.ts, tr.p0, tr.v0, tr.a0, tr.j,
-                                                  float(lvl), t, t1)))
+            cands.append(np.array(cr.level_events(tr, float(lvl), t, t1)))
     cand = np.unique(np.concatenate(cands))
     cand = cand[(cand >= t) & (cand <= t1)]
     ok = np.ones(cand.size, dtype=bool)

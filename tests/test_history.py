@@ -498,3 +498,32 @@ def test_rows_and_record_at_read_the_store_without_copying() -> None:
         h.rows(0, 0.0, math.nan)
     with pytest.raises(MotionError, match="axis must be in"):
         h.record_at(1, 0.0)
+
+
+def test_subnormal_jerk_or_acceleration_does_not_overflow() -> None:
+    """A record with a subnormal jerk (or acceleration) has a velocity root beyond any
+    time: the vectorised solver leaves it out instead of dividing into an overflow, and
+    agrees with the scalar one."""
+    import warnings
+
+    import openmotion.crossings as cr
+
+    ts = np.array([0.0, 1.0, 2.0])
+    for v, a, j in (([0.0, 1.0, 1.0], [2.0, 0.0, 0.0], [2.2250738585072014e-308, 0.0, 0.0]),
+                    ([1.0, -1.0, 1.0], [5e-324, 0.0, 1.0], [0.0, 0.0, 0.0])):
+        p0 = np.array([0.0, 1.0, 2.0])
+        va, aa, ja = np.array(v), np.array(a), np.array(j)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            c1, c2 = cr._critical_points(va, aa, ja)
+            old = cr._SCALAR_RECORDS
+            try:
+                cr._SCALAR_RECORDS = 0
+                tv, dv = cr.find_crossings(ts, p0, va, aa, ja, 1.5, 0.0, 3.0)
+                cr._SCALAR_RECORDS = 10**9
+                tsc, dsc = cr.find_crossings(ts, p0, va, aa, ja, 1.5, 0.0, 3.0)
+            finally:
+                cr._SCALAR_RECORDS = old
+        assert not np.any(np.isinf(c1)) and not np.any(np.isinf(c2))
+        np.testing.assert_array_equal(tv, tsc)
+        np.testing.assert_array_equal(dv, dsc)

@@ -77,7 +77,7 @@ MAPPING: dict[str, str] = {
     "network": "cards", "speed_range": "cards",
     # compare and PSO
     "compare": "trigger", "compare_due": "trigger", "compare_io": "trigger",
-    "compare_jobs": "trigger", "compare_math": "trigger", "compare_roots": "trigger",
+    "compare_jobs": "trigger", "compare_math": "trigger",
     "compare_scope": "trigger", "pso": "trigger", "hsl_trigger": "trigger",
     # homing and latch
     "homing": "home", "homing_modes": "home", "homing_sequence": "home", "latch": "home",

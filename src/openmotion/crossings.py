@@ -38,20 +38,32 @@ def _snapped(f: Array, level: float, p0: Array, v: Array, a: Array, j: Array,
     return np.where(np.abs(f) <= 8.0 * _EPS * scale, 0.0, f)
 
 
+# A root beyond this many seconds is outside any record: it is left out (NaN) instead of
+# computed, so a quotient by a subnormal jerk or acceleration cannot overflow. The scalar
+# velocity_roots computes it (as +-inf) and drops it by the same `0 < x < L` test.
+_FAR_S = 1e300
+
+
+def _quotient(num: Array, den: Array, sel: Array) -> Array:
+    """num / den where `sel` and the quotient is below _FAR_S in size, else NaN."""
+    out = np.full(num.size, np.nan)
+    ok = sel & (np.abs(num) / _FAR_S < np.abs(den))
+    out[ok] = num[ok] / den[ok]
+    return out
+
+
 def _critical_points(v: Array, a: Array, j: Array) -> tuple[Array, Array]:
-    """Roots of the velocity v + a*dt + j*dt**2/2 (NaN where there is none)."""
+    """Roots of the velocity v + a*dt + j*dt**2/2 (NaN where there is none or it lies
+    farther than _FAR_S)."""
     half_j = 0.5 * j
-    c1 = np.full(v.size, np.nan)
-    c2 = np.full(v.size, np.nan)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(invalid="ignore"):  # NaN records compare False: no root
         lin = (half_j == 0.0) & (a != 0.0)
-        c1[lin] = -v[lin] / a[lin]
         disc = a * a - 4.0 * half_j * v
         quad = (half_j != 0.0) & (disc >= 0.0)
         q = -0.5 * (a + np.copysign(np.sqrt(np.where(quad, disc, 0.0)), a))
         qn = quad & (q != 0.0)
-        c1[qn] = q[qn] / half_j[qn]
-        c2[qn] = v[qn] / q[qn]
+        c1 = np.where(lin, _quotient(-v, a, lin), _quotient(q, half_j, qn))
+        c2 = _quotient(v, q, qn)
         c1[quad & (q == 0.0)] = 0.0  # v == a == 0: double root at dt = 0
     return c1, c2
 

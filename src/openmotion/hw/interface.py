@@ -142,7 +142,10 @@ class TimedOutputHardware(Protocol):
     its computed instant instead of at a cycle boundary.
 
     The control layer checks `isinstance(hw, TimedOutputHardware)` and otherwise falls back
-    to `Hardware.write_output` once per cycle.
+    to `Hardware.write_output` once per cycle. A back end may also offer
+    `write_outputs_at(times, axis, signal, levels)` (the same for several edges of one
+    output, in order, checked as a whole first): the compare engine then hands a cycle's
+    edges of a line in one call (the simulator has it; it is looked up, not required).
     """
 
     def write_output_at(self, t: float, axis: int | None, signal: str, level: bool) -> None:

@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import MotionError, check_finite, check_int, check_positive
+from . import compare_math as _cm
 from .compare_due import engine_due
 from .compare_io import EventLog, OutputLine
 from .compare_jobs import (
@@ -66,7 +67,6 @@ from .compare_math import (
     VectorCycle,
     affine_track,
     history_track,
-    positions,
     track_range,
 )
 
@@ -154,6 +154,9 @@ class CompareEngine:
         self._pre_rows: list[tuple[float, int, int, float, int, int]] = []
         self._pre_pos: list[Array] = []
         self._plan: list[tuple[float, ...]] | None = None  # records planned (rollback)
+        self._plan_key: tuple[int, int, int] | None = None  # what _plan_axes was made for
+        self._plan_axes: list[int] = []
+        self._timers: dict[int, Any] = {}
         controller.add_cycle_hook(self._on_cycle, due=self._due)
         if self.timed:
             controller.add_pre_advance_hook(self._pre_advance, due=self._due)
@@ -357,19 +360,32 @@ class CompareEngine:
         for job in list(self._jobs.values()):
             if not job.active or (pre is not None and _on_command(job) != pre):
                 continue
-            for tf, idx, val in job.scan(self, ta, t1):
-                state = job.action.apply(self, tf, job.hits)
-                job.hits += 1
-                rows.append((tf, job.id, idx, val, job.action.output, int(state)))
+            hits = job.scan(self, ta, t1)
+            if hits:
+                act = job.action
+                many = getattr(act, "apply_many", None)
+                if many is not None:  # the job's firings of this cycle in one call
+                    states = many(self, [h[0] for h in hits], job.hits)
+                    job.hits += len(hits)
+                else:
+                    states = []
+                    for h in hits:
+                        states.append(act.apply(self, h[0], job.hits))
+                        job.hits += 1
+                out, jid = act.output, job.id
+                rows.extend([(tf, jid, idx, val, out, int(st))
+                             for (tf, idx, val), st in zip(hits, states, strict=True)])
             if job.done:
                 self._jobs.pop(job.id, None)
                 job.active = False
         return rows
 
     def _positions(self, rows: list[tuple[float, int, int, float, int, int]]) -> Array:
-        times = np.array([r[0] for r in rows])
-        return np.column_stack([positions(self.track(AxisSource(a)), times)
-                                for a in range(len(self.ctl.axes))])
+        """Every axis's command position at each row's time: (len(rows), n_axes)."""
+        out = np.empty((len(rows), len(self.ctl.axes)))
+        tracks = [self.track(AxisSource(a)) for a in range(len(self.ctl.axes))]
+        _cm._solvers().positions(tracks, [r[0] for r in rows], out)
+        return out
 
     def _vectors_end(self, ta: float, t1: float) -> None:
         """Speed PWMs over (ta, t1], then every VECTOR_MOVED to its value at t1."""
@@ -394,17 +410,22 @@ class CompareEngine:
         if not (self._jobs or self._pwms or self._vectors):
             self._plan = None
             return
-        axes: set[int] = set()
-        for j in self._jobs.values():
-            src = getattr(j, "source", None)
-            axes.update(j.axes if isinstance(j, WindowJob) else
-                        src.axes if isinstance(src, VectorSource) else (src.axis,))
-        for v in self._vectors:
-            axes.update(v.axes)
-        self._plan_axes = sorted(axes)
+        # the compared axes and the pulse timers change only with the jobs and vectors
+        key = (self._next_id, len(self._jobs), len(self._vectors))
+        if key != self._plan_key:
+            axes: set[int] = set()
+            for j in self._jobs.values():
+                src = getattr(j, "source", None)
+                axes.update(j.axes if isinstance(j, WindowJob) else
+                            src.axes if isinstance(src, VectorSource) else (src.axis,))
+            for v in self._vectors:
+                axes.update(v.axes)
+            self._plan_axes = sorted(axes)
+            self._timers = {id(x): x for x in (_timer_of(j.action)
+                                               for j in self._jobs.values()) if x is not None}
+            self._plan_key = key
         self._plan = [self._last_record(a, t1) for a in self._plan_axes]
-        timers = {id(x): x for x in (_timer_of(j.action) for j in self._jobs.values())
-                  if x is not None}
+        timers = self._timers
         self._snap = (
             dict(self._jobs),
             {k: (j.index, j.hits, j.active) for k, j in self._jobs.items()},
@@ -456,7 +477,7 @@ class CompareEngine:
         rows = self._scan(True, ta, t1)
         if rows:
             self._pre_rows.extend(rows)
-            self._pre_pos.extend(self._positions(rows))
+            self._pre_pos.append(self._positions(rows))
         self._vectors_end(ta, t1)
         hw = ctl.hardware
         for line in self._lines.values():
@@ -482,14 +503,19 @@ class CompareEngine:
         if not self.timed:
             self._vectors_end(ta, t1)
         self._mpos_err.update(self._mpos_e1)
-        pos = list(self._positions(rows)) if rows else []
+        pos = [self._positions(rows)] if rows else []
         if self._pre_rows:
             rows = self._pre_rows + rows
             pos = self._pre_pos + pos
             self._pre_rows, self._pre_pos = [], []
-        if rows:
-            order = sorted(range(len(rows)), key=lambda k: rows[k][0])
-            self.log.add([rows[k] for k in order], np.array([pos[k] for k in order]))
+        if rows:  # in time order (a stable sort: equal times keep job order)
+            p = pos[0] if len(pos) == 1 else np.concatenate(pos)
+            times = [r[0] for r in rows]
+            if all(a <= b for a, b in zip(times, times[1:], strict=False)):
+                self.log.add(rows, p)
+            else:
+                order = np.argsort(np.array(times), kind="stable")
+                self.log.add([rows[k] for k in order.tolist()], p[order])
         hw = ctl.hardware
         keep = t1 - ctl.history.window_s  # waveforms are kept as long as the motion history
         for line in self._lines.values():

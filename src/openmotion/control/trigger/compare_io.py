@@ -24,6 +24,7 @@ from __future__ import annotations
 import bisect
 import csv
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -31,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import MotionError
+from . import compare_math as _cm
 
 if TYPE_CHECKING:
     from ...hw.interface import Hardware
@@ -74,25 +76,16 @@ class OutputLine:
 
     def set(self, t: float, level: bool) -> None:
         """Drive the level from time t on (until the next later edge, if one is scheduled)."""
-        k = bisect.bisect_right(self._t, t)
-        before = self._lv[k - 1] if k else self.initial
-        after_same = k < len(self._t) and self._lv[k] == level
-        if before == level and not after_same:
-            return
-        if self.timed and t <= self._sent_until:
-            self._late.append(t)
-        self._t.insert(k, t)
-        self._lv.insert(k, level)
-        self._merge(k)
+        self.set_many((t,), (level,))
 
-    def _merge(self, k: int) -> None:
-        # drop an edge that no longer changes the level (after an insertion at k)
-        for i in (k + 1, k):
-            if 0 <= i < len(self._t):
-                prev = self._lv[i - 1] if i else self.initial
-                if self._lv[i] == prev:
-                    del self._t[i]
-                    del self._lv[i]
+    def set_many(self, times: Sequence[float], levels: Sequence[bool]) -> None:
+        """`set(times[i], levels[i])` for each i in order, in one compiled call: an edge is
+        inserted after those at equal times, and an edge that no longer changes the level
+        (the one it replaces or repeats) is dropped. A set at or before what was already
+        handed to timed hardware is "late" (flush corrects the physical line)."""
+        sent = self._sent_until if self.timed else -math.inf
+        _cm._solvers().line_set(self._t, self._lv, bool(self.initial), times, levels, sent,
+                                self._late)
 
     def snapshot(self, t: float) -> tuple[bool, list[float], list[bool]]:
         """The waveform from time t on (to undo a cycle's edits with `restore`)."""
@@ -114,6 +107,8 @@ class OutputLine:
 
     def forget_before(self, t: float) -> None:
         """Drop edges before t (bounded memory); the level at t becomes the start level."""
+        if not self._t or self._t[0] >= t:
+            return
         k = bisect.bisect_left(self._t, t)
         if k:
             self.initial = self._lv[k - 1]
@@ -140,9 +135,14 @@ class OutputLine:
                 hw.write_output_at(t_r, None, self.signal, bool(lvl0))  # type: ignore[attr-defined]
             else:
                 hw.write_output(None, self.signal, bool(lvl0))
-        for k in range(a, b):
-            hw.write_output_at(self._t[k], None, self.signal,  # type: ignore[attr-defined]
-                               bool(self._lv[k]))
+        if b > a:
+            bulk = getattr(hw, "write_outputs_at", None)
+            if bulk is not None:  # one call for the cycle's edges
+                bulk(self._t[a:b], None, self.signal, self._lv[a:b])
+            else:
+                for k in range(a, b):
+                    hw.write_output_at(self._t[k], None, self.signal,  # type: ignore[attr-defined]
+                                       bool(self._lv[k]))
         self._sent = list(zip(self._t[a:b], self._lv[a:b], strict=True))
         self._written = self.level_at(t1)
         self._sent_until = t1
@@ -152,6 +152,8 @@ class OutputLine:
     def flush(self, hw: Hardware, t0: float, t1: float) -> None:
         """Write the physical line for the cycle (t0, t1] (see module docstring)."""
         if self.timed:
+            if not self._late:  # nothing was added for times already handed over
+                return
             late = any(t0 <= t <= t1 for t in self._late)
             self._late.clear()
             if not late:
@@ -185,19 +187,25 @@ class EventLog:
     def __init__(self, n_axes: int) -> None:
         self.n_axes = n_axes
         self._rows: list[tuple[float, int, int, float, int, int]] = []
-        self._pos: list[Array] = []
+        self._pos: list[Array] = []  # blocks of rows (k x n_axes), as added
 
     def __len__(self) -> int:
         return len(self._rows)
 
     def add(self, rows: list[tuple[float, int, int, float, int, int]], pos: Array) -> None:
         """Append firings (rows as FIELDS) with their positions (len(rows) x n_axes)."""
+        p = np.asarray(pos, dtype=np.float64).reshape(len(rows), self.n_axes)
         self._rows.extend(rows)
-        self._pos.extend(pos)
+        self._pos.append(p)
 
     def clear(self) -> None:
         self._rows.clear()
         self._pos.clear()
+
+    def _positions(self) -> Array:
+        if len(self._pos) > 1:  # join the blocks once
+            self._pos[:] = [np.concatenate(self._pos)]
+        return self._pos[0] if self._pos else np.empty((0, self.n_axes))
 
     def arrays(self) -> dict[str, NDArray]:
         """Columns: time, job, index, value, output, state (-1 none), positions (n x axes)."""
@@ -210,7 +218,7 @@ class EventLog:
             "value": np.array(cols[3], dtype=np.float64),
             "output": np.array(cols[4], dtype=np.int64),
             "state": np.array(cols[5], dtype=np.int64),
-            "positions": np.array(self._pos, dtype=np.float64).reshape(n, self.n_axes),
+            "positions": self._positions().copy(),
         }
 
     def for_job(self, job: int) -> dict[str, NDArray]:
@@ -235,7 +243,7 @@ class EventLog:
         with p.open("w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow([*self.FIELDS, *(f"pos{i}" for i in range(self.n_axes))])
-            for row, pos in zip(self._rows, self._pos, strict=True):
+            for row, pos in zip(self._rows, self._positions(), strict=True):
                 t, job, idx, val, out, st = row
                 w.writerow([repr(t), job, idx, repr(val), out, st, *(repr(float(x)) for x in pos)])
         return p

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import MotionError, check_finite, check_positive, show
 from ...limits import as_array, check_pulses
-from .compare_math import crossings_after, first_crossing, first_inside
+from .compare_math import LevelValues, crossings_after, level_scan, window_scan
 
 if TYPE_CHECKING:
     from .compare import CompareEngine
@@ -73,6 +73,10 @@ class LevelSeq:
 
 # ---------------------------------------------------------------------------- actions
 class Action(Protocol):
+    """What a firing does. An action may also offer `apply_many(eng, times, hit0)`: the
+    same as `apply(eng, times[k], hit0 + k)` for each k in order, returning the states
+    (the built-in ones do, so a cycle's firings of a job reach the line in one call)."""
+
     output: int
 
     def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
@@ -87,9 +91,13 @@ class Toggle:
     first: bool = True
 
     def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
-        level = self.first if hit % 2 == 0 else not self.first
-        eng.output(self.output).set(t, level)
-        return level
+        return self.apply_many(eng, [t], hit)[0]
+
+    def apply_many(self, eng: CompareEngine, times: list[float], hit0: int) -> list[bool]:
+        first, other = bool(self.first), not self.first
+        levels = [first if (hit0 + k) % 2 == 0 else other for k in range(len(times))]
+        eng.output(self.output).set_many(times, levels)
+        return levels
 
 
 @dataclass
@@ -100,8 +108,12 @@ class SetLevel:
     level: bool = True
 
     def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
-        eng.output(self.output).set(t, self.level)
-        return self.level
+        return self.apply_many(eng, [t], hit)[0]
+
+    def apply_many(self, eng: CompareEngine, times: list[float], hit0: int) -> list[bool]:
+        levels = [self.level] * len(times)
+        eng.output(self.output).set_many(times, levels)
+        return levels
 
 
 @dataclass
@@ -116,10 +128,13 @@ class Pulse:
         self.width = check_positive("width", self.width)
 
     def apply(self, eng: CompareEngine, t: float, hit: int) -> bool:
-        line = eng.output(self.output)
-        line.set(t, self.active)
-        line.set(t + self.width, not self.active)
-        return self.active
+        return self.apply_many(eng, [t], hit)[0]
+
+    def apply_many(self, eng: CompareEngine, times: list[float], hit0: int) -> list[bool]:
+        w, on, off = self.width, self.active, not self.active
+        edges = [x for t in times for x in (t, t + w)]
+        eng.output(self.output).set_many(edges, [on, off] * len(times))
+        return [on] * len(times)
 
 
 # ---------------------------------------------------------------------------- jobs
@@ -241,6 +256,15 @@ class LevelJob(CompareJob):
                 self.index += 1
                 self.skipped += 1
 
+    def _values(self) -> tuple[LevelValues, int, float | None]:
+        """The value list as the solvers take it: (array or (start, step), count, after)."""
+        lv = self.levels
+        if isinstance(lv, LevelSeq):
+            return (lv.start, lv.step), len(lv), self.after_final
+        if not lv.flags.c_contiguous or lv.dtype != np.float64:
+            self.levels = lv = np.ascontiguousarray(lv, dtype=np.float64)
+        return lv, lv.size, self.after_final
+
     def scan(self, eng: CompareEngine, ta: float, t1: float) -> list[tuple[float, int, float]]:
         ta = max(ta, self.t_armed)
         if ta >= t1:
@@ -249,29 +273,25 @@ class LevelJob(CompareJob):
         if self.repeat:
             lvl = self.level(0)
             if isinstance(src, VectorSource):
-                tf = eng.vector_cycle(src).time_of(lvl, ta)
-                times = [tf] if tf is not None else []
-            elif eng.reachable(src, lvl):
+                vals, n, after = self._values()
+                return [(tf, 0, v) for tf, v in
+                        eng.vector_cycle(src).scan(vals, n, after, 0, ta, True)]
+            if eng.reachable(src, lvl):
                 times = crossings_after(eng.track(src), lvl, ta, t1, self.direction).tolist()
             else:
                 times = []
             return [(float(t), 0, lvl) for t in times]
-        hits = []
-        t = ta
-        while self.index < self.size:
-            lvl = self.level(self.index)
-            if isinstance(src, VectorSource):
-                tf = eng.vector_cycle(src).time_of(lvl, t)
-            elif eng.reachable(src, lvl):
-                tf = first_crossing(eng.track(src), lvl, t, t1, self.direction)
-            else:
-                tf = None
-            if tf is None:
-                break
-            hits.append((tf, self.index, lvl))
-            self.index += 1
-            t = tf
-        return hits
+        if self.index >= self.size:
+            return []
+        vals, n, after = self._values()
+        if isinstance(src, VectorSource):
+            found = eng.vector_cycle(src).scan(vals, n, after, self.index, ta, False)
+        else:
+            found = level_scan(eng.track(src), eng.track_range(src), vals, n, after,
+                               self.index, ta, t1, self.direction)
+        k0 = self.index
+        self.index += len(found)
+        return [(tf, k0 + i, v) for i, (tf, v) in enumerate(found)]
 
 
 class WindowJob(CompareJob):
@@ -294,7 +314,7 @@ class WindowJob(CompareJob):
         self.maxerr = check_positive("maxerr", maxerr)
         if kind not in SOURCE_KINDS:
             raise MotionError(f"kind must be one of {SOURCE_KINDS}, got {kind!r}")
-        self.points = pts
+        self.points = np.ascontiguousarray(pts, dtype=np.float64)  # the solver reads it as is
         self.kind = kind
 
     @property
@@ -309,19 +329,15 @@ class WindowJob(CompareJob):
         ta = max(ta, self.t_armed)
         if ta > t1:
             return []
+        if self.index >= self.size:
+            return []
         srcs = [AxisSource(a, self.kind) for a in self.axes]
         tracks = [eng.track(s) for s in srcs]
         ranges = [eng.track_range(s) for s in srcs]
-        hits = []
-        t = ta
-        while self.index < self.size:
-            tf = first_inside(tracks, self.points[self.index], self.maxerr, t, t1, ranges)
-            if tf is None:
-                break
-            hits.append((tf, self.index, float(self.index)))
-            self.index += 1
-            t = tf
-        return hits
+        found = window_scan(tracks, ranges, self.points, self.maxerr, self.index, ta, t1)
+        k0 = self.index
+        self.index += len(found)
+        return [(tf, k0 + i, float(k0 + i)) for i, tf in enumerate(found)]
 
 
 def every_distance(source: VectorSource, interval: float, action: Action, *,

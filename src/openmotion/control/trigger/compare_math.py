@@ -10,19 +10,32 @@ feedback model) and asks three questions, each answered between cycles, not at c
 - `VectorCycle`: the accumulated path length s(t) (ZMotion VECTOR_MOVED) over the cycle and
   the time it reaches a given distance;
 - `first_inside`: the first time all axes are within +-maxerr of a point (2-D/3-D tables).
+
+The solvers themselves are compiled (openmotion._compare, src/openmotion/_kernel_compare.c):
+a job's whole scan of a cycle (every value or point it reaches, in turn) is one call. Their
+plain-Python versions, which give the same floats, are the test oracle in
+tests/compare_oracle.py; `_ck` is the one handle the engine calls them through.
 """
 
 from __future__ import annotations
 
-import bisect
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ...crossings import velocity_roots
+from ...errors import MotionError
 from ...history import MotionHistory
-from .compare_roots import level_events, velocity_roots
+
+try:
+    from ... import _compare as _ck_built
+except ImportError:  # pragma: no cover - the package's build compiles it
+    _ck_built = None
+
+#: the compiled solvers (a test may swap in the Python oracle, tests/compare_oracle.py)
+_ck: Any = _ck_built
 
 Array = NDArray[np.float64]
 
@@ -30,9 +43,8 @@ Array = NDArray[np.float64]
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _QUAD_RTOL = 1e-13
 _QUAD_DEPTH = 10
-_SNAP_RTOL = 1e-10  # distances this close count as reached
-_EPS = float(np.finfo(np.float64).eps)
-_GL_PAIRS = list(zip(_GL_X.tolist(), _GL_W.tolist(), strict=True))
+if _ck is not None:
+    _ck.set_gauss(_GL_X, _GL_W)  # the compiled quadrature uses these very floats
 
 
 class Track(NamedTuple):
@@ -76,20 +88,45 @@ def velocities(tr: Track, times: Array) -> Array:
     return tr.v0[k] + dt * (tr.a0[k] + dt * tr.j[k] / 2.0)
 
 
+def _solvers() -> Any:
+    if _ck is None:
+        raise MotionError("openmotion._compare is not built: run `pip install .` (or "
+                          "`python setup.py build_ext --inplace` in a checkout)")
+    return _ck
+
+
 def crossings_after(tr: Track, level: float, t: float, t1: float,
                     direction: int) -> Array:
     """Times in (t, t1] where the track reaches `level` (direction +1 up, -1 down, 0 both).
 
-    An arrival exactly at t belongs to the window that ended at t, so it is not repeated.
+    The events of MotionHistory.crossings (an upward event: below the level just before,
+    at or above it then; a tangent touch counts as reaching it from the side it came
+    from; a dwell on the level counts once, on arrival), each root refined by Newton's
+    method inside its sign bracket. An arrival exactly at t belongs to the window that
+    ended at t, so it is not repeated.
     """
-    return np.array(level_events(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, level, t, t1, direction))
+    return np.array(_solvers().level_events(tr, float(level), t, t1, direction, False))
 
 
 def first_crossing(tr: Track, level: float, t: float, t1: float,
                    direction: int) -> float | None:
     """The first time in (t, t1] the track reaches `level` in `direction`, or None."""
-    times = level_events(tr.ts, tr.p0, tr.v0, tr.a0, tr.j, level, t, t1, direction, first=True)
+    times = _solvers().level_events(tr, float(level), t, t1, direction, True)
     return times[0] if times else None
+
+
+LevelValues = Array | tuple[float, float]  # an array, or (start, step): start + k * step
+
+
+def level_scan(tr: Track, rng: tuple[float, float], levels: LevelValues, n: int,
+               after_final: float | None, index: int, t: float,
+               t1: float, direction: int) -> list[tuple[float, float]]:
+    """A level table's hits in (t, t1]: from value `index` on, the first crossing of each
+    value in turn after the previous hit, until one is not reached (or out of the track's
+    (min, max) `rng`). Values: `n` of `levels`, then `after_final` (None: none).
+    Returns [(time, value), ...]."""
+    return _solvers().level_scan(tr, rng, levels, n, after_final, index, t, t1,  # type: ignore[no-any-return]
+                                 direction)
 
 
 # ---------------------------------------------------------------------------- window
@@ -99,59 +136,23 @@ def first_crossing(tr: Track, level: float, t: float, t1: float,
 def first_inside(tracks: list[Track], centre: Array, maxerr: float, t: float,
                  t1: float, ranges: list[tuple[float, float]] | None = None) -> float | None:
     """The first time in [t, t1] every track is within +-maxerr of its centre, or None.
-    `ranges`: each track's (min, max) over the window, to skip hopeless solver calls.
-
-    Plain floats (a query touches a few records, where numpy's per-call cost dominated),
-    candidates tested in time order until the first one inside: the same arithmetic as the
-    vectorized version, so the same time (tests/test_compare_roots.py)."""
-    cands = {t}
-    rows = []
-    for k, (tr, c_) in enumerate(zip(tracks, centre, strict=True)):
-        c = float(c_)
-        lo_k, hi_k = ranges[k] if ranges is not None else (-math.inf, math.inf)
-        slack = 1e-9 * (abs(c) + maxerr + 1.0)
-        if c + maxerr < lo_k - slack or c - maxerr > hi_k + slack:
-            return None  # this axis never gets near its coordinate in the window
-        rec = (tr.ts.tolist(), tr.p0.tolist(), tr.v0.tolist(), tr.a0.tolist(), tr.j.tolist())
-        rows.append((rec, c, maxerr + 1e-12 * (abs(c) + maxerr + 1.0)))
-        for lvl in (c - maxerr, c + maxerr):
-            if not lo_k - slack <= lvl <= hi_k + slack:
-                continue
-            cands.update(level_events(*rec, float(lvl), t, t1))
-    for x in sorted(cands):
-        if not t <= x <= t1:
-            continue
-        # the crossing solver lands on the level: tol 1e-12 relative
-        if all(abs(_position(rec, x) - c) <= lim for rec, c, lim in rows):
-            return float(x)
-    return None
+    `ranges`: each track's (min, max) over the window, to skip hopeless solver calls."""
+    c = np.ascontiguousarray(centre, dtype=np.float64)
+    return _solvers().first_inside(tracks, c, maxerr, t, t1, ranges)  # type: ignore[no-any-return]
 
 
-def _position(rec: tuple[list[float], ...], x: float) -> float:
-    """`positions` at one time, on the records as lists (same arithmetic)."""
-    ts, p0, v0, a0, j = rec
-    k = max(bisect.bisect_right(ts, x) - 1, 0)
-    dt = x - ts[k]
-    return p0[k] + dt * (v0[k] + dt * (a0[k] / 2.0 + dt * j[k] / 6.0))
+def window_scan(tracks: list[Track], ranges: list[tuple[float, float]] | None,
+                points: Array, maxerr: float, index: int, t: float,
+                t1: float) -> list[float]:
+    """A point table's hits in [t, t1]: `first_inside` of point `index`, then of the next
+    point from that time on, until one is not reached. points: C-contiguous (n, k)."""
+    return _solvers().window_scan(tracks, ranges, points, maxerr, index, t, t1)  # type: ignore[no-any-return]
 
 
 def track_range(tr: Track, ta: float, t1: float) -> tuple[float, float]:
     """(min, max) of the track's position over [ta, t1]: a cheap test that a level cannot
     be reached in this window, so the exact solver is skipped."""
-    lo, hi = math.inf, -math.inf
-    n = tr.ts.size
-    for k in range(n):
-        a_k = float(tr.ts[k])
-        b_k = float(tr.ts[k + 1]) if k + 1 < n else math.inf
-        u, w = max(a_k, ta), min(b_k, t1)
-        if w < u:
-            continue
-        p, v, a, j = float(tr.p0[k]), float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])
-        xs = [u - a_k, w - a_k] + [r for r in velocity_roots(v, a, j) if u - a_k < r < w - a_k]
-        for x in xs:
-            y = p + x * (v + x * (a / 2.0 + x * j / 6.0))
-            lo, hi = min(lo, y), max(hi, y)
-    return lo, hi
+    return _solvers().track_range(tr, ta, t1)  # type: ignore[no-any-return]
 
 
 # ---------------------------------------------------------------------------- vector distance
@@ -200,7 +201,6 @@ class VectorCycle:
             Q[:, 3] += 2.0 * c1 * c2
             Q[:, 4] += c2 * c2
         self.Q = Q
-        self._q = Q.tolist()
         H = B[1:] - u
         # all pieces at once with one and two GL panels; refine only those that disagree
         x1 = (H[:, None] / 2.0) * (_GL_X[None, :] + 1.0)
@@ -217,24 +217,10 @@ class VectorCycle:
         y = Q[:, 0:1] + x * (Q[:, 1:2] + x * (Q[:, 2:3] + x * (Q[:, 3:4] + x * Q[:, 4:5])))
         return np.sqrt(np.maximum(y, 0.0))
 
-    def _gl(self, i: int, a: float, b: float) -> float:
-        # plain floats: ~10x cheaper than numpy on 8 nodes (this runs per Newton step)
-        q0, q1, q2, q3, q4 = self._q[i]
-        h = 0.5 * (b - a)
-        acc = 0.0
-        for xg, wg in _GL_PAIRS:
-            x = a + h * (xg + 1.0)
-            y = q0 + x * (q1 + x * (q2 + x * (q3 + x * q4)))
-            acc += wg * math.sqrt(y) if y > 0.0 else 0.0
-        return h * acc
-
     def _adaptive(self, i: int, a: float, b: float, depth: int) -> float:
-        m = 0.5 * (a + b)
-        whole = self._gl(i, a, b)
-        halves = self._gl(i, a, m) + self._gl(i, m, b)
-        if abs(halves - whole) <= _QUAD_RTOL * max(abs(halves), 1e-300) or depth >= _QUAD_DEPTH:
-            return halves
-        return self._adaptive(i, a, m, depth + 1) + self._adaptive(i, m, b, depth + 1)
+        """The piece's length over [a, b], halved until two levels agree (compiled)."""
+        return _solvers().adaptive(self.Q[i].tolist(), a, b, _QUAD_RTOL,  # type: ignore[no-any-return]
+                                   _QUAD_DEPTH - depth)
 
     @property
     def end(self) -> float:
@@ -242,38 +228,16 @@ class VectorCycle:
 
     def at(self, t: float) -> float:
         """s(t) for t in the window."""
-        i = min(max(int(np.searchsorted(self.B, t, side="right")) - 1, 0), self.B.size - 2)
-        return float(self.S[i]) + self._gl(i, 0.0, t - float(self.B[i]))
+        return _solvers().vector_at(self.B, self.S, self.Q, t)  # type: ignore[no-any-return]
 
     def time_of(self, d: float, after: float) -> float | None:
-        """First time > `after` with s(t) >= d (s is non-decreasing), or None."""
-        if d > self.S[-1]:
-            # a point exactly at the end of a move: the quadrature sum may land an ulp short
-            if d - self.S[-1] > _SNAP_RTOL * max(abs(d), 1.0):
-                return None
-            d = float(self.S[-1])
-        i = max(int(np.searchsorted(self.S, d, side="left")), 1) - 1  # S[i] < d <= S[i+1]
-        u = float(self.B[i])
-        lo, hi = max(after, u) - u, float(self.B[i + 1]) - u
-        su = float(self.S[i])
-        if su + self._gl(i, 0.0, lo) >= d:  # already there at `after`
-            return u + lo if u + lo > after else None
-        q0, q1, q2, q3, q4 = self._q[i]
-        x = 0.5 * (lo + hi)
-        for _ in range(100):
-            f = su + self._gl(i, 0.0, x) - d
-            if f >= 0.0:
-                hi = x
-            else:
-                lo = x
-            tol = 4.0 * _EPS * max(abs(u + x), 1.0)
-            if hi - lo <= tol:
-                return u + hi
-            sp = math.sqrt(max(q0 + x * (q1 + x * (q2 + x * (q3 + x * q4))), 0.0))
-            xn = x - f / sp if sp > 0.0 else math.nan
-            if abs(xn - x) <= tol:  # converged (also when the step rounds to nothing)
-                return u + max(xn, x) if f < 0.0 else u + x
-            if not lo < xn < hi:
-                xn = 0.5 * (lo + hi)
-            x = xn
-        return u + hi
+        """First time > `after` with s(t) >= d (s is non-decreasing), or None: safeguarded
+        Newton on the piece holding d (s' = speed)."""
+        return _solvers().time_of(self.B, self.S, self.Q, d, after)  # type: ignore[no-any-return]
+
+    def scan(self, levels: LevelValues, n: int, after_final: float | None, index: int,
+             t: float, first_only: bool) -> list[tuple[float, float]]:
+        """A distance table's hits: `time_of` each value from `index` on in turn (see
+        level_scan; first_only: the value at `index` only)."""
+        return _solvers().vector_scan(self.B, self.S, self.Q, levels, n, after_final,  # type: ignore[no-any-return]
+                                      index, t, first_only)

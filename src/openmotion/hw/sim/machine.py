@@ -388,6 +388,39 @@ class SimMachine:
         else:
             self.scenario._push(t, lambda raw: self._timed_axis_output(axis, signal, level, raw))
 
+    def write_outputs_at(self, times: Sequence[float], axis: int | None, signal: str,
+                         levels: Sequence[bool]) -> None:
+        """`write_output_at(times[k], axis, signal, levels[k])` for every k in order, in one
+        call (the compare engine hands a cycle's edges of one line this way). Everything is
+        checked first: on refusal nothing is scheduled."""
+        if len(times) != len(levels):
+            raise MotionError(f"times and levels must have one entry each, got {len(times)} "
+                              f"times and {len(levels)} levels")
+        if not all(map(math.isfinite, times)):
+            raise MotionError(f"times must be finite, got {list(times)!r}")
+        if not times:
+            return
+        first = min(times)
+        if first < self._t:
+            raise MotionError(f"t must be >= the current time {self._t!r}, got {first!r}")
+        if not set(map(type, levels)) <= {bool}:
+            raise MotionError(f"levels must be bools, got {list(levels)!r}")
+        if axis is None:
+            self._board_index(signal, "do", len(self._do))
+            now = self._t
+            if first != now:
+                self._timed.push_many(list(times), None, signal, list(levels))
+                return
+            for t, lv in zip(times, levels, strict=True):  # those at `now` go out at once
+                if t == now:
+                    self.write_output(None, signal, lv)
+            later = [k for k, t in enumerate(times) if t != now]
+            self._timed.push_many([times[k] for k in later], None, signal,
+                                  [levels[k] for k in later])
+            return
+        for t, lv in zip(times, levels, strict=True):
+            self.write_output_at(t, axis, signal, lv)
+
     def _timed_axis_output(self, axis: int, signal: str, level: bool, raw: list) -> None:
         self.write_output(axis, signal, level)
         raw.extend(self._pending)  # RDY/INP edges it caused belong to this advance

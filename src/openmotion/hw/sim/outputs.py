@@ -27,6 +27,18 @@ class TimedOutputs:
     def push(self, t: float, axis: int | None, signal: str, level: bool) -> None:
         heapq.heappush(self._heap, (t, next(self._seq), axis, signal, level))
 
+    def push_many(self, times: list[float], axis: int | None, signal: str,
+                  levels: list[bool]) -> None:
+        """`push(times[k], axis, signal, levels[k])` for every k, in order."""
+        seq = self._seq
+        items = [(t, next(seq), axis, signal, lv) for t, lv in zip(times, levels, strict=True)]
+        if len(items) > 4:  # one heapify beats pushing one by one (same (time, seq) order)
+            self._heap.extend(items)
+            heapq.heapify(self._heap)
+        else:
+            for it in items:
+                heapq.heappush(self._heap, it)
+
     def next_time(self) -> float | None:
         return self._heap[0][0] if self._heap else None
 

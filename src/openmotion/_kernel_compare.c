@@ -1,0 +1,996 @@
+/* The compare engine's solvers, compiled (openmotion._compare): exact trigger times on
+ * piecewise-cubic tracks for every job kind (control/trigger/compare_math.py calls them).
+ *
+ * A separate extension module (not entries in _kernel.c's method table): it has several
+ * entry points of its own, shares no state with the stepper kernel, and its build can
+ * change without touching the kernel's table.
+ *
+ * A track is five float64 arrays (ts, p0, v0, a0, j): record k covers [ts[k], ts[k+1]),
+ * the last is open-ended (compare_math.Track). Every formula repeats the operation order
+ * of the plain-float Python versions kept as oracles in tests/compare_oracle.py, so the
+ * times are the same floats (compiled with -ffp-contract=off: no fused multiply-add;
+ * Python's max/min are `pymax`/`pymin`, which keep the first argument on ties and NaN).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef __clang__
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+#define EPS 2.220446049250313e-16
+#define SNAP_RTOL 1e-10
+#define MAX_AXES 8
+
+static inline double pymax(double a, double b) { return b > a ? b : a; }
+static inline double pymin(double a, double b) { return b < a ? b : a; }
+static inline int isign(double x) { return x > 0.0 ? 1 : x < 0.0 ? -1 : 0; }
+
+/* ------------------------------------------------------------------ buffers */
+typedef struct {
+    const double *ts, *p0, *v0, *a0, *j;
+    Py_ssize_t n;
+} Trk;
+
+typedef struct {
+    Py_buffer b[5];
+    int held;
+} TrkBuf;
+
+static int get_vec(PyObject *o, Py_buffer *b, const char *name)
+{
+    if (PyObject_GetBuffer(o, b, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) return -1;
+    const char *f = b->format ? b->format : "B";
+    size_t fl = strlen(f);
+    if (b->itemsize != 8 || fl == 0 || f[fl - 1] != 'd') {
+        PyBuffer_Release(b);
+        PyErr_Format(PyExc_TypeError, "%s must be a float64 array", name);
+        return -1;
+    }
+    return 0;
+}
+
+static void release_track(TrkBuf *tb)
+{
+    for (int k = 0; k < tb->held; k++) PyBuffer_Release(&tb->b[k]);
+    tb->held = 0;
+}
+
+static int get_track(PyObject *o, Trk *t, TrkBuf *tb)
+{
+    tb->held = 0;
+    PyObject *seq = PySequence_Fast(o, "track must be a sequence of 5 arrays");
+    if (seq == NULL) return -1;
+    if (PySequence_Fast_GET_SIZE(seq) != 5) {
+        Py_DECREF(seq);
+        PyErr_SetString(PyExc_ValueError, "track must hold 5 arrays (ts, p0, v0, a0, j)");
+        return -1;
+    }
+    PyObject **items = PySequence_Fast_ITEMS(seq);
+    for (int k = 0; k < 5; k++) {
+        if (get_vec(items[k], &tb->b[k], "track column") < 0) {
+            Py_DECREF(seq);
+            release_track(tb);
+            return -1;
+        }
+        tb->held = k + 1;
+    }
+    Py_DECREF(seq);
+    Py_ssize_t n = tb->b[0].len / 8;
+    for (int k = 1; k < 5; k++)
+        if (tb->b[k].len / 8 != n) {
+            release_track(tb);
+            PyErr_SetString(PyExc_ValueError, "track columns differ in length");
+            return -1;
+        }
+    if (n == 0) {
+        release_track(tb);
+        PyErr_SetString(PyExc_ValueError, "track must hold at least one record");
+        return -1;
+    }
+    t->ts = tb->b[0].buf; t->p0 = tb->b[1].buf; t->v0 = tb->b[2].buf;
+    t->a0 = tb->b[3].buf; t->j = tb->b[4].buf; t->n = n;
+    return 0;
+}
+
+/* ------------------------------------------------------------------ level events */
+/* crossings.velocity_roots, in its tuple order; returns the count */
+static int velocity_roots(double v, double a, double j, double *r)
+{
+    double h = 0.5 * j;
+    if (h == 0.0) {
+        if (a != 0.0) { r[0] = -v / a; return 1; }
+        return 0;
+    }
+    double disc = a * a - 4.0 * h * v;
+    if (disc < 0.0) return 0;
+    double q = -0.5 * (a + copysign(sqrt(disc), a));
+    if (q != 0.0) { r[0] = q / h; r[1] = v / q; return 2; }
+    r[0] = 0.0;
+    return 1;
+}
+
+/* compare_roots._f: position minus level, snapped to 0 within rounding of the terms */
+static inline double snapped(double c, double v, double a, double j, double x, double level,
+                             double p)
+{
+    double f = c + x * (v + x * (a / 2.0 + x * j / 6.0));
+    double scale = fabs(level) + fabs(p) + fabs(x * v) + fabs(x * x * a / 2.0)
+                   + fabs(x * x * x * j / 6.0);
+    return fabs(f) <= 8.0 * EPS * scale ? 0.0 : f;
+}
+
+/* compare_roots._refine: Newton inside the sign bracket */
+static double refine(double c, double v, double a, double j, double lo, double hi, int s_lo,
+                     double t_base)
+{
+    double x = 0.5 * (lo + hi);
+    double tb = fabs(t_base);
+    double a2 = a / 2.0;
+    int up = s_lo > 0;
+    for (int it = 0; it < 200; it++) {
+        double f = c + x * (v + x * (a2 + x * j / 6.0));
+        if (up ? (f > 0.0) : (f < 0.0)) lo = x; else hi = x;
+        double tol = 2.0 * EPS * (tb + fabs(x));
+        if (hi - lo <= tol) return hi;
+        double d = v + x * (a + x * j / 2.0);
+        double xn = d != 0.0 ? x - f / d : NAN;
+        if (!(lo < xn && xn < hi)) xn = 0.5 * (lo + hi);
+        else if (fabs(xn - x) <= tol) return xn;
+        x = xn;
+    }
+    return hi;
+}
+
+/* the most events level_events can return for a track of n records */
+static inline Py_ssize_t max_events(Py_ssize_t n) { return 6 * n + 2; }
+
+/* compare_roots.level_events: times in (t, t1] where the track reaches `level`; writes
+ * them to out (room for max_events(n)) and returns their count */
+static Py_ssize_t level_events(const Trk *T, double level, double t, double t1,
+                               int direction, int first, double *out)
+{
+    Py_ssize_t n = T->n, k = 0, m = 0;
+    while (k + 1 < n && T->ts[k + 1] <= t) k++;
+    int have_left = 0, s_left = 0, ends_at_t1 = 0;
+    double f_end = 1.0;
+    for (; k < n; k++) {
+        double tk = T->ts[k];
+        if (tk > t1) break;
+        double end = k + 1 < n ? T->ts[k + 1] : INFINITY;
+        double xa = pymax(t - tk, 0.0), xb = pymin(end, t1) - tk;
+        double p = T->p0[k], v = T->v0[k], a = T->a0[k], j = T->j[k];
+        double c = p - level;
+        double r[2], cuts[4];
+        int nr = velocity_roots(v, a, j, r), nc = 0;
+        cuts[nc++] = xa;
+        double in[2];
+        int ni = 0;
+        for (int q = 0; q < nr; q++)
+            if (xa < r[q] && r[q] < xb) in[ni++] = r[q];
+        if (ni == 2 && in[1] < in[0]) { double s = in[0]; in[0] = in[1]; in[1] = s; }
+        for (int q = 0; q < ni; q++) cuts[nc++] = in[q];
+        cuts[nc++] = xb;
+        for (int q = 0; q + 1 < nc; q++) {
+            double u = cuts[q], w = cuts[q + 1];
+            if (!(w > u)) continue;
+            double fu = snapped(c, v, a, j, u, level, p);
+            double fw = snapped(c, v, a, j, w, level, p);
+            int su = isign(fu), sw = isign(fw);
+            if (!have_left) {
+                have_left = 1;
+                s_left = su;  /* the scan starts at t: no event there */
+            } else if ((s_left < 0 && 0 <= fu && direction >= 0)
+                       || (s_left > 0 && 0 >= fu && direction <= 0)) {
+                out[m++] = tk + u;  /* arrival at a piece start */
+                if (first) return m;
+            }
+            if (su * sw < 0 && (direction == 0 || direction == -su)) {
+                out[m++] = tk + refine(c, v, a, j, u, w, su, tk);
+                if (first) return m;
+            }
+            s_left = sw != 0 ? sw : su;
+            f_end = fw;
+            ends_at_t1 = end >= t1;
+        }
+    }
+    if (ends_at_t1 && f_end == 0.0 && have_left && s_left != 0
+            && (direction == 0 || direction == -s_left))
+        out[m++] = t1;  /* arrival exactly at the window end */
+    return m;
+}
+
+/* compare_math.positions at one time */
+static inline double position(const Trk *T, double x)
+{
+    Py_ssize_t lo = 0, hi = T->n;  /* bisect_right */
+    while (lo < hi) {
+        Py_ssize_t mid = (lo + hi) / 2;
+        if (x < T->ts[mid]) hi = mid; else lo = mid + 1;
+    }
+    Py_ssize_t k = lo - 1 > 0 ? lo - 1 : 0;
+    double dt = x - T->ts[k];
+    return T->p0[k] + dt * (T->v0[k] + dt * (T->a0[k] / 2.0 + dt * T->j[k] / 6.0));
+}
+
+/* compare_math.track_range: (min, max) of the track over [ta, t1] */
+static void track_range(const Trk *T, double ta, double t1, double *lo_o, double *hi_o)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    Py_ssize_t n = T->n;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double a_k = T->ts[k];
+        double b_k = k + 1 < n ? T->ts[k + 1] : INFINITY;
+        double u = pymax(a_k, ta), w = pymin(b_k, t1);
+        if (w < u) continue;
+        double p = T->p0[k], v = T->v0[k], a = T->a0[k], j = T->j[k];
+        double xs[4], r[2];
+        int nx = 0, nr = velocity_roots(v, a, j, r);
+        xs[nx++] = u - a_k;
+        xs[nx++] = w - a_k;
+        for (int q = 0; q < nr; q++)
+            if (u - a_k < r[q] && r[q] < w - a_k) xs[nx++] = r[q];
+        for (int q = 0; q < nx; q++) {
+            double x = xs[q];
+            double y = p + x * (v + x * (a / 2.0 + x * j / 6.0));
+            lo = pymin(lo, y);
+            hi = pymax(hi, y);
+        }
+    }
+    *lo_o = lo;
+    *hi_o = hi;
+}
+
+/* ------------------------------------------------------------------ window */
+typedef struct {
+    double *buf;
+    Py_ssize_t cap;
+} Scratch;
+
+static int reserve(Scratch *s, Py_ssize_t n)
+{
+    if (n <= s->cap) return 0;
+    double *b = realloc(s->buf, (size_t)n * sizeof(double));
+    if (b == NULL) { PyErr_NoMemory(); return -1; }
+    s->buf = b;
+    s->cap = n;
+    return 0;
+}
+
+/* compare_math.first_inside: the first time in [t, t1] every track is within +-maxerr of
+ * its centre. Returns 1 and *x, 0 for none, -1 on error. lo/hi: each track's range. */
+static int first_inside(const Trk *T, int na, const double *centre, double maxerr, double t,
+                        double t1, const double *lo, const double *hi, Scratch *sc,
+                        double *x_out)
+{
+    double lim[MAX_AXES];
+    Py_ssize_t need = 1;
+    for (int i = 0; i < na; i++) need += 2 * max_events(T[i].n);
+    if (reserve(sc, need) < 0) return -1;
+    double *cand = sc->buf;
+    Py_ssize_t m = 0;
+    cand[m++] = t;
+    for (int i = 0; i < na; i++) {
+        double c = centre[i];
+        double slack = 1e-9 * (fabs(c) + maxerr + 1.0);
+        if (c + maxerr < lo[i] - slack || c - maxerr > hi[i] + slack) return 0;
+        lim[i] = maxerr + 1e-12 * (fabs(c) + maxerr + 1.0);
+        double lv[2] = {c - maxerr, c + maxerr};
+        for (int q = 0; q < 2; q++) {
+            if (!(lo[i] - slack <= lv[q] && lv[q] <= hi[i] + slack)) continue;
+            m += level_events(&T[i], lv[q], t, t1, 0, 0, cand + m);
+        }
+    }
+    /* stable insertion sort (few candidates): equal times keep their first entry */
+    for (Py_ssize_t a = 1; a < m; a++) {
+        double key = cand[a];
+        Py_ssize_t b = a - 1;
+        while (b >= 0 && key < cand[b]) { cand[b + 1] = cand[b]; b--; }
+        cand[b + 1] = key;
+    }
+    for (Py_ssize_t a = 0; a < m; a++) {
+        double x = cand[a];
+        if (a > 0 && x == cand[a - 1]) continue;
+        if (!(t <= x && x <= t1)) continue;
+        int ok = 1;
+        for (int i = 0; i < na && ok; i++)
+            ok = fabs(position(&T[i], x) - centre[i]) <= lim[i];
+        if (ok) { *x_out = x; return 1; }
+    }
+    return 0;
+}
+
+static int get_tracks(PyObject *seq_o, Trk *T, TrkBuf *tb, int *na_out)
+{
+    PyObject *seq = PySequence_Fast(seq_o, "tracks must be a sequence of tracks");
+    if (seq == NULL) return -1;
+    Py_ssize_t na = PySequence_Fast_GET_SIZE(seq);
+    if (na < 1 || na > MAX_AXES) {
+        Py_DECREF(seq);
+        PyErr_Format(PyExc_ValueError, "tracks: 1..%d axes, got %zd", MAX_AXES, na);
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < na; i++) {
+        if (get_track(PySequence_Fast_GET_ITEM(seq, i), &T[i], &tb[i]) < 0) {
+            for (Py_ssize_t q = 0; q < i; q++) release_track(&tb[q]);
+            Py_DECREF(seq);
+            return -1;
+        }
+    }
+    Py_DECREF(seq);
+    *na_out = (int)na;
+    return 0;
+}
+
+static int get_ranges(PyObject *o, int na, double *lo, double *hi)
+{
+    if (o == Py_None) {
+        for (int i = 0; i < na; i++) { lo[i] = -INFINITY; hi[i] = INFINITY; }
+        return 0;
+    }
+    PyObject *seq = PySequence_Fast(o, "ranges must be a sequence of (lo, hi)");
+    if (seq == NULL) return -1;
+    if (PySequence_Fast_GET_SIZE(seq) != na) {
+        Py_DECREF(seq);
+        PyErr_SetString(PyExc_ValueError, "ranges: one (lo, hi) per track");
+        return -1;
+    }
+    for (int i = 0; i < na; i++) {
+        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(seq, i), "dd", &lo[i], &hi[i])) {
+            Py_DECREF(seq);
+            return -1;
+        }
+    }
+    Py_DECREF(seq);
+    return 0;
+}
+
+PyDoc_STRVAR(window_scan_doc,
+"window_scan(tracks, ranges, points, maxerr, index, t, t1) -> list of times\n\n"
+"A WindowJob's scan of one window: from point `index` of points (float64[n, k], one\n"
+"column per track), the first time in [t, t1] all tracks are within +-maxerr of the\n"
+"point (compare_math.first_inside), then the next point from that time on, until one\n"
+"is not reached. ranges: each track's (min, max) over the window, or None.");
+
+static PyObject *window_scan(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o, *rg_o, *pt_o;
+    double maxerr, t, t1;
+    Py_ssize_t index;
+    if (!PyArg_ParseTuple(args, "OOOdndd", &tr_o, &rg_o, &pt_o, &maxerr, &index, &t, &t1))
+        return NULL;
+    Trk T[MAX_AXES];
+    TrkBuf tb[MAX_AXES];
+    int na;
+    if (get_tracks(tr_o, T, tb, &na) < 0) return NULL;
+    PyObject *res = NULL;
+    double lo[MAX_AXES], hi[MAX_AXES];
+    Py_buffer pb;
+    if (get_ranges(rg_o, na, lo, hi) < 0) goto done_tracks;
+    if (get_vec(pt_o, &pb, "points") < 0) goto done_tracks;
+    Py_ssize_t n = pb.len / 8 / na;
+    if (n * na * 8 != pb.len) {
+        PyErr_SetString(PyExc_ValueError, "points must be float64[n, len(tracks)]");
+        goto done_points;
+    }
+    res = PyList_New(0);
+    if (res == NULL) goto done_points;
+    const double *pts = pb.buf;
+    Scratch sc = {NULL, 0};
+    while (index < n) {
+        double x;
+        int r = first_inside(T, na, pts + index * na, maxerr, t, t1, lo, hi, &sc, &x);
+        if (r < 0) { Py_CLEAR(res); break; }
+        if (r == 0) break;
+        PyObject *f = PyFloat_FromDouble(x);
+        if (f == NULL || PyList_Append(res, f) < 0) { Py_XDECREF(f); Py_CLEAR(res); break; }
+        Py_DECREF(f);
+        index++;
+        t = x;
+    }
+    free(sc.buf);
+done_points:
+    PyBuffer_Release(&pb);
+done_tracks:
+    for (int i = 0; i < na; i++) release_track(&tb[i]);
+    return res;
+}
+
+PyDoc_STRVAR(first_inside_doc,
+"first_inside(tracks, centre, maxerr, t, t1, ranges) -> time or None\n\n"
+"The first time in [t, t1] every track is within +-maxerr of its centre (float64[k]).");
+
+static PyObject *first_inside_py(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o, *c_o, *rg_o;
+    double maxerr, t, t1;
+    if (!PyArg_ParseTuple(args, "OOdddO", &tr_o, &c_o, &maxerr, &t, &t1, &rg_o)) return NULL;
+    Trk T[MAX_AXES];
+    TrkBuf tb[MAX_AXES];
+    int na;
+    if (get_tracks(tr_o, T, tb, &na) < 0) return NULL;
+    PyObject *res = NULL;
+    double lo[MAX_AXES], hi[MAX_AXES];
+    Py_buffer cb;
+    if (get_ranges(rg_o, na, lo, hi) < 0) goto done;
+    if (get_vec(c_o, &cb, "centre") < 0) goto done;
+    if (cb.len != 8 * na) {
+        PyErr_SetString(PyExc_ValueError, "centre: one coordinate per track");
+    } else {
+        Scratch sc = {NULL, 0};
+        double x;
+        int r = first_inside(T, na, cb.buf, maxerr, t, t1, lo, hi, &sc, &x);
+        free(sc.buf);
+        if (r > 0) res = PyFloat_FromDouble(x);
+        else if (r == 0) res = Py_NewRef(Py_None);
+    }
+    PyBuffer_Release(&cb);
+done:
+    for (int i = 0; i < na; i++) release_track(&tb[i]);
+    return res;
+}
+
+PyDoc_STRVAR(positions_doc,
+"positions(tracks, times, out)\n\n"
+"out[i, k] = position of track k at times[i] (compare_math.positions, every track at\n"
+"once); out: a writable C-contiguous float64 (len(times), len(tracks)) array.");
+
+static PyObject *positions_py(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o, *t_o, *out_o;
+    if (!PyArg_ParseTuple(args, "OOO", &tr_o, &t_o, &out_o)) return NULL;
+    PyObject *trs = PySequence_Fast(tr_o, "tracks must be a sequence of tracks");
+    if (trs == NULL) return NULL;
+    PyObject *res = NULL, *ts = NULL;
+    double *x = NULL;
+    Py_buffer ob;
+    int have_out = 0;
+    Py_ssize_t na = PySequence_Fast_GET_SIZE(trs);
+    ts = PySequence_Fast(t_o, "times must be a sequence");
+    if (ts == NULL) goto done;
+    if (PyObject_GetBuffer(out_o, &ob, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE | PyBUF_FORMAT) < 0)
+        goto done;
+    have_out = 1;
+    Py_ssize_t m = PySequence_Fast_GET_SIZE(ts);
+    size_t fl = ob.format ? strlen(ob.format) : 0;
+    if (ob.itemsize != 8 || fl == 0 || ob.format[fl - 1] != 'd' || ob.len != 8 * m * na) {
+        PyErr_SetString(PyExc_ValueError, "out must be float64[len(times), len(tracks)]");
+        goto done;
+    }
+    x = malloc((size_t)(m > 0 ? m : 1) * sizeof(double));
+    if (x == NULL) { PyErr_NoMemory(); goto done; }
+    for (Py_ssize_t i = 0; i < m; i++) {
+        x[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(ts, i));
+        if (x[i] == -1.0 && PyErr_Occurred()) goto done;
+    }
+    double *out = ob.buf;
+    for (Py_ssize_t k = 0; k < na; k++) {  /* one track at a time: any number of axes */
+        Trk T;
+        TrkBuf tb;
+        if (get_track(PySequence_Fast_GET_ITEM(trs, k), &T, &tb) < 0) goto done;
+        for (Py_ssize_t i = 0; i < m; i++) out[i * na + k] = position(&T, x[i]);
+        release_track(&tb);
+    }
+    res = Py_NewRef(Py_None);
+done:
+    free(x);
+    if (have_out) PyBuffer_Release(&ob);
+    Py_XDECREF(ts);
+    Py_DECREF(trs);
+    return res;
+}
+
+/* ------------------------------------------------------------------ levels */
+/* The value list of a LevelJob: an array, or start + k * step (LevelSeq); `n` values,
+ * then `after` if has_after. */
+typedef struct {
+    const double *arr;
+    double start, step, after;
+    long long n;
+    int has_after;
+} Levels;
+
+static inline double level_at(const Levels *L, long long k)
+{
+    if (k < L->n) return L->arr ? L->arr[k] : L->start + (double)k * L->step;
+    return L->after;
+}
+
+static int get_levels(PyObject *o, long long n, PyObject *after_o, Levels *L, Py_buffer *b,
+                      int *held)
+{
+    *held = 0;
+    memset(L, 0, sizeof *L);
+    L->n = n;
+    if (PyTuple_Check(o) && PyTuple_GET_SIZE(o) == 2) {
+        if (!PyArg_ParseTuple(o, "dd", &L->start, &L->step)) return -1;
+    } else {
+        if (get_vec(o, b, "levels") < 0) return -1;
+        *held = 1;
+        if (b->len / 8 < n) {
+            PyErr_SetString(PyExc_ValueError, "levels shorter than their count");
+            return -1;
+        }
+        L->arr = b->buf;
+    }
+    if (after_o != Py_None) {
+        L->after = PyFloat_AsDouble(after_o);
+        if (L->after == -1.0 && PyErr_Occurred()) return -1;
+        L->has_after = 1;
+    }
+    return 0;
+}
+
+PyDoc_STRVAR(level_scan_doc,
+"level_scan(track, range, levels, n, after_final, index, t, t1, direction) -> list\n\n"
+"A LevelJob's scan of one window on an axis track: from value `index` on, the first\n"
+"crossing after t of each value in turn (level_events, first only), skipped when the\n"
+"value is out of the track's (min, max) `range` (+- 1e-9 relative); stops at the first\n"
+"value not reached. levels: float64 array or (start, step) for start + k * step; n\n"
+"values, then after_final (None: none). Returns [(time, level), ...].");
+
+static PyObject *level_scan(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o, *lv_o, *af_o;
+    double rlo, rhi, t, t1;
+    long long n, index;
+    int direction;
+    if (!PyArg_ParseTuple(args, "O(dd)OLOLddi", &tr_o, &rlo, &rhi, &lv_o, &n, &af_o, &index,
+                          &t, &t1, &direction))
+        return NULL;
+    Trk T;
+    TrkBuf tb;
+    if (get_track(tr_o, &T, &tb) < 0) return NULL;
+    Levels L;
+    Py_buffer lb;
+    int held;
+    PyObject *res = NULL;
+    if (get_levels(lv_o, n, af_o, &L, &lb, &held) < 0) goto done;
+    long long size = L.n + L.has_after;
+    Py_ssize_t cap = max_events(T.n);
+    double *ev = malloc((size_t)cap * sizeof(double));
+    if (ev == NULL) { PyErr_NoMemory(); goto done; }
+    res = PyList_New(0);
+    while (res != NULL && index < size) {
+        double lvl = level_at(&L, index);
+        double slack = 1e-9 * (fabs(lvl) + 1.0);
+        if (!(rlo - slack <= lvl && lvl <= rhi + slack)) break;
+        if (level_events(&T, lvl, t, t1, direction, 1, ev) == 0) break;
+        PyObject *it = Py_BuildValue("(dd)", ev[0], lvl);
+        if (it == NULL || PyList_Append(res, it) < 0) { Py_XDECREF(it); Py_CLEAR(res); break; }
+        Py_DECREF(it);
+        index++;
+        t = ev[0];
+    }
+    free(ev);
+done:
+    if (held) PyBuffer_Release(&lb);
+    release_track(&tb);
+    return res;
+}
+
+PyDoc_STRVAR(level_events_doc,
+"level_events(track, level, t, t1, direction=0, first=False) -> list of times\n\n"
+"Times in (t, t1] where the track reaches `level` (direction +1 up, -1 down, 0 both;\n"
+"the semantics of MotionHistory.crossings, compare_roots docstring).");
+
+static PyObject *level_events_py(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o;
+    double level, t, t1;
+    int direction = 0, first = 0;
+    if (!PyArg_ParseTuple(args, "Oddd|ip", &tr_o, &level, &t, &t1, &direction, &first))
+        return NULL;
+    Trk T;
+    TrkBuf tb;
+    if (get_track(tr_o, &T, &tb) < 0) return NULL;
+    Py_ssize_t cap = max_events(T.n);
+    double *ev = malloc((size_t)cap * sizeof(double));
+    PyObject *res = NULL;
+    if (ev == NULL) {
+        PyErr_NoMemory();
+    } else {
+        Py_ssize_t m = level_events(&T, level, t, t1, direction, first, ev);
+        res = PyList_New(m);
+        for (Py_ssize_t i = 0; res != NULL && i < m; i++) {
+            PyObject *f = PyFloat_FromDouble(ev[i]);
+            if (f == NULL) { Py_CLEAR(res); break; }
+            PyList_SET_ITEM(res, i, f);
+        }
+        free(ev);
+    }
+    release_track(&tb);
+    return res;
+}
+
+PyDoc_STRVAR(track_range_doc,
+"track_range(track, ta, t1) -> (min, max) of the track's position over [ta, t1]");
+
+static PyObject *track_range_py(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o;
+    double ta, t1;
+    if (!PyArg_ParseTuple(args, "Odd", &tr_o, &ta, &t1)) return NULL;
+    Trk T;
+    TrkBuf tb;
+    if (get_track(tr_o, &T, &tb) < 0) return NULL;
+    double lo, hi;
+    track_range(&T, ta, t1, &lo, &hi);
+    release_track(&tb);
+    return Py_BuildValue("(dd)", lo, hi);
+}
+
+/* ------------------------------------------------------------------ path length */
+/* Gauss-Legendre nodes and weights, set once from Python (compare_math._GL_X/_GL_W) so the
+ * compiled quadrature uses the very floats of the module. */
+static double gl_x[8], gl_w[8];
+static int gl_set = 0;
+
+/* VectorCycle._gl: the speed sqrt(Q(x)) of piece q integrated over [a, b] */
+static double gl(const double *q, double a, double b)
+{
+    double h = 0.5 * (b - a), acc = 0.0;
+    for (int k = 0; k < 8; k++) {
+        double x = a + h * (gl_x[k] + 1.0);
+        double y = q[0] + x * (q[1] + x * (q[2] + x * (q[3] + x * q[4])));
+        acc += y > 0.0 ? gl_w[k] * sqrt(y) : 0.0;
+    }
+    return h * acc;
+}
+
+static double adaptive(const double *q, double a, double b, int depth, double rtol,
+                       int max_depth)
+{
+    double m = 0.5 * (a + b);
+    double whole = gl(q, a, b);
+    double halves = gl(q, a, m) + gl(q, m, b);
+    if (fabs(halves - whole) <= rtol * pymax(fabs(halves), 1e-300) || depth >= max_depth)
+        return halves;
+    return adaptive(q, a, m, depth + 1, rtol, max_depth)
+           + adaptive(q, m, b, depth + 1, rtol, max_depth);
+}
+
+typedef struct {
+    const double *B, *S, *Q;
+    Py_ssize_t nb;  /* breakpoints; pieces nb - 1 */
+} Vc;
+
+/* VectorCycle.time_of: first time > after with s(t) >= d. Returns 1 and *t, or 0. */
+static int time_of(const Vc *V, double d, double after, double *t_out)
+{
+    const double *B = V->B, *S = V->S;
+    Py_ssize_t nb = V->nb;
+    double s_end = S[nb - 1];
+    if (d > s_end) {
+        if (d - s_end > SNAP_RTOL * pymax(fabs(d), 1.0)) return 0;
+        d = s_end;
+    }
+    Py_ssize_t lo_i = 0, hi_i = nb;  /* searchsorted left */
+    while (lo_i < hi_i) {
+        Py_ssize_t mid = (lo_i + hi_i) / 2;
+        if (S[mid] < d) lo_i = mid + 1; else hi_i = mid;
+    }
+    Py_ssize_t i = (lo_i > 1 ? lo_i : 1) - 1;
+    const double *q = V->Q + 5 * i;
+    double u = B[i];
+    double lo = pymax(after, u) - u, hi = B[i + 1] - u;
+    double su = S[i];
+    if (su + gl(q, 0.0, lo) >= d) {
+        if (u + lo > after) { *t_out = u + lo; return 1; }
+        return 0;
+    }
+    double x = 0.5 * (lo + hi);
+    for (int it = 0; it < 100; it++) {
+        double f = su + gl(q, 0.0, x) - d;
+        if (f >= 0.0) hi = x; else lo = x;
+        double tol = 4.0 * EPS * pymax(fabs(u + x), 1.0);
+        if (hi - lo <= tol) { *t_out = u + hi; return 1; }
+        double sp = sqrt(pymax(q[0] + x * (q[1] + x * (q[2] + x * (q[3] + x * q[4]))), 0.0));
+        double xn = sp > 0.0 ? x - f / sp : NAN;
+        if (fabs(xn - x) <= tol) {
+            *t_out = f < 0.0 ? u + pymax(xn, x) : u + x;
+            return 1;
+        }
+        if (!(lo < xn && xn < hi)) xn = 0.5 * (lo + hi);
+        x = xn;
+    }
+    *t_out = u + hi;
+    return 1;
+}
+
+typedef struct {
+    Py_buffer b[3];
+    int held;
+} VcBuf;
+
+static void release_vc(VcBuf *vb)
+{
+    for (int k = 0; k < vb->held; k++) PyBuffer_Release(&vb->b[k]);
+    vb->held = 0;
+}
+
+static int get_vc(PyObject *B, PyObject *S, PyObject *Q, Vc *V, VcBuf *vb)
+{
+    PyObject *o[3] = {B, S, Q};
+    static const char *names[3] = {"B", "S", "Q"};
+    vb->held = 0;
+    if (!gl_set) {
+        PyErr_SetString(PyExc_RuntimeError, "set_gauss was not called");
+        return -1;
+    }
+    for (int k = 0; k < 3; k++) {
+        if (get_vec(o[k], &vb->b[k], names[k]) < 0) { release_vc(vb); return -1; }
+        vb->held = k + 1;
+    }
+    Py_ssize_t nb = vb->b[0].len / 8;
+    if (nb < 2 || vb->b[1].len / 8 != nb || vb->b[2].len / 8 != 5 * (nb - 1)) {
+        release_vc(vb);
+        PyErr_SetString(PyExc_ValueError, "B, S need n >= 2 entries and Q (n - 1) x 5");
+        return -1;
+    }
+    V->B = vb->b[0].buf; V->S = vb->b[1].buf; V->Q = vb->b[2].buf; V->nb = nb;
+    return 0;
+}
+
+PyDoc_STRVAR(set_gauss_doc, "set_gauss(x, w): the 8 Gauss-Legendre nodes and weights.");
+
+static PyObject *set_gauss(PyObject *self, PyObject *args)
+{
+    PyObject *xo, *wo;
+    if (!PyArg_ParseTuple(args, "OO", &xo, &wo)) return NULL;
+    Py_buffer xb, wb;
+    if (get_vec(xo, &xb, "x") < 0) return NULL;
+    if (get_vec(wo, &wb, "w") < 0) { PyBuffer_Release(&xb); return NULL; }
+    int ok = xb.len == 64 && wb.len == 64;
+    if (ok) {
+        memcpy(gl_x, xb.buf, 64);
+        memcpy(gl_w, wb.buf, 64);
+        gl_set = 1;
+    }
+    PyBuffer_Release(&xb);
+    PyBuffer_Release(&wb);
+    if (!ok) {
+        PyErr_SetString(PyExc_ValueError, "set_gauss needs 8 nodes and 8 weights");
+        return NULL;
+    }
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(gl_doc,
+"gl(q, a, b) -> integral over [a, b] of sqrt(q0 + q1 x + ... + q4 x^4), 8-point GL");
+
+static PyObject *gl_py(PyObject *self, PyObject *args)
+{
+    double q[5], a, b;
+    if (!PyArg_ParseTuple(args, "(ddddd)dd", &q[0], &q[1], &q[2], &q[3], &q[4], &a, &b))
+        return NULL;
+    if (!gl_set) {
+        PyErr_SetString(PyExc_RuntimeError, "set_gauss was not called");
+        return NULL;
+    }
+    return PyFloat_FromDouble(gl(q, a, b));
+}
+
+PyDoc_STRVAR(adaptive_doc,
+"adaptive(q, a, b, rtol, max_depth) -> the integral of gl halved until two levels agree");
+
+static PyObject *adaptive_py(PyObject *self, PyObject *args)
+{
+    double q[5], a, b, rtol;
+    int max_depth;
+    if (!PyArg_ParseTuple(args, "(ddddd)dddi", &q[0], &q[1], &q[2], &q[3], &q[4], &a, &b,
+                          &rtol, &max_depth))
+        return NULL;
+    if (!gl_set) {
+        PyErr_SetString(PyExc_RuntimeError, "set_gauss was not called");
+        return NULL;
+    }
+    return PyFloat_FromDouble(adaptive(q, a, b, 0, rtol, max_depth));
+}
+
+PyDoc_STRVAR(vector_at_doc, "vector_at(B, S, Q, t) -> s(t) (VectorCycle.at)");
+
+static PyObject *vector_at(PyObject *self, PyObject *args)
+{
+    PyObject *B, *S, *Q;
+    double t;
+    if (!PyArg_ParseTuple(args, "OOOd", &B, &S, &Q, &t)) return NULL;
+    Vc V;
+    VcBuf vb;
+    if (get_vc(B, S, Q, &V, &vb) < 0) return NULL;
+    Py_ssize_t lo = 0, hi = V.nb;  /* searchsorted right */
+    while (lo < hi) {
+        Py_ssize_t mid = (lo + hi) / 2;
+        if (t < V.B[mid]) hi = mid; else lo = mid + 1;
+    }
+    Py_ssize_t i = lo - 1;
+    if (i > V.nb - 2) i = V.nb - 2;
+    if (i < 0) i = 0;
+    double s = V.S[i] + gl(V.Q + 5 * i, 0.0, t - V.B[i]);
+    release_vc(&vb);
+    return PyFloat_FromDouble(s);
+}
+
+PyDoc_STRVAR(vector_scan_doc,
+"vector_scan(B, S, Q, levels, n, after_final, index, t, first_only) -> list\n\n"
+"A LevelJob's scan of one window on a path length (VectorCycle B, S, Q): from value\n"
+"`index` on, the first time after t that s reaches each value in turn (time_of), until\n"
+"one is not reached (first_only: the value at `index` only). Returns [(time, level)].");
+
+static PyObject *vector_scan(PyObject *self, PyObject *args)
+{
+    PyObject *B, *S, *Q, *lv_o, *af_o;
+    long long n, index;
+    double t;
+    int first_only;
+    if (!PyArg_ParseTuple(args, "OOOOLOLdp", &B, &S, &Q, &lv_o, &n, &af_o, &index, &t,
+                          &first_only))
+        return NULL;
+    Vc V;
+    VcBuf vb;
+    if (get_vc(B, S, Q, &V, &vb) < 0) return NULL;
+    Levels L;
+    Py_buffer lb;
+    int held;
+    PyObject *res = NULL;
+    if (get_levels(lv_o, n, af_o, &L, &lb, &held) < 0) goto done;
+    long long size = L.n + L.has_after;
+    res = PyList_New(0);
+    while (res != NULL && index < size) {
+        double lvl = level_at(&L, index), tf;
+        if (!time_of(&V, lvl, t, &tf)) break;
+        PyObject *it = Py_BuildValue("(dd)", tf, lvl);
+        if (it == NULL || PyList_Append(res, it) < 0) { Py_XDECREF(it); Py_CLEAR(res); break; }
+        Py_DECREF(it);
+        if (first_only) break;
+        index++;
+        t = tf;
+    }
+done:
+    if (held) PyBuffer_Release(&lb);
+    release_vc(&vb);
+    return res;
+}
+
+PyDoc_STRVAR(time_of_doc, "time_of(B, S, Q, d, after) -> first time > after with s >= d, or None");
+
+static PyObject *time_of_py(PyObject *self, PyObject *args)
+{
+    PyObject *B, *S, *Q;
+    double d, after, tf;
+    if (!PyArg_ParseTuple(args, "OOOdd", &B, &S, &Q, &d, &after)) return NULL;
+    Vc V;
+    VcBuf vb;
+    if (get_vc(B, S, Q, &V, &vb) < 0) return NULL;
+    int r = time_of(&V, d, after, &tf);
+    release_vc(&vb);
+    if (!r) Py_RETURN_NONE;
+    return PyFloat_FromDouble(tf);
+}
+
+/* ------------------------------------------------------------------ output lines */
+/* compare_io.OutputLine.set applied to a sequence of (time, level): the edge lists t (floats,
+ * time-ordered) and lv (bools) are edited in place exactly as by one `set` call after the
+ * other. Times <= sent_until of sets that changed something are appended to `late`. */
+static int lv_of(PyObject *lst, Py_ssize_t k, int initial)
+{
+    if (k < 0) return initial;
+    PyObject *o = PyList_GET_ITEM(lst, k);
+    return o == Py_True ? 1 : o == Py_False ? 0 : PyObject_IsTrue(o) > 0;
+}
+
+static inline double as_double(PyObject *o)
+{
+    return PyFloat_Check(o) ? PyFloat_AS_DOUBLE(o) : PyFloat_AsDouble(o);
+}
+
+static int line_set_one(PyObject *tl, PyObject *ll, int initial, double t, int level,
+                        double sent_until, PyObject *late)
+{
+    Py_ssize_t n = PyList_GET_SIZE(tl), lo = 0, hi = n;
+    while (lo < hi) {  /* bisect_right */
+        Py_ssize_t mid = (lo + hi) / 2;
+        if (t < as_double(PyList_GET_ITEM(tl, mid))) hi = mid; else lo = mid + 1;
+    }
+    Py_ssize_t k = lo;
+    int before = lv_of(ll, k - 1, initial);
+    int after_same = k < n && lv_of(ll, k, initial) == level;
+    if (before == level && !after_same) return 0;
+    if (t <= sent_until) {
+        PyObject *f = PyFloat_FromDouble(t);
+        if (f == NULL || PyList_Append(late, f) < 0) { Py_XDECREF(f); return -1; }
+        Py_DECREF(f);
+    }
+    /* the insertion and OutputLine._merge, without moving the lists twice: the new edge
+     * at k is followed by edge k (old); drop k+1 (old k) if it repeats the new level, then
+     * the new one if it repeats the level before it */
+    int drop_next = after_same;  /* lv[k+1] == lv[k] == level */
+    int drop_new = before == level;
+    if (drop_next && drop_new) {  /* the old edge k goes, nothing is inserted */
+        if (PySequence_DelItem(tl, k) < 0 || PySequence_DelItem(ll, k) < 0) return -1;
+        return 0;
+    }
+    if (drop_next) {  /* the new edge replaces the old one at k */
+        PyObject *f = PyFloat_FromDouble(t);
+        if (f == NULL) return -1;
+        if (PyList_SetItem(tl, k, f) < 0) return -1;
+        return 0;
+    }
+    if (drop_new) return 0;  /* unreachable: handled by the early return above */
+    PyObject *f = PyFloat_FromDouble(t);
+    if (f == NULL) return -1;
+    int r = PyList_Insert(tl, k, f);
+    Py_DECREF(f);
+    if (r < 0 || PyList_Insert(ll, k, level ? Py_True : Py_False) < 0) return -1;
+    return 0;
+}
+
+PyDoc_STRVAR(line_set_doc,
+"line_set(t, lv, initial, times, levels, sent_until, late)\n\n"
+"OutputLine.set(times[i], levels[i]) for i in order, on the edge lists t (floats) and lv\n"
+"(bools) in place; set times <= sent_until that changed the waveform go to `late`.");
+
+static PyObject *line_set(PyObject *self, PyObject *args)
+{
+    PyObject *tl, *ll, *ts_o, *lvs_o, *late;
+    int initial;
+    double sent_until;
+    if (!PyArg_ParseTuple(args, "O!O!pOOdO!", &PyList_Type, &tl, &PyList_Type, &ll, &initial,
+                          &ts_o, &lvs_o, &sent_until, &PyList_Type, &late))
+        return NULL;
+    if (PyList_GET_SIZE(tl) != PyList_GET_SIZE(ll)) {
+        PyErr_SetString(PyExc_ValueError, "line_set: t and lv differ in length");
+        return NULL;
+    }
+    PyObject *ts = PySequence_Fast(ts_o, "times must be a sequence");
+    if (ts == NULL) return NULL;
+    PyObject *lvs = PySequence_Fast(lvs_o, "levels must be a sequence");
+    if (lvs == NULL) { Py_DECREF(ts); return NULL; }
+    Py_ssize_t m = PySequence_Fast_GET_SIZE(ts);
+    PyObject *res = NULL;
+    if (PySequence_Fast_GET_SIZE(lvs) != m) {
+        PyErr_SetString(PyExc_ValueError, "line_set: one level per time");
+        goto done;
+    }
+    for (Py_ssize_t i = 0; i < m; i++) {
+        double t = as_double(PySequence_Fast_GET_ITEM(ts, i));
+        if (t == -1.0 && PyErr_Occurred()) goto done;
+        int level = PyObject_IsTrue(PySequence_Fast_GET_ITEM(lvs, i));
+        if (level < 0 || line_set_one(tl, ll, initial, t, level, sent_until, late) < 0)
+            goto done;
+    }
+    res = Py_NewRef(Py_None);
+done:
+    Py_DECREF(lvs);
+    Py_DECREF(ts);
+    return res;
+}
+
+/* ------------------------------------------------------------------ module */
+static PyMethodDef methods[] = {
+    {"level_events", level_events_py, METH_VARARGS, level_events_doc},
+    {"level_scan", level_scan, METH_VARARGS, level_scan_doc},
+    {"track_range", track_range_py, METH_VARARGS, track_range_doc},
+    {"first_inside", first_inside_py, METH_VARARGS, first_inside_doc},
+    {"window_scan", window_scan, METH_VARARGS, window_scan_doc},
+    {"positions", positions_py, METH_VARARGS, positions_doc},
+    {"set_gauss", set_gauss, METH_VARARGS, set_gauss_doc},
+    {"gl", gl_py, METH_VARARGS, gl_doc},
+    {"adaptive", adaptive_py, METH_VARARGS, adaptive_doc},
+    {"vector_at", vector_at, METH_VARARGS, vector_at_doc},
+    {"time_of", time_of_py, METH_VARARGS, time_of_doc},
+    {"vector_scan", vector_scan, METH_VARARGS, vector_scan_doc},
+    {"line_set", line_set, METH_VARARGS, line_set_doc},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_compare",
+    "openmotion's compiled compare solvers (control/trigger/compare_math.py).", -1, methods,
+    NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__compare(void) { return PyModule_Create(&module); }

@@ -1,0 +1,318 @@
+"""The compare engine's solvers in plain Python: the test oracle of openmotion._compare.
+
+These are the Python versions the engine ran before the solvers were compiled
+(src/openmotion/_kernel_compare.c), moved here unchanged in their arithmetic (the
+one-implementation rule: src/ holds only the compiled one). The functions have the
+compiled module's signatures, so a test can run the whole engine on them by replacing
+`compare_math._ck` with this module (`use_oracle`), and compare every fired time, log row
+and output waveform with the compiled run (tests/test_compare_compiled.py).
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Sequence
+
+from openmotion.crossings import velocity_roots
+
+_EPS = 2.220446049250313e-16
+_SNAP_RTOL = 1e-10
+_GL_PAIRS: list[tuple[float, float]] = []
+
+
+# ---------------------------------------------------------------------------- level events
+def _f(c: float, v: float, a: float, j: float, x: float, level: float, p: float) -> float:
+    """Position minus level at local time x, snapped to 0 within rounding of the terms."""
+    f = c + x * (v + x * (a / 2.0 + x * j / 6.0))
+    scale = abs(level) + abs(p) + abs(x * v) + abs(x * x * a / 2.0) + abs(x * x * x * j / 6.0)
+    return 0.0 if abs(f) <= 8.0 * _EPS * scale else f
+
+
+def _sign(x: float) -> int:
+    return 1 if x > 0.0 else -1 if x < 0.0 else 0
+
+
+def _refine(c: float, v: float, a: float, j: float, lo: float, hi: float, s_lo: int,
+            t_base: float) -> float:
+    """Root of the monotone cubic in (lo, hi): Newton kept inside the sign bracket."""
+    x = 0.5 * (lo + hi)
+    tb = abs(t_base)
+    a2 = a / 2.0
+    up = s_lo > 0
+    for _ in range(200):
+        f = c + x * (v + x * (a2 + x * j / 6.0))
+        if (f > 0.0) if up else (f < 0.0):
+            lo = x
+        else:
+            hi = x
+        tol = 2.0 * _EPS * (tb + abs(x))
+        if hi - lo <= tol:
+            return hi
+        d = v + x * (a + x * j / 2.0)
+        xn = x - f / d if d != 0.0 else math.nan
+        if not lo < xn < hi:
+            xn = 0.5 * (lo + hi)
+        elif abs(xn - x) <= tol:
+            return xn
+        x = xn
+    return hi
+
+
+def _events(ts: Sequence[float], p0: Sequence[float], v0: Sequence[float],
+            a0: Sequence[float], j0: Sequence[float], level: float, t: float, t1: float,
+            direction: int = 0, first: bool = False) -> list[float]:
+    n = len(ts)
+    out: list[float] = []
+    k = 0
+    while k + 1 < n and ts[k + 1] <= t:
+        k += 1
+    s_left: int | None = None
+    f_end, ends_at_t1 = 1.0, False
+    while k < n:
+        tk = float(ts[k])
+        if tk > t1:
+            break
+        end = float(ts[k + 1]) if k + 1 < n else math.inf
+        xa, xb = max(t - tk, 0.0), min(end, t1) - tk
+        p, v, a, j = float(p0[k]), float(v0[k]), float(a0[k]), float(j0[k])
+        c = p - level
+        cuts = [xa, *sorted(r for r in velocity_roots(v, a, j) if xa < r < xb), xb]
+        for u, w in zip(cuts[:-1], cuts[1:], strict=True):
+            if not w > u:
+                continue
+            fu = _f(c, v, a, j, u, level, p)
+            fw = _f(c, v, a, j, w, level, p)
+            su, sw = _sign(fu), _sign(fw)
+            if s_left is None:
+                s_left = su
+            elif (s_left < 0 <= fu and direction >= 0) or (s_left > 0 >= fu and direction <= 0):
+                out.append(tk + u)
+                if first:
+                    return out
+            if su * sw < 0 and (direction == 0 or direction == -su):
+                out.append(tk + _refine(c, v, a, j, u, w, su, tk))
+                if first:
+                    return out
+            s_left = sw if sw != 0 else su
+            f_end, ends_at_t1 = fw, end >= t1
+        k += 1
+    if ends_at_t1 and f_end == 0.0 and s_left and (direction == 0 or direction == -s_left):
+        out.append(t1)
+    return out
+
+
+def _lists(track) -> tuple[list[float], ...]:  # noqa: ANN001
+    return tuple(list(map(float, c)) for c in track)
+
+
+def level_events(track, level: float, t: float, t1: float, direction: int = 0,  # noqa: ANN001
+                 first: bool = False) -> list[float]:
+    return _events(*_lists(track), float(level), t, t1, direction, first)
+
+
+def track_range(track, ta: float, t1: float) -> tuple[float, float]:  # noqa: ANN001
+    ts, p0, v0, a0, j0 = _lists(track)
+    lo, hi = math.inf, -math.inf
+    n = len(ts)
+    for k in range(n):
+        a_k = ts[k]
+        b_k = ts[k + 1] if k + 1 < n else math.inf
+        u, w = max(a_k, ta), min(b_k, t1)
+        if w < u:
+            continue
+        p, v, a, j = p0[k], v0[k], a0[k], j0[k]
+        xs = [u - a_k, w - a_k] + [r for r in velocity_roots(v, a, j) if u - a_k < r < w - a_k]
+        for x in xs:
+            y = p + x * (v + x * (a / 2.0 + x * j / 6.0))
+            lo, hi = min(lo, y), max(hi, y)
+    return lo, hi
+
+
+def _level(levels, n: int, after, k: int) -> float:  # noqa: ANN001
+    if k < n:
+        if isinstance(levels, tuple):
+            return levels[0] + k * levels[1]
+        return float(levels[k])
+    return float(after)
+
+
+def level_scan(track, rng, levels, n, after_final, index, t, t1, direction):  # noqa: ANN001, ANN201
+    """LevelJob.scan's loop on an axis track, as it was in Python."""
+    rec = _lists(track)
+    lo, hi = rng
+    size = n + (after_final is not None)
+    out = []
+    while index < size:
+        lvl = _level(levels, n, after_final, index)
+        slack = 1e-9 * (abs(lvl) + 1.0)
+        if not lo - slack <= lvl <= hi + slack:
+            break
+        times = _events(*rec, lvl, t, t1, direction, first=True)
+        if not times:
+            break
+        out.append((times[0], lvl))
+        index += 1
+        t = times[0]
+    return out
+
+
+# ---------------------------------------------------------------------------- window
+def _position(rec: tuple[list[float], ...], x: float) -> float:
+    ts, p0, v0, a0, j = rec
+    k = max(bisect.bisect_right(ts, x) - 1, 0)
+    dt = x - ts[k]
+    return p0[k] + dt * (v0[k] + dt * (a0[k] / 2.0 + dt * j[k] / 6.0))
+
+
+def first_inside(tracks, centre, maxerr: float, t: float, t1: float,  # noqa: ANN001
+                 ranges=None) -> float | None:  # noqa: ANN001
+    """compare_math.first_inside as it was in Python (plain floats, a set of candidates)."""
+    cands = {t}
+    rows = []
+    for k, (tr, c_) in enumerate(zip(tracks, centre, strict=True)):
+        c = float(c_)
+        lo_k, hi_k = ranges[k] if ranges is not None else (-math.inf, math.inf)
+        slack = 1e-9 * (abs(c) + maxerr + 1.0)
+        if c + maxerr < lo_k - slack or c - maxerr > hi_k + slack:
+            return None
+        rec = _lists(tr)
+        rows.append((rec, c, maxerr + 1e-12 * (abs(c) + maxerr + 1.0)))
+        for lvl in (c - maxerr, c + maxerr):
+            if not lo_k - slack <= lvl <= hi_k + slack:
+                continue
+            cands.update(_events(*rec, float(lvl), t, t1))
+    for x in sorted(cands):
+        if not t <= x <= t1:
+            continue
+        if all(abs(_position(rec, x) - c) <= lim for rec, c, lim in rows):
+            return float(x)
+    return None
+
+
+def window_scan(tracks, ranges, points, maxerr, index, t, t1):  # noqa: ANN001, ANN201
+    """WindowJob.scan's loop, as it was in Python."""
+    out = []
+    while index < len(points):
+        tf = first_inside(tracks, points[index], maxerr, t, t1, ranges)
+        if tf is None:
+            break
+        out.append(tf)
+        index += 1
+        t = tf
+    return out
+
+
+def positions(tracks, times, out) -> None:  # noqa: ANN001
+    """Every track's position at each time into out[i, k] (compare_math.positions)."""
+    for i, x in enumerate(times):
+        for k, tr in enumerate(tracks):
+            out[i, k] = _position(_lists(tr), float(x))
+
+
+# ---------------------------------------------------------------------------- path length
+def set_gauss(x, w) -> None:  # noqa: ANN001
+    _GL_PAIRS[:] = list(zip(list(map(float, x)), list(map(float, w)), strict=True))
+
+
+def gl(q, a: float, b: float) -> float:  # noqa: ANN001
+    q0, q1, q2, q3, q4 = q
+    h = 0.5 * (b - a)
+    acc = 0.0
+    for xg, wg in _GL_PAIRS:
+        x = a + h * (xg + 1.0)
+        y = q0 + x * (q1 + x * (q2 + x * (q3 + x * q4)))
+        acc += wg * math.sqrt(y) if y > 0.0 else 0.0
+    return h * acc
+
+
+def adaptive(q, a: float, b: float, rtol: float, max_depth: int, depth: int = 0) -> float:  # noqa: ANN001
+    m = 0.5 * (a + b)
+    whole = gl(q, a, b)
+    halves = gl(q, a, m) + gl(q, m, b)
+    if abs(halves - whole) <= rtol * max(abs(halves), 1e-300) or depth >= max_depth:
+        return halves
+    return (adaptive(q, a, m, rtol, max_depth, depth + 1)
+            + adaptive(q, m, b, rtol, max_depth, depth + 1))
+
+
+def _row(Q, i: int) -> tuple[float, ...]:  # noqa: ANN001
+    return tuple(float(x) for x in Q[i])
+
+
+def vector_at(B, S, Q, t: float) -> float:  # noqa: ANN001
+    i = min(max(bisect.bisect_right(list(B), t) - 1, 0), len(B) - 2)
+    return float(S[i]) + gl(_row(Q, i), 0.0, t - float(B[i]))
+
+
+def time_of(B, S, Q, d: float, after: float) -> float | None:  # noqa: ANN001
+    """VectorCycle.time_of as it was in Python."""
+    if d > S[-1]:
+        if d - S[-1] > _SNAP_RTOL * max(abs(d), 1.0):
+            return None
+        d = float(S[-1])
+    i = max(bisect.bisect_left(list(S), d), 1) - 1
+    u = float(B[i])
+    lo, hi = max(after, u) - u, float(B[i + 1]) - u
+    su = float(S[i])
+    q = _row(Q, i)
+    if su + gl(q, 0.0, lo) >= d:
+        return u + lo if u + lo > after else None
+    q0, q1, q2, q3, q4 = q
+    x = 0.5 * (lo + hi)
+    for _ in range(100):
+        f = su + gl(q, 0.0, x) - d
+        if f >= 0.0:
+            hi = x
+        else:
+            lo = x
+        tol = 4.0 * _EPS * max(abs(u + x), 1.0)
+        if hi - lo <= tol:
+            return u + hi
+        sp = math.sqrt(max(q0 + x * (q1 + x * (q2 + x * (q3 + x * q4))), 0.0))
+        xn = x - f / sp if sp > 0.0 else math.nan
+        if abs(xn - x) <= tol:
+            return u + max(xn, x) if f < 0.0 else u + x
+        if not lo < xn < hi:
+            xn = 0.5 * (lo + hi)
+        x = xn
+    return u + hi
+
+
+def vector_scan(B, S, Q, levels, n, after_final, index, t, first_only):  # noqa: ANN001, ANN201
+    """LevelJob.scan's loop on a path length, as it was in Python."""
+    size = n + (after_final is not None)
+    out = []
+    while index < size:
+        lvl = _level(levels, n, after_final, index)
+        tf = time_of(B, S, Q, lvl, t)
+        if tf is None:
+            break
+        out.append((tf, lvl))
+        if first_only:
+            break
+        index += 1
+        t = tf
+    return out
+
+
+# ---------------------------------------------------------------------------- output lines
+def line_set(t_list: list[float], lv_list: list[bool], initial: bool, times, levels,  # noqa: ANN001
+             sent_until: float, late: list[float]) -> None:
+    """OutputLine.set, one call after the other, as it was in Python."""
+    for t, level in zip(list(map(float, times)), levels, strict=True):
+        k = bisect.bisect_right(t_list, t)
+        before = lv_list[k - 1] if k else initial
+        after_same = k < len(t_list) and lv_list[k] == level
+        if before == level and not after_same:
+            continue
+        if t <= sent_until:
+            late.append(t)
+        t_list.insert(k, t)
+        lv_list.insert(k, bool(level))
+        for i in (k + 1, k):
+            if 0 <= i < len(t_list):
+                prev = lv_list[i - 1] if i else initial
+                if lv_list[i] == prev:
+                    del t_list[i]
+                    del lv_list[i]
