@@ -180,8 +180,32 @@ def _build(start: float, distance: float, times: Sequence[float], a_max: float,
            d_max: float, j_max: float, duration: float | None = None) -> Profile:
     """The seven-phase profile straight from its phase times: the arithmetic of
     ProfileBuilder (same operations in the same order, so bit for bit the same profile,
-    tests/test_jerk.py compares them) without its per-segment calls. The seven phases are
-    written out one after the other (a loop over them cost half of the build)."""
+    tests/test_jerk.py compares them) without its per-segment calls."""
+    rows, labels, t = _rows(start, distance, times, a_max, d_max, j_max)
+    # one array for all columns (each column a contiguous row of its transpose)
+    cols = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
+    return _profile(cols, start, distance, labels, t if duration is None else duration)
+
+
+def _profile(cols: np.ndarray, start: float, distance: float, labels: list[str],
+             duration: float) -> Profile:
+    """The Profile of the columns (t0, p0, v0, a0, j, dt) as rows of `cols`."""
+    dr = 1.0 if distance >= 0.0 else -1.0
+    # Profile's own fields set at once (it is a frozen dataclass without __post_init__:
+    # the same object Profile(...) makes, without its per-field frozen setattr)
+    prof = object.__new__(Profile)
+    prof.__dict__.update(t0=cols[0], p0=cols[1], v0=cols[2], a0=cols[3], j=cols[4],
+                         duration=duration, start=State(float(start), 0.0 * dr, 0.0),
+                         end=State(float(start + distance), 0.0 * dr, 0.0),
+                         labels=tuple(labels), dt=cols[5])
+    return prof
+
+
+def _rows(start: float, distance: float, times: Sequence[float], a_max: float,
+          d_max: float, j_max: float) -> tuple[list[float], list[str], float]:
+    """The phases that last, (t0, p0, v0, a0, j, dt) end to end, their labels and the end
+    time. The seven phases are written out one after the other (a loop over them cost
+    half of the build)."""
     dr = 1.0 if distance >= 0.0 else -1.0
     tj1, ta, _, tv, tj2, td, _ = times
     a_pk = min(a_max, j_max * tj1)
@@ -236,17 +260,7 @@ def _build(start: float, distance: float, times: Sequence[float], a_max: float,
         v = v + tj2 * (dn + tj2 * jp / 2.0)
         t += tj2
 
-    # one array for all columns (each column a contiguous row of its transpose)
-    t0, p0, v0, a0, jj, dts = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
-    # Profile's own fields set at once (it is a frozen dataclass without __post_init__:
-    # the same object Profile(...) makes, without its per-field frozen setattr)
-    prof = object.__new__(Profile)
-    prof.__dict__.update(t0=t0, p0=p0, v0=v0, a0=a0, j=jj,
-                         duration=t if duration is None else duration,
-                         start=State(float(start), 0.0 * dr, 0.0),
-                         end=State(float(start + distance), 0.0 * dr, 0.0),
-                         labels=tuple(labels), dt=dts)
-    return prof
+    return rows, labels, t
 
 
 def _build_with_builder(start: float, distance: float, times: Sequence[float],
@@ -341,7 +355,9 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
         _check_times(t)
     durs = [math.fsum(t) for t in times]
     t_sync = max(durs)
-    out = []
+    out: list[Profile | None] = []
+    rows: list[float] = []   # every moving axis's phases, one array for all of them
+    parts: list[tuple[int, int, list[str]]] = []
     for i in range(n):
         v, a, d, j = lims[i]
         if t_sync <= 0.0:
@@ -356,6 +372,13 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
         if durs[i] < t_sync:
             cap = _synced_cap(abs(dists[i]), t_sync, v, a, d, j)
             tm = phase_times(abs(dists[i]), v, a, d, j, v_cap=cap)
-        # Float sums of phase times differ from T in the last ulp; pin every axis to T.
-        out.append(_build(st[i], dists[i], tm, a, d, j, duration=t_sync))
-    return out
+        r, labels, _ = _rows(st[i], dists[i], tm, a, d, j)
+        parts.append((i, len(rows) // 6, labels))
+        rows += r
+        out.append(None)
+    if parts:
+        cols = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
+        for i, k, labels in parts:
+            # Float sums of phase times differ from T in the last ulp; pin every axis to T.
+            out[i] = _profile(cols[:, k:k + len(labels)], st[i], dists[i], labels, t_sync)
+    return out  # type: ignore[return-value]
