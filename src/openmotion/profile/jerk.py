@@ -95,7 +95,13 @@ def phase_times(length: float, v_max: float, a_max: float, d_max: float,
     """The seven phase durations of the fastest move of `length` >= 0 (cruise capped)."""
     if length <= 0.0:
         return (0.0,) * 7
-    vp = peak_velocity(length, v_max, a_max, d_max, j_max)
+    return _times_at(length, v_max, a_max, d_max, j_max,
+                     peak_velocity(length, v_max, a_max, d_max, j_max), v_cap)
+
+
+def _times_at(length: float, v_max: float, a_max: float, d_max: float, j_max: float,
+              vp: float, v_cap: float | None = None) -> tuple[float, ...]:
+    """`phase_times` of a `length` > 0 whose peak velocity `vp` is known."""
     if v_cap is not None and v_cap < vp:
         vp = v_cap
     elif vp < v_max and vp * j_max < min(a_max, d_max) ** 2:
@@ -110,8 +116,9 @@ def phase_times(length: float, v_max: float, a_max: float, d_max: float,
 
 
 def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
-                d_max: float, j_max: float) -> float:
-    """Cruise cap vc whose capped move lasts exactly t_target (>= the optimum)."""
+                d_max: float, j_max: float, hi: float | None = None) -> float:
+    """Cruise cap vc whose capped move lasts exactly t_target (>= the optimum); `hi`:
+    the move's peak velocity when the caller has it."""
 
     def dur(vc: float) -> tuple[float, float]:
         # T(vc) and dT/dvc, from T = T_acc/2 + T_dec/2 + L/vc.
@@ -125,7 +132,8 @@ def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
                 dt += 0.5 / math.sqrt(vc * j_max)
         return t, dt
 
-    hi = peak_velocity(length, v_max, a_max, d_max, j_max)
+    if hi is None:
+        hi = peak_velocity(length, v_max, a_max, d_max, j_max)
     lo = length / t_target  # T(lo) >= t_target since T(vc) > L/vc
     # Both limits reached at vc (vc*J >= max(A, D)**2): T*vc = k*vc**2 + c*vc + L, a
     # quadratic with k = (1/A + 1/D)/2, c = (A + D)/(2J); its larger root (T decreasing
@@ -350,7 +358,10 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
             lims.append(_limits(vs[i], as_[i], js[i], ds[i]))
         except MotionError as e:
             raise MotionError(f"axis {i}: {e}") from None
-    times = [phase_times(abs(x), *lim) for x, lim in zip(dists, lims, strict=True)]
+    peaks = [peak_velocity(abs(x), *lim) if x != 0.0 else 0.0
+             for x, lim in zip(dists, lims, strict=True)]
+    times = [_times_at(abs(x), *lim, vp) if x != 0.0 else (0.0,) * 7
+             for x, lim, vp in zip(dists, lims, peaks, strict=True)]
     for t in times:
         _check_times(t)
     durs = [math.fsum(t) for t in times]
@@ -370,8 +381,8 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
             continue
         tm = times[i]
         if durs[i] < t_sync:
-            cap = _synced_cap(abs(dists[i]), t_sync, v, a, d, j)
-            tm = phase_times(abs(dists[i]), v, a, d, j, v_cap=cap)
+            cap = _synced_cap(abs(dists[i]), t_sync, v, a, d, j, peaks[i])
+            tm = _times_at(abs(dists[i]), v, a, d, j, peaks[i], v_cap=cap)
         r, labels, _ = _rows(st[i], dists[i], tm, a, d, j)
         parts.append((i, len(rows) // 6, labels))
         rows += r
