@@ -32,8 +32,20 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import MotionError, check_distance
-from ..limits import check_pulses, check_quantity
+from ..limits import (
+    PPS2_MAX,
+    PPS2_MIN,
+    PPS3_MAX,
+    PPS3_MIN,
+    PPS_MAX,
+    PPS_MIN,
+    check_pulses,
+    check_quantity,
+)
 from .segments import Profile, ProfileBuilder, State
+
+#: State(p, v, a) without the Python frame of the namedtuple's __new__ (the same tuple)
+_new_state = tuple.__new__
 
 NEWTON_STEPS = 10  # from within a factor sqrt(3) of the root, 7 reach full double precision
 
@@ -170,6 +182,12 @@ def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
 # ------------------------------------------------------------------ validation
 def _limits(v_max: float, a_max: float, j_max: float,
             d_max: float | None) -> tuple[float, float, float, float]:
+    if type(v_max) is float and type(a_max) is float and type(j_max) is float and \
+            PPS_MIN <= v_max <= PPS_MAX and PPS2_MIN <= a_max <= PPS2_MAX and \
+            PPS3_MIN <= j_max <= PPS3_MAX and (d_max is None or (
+                type(d_max) is float and PPS2_MIN <= d_max <= PPS2_MAX)):
+        # every value a float within its range: what check_quantity would return
+        return v_max, a_max, a_max if d_max is None else d_max, j_max
     v = check_quantity("v_max", v_max, "pps")
     a = check_quantity("a_max", a_max, "pps2")
     j = check_quantity("j_max", j_max, "pps3")
@@ -202,9 +220,11 @@ def _profile(cols: np.ndarray, start: float, distance: float, labels: list[str],
     # Profile's own fields set at once (it is a frozen dataclass without __post_init__:
     # the same object Profile(...) makes, without its per-field frozen setattr)
     prof = object.__new__(Profile)
+    z = 0.0 * dr
     prof.__dict__.update(t0=cols[0], p0=cols[1], v0=cols[2], a0=cols[3], j=cols[4],
-                         duration=duration, start=State(float(start), 0.0 * dr, 0.0),
-                         end=State(float(start + distance), 0.0 * dr, 0.0),
+                         duration=duration,
+                         start=_new_state(State, (float(start), z, 0.0)),
+                         end=_new_state(State, (float(start + distance), z, 0.0)),
                          labels=tuple(labels), dt=cols[5])
     return prof
 
