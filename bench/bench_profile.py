@@ -4,7 +4,9 @@ Plans the same N seeded random moves (distances 1e-3..1.3e8 pulses, v 1..1e7, a 
 j 1..1e12, half of them with a separate deceleration limit) with both libraries and prints
 agreement of durations, ruckig's failures, throughputs (CPU time; also with new objects
 per move, and three axes synchronised against ruckig 3-DoF, with the goals of issue 14)
-and the batch planner's peak memory.
+and the batch planner's peak memory. Each throughput is the least CPU time of 3 runs,
+the planners' runs taken in turn (one under a passing load would skew a ratio); ruckig's
+inputs are built before its timed loops, as ours are.
 
     python bench/bench_profile.py            # N = 100 000, batch of 1 000 000 (< 60 s)
     python bench/bench_profile.py --quick    # a few seconds
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import time
 import tracemalloc
 
@@ -56,6 +59,22 @@ def ruckig_inputs(dist, v, a, j, d) -> list:
     return out
 
 
+#: Runs of every timed loop; each figure is the least CPU time of its runs.
+ROUNDS = 3
+
+
+def least_times(fns: list, rounds: int) -> list[float]:
+    """The least CPU time of each function over `rounds` runs, the functions run in turn
+    (a change of load in between affects every planner alike)."""
+    best = [math.inf] * len(fns)
+    for _ in range(rounds):
+        for k, fn in enumerate(fns):
+            t0 = time.process_time()
+            fn()
+            best[k] = min(best[k], time.process_time() - t0)
+    return best
+
+
 def rate(n: int, seconds: float) -> float:
     return n / seconds if seconds > 0 else float("inf")
 
@@ -92,83 +111,91 @@ def main(argv: list[str] | None = None) -> None:
     rel_batch = np.abs(batch - ours) / ours
     ours_valid = np.isfinite(ours) & (ours > 0)
 
-    # throughput: ruckig on the cases it solves (no exceptions in the timed loop)
+    # throughput: every figure is the least CPU time of ROUNDS runs, the runs of all the
+    # planners taken in turn, so a change of the machine's load hits each of them alike
     solvable = [inp for inp, good in zip(inputs, ok, strict=True) if good]
-    t0 = time.process_time()
-    for inp in solvable:
-        otg.calculate(inp, traj)
-    t_ruckig = time.process_time() - t0
+
+    def ruckig_reused() -> None:  # ruckig on the cases it solves (no exceptions)
+        for inp in solvable:
+            otg.calculate(inp, traj)
 
     # the same with one reused InputParameter whose fields are set per move (a user's loop)
     one = ruckig.InputParameter(1)
     one.current_position = [0.0]
     fields = [(inp.target_position, inp.max_velocity, inp.max_acceleration,
                inp.min_acceleration, inp.max_jerk) for inp in solvable]
-    t0 = time.process_time()
-    for tp, mv, ma, mi, mj in fields:
-        one.target_position, one.max_velocity, one.max_acceleration = tp, mv, ma
-        one.min_acceleration, one.max_jerk = mi, mj
-        otg.calculate(one, traj)
-    t_ruckig_set = time.process_time() - t0
+
+    def ruckig_set() -> None:
+        for tp, mv, ma, mi, mj in fields:
+            one.target_position, one.max_velocity, one.max_acceleration = tp, mv, ma
+            one.min_acceleration, one.max_jerk = mi, mj
+            otg.calculate(one, traj)
 
     args_list = list(zip(dist.tolist(), v.tolist(), a.tolist(), j.tolist(), d.tolist(),
                          strict=True))
-    t0 = time.process_time()
-    for dd, vv, aa, jj, de in args_list:
-        jerk_limited(dd, vv, aa, jj, d_max=de)
-    t_profile = time.process_time() - t0
-    t0 = time.process_time()
-    for dd, vv, aa, jj, de in args_list:
-        jerk_limited_duration(dd, vv, aa, jj, d_max=de)
-    t_duration = time.process_time() - t0
+
+    def ours_profile() -> None:
+        for dd, vv, aa, jj, de in args_list:
+            jerk_limited(dd, vv, aa, jj, d_max=de)
+
+    def ours_duration() -> None:
+        for dd, vv, aa, jj, de in args_list:
+            jerk_limited_duration(dd, vv, aa, jj, d_max=de)
 
     # new objects per move (what a caller without a planner object pays), ruckig's cases
     m = min(len(solvable), 20_000)
     new_args = [(inp.target_position, inp.max_velocity, inp.max_acceleration,
                  inp.min_acceleration, inp.max_jerk) for inp in solvable[:m]]
-    t0 = time.process_time()
-    for tp, mv, ma, mi, mj in new_args:
-        otg1, inp1, tr1 = ruckig.Ruckig(1), ruckig.InputParameter(1), ruckig.Trajectory(1)
-        inp1.current_position = [0.0]
-        inp1.target_position, inp1.max_velocity, inp1.max_acceleration = tp, mv, ma
-        inp1.min_acceleration, inp1.max_jerk = mi, mj
-        otg1.calculate(inp1, tr1)
-    t_ruckig_new = time.process_time() - t0
+
+    def ruckig_new() -> None:
+        for tp, mv, ma, mi, mj in new_args:
+            otg1, inp1, tr1 = ruckig.Ruckig(1), ruckig.InputParameter(1), ruckig.Trajectory(1)
+            inp1.current_position = [0.0]
+            inp1.target_position, inp1.max_velocity, inp1.max_acceleration = tp, mv, ma
+            inp1.min_acceleration, inp1.max_jerk = mi, mj
+            otg1.calculate(inp1, tr1)
+
     ok_idx = np.flatnonzero(ok)[:m]
     ours_args = [args_list[i] for i in ok_idx.tolist()]
-    t0 = time.process_time()
-    for dd, vv, aa, jj, de in ours_args:
-        jerk_limited(dd, vv, aa, jj, d_max=de)
-    t_profile_new = time.process_time() - t0
+
+    def ours_new() -> None:
+        for dd, vv, aa, jj, de in ours_args:
+            jerk_limited(dd, vv, aa, jj, d_max=de)
 
     # three axes synchronised, new objects per move (moves of 3 consecutive random cases)
     k3 = (m // 3) * 3
     tri = [ok_idx[i:i + 3] for i in range(0, k3, 3)]
-    t0 = time.process_time()
-    for idx in tri:
-        otg3, inp3, tr3 = ruckig.Ruckig(3), ruckig.InputParameter(3), ruckig.Trajectory(3)
-        inp3.current_position = [0.0, 0.0, 0.0]
-        inp3.target_position = [abs(float(dist[i])) for i in idx]
-        inp3.max_velocity = [float(v[i]) for i in idx]
-        inp3.max_acceleration = [float(a[i]) for i in idx]
-        inp3.min_acceleration = [-float(d[i]) for i in idx]
-        inp3.max_jerk = [float(j[i]) for i in idx]
-        with contextlib.suppress(ruckig.RuckigError, ValueError):  # its failures
-            otg3.calculate(inp3, tr3)
-    t_ruckig3 = time.process_time() - t0
+    tri_in = [([abs(float(dist[i])) for i in idx], [float(v[i]) for i in idx],
+               [float(a[i]) for i in idx], [-float(d[i]) for i in idx],
+               [float(j[i]) for i in idx]) for idx in tri]
+
+    def ruckig3() -> None:
+        for tp, mv, ma, mi, mj in tri_in:
+            otg3, inp3, tr3 = ruckig.Ruckig(3), ruckig.InputParameter(3), ruckig.Trajectory(3)
+            inp3.current_position = [0.0, 0.0, 0.0]
+            inp3.target_position, inp3.max_velocity = tp, mv
+            inp3.max_acceleration, inp3.min_acceleration, inp3.max_jerk = ma, mi, mj
+            with contextlib.suppress(ruckig.RuckigError, ValueError):  # its failures
+                otg3.calculate(inp3, tr3)
+
     sync_args = [([abs(float(dist[i])) for i in idx], [float(v[i]) for i in idx],
                   [float(a[i]) for i in idx], [float(j[i]) for i in idx],
                   [float(d[i]) for i in idx]) for idx in tri]
-    t0 = time.process_time()
-    for dd, vv, aa, jj, de in sync_args:
-        jerk_limited_sync(dd, vv, aa, jj, d_max=de)
-    t_sync = time.process_time() - t0
+
+    def ours_sync() -> None:
+        for dd, vv, aa, jj, de in sync_args:
+            jerk_limited_sync(dd, vv, aa, jj, d_max=de)
 
     bd, bv, ba, bj, bdd = random_moves(n_batch, args.seed + 1)
     jerk_limited_durations(bd[:1000], bv[:1000], ba[:1000], bj[:1000], bdd[:1000])  # warm-up
-    t0 = time.process_time()
-    jerk_limited_durations(bd, bv, ba, bj, bdd)
-    t_batch = time.process_time() - t0
+
+    def ours_batch() -> None:
+        jerk_limited_durations(bd, bv, ba, bj, bdd)
+
+    (t_ruckig, t_ruckig_set, t_profile, t_duration, t_ruckig_new, t_profile_new,
+     t_ruckig3, t_sync, t_batch) = least_times(
+        [ruckig_reused, ruckig_set, ours_profile, ours_duration, ruckig_new, ours_new,
+         ruckig3, ours_sync, ours_batch], 1 if args.quick else ROUNDS)
     tracemalloc.start()
     jerk_limited_durations(bd, bv, ba, bj, bdd)
     _, peak = tracemalloc.get_traced_memory()

@@ -45,10 +45,8 @@ def check_finite(name: str, value: float, *, strict: bool = False) -> float:
     (even of one element) are refused, so a typing slip fails here and not deep in a
     planner. `strict` accepts only Python int and float (values read from files).
     """
-    if type(value) is float:  # the common case (NaN and infinities fail below)
-        if value - value == 0.0:
-            return value
-        raise MotionError(f"{name} must be finite, got {show(value)}")
+    if type(value) is float and math.isfinite(value):  # the common case, decided at once
+        return value
     if strict and (isinstance(value, bool) or not isinstance(value, (int, float))):
         raise MotionError(f"{name} must be a real number, got {show(value)}")
     if not is_real(value):

@@ -100,12 +100,15 @@ def check_quantity(name: str, value: object, kind: str, *, zero: bool = False,
         if (n < 0 and not signed) or abs(n) > r.maximum or (n == 0 and not zero):
             raise MotionError(f"{name} must be {rule}, got {show(value)}")
         return n
-    if not is_real(value):
-        check_finite(name, value)  # type: ignore[arg-type]  # raises: not a real number
-    try:
-        x = float(value)  # type: ignore[arg-type]
-    except OverflowError:  # an int beyond the float range
-        x = math.inf
+    if type(value) is float:  # the common case: no abstract-class check
+        x = value
+    else:
+        if not is_real(value):
+            check_finite(name, value)  # type: ignore[arg-type]  # raises: not a real number
+        try:
+            x = float(value)  # type: ignore[arg-type]
+        except OverflowError:  # an int beyond the float range
+            x = math.inf
     m = abs(x)
     if not math.isfinite(x) or (x < 0.0 and not signed) or m > r.maximum \
             or (x == 0.0 and not zero) or (0.0 < m < r.minimum and not signed and not zero):

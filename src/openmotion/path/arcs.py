@@ -85,8 +85,8 @@ class _Frame:
         last = self.centre + self.radius * (c * self.e1 + sn * self.e2) + self.helix
         object.__setattr__(self, "length", length)
         object.__setattr__(self, "lin", frozen(self.helix + (self.end - last)))
-        object.__setattr__(self, "t_start", frozen(self._tangent_at(np.asarray(0.0))))
-        object.__setattr__(self, "t_end", frozen(self._tangent_at(np.asarray(length))))
+        object.__setattr__(self, "t_start", frozen(self._tangent_one(0.0)))
+        object.__setattr__(self, "t_end", frozen(self._tangent_one(length)))
 
     def sub(self, s0: float, s1: float) -> _Frame:
         """The part [s0, s1] (0 <= s0 < s1 <= length) as a frame of its own: the same circle,
@@ -117,6 +117,14 @@ class _Frame:
     def tangent(self, s: ArrayLike) -> Array:
         ss = path_positions(s, self.length)
         return self._tangent_at(ss)
+
+    def _tangent_one(self, s: float) -> Array:
+        """`_tangent_at` at one s: the same operations on the (N,) vectors without the
+        broadcasting and np.linalg.norm dispatch (bit for bit, tests/test_arcs_fast.py)."""
+        phi = s * (self.sweep / self.length)
+        t = self.radius * self.sweep * (np.cos(phi) * self.e2 - np.sin(phi) * self.e1) \
+            + self.helix
+        return t / math.sqrt(np.add.reduce(t * t))
 
     def _tangent_at(self, ss: Array) -> Array:
         phi = (ss * (self.sweep / self.length))[..., None]

@@ -122,11 +122,19 @@ _LIMITS: weakref.WeakKeyDictionary[Any, tuple[tuple, tuple[float, float]]] = \
     weakref.WeakKeyDictionary()
 
 
+def _axes_key(vmax_ax: Array | None, amax_ax: Array | None) -> tuple:
+    """The per-axis part of `_element_limits`' memo key (computed once per plan)."""
+    return (None if vmax_ax is None else vmax_ax.tobytes(),
+            None if amax_ax is None else amax_ax.tobytes())
+
+
 def _element_limits(el: PathElement, feed: float, accel: float, vmax_ax: Array | None,
-                    amax_ax: Array | None, ratio: float) -> tuple[float, float]:
-    """(tangential accel, speed cap) of one element (memoized)."""
-    key = (feed, accel, ratio, None if vmax_ax is None else vmax_ax.tobytes(),
-           None if amax_ax is None else amax_ax.tobytes())
+                    amax_ax: Array | None, ratio: float,
+                    axes_key: tuple | None = None) -> tuple[float, float]:
+    """(tangential accel, speed cap) of one element (memoized). `axes_key`: the
+    caller's `_axes_key(vmax_ax, amax_ax)`, when it asks for many elements."""
+    key = (feed, accel, ratio) + (_axes_key(vmax_ax, amax_ax) if axes_key is None
+                                  else axes_key)
     try:
         hit = _LIMITS.get(el)
     except TypeError:  # an element that is not hashable or weak-referenceable
@@ -290,6 +298,8 @@ def _per_element(name: str, value: float | Sequence[float], n: int) -> list[floa
         raise MotionError(f"{name} must be a number > 0 or {n} of them, got {value!r}") from None
     if len(vals) != n:
         raise MotionError(f"{name} must be a number > 0 or {n} of them, got {len(vals)} values")
+    if all(0.0 < x < math.inf for x in vals):  # (NaN fails too) all good: no message built
+        return vals
     return [check_positive(f"{name}[{k}]", x) for k, x in enumerate(vals)]
 
 
@@ -365,7 +375,8 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
         return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0, d)
                      for f, a, d in zip(feeds, accels, decels, strict=True))
     els = [elements[k] for k in live]
-    lim = [_element_limits(el, feeds[k], accels[k], vmax_ax, amax_ax, ratio)
+    axes_key = _axes_key(vmax_ax, amax_ax)
+    lim = [_element_limits(el, feeds[k], accels[k], vmax_ax, amax_ax, ratio, axes_key)
            for el, k in zip(els, live, strict=True)]
     acc = [x[0] for x in lim]
     cap = [x[1] for x in lim]

@@ -32,8 +32,20 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import MotionError, check_distance
-from ..limits import check_pulses, check_quantity
+from ..limits import (
+    PPS2_MAX,
+    PPS2_MIN,
+    PPS3_MAX,
+    PPS3_MIN,
+    PPS_MAX,
+    PPS_MIN,
+    check_pulses,
+    check_quantity,
+)
 from .segments import Profile, ProfileBuilder, State
+
+#: State(p, v, a) without the Python frame of the namedtuple's __new__ (the same tuple)
+_new_state = tuple.__new__
 
 NEWTON_STEPS = 10  # from within a factor sqrt(3) of the root, 7 reach full double precision
 
@@ -95,7 +107,13 @@ def phase_times(length: float, v_max: float, a_max: float, d_max: float,
     """The seven phase durations of the fastest move of `length` >= 0 (cruise capped)."""
     if length <= 0.0:
         return (0.0,) * 7
-    vp = peak_velocity(length, v_max, a_max, d_max, j_max)
+    return _times_at(length, v_max, a_max, d_max, j_max,
+                     peak_velocity(length, v_max, a_max, d_max, j_max), v_cap)
+
+
+def _times_at(length: float, v_max: float, a_max: float, d_max: float, j_max: float,
+              vp: float, v_cap: float | None = None) -> tuple[float, ...]:
+    """`phase_times` of a `length` > 0 whose peak velocity `vp` is known."""
     if v_cap is not None and v_cap < vp:
         vp = v_cap
     elif vp < v_max and vp * j_max < min(a_max, d_max) ** 2:
@@ -110,8 +128,9 @@ def phase_times(length: float, v_max: float, a_max: float, d_max: float,
 
 
 def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
-                d_max: float, j_max: float) -> float:
-    """Cruise cap vc whose capped move lasts exactly t_target (>= the optimum)."""
+                d_max: float, j_max: float, hi: float | None = None) -> float:
+    """Cruise cap vc whose capped move lasts exactly t_target (>= the optimum); `hi`:
+    the move's peak velocity when the caller has it."""
 
     def dur(vc: float) -> tuple[float, float]:
         # T(vc) and dT/dvc, from T = T_acc/2 + T_dec/2 + L/vc.
@@ -125,7 +144,8 @@ def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
                 dt += 0.5 / math.sqrt(vc * j_max)
         return t, dt
 
-    hi = peak_velocity(length, v_max, a_max, d_max, j_max)
+    if hi is None:
+        hi = peak_velocity(length, v_max, a_max, d_max, j_max)
     lo = length / t_target  # T(lo) >= t_target since T(vc) > L/vc
     # Both limits reached at vc (vc*J >= max(A, D)**2): T*vc = k*vc**2 + c*vc + L, a
     # quadratic with k = (1/A + 1/D)/2, c = (A + D)/(2J); its larger root (T decreasing
@@ -134,7 +154,9 @@ def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
     c = (a_max + d_max) / (2.0 * j_max)
     b = t_target - c
     disc = b * b - 4.0 * k * length
-    vc = hi
+    # Newton from the left end L/T_sync: ~3.6 steps on bench_profile's moves, where the
+    # start at the peak velocity took ~26 (its first step overshoots, bisection follows)
+    vc = lo
     if b > 0.0 and disc >= 0.0:
         q = (b + math.sqrt(disc)) / (2.0 * k)
         if lo < q < hi and q * j_max >= max(a_max, d_max) ** 2:
@@ -160,6 +182,12 @@ def _synced_cap(length: float, t_target: float, v_max: float, a_max: float,
 # ------------------------------------------------------------------ validation
 def _limits(v_max: float, a_max: float, j_max: float,
             d_max: float | None) -> tuple[float, float, float, float]:
+    if type(v_max) is float and type(a_max) is float and type(j_max) is float and \
+            PPS_MIN <= v_max <= PPS_MAX and PPS2_MIN <= a_max <= PPS2_MAX and \
+            PPS3_MIN <= j_max <= PPS3_MAX and (d_max is None or (
+                type(d_max) is float and PPS2_MIN <= d_max <= PPS2_MAX)):
+        # every value a float within its range: what check_quantity would return
+        return v_max, a_max, a_max if d_max is None else d_max, j_max
     v = check_quantity("v_max", v_max, "pps")
     a = check_quantity("a_max", a_max, "pps2")
     j = check_quantity("j_max", j_max, "pps3")
@@ -168,7 +196,8 @@ def _limits(v_max: float, a_max: float, j_max: float,
 
 
 def _check_times(times: Sequence[float]) -> None:
-    if not all(math.isfinite(t) for t in times):
+    # a finite sum of the (non-negative) times means every time is finite: one test
+    if not math.isfinite(sum(times)) and not all(math.isfinite(t) for t in times):
         raise MotionError("distance, v_max, a_max, d_max and j_max must be within a numeric "
                           "range where the phase times are finite (magnitudes ~1e-100..1e100)")
 
@@ -178,38 +207,88 @@ def _build(start: float, distance: float, times: Sequence[float], a_max: float,
     """The seven-phase profile straight from its phase times: the arithmetic of
     ProfileBuilder (same operations in the same order, so bit for bit the same profile,
     tests/test_jerk.py compares them) without its per-segment calls."""
+    rows, labels, t = _rows(start, distance, times, a_max, d_max, j_max)
+    # one array for all columns (each column a contiguous row of its transpose)
+    cols = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
+    return _profile(cols, start, distance, labels, t if duration is None else duration)
+
+
+def _profile(cols: np.ndarray, start: float, distance: float, labels: list[str],
+             duration: float) -> Profile:
+    """The Profile of the columns (t0, p0, v0, a0, j, dt) as rows of `cols`."""
+    dr = 1.0 if distance >= 0.0 else -1.0
+    # Profile's own fields set at once (it is a frozen dataclass without __post_init__:
+    # the same object Profile(...) makes, without its per-field frozen setattr)
+    prof = object.__new__(Profile)
+    z = 0.0 * dr
+    prof.__dict__.update(t0=cols[0], p0=cols[1], v0=cols[2], a0=cols[3], j=cols[4],
+                         duration=duration,
+                         start=_new_state(State, (float(start), z, 0.0)),
+                         end=_new_state(State, (float(start + distance), z, 0.0)),
+                         labels=tuple(labels), dt=cols[5])
+    return prof
+
+
+def _rows(start: float, distance: float, times: Sequence[float], a_max: float,
+          d_max: float, j_max: float) -> tuple[list[float], list[str], float]:
+    """The phases that last, (t0, p0, v0, a0, j, dt) end to end, their labels and the end
+    time. The seven phases are written out one after the other (a loop over them cost
+    half of the build)."""
     dr = 1.0 if distance >= 0.0 else -1.0
     tj1, ta, _, tv, tj2, td, _ = times
     a_pk = min(a_max, j_max * tj1)
     d_pk = min(d_max, j_max * tj2)
+    # each phase's acceleration at its start and jerk, signed by the direction
+    z, ap, dn = 0.0 * dr, a_pk * dr, -d_pk * dr
+    jp, jn = j_max * dr, -j_max * dr
     p, v = float(start), 0.0 * dr
     t = 0.0
-    rows: list[tuple[float, float, float, float, float, float]] = []
+    rows: list[float] = []  # (t0, p0, v0, a0, j, dt) of each phase that lasts, end to end
     labels: list[str] = []
-    for k, (dt, jerk, acc) in enumerate(((tj1, j_max, 0.0), (ta, 0.0, a_pk),
-                                         (tj1, -j_max, a_pk), (tv, 0.0, 0.0),
-                                         (tj2, -j_max, 0.0), (td, 0.0, -d_pk),
-                                         (tj2, j_max, -d_pk))):
-        if dt <= 0.0:
-            continue
-        a = acc * dr
-        j = jerk * dr
-        rows.append((t, p, v, a, j, dt))
-        labels.append(PHASE_LABELS[k])
-        p = p + dt * (v + dt * (a / 2.0 + dt * j / 6.0))
-        v = v + dt * (a + dt * j / 2.0)
-        t += dt
-    # one array for all columns (each column a contiguous row of its transpose)
-    t0, p0, v0, a0, jj, dts = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
-    # Profile's own fields set at once (it is a frozen dataclass without __post_init__:
-    # the same object Profile(...) makes, without its per-field frozen setattr)
-    prof = object.__new__(Profile)
-    prof.__dict__.update(t0=t0, p0=p0, v0=v0, a0=a0, j=jj,
-                         duration=t if duration is None else duration,
-                         start=State(float(start), 0.0 * dr, 0.0),
-                         end=State(float(start + distance), 0.0 * dr, 0.0),
-                         labels=tuple(labels), dt=dts)
-    return prof
+    if tj1 > 0.0:
+        rows += (t, p, v, z, jp, tj1)
+        labels.append(PHASE_LABELS[0])
+        p = p + tj1 * (v + tj1 * (z / 2.0 + tj1 * jp / 6.0))
+        v = v + tj1 * (z + tj1 * jp / 2.0)
+        t += tj1
+    if ta > 0.0:
+        rows += (t, p, v, ap, z, ta)
+        labels.append(PHASE_LABELS[1])
+        p = p + ta * (v + ta * (ap / 2.0 + ta * z / 6.0))
+        v = v + ta * (ap + ta * z / 2.0)
+        t += ta
+    if tj1 > 0.0:
+        rows += (t, p, v, ap, jn, tj1)
+        labels.append(PHASE_LABELS[2])
+        p = p + tj1 * (v + tj1 * (ap / 2.0 + tj1 * jn / 6.0))
+        v = v + tj1 * (ap + tj1 * jn / 2.0)
+        t += tj1
+    if tv > 0.0:
+        rows += (t, p, v, z, z, tv)
+        labels.append(PHASE_LABELS[3])
+        p = p + tv * (v + tv * (z / 2.0 + tv * z / 6.0))
+        v = v + tv * (z + tv * z / 2.0)
+        t += tv
+    if tj2 > 0.0:
+        rows += (t, p, v, z, jn, tj2)
+        labels.append(PHASE_LABELS[4])
+        p = p + tj2 * (v + tj2 * (z / 2.0 + tj2 * jn / 6.0))
+        v = v + tj2 * (z + tj2 * jn / 2.0)
+        t += tj2
+    if td > 0.0:
+        rows += (t, p, v, dn, z, td)
+        labels.append(PHASE_LABELS[5])
+        p = p + td * (v + td * (dn / 2.0 + td * z / 6.0))
+        v = v + td * (dn + td * z / 2.0)
+        t += td
+    if tj2 > 0.0:
+        rows += (t, p, v, dn, jp, tj2)
+        labels.append(PHASE_LABELS[6])
+        p = p + tj2 * (v + tj2 * (dn / 2.0 + tj2 * jp / 6.0))
+        v = v + tj2 * (dn + tj2 * jp / 2.0)
+        t += tj2
+
+    return rows, labels, t
 
 
 def _build_with_builder(start: float, distance: float, times: Sequence[float],
@@ -299,12 +378,17 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
             lims.append(_limits(vs[i], as_[i], js[i], ds[i]))
         except MotionError as e:
             raise MotionError(f"axis {i}: {e}") from None
-    times = [phase_times(abs(x), *lim) for x, lim in zip(dists, lims, strict=True)]
+    peaks = [peak_velocity(abs(x), *lim) if x != 0.0 else 0.0
+             for x, lim in zip(dists, lims, strict=True)]
+    times = [_times_at(abs(x), *lim, vp) if x != 0.0 else (0.0,) * 7
+             for x, lim, vp in zip(dists, lims, peaks, strict=True)]
     for t in times:
         _check_times(t)
     durs = [math.fsum(t) for t in times]
     t_sync = max(durs)
-    out = []
+    out: list[Profile | None] = []
+    rows: list[float] = []   # every moving axis's phases, one array for all of them
+    parts: list[tuple[int, int, list[str]]] = []
     for i in range(n):
         v, a, d, j = lims[i]
         if t_sync <= 0.0:
@@ -317,8 +401,15 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
             continue
         tm = times[i]
         if durs[i] < t_sync:
-            cap = _synced_cap(abs(dists[i]), t_sync, v, a, d, j)
-            tm = phase_times(abs(dists[i]), v, a, d, j, v_cap=cap)
-        # Float sums of phase times differ from T in the last ulp; pin every axis to T.
-        out.append(_build(st[i], dists[i], tm, a, d, j, duration=t_sync))
-    return out
+            cap = _synced_cap(abs(dists[i]), t_sync, v, a, d, j, peaks[i])
+            tm = _times_at(abs(dists[i]), v, a, d, j, peaks[i], v_cap=cap)
+        r, labels, _ = _rows(st[i], dists[i], tm, a, d, j)
+        parts.append((i, len(rows) // 6, labels))
+        rows += r
+        out.append(None)
+    if parts:
+        cols = np.array(rows, dtype=np.float64).reshape(-1, 6).T.copy()
+        for i, k, labels in parts:
+            # Float sums of phase times differ from T in the last ulp; pin every axis to T.
+            out[i] = _profile(cols[:, k:k + len(labels)], st[i], dists[i], labels, t_sync)
+    return out  # type: ignore[return-value]

@@ -152,6 +152,7 @@ class Group(GroupSettings):
         self._unit_names = unit_names(controller, ax, units)  # messages in the user's units
         self._queue: deque[_Cmd] = deque()
         self._pre: dict[int, tuple[Any, ...]] = {}  # corners blended ahead (groupexec)
+        self._index_memo: tuple[Any, ...] | None = None  # (t, run, plan, index): index_at
         self._pre_tail: tuple[int, Any] | None = None
         self._queue_size = queue_size
         self._next_index = 0
@@ -237,10 +238,16 @@ class Group(GroupSettings):
         r = self._run or self._held
         if r is None:
             return -1
+        memo = self._index_memo  # asked several times a cycle (runner, outputs, progress)
+        if memo is not None and memo[0] == t and memo[1] is r and memo[2] is r.plan:
+            return memo[3]
         if r.plan is not None:
             chain = r.plan.chain
-            return chain.owners[chain.locate(r.plan.s_at(t))]
-        return r.cmds[0].index
+            idx = chain.owners[chain.locate(r.plan.s_at(t))]
+        else:
+            idx = r.cmds[0].index
+        self._index_memo = (t, r, r.plan, idx)
+        return idx
 
     def _due(self, ctl: Controller) -> float:
         """When the cycle hook may next act (control/groups/groupdue.py)."""

@@ -165,19 +165,22 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
     # a stall is a piece crawling at a speed rounding left (> 1e6 s at under 1e-6 of the
     # curve's peak); a long piece at a real speed is a long path (2^45 pulses at a low feed)
     crawl = 2e-6 * float(v.max(initial=0.0))
-    for k in range(len(ds)):
-        if ds[k] <= 0.0:
+    # Python floats: the same double arithmetic as numpy scalars, without their overhead
+    dsl, dv2l, vl = ds.tolist(), dv2.tolist(), v.tolist()
+    for k in range(len(dsl)):
+        d = dsl[k]
+        if d <= 0.0:
             continue
-        a = dv2[k] / (2.0 * ds[k])
-        vm = v[k] + v[k + 1]
-        if vm <= 0.0 or (2.0 * ds[k] / vm > 1e6 and vm < crawl):
-            if ds[k] <= 1e-9 * max(1.0, s_end):  # a sliver left by rounding: step over it
+        a = dv2l[k] / (2.0 * d)
+        vm = vl[k] + vl[k + 1]
+        if vm <= 0.0 or (2.0 * d / vm > 1e6 and vm < crawl):
+            if d <= 1e-9 * max(1.0, s_end):  # a sliver left by rounding: step over it
                 continue
             raise InfeasibleError("path speed curve stalls at rest before its end")
-        dt = 2.0 * ds[k] / vm  # exact for constant acceleration, also when a = 0
-        b.set_velocity(float(v[k]))
-        b.segment(dt, 0.0, accel=float(a))
-        if dwell > 0.0 and v[k + 1] == 0.0 and k < last:
+        dt = 2.0 * d / vm  # exact for constant acceleration, also when a = 0
+        b.set_velocity(vl[k])
+        b.segment(dt, 0.0, accel=a)
+        if dwell > 0.0 and vl[k + 1] == 0.0 and k < last:
             b.set_velocity(0.0)
             b.segment(dwell, 0.0, accel=0.0, label="dwell")
     return b.build(end_p=float(s_end))
