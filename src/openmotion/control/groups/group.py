@@ -32,7 +32,7 @@ from ...path import Arc, Arc3D, Line
 from ...profile.pcl import MoveSpec
 from ...units import AxisUnits
 from ..core.states import AxisState
-from . import pathrun
+from . import pathmove, pathrun
 from .group_checks import unit_names, unit_scales
 from .group_settings import PERIOD_PULSES_DEFAULT, PERIOD_PULSES_MAX, GroupSettings
 from .groupdue import group_due
@@ -492,9 +492,10 @@ class Group(GroupSettings):
         r, self._held = self._held, None
         t = self._ctl.time
         if r.plan is not None:  # from rest (with the StrVel jump again)
-            chain = r.plan.chain
-            self._launch(pathrun.start(chain, self._limits(chain, r.cmds[0].str_vel),
-                                       r.plan.tj, t, s0=r.plan.sprof.end.p), r.cmds, t)
+            chain, s0 = r.plan.chain, r.plan.sprof.end.p
+            lim = self._limits(chain, r.cmds[0].str_vel)
+            self._launch(pathmove.start(chain, r.plan.move, lim, t, s0) if r.plan.move
+                         else pathrun.start(chain, lim, r.plan.tj, t, s0=s0), r.cmds, t)
         elif r.kind == "ptp":
             self._launch_ptp(r.cmds[0], t)
         else:

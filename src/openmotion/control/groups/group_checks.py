@@ -20,6 +20,7 @@ from ...errors import MotionError, show
 from ...limits import PATH_LENGTH_MAX, PULSES_MAX, as_array
 from ...path.extent import element_extent
 from ...path.geometry import PathElement
+from ...profile.pcl import MoveSpec
 from ...units import AxisUnits
 from ..core.states import AxisState
 from .groupexec import (
@@ -181,7 +182,19 @@ class GroupChecks(GroupEngine):
                                             f"its maximum acceleration "
                                             f"{self._in_units(k, self._amax[k], '/s^2')}")
         return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
-                               decel=decel, jerk=jerk, str_vel=sv), end)
+                               decel=decel, jerk=jerk, str_vel=sv,
+                               move=self._path_move(feed, sv)), end)
+
+    def _path_move(self, feed: float, str_vel: float) -> MoveSpec | None:
+        """The 1-D move a path command runs as when its deceleration shape differs from
+        its acceleration shape (pathmove.py), else None (it chains)."""
+        acc, dec = self.path_shapes  # type: ignore[attr-defined]
+        if acc == dec:
+            return None
+        if str_vel:
+            raise GroupError(ERR_ARGUMENT, "a path deceleration shape apart needs StrVel 0")
+        return MoveSpec(acc, 0.0, feed, self._acc_time, self.dec_time,
+                        dec_shape=dec)  # type: ignore[attr-defined]
 
     def _path_ramps(self, feed: float) -> tuple[float, float | None, float]:
         """(acceleration, deceleration or None = the same, jerk or 0 = T) of a path command
