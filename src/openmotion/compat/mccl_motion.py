@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from openmotion.control.groups import group as G
+from openmotion.errors import MotionError
 
 from . import mccl_defs as D
 from .mccl_base import GroupSlot, Refused, _api, _int, _num
@@ -128,13 +129,30 @@ class MCCLMotion(MCCLSpeed):
 
     @_api
     def MCC_SetInterpolationTime(self, nInterpolateTime: int) -> int:
-        """The interpolation time (ms) is fixed by MCC_InitSystem in this library: the
-        same value is accepted, another one refused (COMMAND_NOTACCEPTED_ERR)."""
+        """The interpolation time, 1..1000 ms, after MCC_InitSystem (2.6.4 I: "set it
+        later any time"): applied at once between two cycles while the machine is at rest
+        (core `Controller.set_period`); the steps set before (MCC_SetAccStep ...) keep their
+        counts, so their times and the per-period pulse caps scale with it. While a group
+        has commands queued, running or held, or an axis moves, refused with
+        COMMAND_NOTACCEPTED_ERR (those commands were checked against the old time's
+        caps), nothing changed."""
         n = _int("nInterpolateTime", nInterpolateTime, 1, 1000)
-        self._ctl()
-        if abs(n / 1000.0 - self._period) > 1e-12:
-            raise Refused(D.COMMAND_NOTACCEPTED_ERR, "the interpolation time is set by "
-                                                     "MCC_InitSystem (close and init again)")
+        ctl = self._ctl()
+        T = n / 1000.0
+        try:
+            ctl.set_period(T)
+        except MotionError as err:
+            raise Refused(D.COMMAND_NOTACCEPTED_ERR, str(err)) from None
+        self._period = T
+        for gs in self._groups.values():
+            g = gs.group
+            g.set_acc_time(gs.acc_step * T)
+            if g._dec_time is not None:
+                g.set_dec_time(gs.dec_step * T)
+            if g._ptp_acc_time is not None:
+                g.set_ptp_acc_time(gs.ptp_acc_step * T)
+            if g._ptp_dec_time is not None:
+                g.set_ptp_dec_time(gs.ptp_dec_step * T)
         return D.NO_ERR
 
     @_api

@@ -83,6 +83,7 @@ SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
 MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
+PeriodHook = Callable[[float, bool], None]
 JumpObserver = Callable[["Controller", int, int, list[list[float]]], None]
 
 
@@ -146,6 +147,7 @@ class Controller:
         self._fault_hooks: list[FaultHook] = []
         self._motion_checks: list[MotionCheck] = []
         self._motion_hooks: list[MotionHook] = []
+        self._period_hooks: list[PeriodHook] = []
         self._estop = False
         self._committed: float | None = None  # inside a cycle: the end its pulses reach
         #: cycles that raised (each one became a fault, see `step`)
@@ -371,6 +373,43 @@ class Controller:
         with self._lock:
             if hook in self._motion_hooks:
                 self._motion_hooks.remove(hook)
+
+    def add_period_hook(self, hook: PeriodHook) -> None:
+        """Call `hook(new_period, commit)` when the period changes (`set_period`): first
+        with commit False for every hook (raise MotionError to refuse the change), then
+        with commit True once it is made. Capabilities whose settings are per period (a
+        group's per-period pulse caps) subscribe here."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._period_hooks.append(hook)
+
+    def remove_period_hook(self, hook: PeriodHook) -> None:
+        with self._lock:
+            if hook in self._period_hooks:
+                self._period_hooks.remove(hook)
+
+    def set_period(self, seconds: float) -> None:
+        """Change the interpolation period (MCC_SetInterpolationTime, 1 ms .. 1 s) between
+        two cycles: the cycle grid goes on from now in steps of the new period. Refused
+        (MotionError, nothing changed) in real-time mode, while an axis moves (its motion
+        was checked against the old period's per-period limits) or when a period hook
+        refuses (a group with commands queued or running)."""
+        p = check_period(seconds)
+        with self._lock:
+            if self.realtime:
+                raise MotionError("period: cannot change while the real-time pacer runs")
+            for a in self.axes:
+                if a.is_moving:
+                    raise MotionError(f"period: cannot change while axis {a.name} moves")
+            hooks = list(self._period_hooks)
+            for hook in hooks:
+                hook(p, False)
+            self.period = p
+            self._t_origin = self._time - self._n * p
+            self._pacer = RealtimePacer(self.step, p, self._overran)
+            for hook in hooks:
+                hook(p, True)
 
     def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
         for check in tuple(self._motion_checks):

@@ -207,6 +207,8 @@ class Group(GroupSettings):
             controller.add_fault_hook(self._on_axis_fault)
         if hasattr(controller, "add_motion_hook"):  # ... and to axes stopped directly
             controller.add_motion_hook(self._on_axis_motion)
+        if hasattr(controller, "add_period_hook"):  # per-period caps follow the period
+            controller.add_period_hook(self._on_period)
 
     # ------------------------------------------------------------------ status
     @property
@@ -336,10 +338,24 @@ class Group(GroupSettings):
             self._ctl.remove_fault_hook(self._on_axis_fault)
         if hasattr(self._ctl, "remove_motion_hook"):
             self._ctl.remove_motion_hook(self._on_axis_motion)
+        if hasattr(self._ctl, "remove_period_hook"):
+            self._ctl.remove_period_hook(self._on_period)
         owners = OWNERS.get(self._ctl, {})
         for a in self.axes:
             if owners.get(a.index) is self:
                 del owners[a.index]
+
+    def _on_period(self, period: float, commit: bool) -> None:
+        """Controller period hook (set_period): refused while the group holds commands
+        (queued, running, held: checked against the old period's caps); then the
+        per-period pulse caps (MCCL 2.6.4: speed/T, acc/T^2) follow the new period."""
+        if not commit:
+            if self._run is not None or self._queue or self._held is not None or \
+                    self._job is not None:
+                raise GroupError(ERR_STATE, f"period: group {'/'.join(self.names)} has "
+                                            "commands queued or running")
+            return
+        self._update_caps()
 
     # ------------------------------------------------------------------ settings
     # (feed, times, caps, blending, shapes, PtP: group_settings.py)

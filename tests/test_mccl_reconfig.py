@@ -1,0 +1,93 @@
+"""MCCL parameters changed on an initialised machine (2.4, 2.6.4 I, 2.9): the interpolation
+time "later any time", MCC_UpdateMachParam after MCC_SetMachParam, the encoder rate."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from helpers import free_axes
+from mccl_common import manual_param, open_lib, per_period_pulses
+from openmotion.compat import mccl_defs as D
+from openmotion.control import Controller
+from openmotion.control.groups.group import Group
+from openmotion.errors import MotionError
+
+FAST = {"dwPPR": 10000, "wRPM": 32767}   # 10 000 pulses/mm, 546 mm/s
+
+
+def test_interpolation_time_set_later_scales_steps_caps_and_delays():
+    lib = open_lib(period_ms=5, param=manual_param(**FAST))
+    lib.MCC_SetSysMaxSpeed(500.0, 0)
+    assert lib.MCC_SetFeedSpeed(360.448, 0) == 0
+    # at 5 ms, 360.448 mm/s is 18 022.4 pulses per period: accepted
+    assert lib.MCC_Line(1, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.wait_motion(0, 30)
+    assert lib.MCC_SetInterpolationTime(10) == D.NO_ERR
+    assert lib.MCC_GetInterpolationTime() == 10 and lib.controller.period == 0.01
+    # 36 044.8 pulses per 10 ms period: now over the 30 000 default cap (2.6.4)
+    assert lib.MCC_Line(100, 0, 0, 0, 0, 0, 0) == D.FEED_RATE_ERR
+    # the acceleration step count stays 20: 20 x 10 ms = 200 ms
+    assert lib.MCC_GetAccStep(0) == 20
+    assert lib.MCC_SetFeedSpeed(100.0, 0) == 0
+    t0 = lib.controller.time
+    assert lib.MCC_Line(101, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.wait_motion(0, 30)
+    t = np.arange(t0, lib.controller.time, 1e-4)
+    v = lib.controller.history.sample(0, t).v / 10_000.0
+    moving, cruise = np.nonzero(v > 1e-9)[0], np.nonzero(v >= 100.0 * (1 - 1e-9))[0]
+    assert t[cruise[0]] - t[moving[0]] == pytest.approx(0.2, abs=2e-4)
+    assert per_period_pulses(lib, 0, t0, lib.controller.time).max() <= 10_000 + 1e-6
+    # the delay counts interpolation times of 10 ms: 200 x 10 ms = 2 s
+    assert lib.MCC_Line(102, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.MCC_DelayMotion(200, 0) >= 0
+    assert lib.MCC_Line(103, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.wait_motion(0, 30)
+    # cycles now come every 10 ms
+    n0, t1 = lib.controller.cycles, lib.controller.time
+    lib.advance(0.1)
+    assert lib.controller.cycles - n0 == 10
+    assert lib.controller.time == pytest.approx(t1 + 0.1, abs=1e-12)
+
+
+def test_interpolation_time_refused_while_a_group_moves():
+    lib = open_lib(period_ms=5)
+    assert lib.MCC_SetFeedSpeed(20.0, 0) == 0
+    assert lib.MCC_Line(30, 0, 0, 0, 0, 0, 0) >= 0
+    lib.advance(0.3)
+    for bad in (0, 1001, 2.5, "5"):
+        assert lib.MCC_SetInterpolationTime(bad) == D.PARAMETER_ERR
+    assert lib.MCC_SetInterpolationTime(10) == D.COMMAND_NOTACCEPTED_ERR
+    assert lib.MCC_GetInterpolationTime() == 5 and lib.controller.period == 0.005
+    assert lib.wait_motion(0, 30)
+    assert lib.MCC_GetCurPos(0)[1] == 30.0
+    assert lib.MCC_SetInterpolationTime(1) == D.NO_ERR
+    assert lib.controller.period == 0.001
+
+
+def test_controller_set_period_keeps_the_grid_and_asks_the_groups():
+    ctl = free_axes(2, period=0.005)
+    g = Group(ctl, ["x", "y"], feed=20_000.0, acc_time=0.05)
+    g.set_period_pulse_caps([30_000, 30_000], [30_000, 30_000])
+    ctl.advance(0.02)
+    for bad in (0.0, 2.0, float("nan")):
+        with pytest.raises(MotionError, match="period"):
+            ctl.set_period(bad)
+    g.line([10_000, 0])
+    with pytest.raises(MotionError, match="period"):
+        ctl.set_period(0.01)     # queued
+    ctl.step()
+    with pytest.raises(MotionError, match="period"):
+        ctl.set_period(0.01)     # moving
+    assert ctl.period == 0.005
+    ctl.run_until(lambda: not g.axes[0].is_moving and g.queue_length == 0, 10.0)
+    t = ctl.time
+    assert g._amax[0] == pytest.approx(30_000 / 0.005 ** 2)
+    ctl.set_period(0.01)
+    assert g._amax[0] == pytest.approx(30_000 / 0.01 ** 2)   # the caps follow (2.6.4)
+    ctl.step()
+    assert ctl.time == pytest.approx(t + 0.01, abs=1e-12)
+    g.line([0, 0])
+    ctl.run_until(lambda: g.queue_length == 0 and not g.axes[0].is_moving, 10.0)
+    assert g.axes[0].position == 0.0
+    assert isinstance(ctl, Controller)
