@@ -91,3 +91,43 @@ def test_controller_set_period_keeps_the_grid_and_asks_the_groups():
     ctl.run_until(lambda: g.queue_length == 0 and not g.axes[0].is_moving, 10.0)
     assert g.axes[0].position == 0.0
     assert isinstance(ctl, Controller)
+
+
+def test_encoder_rate_on_a_running_machine_changes_the_count_rate():
+    lib = open_lib(period_ms=5)
+    ppmm = lib.controller.axes[0].config.pulses_per_unit
+
+    def moved(mm):
+        before = lib.MCC_GetENCValue(0)[1]
+        pos = lib.MCC_GetCurPos(0)[1]
+        assert lib.MCC_Line(pos + mm, 0, 0, 0, 0, 0, 0) >= 0
+        assert lib.wait_motion(0, 30)
+        return lib.MCC_GetENCValue(0)[1] - before
+    assert moved(4) == round(4 * ppmm)                    # x4, the default
+    assert lib.MCC_SetENCInputRate(1, 0) == D.NO_ERR      # x1 of the same encoder
+    assert moved(4) == round(4 * ppmm) // 4
+    assert lib.MCC_SetENCInputRate(2, 0) == D.NO_ERR
+    assert moved(-4) == -(round(4 * ppmm) // 2)
+    assert lib.MCC_SetENCInputRate(4, 0) == D.NO_ERR
+    assert moved(4) == round(4 * ppmm)
+    assert lib.controller.axes[1].config.encoder_mode == "ab_x4"   # other channels keep
+    # refused while the channel moves, and bad values; nothing changed
+    assert lib.MCC_Line(30, 0, 0, 0, 0, 0, 0) >= 0
+    lib.advance(0.2)
+    assert lib.MCC_SetENCInputRate(1, 0) == D.COMMAND_NOTACCEPTED_ERR
+    for bad in (3, 0, 8, 1.5):
+        assert lib.MCC_SetENCInputRate(bad, 0) == D.PARAMETER_ERR
+    assert lib.controller.axes[0].config.encoder_mode == "ab_x4"
+    assert lib.wait_motion(0, 30)
+
+
+def test_controller_set_encoder_mode_refusals():
+    ctl = free_axes(1, period=0.005)
+    before = ctl.axes[0].config
+    for bad in ("x4", "cw_ccw", 4):
+        with pytest.raises(MotionError, match="mode"):
+            ctl.set_encoder_mode(0, bad)
+    assert ctl.axes[0].config == before
+    ctl.set_encoder_mode(0, "ab_x2")
+    assert ctl.axes[0].config.encoder_mode == "ab_x2"
+    assert ctl.config.axes[0].encoder_mode == "ab_x2"

@@ -20,6 +20,7 @@ a thread; `stop_realtime()`; `with controller.start_realtime(): ...`; `cycle_sta
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import threading
 from collections.abc import Callable, Collection, Sequence
@@ -410,6 +411,31 @@ class Controller:
             self._pacer = RealtimePacer(self.step, p, self._overran)
             for hook in hooks:
                 hook(p, True)
+
+    def set_encoder_mode(self, axis: int | str, mode: str) -> None:
+        """Change how an axis's A/B encoder input is decoded (x1, x2, x4: "ab_x1" ..
+        "ab_x4") on a running machine (MCC_SetENCInputRate, HSL pls_iptmode): the feedback
+        count keeps its value and counts at the new rate from now on. Refused
+        (MotionError, nothing changed) while the axis moves, for another mode kind, or
+        when the hardware cannot change it."""
+        ax = self.axis(axis)
+        if not isinstance(mode, str) or mode not in ("ab_x1", "ab_x2", "ab_x4"):
+            raise MotionError(f"mode must be 'ab_x1', 'ab_x2' or 'ab_x4', got {mode!r}")
+        if not ax.config.encoder_mode.startswith("ab"):
+            raise MotionError(f"axis {ax.name}: encoder_mode {ax.config.encoder_mode!r} is "
+                              "not an A/B input")
+        setter = getattr(self.hardware, "set_encoder_mode", None)
+        if setter is None:
+            raise MotionError("mode: this hardware cannot change the encoder mode")
+        with self._lock:
+            if ax.is_moving:
+                raise MotionError(f"mode: cannot change while axis {ax.name} moves")
+            cfg = dataclasses.replace(ax.config, encoder_mode=mode)
+            setter(ax.index, mode)
+            ax.config = cfg
+            axes = list(self.config.axes)
+            axes[ax.index] = cfg
+            self.config = dataclasses.replace(self.config, axes=tuple(axes))
 
     def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
         for check in tuple(self._motion_checks):

@@ -15,6 +15,7 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Collection, Sequence
 
@@ -34,7 +35,7 @@ from openmotion.hw.interface import (
 
 from . import kernel
 from .cubic import Cubic
-from .encoder import EncoderWiring
+from .encoder import Decoder, EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
 from .piecequeue import PieceQueue
 from .pieces import JumpPiece
@@ -457,6 +458,25 @@ class SimMachine:
         return rec
 
     # -- internals ----------------------------------------------------------------------------
+    def set_encoder_mode(self, axis: int, mode: str) -> None:
+        """The board's decoding of an axis's encoder input from now on (HSL pls_iptmode,
+        MCCL MCC_SetENCInputRate: x1, x2, x4 of an A/B encoder): the encoder itself (its
+        wiring, resolution) stays, the count keeps its value and goes on at the new
+        mode's rate. Refused (MotionError) for a mode of another signal kind."""
+        ax = self._axis(axis)
+        old = ax.decoder
+        if not isinstance(mode, str) or not mode.startswith("ab_") or old.kind != "ab":
+            raise MotionError(f"mode must be ab_x1, ab_x2 or ab_x4 on an A/B encoder, "
+                              f"got {mode!r} (encoder {old.kind})")
+        cfg = dataclasses.replace(ax.cfg, encoder_mode=mode)
+        wiring = EncoderWiring(old.kind, old.upp, old.swap != cfg.swap_ab,
+                               old.flip_a != cfg.invert_a, old.flip_b != cfg.invert_b,
+                               ax.z_flip != cfg.invert_z)
+        new = Decoder(wiring, cfg, ax.y)
+        new.q, new.last_dir, new.count = old.q, old.last_dir, old.count
+        ax.decoder, ax.cfg = new, cfg
+        ax.run_start = (ax.run_start[0], ax._dec_state())
+
     def _axis(self, axis: int) -> SimAxis:
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(self._axes):
             raise MotionError(f"axis must be an int in 0..{len(self._axes) - 1}, got {axis!r}")
