@@ -131,3 +131,76 @@ def test_controller_set_encoder_mode_refusals():
     ctl.set_encoder_mode(0, "ab_x2")
     assert ctl.axes[0].config.encoder_mode == "ab_x2"
     assert ctl.config.axes[0].encoder_mode == "ab_x2"
+
+
+def test_update_mach_param_applies_the_mechanism_on_a_machine_at_rest():
+    lib = open_lib(period_ms=5)
+    p = manual_param()
+    ppmm = lib.controller.axes[0].config.pulses_per_unit
+    assert lib.MCC_SetFeedSpeed(10.0, 0) == 0
+    assert lib.MCC_Line(10, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.wait_motion(0, 30)
+    pulses = lib.MCC_GetPulsePos(0)[1]
+    assert pulses == round(10 * ppmm)
+    # 2.4: change the mechanism after MCC_InitSystem, then MCC_UpdateMachParam
+    p.dwPPR *= 2                                   # twice the pulses per mm
+    p.stEncoder.wABSwap = 1                        # encoder read with A/B swapped
+    assert lib.MCC_SetMachParam(p, 0, 0) == 0
+    assert lib.controller.axes[0].config.pulses_per_unit == ppmm   # not yet
+    assert lib.MCC_UpdateMachParam() == D.NO_ERR
+    assert lib.controller.axes[0].config.pulses_per_unit == 2 * ppmm
+    assert lib.MCC_GetPulsePos(0)[1] == pulses     # the counters keep their pulses
+    assert lib.MCC_GetCurPos(0)[1] == pytest.approx(5.0)   # 10 mm of the old ratio
+    enc0 = lib.MCC_GetENCValue(0)[1]
+    assert lib.MCC_Line(15, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.wait_motion(0, 30)
+    assert lib.MCC_GetPulsePos(0)[1] == pulses + round(10 * 2 * ppmm)
+    assert lib.MCC_GetCurPos(0)[1] == pytest.approx(15.0)
+    # the swapped A/B reading counts backwards (the encoder is wired as before)
+    assert lib.MCC_GetENCValue(0)[1] - enc0 < 0
+    # the speed limit follows wRPM (max speed = wRPM x pitch / (gear x 60))
+    assert lib.MCC_SetFeedSpeed(40.0, 0) == 0
+    p.wRPM = 600                                    # 600 x 2 / 60 = 20 mm/s
+    assert lib.MCC_SetMachParam(p, 0, 0) == 0
+    assert lib.MCC_UpdateMachParam() == D.NO_ERR
+    assert lib.MCC_Line(0, 0, 0, 0, 0, 0, 0) == D.FEED_RATE_ERR
+
+
+def test_update_mach_param_refusals_change_nothing():
+    lib = open_lib(period_ms=5)
+    cfg = lib.controller.axes[0].config
+    p = manual_param()
+    p.dwPPR = 4000
+    assert lib.MCC_SetMachParam(p, 0, 0) == 0
+    assert lib.MCC_SetFeedSpeed(20.0, 0) == 0
+    assert lib.MCC_Line(30, 0, 0, 0, 0, 0, 0) >= 0
+    lib.advance(0.2)
+    assert lib.MCC_UpdateMachParam() == D.COMMAND_NOTACCEPTED_ERR    # moving
+    assert lib.controller.axes[0].config == cfg
+    assert lib.wait_motion(0, 30)
+    assert lib.MCC_GetCurPos(0)[1] == 30.0
+    bad = manual_param()
+    bad.dfPitch = 0.0
+    assert lib.MCC_SetMachParam(bad, 1, 0) == D.PARAMETER_ERR
+    assert lib.controller.axes[0].config == cfg
+    assert lib.MCC_UpdateMachParam() == D.NO_ERR
+    assert lib.controller.axes[0].config.pulses_per_rev == 4000
+
+
+def test_controller_reconfigure_axis_is_validated_and_told_to_groups():
+    ctl = free_axes(2, period=0.005)
+    g = Group(ctl, ["x", "y"], units=True, feed=10.0)
+    before = ctl.axes[0].config
+    for kw in ({"name": "q"}, {"lead": 0.0}, {"logic": {"pel": "x"}}):
+        with pytest.raises(MotionError):
+            ctl.reconfigure_axis(0, **kw)
+        assert ctl.axes[0].config == before
+    g.line([1.0, 0.0])
+    with pytest.raises(MotionError, match="queued|running"):
+        ctl.reconfigure_axis(0, pulses_per_rev=before.pulses_per_rev * 2)
+    ctl.run_until(lambda: g.queue_length == 0 and not g.axes[0].is_moving, 10.0)
+    x_pulses = ctl.axes[0].position
+    ctl.reconfigure_axis(0, pulses_per_rev=before.pulses_per_rev * 2,
+                         logic={"pel": "nc"})
+    assert g.position[0] == pytest.approx(x_pulses / (2 * before.pulses_per_unit))
+    assert ctl.config.axes[0].signal_logic("pel") == "nc"

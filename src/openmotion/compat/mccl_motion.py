@@ -49,21 +49,35 @@ class MCCLMotion(MCCLSpeed):
 
     @_api
     def MCC_UpdateMachParam(self) -> int:
-        """Apply parameters set after MCC_InitSystem: the working interval (soft limits),
-        homing and limit-switch settings. Parameters of the pulse output, the encoder,
-        the sensor logic and the mechanism ratio need a new MCC_InitSystem (the cards'
-        configuration): refused (PARAMETER_ERR) when they changed."""
+        """Apply the mechanism parameters set (MCC_SetMachParam) after MCC_InitSystem
+        (2.4): the mechanism ratio (dwPPR, dfPitch, dfGearRatio), wRPM, wPosToEncoderDir,
+        the pulse output format and width, the encoder format and its inversions, the
+        sensor logic of home and over-travel inputs (core `Controller.reconfigure_axis`),
+        the working interval (soft limits) and the homing settings. The counters keep
+        their pulses (positions in mm follow the new ratio). Every channel is checked
+        before any changes: a bad value is PARAMETER_ERR; while a group has commands
+        queued, running or held, or an axis moves, COMMAND_NOTACCEPTED_ERR."""
+        from openmotion.control.core.controller import RECONFIGURABLE
+
         ctl = self._ctl()
+        if not all(self._idle(gs) for gs in self._groups.values()) or \
+                any(a.is_moving for a in ctl.axes):
+            raise Refused(D.COMMAND_NOTACCEPTED_ERR, "the machine must be at rest (groups "
+                                                     "idle) to update its parameters")
+        plan = []
         for ax in ctl.axes:
             card, ch = divmod(ax.index, D.CHANNELS_PER_CARD)
+            _check_mach(self._param(ch, card))
             new = self._axis_config(card, ch)
-            keep = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed",
-                    "pulse_mode", "encoder_mode", "logic", "swap_ab", "invert_a",
-                    "invert_b", "invert_z")
-            if any(getattr(new, k) != getattr(ax.config, k) for k in keep):
-                raise Refused(D.PARAMETER_ERR, f"card {card} channel {ch}: mechanism, "
-                                               "pulse, encoder or sensor parameters "
-                                               "changed: call MCC_InitSystem again")
+            changes = {k: getattr(new, k) for k in RECONFIGURABLE
+                       if getattr(new, k) != getattr(ax.config, k)}
+            plan.append((ax.index, changes))
+        for index, changes in plan:
+            if changes:
+                try:
+                    ctl.reconfigure_axis(index, **changes)
+                except MotionError as err:
+                    raise Refused(D.PARAMETER_ERR, str(err)) from None
         for gs in self._groups.values():
             self._apply_soft_limits(gs)
         return D.NO_ERR

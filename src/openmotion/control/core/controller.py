@@ -31,6 +31,7 @@ from ...errors import MotionError, check_int, check_nonnegative
 from ...history import MotionHistory
 from ...hw.interface import Hardware, InputEdge
 from ...recording import Recorder
+from ...units import MAX_PULSE_RATE
 from .axis import Axis
 from .clock import CycleStats, RealtimePacer, check_period
 from .events import EventLog
@@ -85,6 +86,11 @@ FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
 MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
 PeriodHook = Callable[[float, bool], None]
+ConfigHook = Callable[[int, Any, bool], None]
+#: AxisConfig fields `Controller.reconfigure_axis` changes on a running machine.
+DECODER_FIELDS = ("encoder_mode", "swap_ab", "invert_a", "invert_b", "invert_z")
+RECONFIGURABLE = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed", "logic",
+                  "pulse_mode", "pulse_width_us", "encoder_lines_per_rev", *DECODER_FIELDS)
 JumpObserver = Callable[["Controller", int, int, list[list[float]]], None]
 
 
@@ -149,6 +155,7 @@ class Controller:
         self._motion_checks: list[MotionCheck] = []
         self._motion_hooks: list[MotionHook] = []
         self._period_hooks: list[PeriodHook] = []
+        self._config_hooks: list[ConfigHook] = []
         self._estop = False
         self._committed: float | None = None  # inside a cycle: the end its pulses reach
         #: cycles that raised (each one became a fault, see `step`)
@@ -414,28 +421,69 @@ class Controller:
 
     def set_encoder_mode(self, axis: int | str, mode: str) -> None:
         """Change how an axis's A/B encoder input is decoded (x1, x2, x4: "ab_x1" ..
-        "ab_x4") on a running machine (MCC_SetENCInputRate, HSL pls_iptmode): the feedback
-        count keeps its value and counts at the new rate from now on. Refused
-        (MotionError, nothing changed) while the axis moves, for another mode kind, or
-        when the hardware cannot change it."""
+        "ab_x4") on a running machine (MCC_SetENCInputRate): `reconfigure_axis` of
+        encoder_mode, limited to the A/B modes of an A/B input."""
         ax = self.axis(axis)
         if not isinstance(mode, str) or mode not in ("ab_x1", "ab_x2", "ab_x4"):
             raise MotionError(f"mode must be 'ab_x1', 'ab_x2' or 'ab_x4', got {mode!r}")
         if not ax.config.encoder_mode.startswith("ab"):
             raise MotionError(f"axis {ax.name}: encoder_mode {ax.config.encoder_mode!r} is "
                               "not an A/B input")
-        setter = getattr(self.hardware, "set_encoder_mode", None)
-        if setter is None:
-            raise MotionError("mode: this hardware cannot change the encoder mode")
+        self.reconfigure_axis(ax.index, encoder_mode=mode)
+
+    def add_config_hook(self, hook: ConfigHook) -> None:
+        """Call `hook(axis_index, new_config, commit)` when an axis is reconfigured
+        (`reconfigure_axis`): first with commit False (raise MotionError to refuse), then
+        with commit True once it is made. A group whose units follow the machine
+        subscribes here."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._config_hooks.append(hook)
+
+    def remove_config_hook(self, hook: ConfigHook) -> None:
+        with self._lock:
+            if hook in self._config_hooks:
+                self._config_hooks.remove(hook)
+
+    def reconfigure_axis(self, axis: int | str, **changes: Any) -> None:
+        """Change an axis's settings on a running machine while it is at rest (MCCL
+        MCC_UpdateMachParam after MCC_SetMachParam): the mechanism ratio (pulses_per_rev,
+        lead, gear_ratio), reverse, max_speed, the signal logic (`logic`: how the board
+        reads its inputs; the switches themselves stay as wired), the pulse output format
+        and the encoder decoding (encoder_mode, swap_ab, invert_a/b/z: the hardware's
+        `configure_decoder`). Counters keep their pulse values; what they mean in user
+        units follows the new ratio. Refused (MotionError, nothing changed) for other
+        fields, an invalid value, a moving axis, a config hook's refusal (a group with
+        commands) or hardware that cannot change its decoder."""
+        ax = self.axis(axis)
+        bad = sorted(set(changes) - set(RECONFIGURABLE))
+        if bad:
+            raise MotionError(f"{', '.join(bad)}: not changeable on a running machine "
+                              f"(changeable: {', '.join(RECONFIGURABLE)})")
+        cfg = dataclasses.replace(ax.config, **changes)  # validated (__post_init__)
+        decode = any(getattr(cfg, k) != getattr(ax.config, k) for k in DECODER_FIELDS)
+        setter = getattr(self.hardware, "configure_decoder", None)
+        if decode and setter is None:
+            raise MotionError("this hardware cannot change its encoder decoding")
         with self._lock:
             if ax.is_moving:
-                raise MotionError(f"mode: cannot change while axis {ax.name} moves")
-            cfg = dataclasses.replace(ax.config, encoder_mode=mode)
-            setter(ax.index, mode)
+                raise MotionError(f"axis {ax.name}: cannot be reconfigured while it moves")
+            hooks = list(self._config_hooks)
+            for hook in hooks:
+                hook(ax.index, cfg, False)
+            if decode:
+                setter(ax.index, cfg)
             ax.config = cfg
+            ax._max_speed = min(cfg.max_speed_pps, MAX_PULSE_RATE)
             axes = list(self.config.axes)
             axes[ax.index] = cfg
             self.config = dataclasses.replace(self.config, axes=tuple(axes))
+            self._nc[ax.index] = {s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm",
+                                              "inp", "rdy") if cfg.signal_logic(s) == "nc"}
+            self._emg_nc = any(a.signal_logic("emg") == "nc" for a in self.config.axes)
+            for hook in hooks:
+                hook(ax.index, cfg, True)
 
     def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
         for check in tuple(self._motion_checks):

@@ -209,6 +209,13 @@ class Group(GroupSettings):
             controller.add_motion_hook(self._on_axis_motion)
         if hasattr(controller, "add_period_hook"):  # per-period caps follow the period
             controller.add_period_hook(self._on_period)
+        # the units each axis takes from the machine config follow its reconfiguration
+        self._units = [AxisUnits.from_axis(controller.config.axes[a.index]) for a in ax] \
+            if units is True else (list(units) if units is not False else None)
+        self._follows: tuple[int, bool] | None = None
+        self._old_max = 0.0  # (the reconfigured axis's speed before: _on_config)
+        if hasattr(controller, "add_config_hook"):
+            controller.add_config_hook(self._on_config)
 
     # ------------------------------------------------------------------ status
     @property
@@ -340,6 +347,8 @@ class Group(GroupSettings):
             self._ctl.remove_motion_hook(self._on_axis_motion)
         if hasattr(self._ctl, "remove_period_hook"):
             self._ctl.remove_period_hook(self._on_period)
+        if hasattr(self._ctl, "remove_config_hook"):
+            self._ctl.remove_config_hook(self._on_config)
         owners = OWNERS.get(self._ctl, {})
         for a in self.axes:
             if owners.get(a.index) is self:
@@ -350,12 +359,50 @@ class Group(GroupSettings):
         (queued, running, held: checked against the old period's caps); then the
         per-period pulse caps (MCCL 2.6.4: speed/T, acc/T^2) follow the new period."""
         if not commit:
-            if self._run is not None or self._queue or self._held is not None or \
-                    self._job is not None:
-                raise GroupError(ERR_STATE, f"period: group {'/'.join(self.names)} has "
-                                            "commands queued or running")
+            self._busy_for("period")
             return
         self._update_caps()
+
+    def _busy_for(self, what: str) -> None:
+        if self._run is not None or self._queue or self._held is not None or \
+                self._job is not None:
+            raise GroupError(ERR_STATE, f"{what}: group {'/'.join(self.names)} has "
+                                        "commands queued or running")
+
+    def _on_config(self, index: int, cfg: Any, commit: bool) -> None:
+        """Controller config hook (reconfigure_axis of one of the group's axes): refused
+        while the group holds commands; then its units (when they come from the machine),
+        speed and acceleration caps follow the axis's new settings."""
+        k = next((i for i, a in enumerate(self.axes) if a.index == index), None)
+        if k is None:
+            return
+        a = self.axes[k]
+        if not commit:
+            self._busy_for("reconfigure")
+            follows = self._units is not None and \
+                self._units[k] == AxisUnits.from_axis(a.config)
+            self._follows = (k, follows)
+            self._old_max = a.max_speed
+            return
+        if self._follows is not None and self._follows == (k, True) and \
+                self._units is not None:
+            self._units[k] = AxisUnits.from_axis(cfg)
+            self._k = np.array([u.sign * u.pulses_per_unit for u in self._units])
+            self._ppu = np.abs(self._k)
+            names = list(self._unit_names)
+            names[k] = cfg.unit
+            self._unit_names = tuple(names)
+        self._follows = None
+        if self._vmax_pps[k] >= self._old_max * (1 - 1e-12):  # the default: the axis's
+            self._vmax_pps[k] = a.max_speed
+        else:
+            self._vmax_pps[k] = min(self._vmax_pps[k], a.max_speed)
+        self._amax_pps[k] = cfg.max_accel * cfg.pulses_per_unit if cfg.max_accel > 0.0 \
+            else math.inf
+        self._sys_max = float(max(x.max_speed / p for x, p in
+                                  zip(self.axes, self._ppu, strict=True)))
+        self._update_caps()
+        self._tail = None
 
     # ------------------------------------------------------------------ settings
     # (feed, times, caps, blending, shapes, PtP: group_settings.py)

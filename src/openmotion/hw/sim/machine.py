@@ -21,7 +21,7 @@ from collections.abc import Callable, Collection, Sequence
 
 import numpy as np
 
-from openmotion.config import MachineConfig
+from openmotion.config import AxisConfig, MachineConfig
 from openmotion.errors import MotionError, check_finite, check_nonnegative
 from openmotion.hw.interface import (
     AXIS_INPUTS,
@@ -458,23 +458,25 @@ class SimMachine:
         return rec
 
     # -- internals ----------------------------------------------------------------------------
-    def set_encoder_mode(self, axis: int, mode: str) -> None:
-        """The board's decoding of an axis's encoder input from now on (HSL pls_iptmode,
-        MCCL MCC_SetENCInputRate: x1, x2, x4 of an A/B encoder): the encoder itself (its
-        wiring, resolution) stays, the count keeps its value and goes on at the new
-        mode's rate. Refused (MotionError) for a mode of another signal kind."""
+    def configure_decoder(self, axis: int, cfg: AxisConfig) -> None:
+        """The board's decoding of an axis's encoder input from now on, as `cfg` sets it
+        (encoder_mode x1/x2/x4 or another signal mode, swap_ab, invert_a/b/z: HSL
+        pls_iptmode, MCCL MCC_SetENCInputRate / stEncoder): the encoder itself (its
+        wiring and resolution) stays, the count keeps its value and goes on as the new
+        settings decode it (a setting that differs from the wiring misreads it)."""
         ax = self._axis(axis)
+        if not isinstance(cfg, AxisConfig):
+            raise MotionError(f"cfg must be an AxisConfig, got {type(cfg).__name__}")
         old = ax.decoder
-        if not isinstance(mode, str) or not mode.startswith("ab_") or old.kind != "ab":
-            raise MotionError(f"mode must be ab_x1, ab_x2 or ab_x4 on an A/B encoder, "
-                              f"got {mode!r} (encoder {old.kind})")
-        cfg = dataclasses.replace(ax.cfg, encoder_mode=mode)
-        wiring = EncoderWiring(old.kind, old.upp, old.swap != cfg.swap_ab,
-                               old.flip_a != cfg.invert_a, old.flip_b != cfg.invert_b,
-                               ax.z_flip != cfg.invert_z)
+        wiring = EncoderWiring(old.kind, old.upp, old.swap != ax.cfg.swap_ab,
+                               old.flip_a != ax.cfg.invert_a, old.flip_b != ax.cfg.invert_b,
+                               ax.z_flip != ax.cfg.invert_z)
         new = Decoder(wiring, cfg, ax.y)
         new.q, new.last_dir, new.count = old.q, old.last_dir, old.count
-        ax.decoder, ax.cfg = new, cfg
+        ax.decoder, ax.z_flip = new, wiring.invert_z != cfg.invert_z
+        ax.cfg = dataclasses.replace(ax.cfg, encoder_mode=cfg.encoder_mode,
+                                     swap_ab=cfg.swap_ab, invert_a=cfg.invert_a,
+                                     invert_b=cfg.invert_b, invert_z=cfg.invert_z)
         ax.run_start = (ax.run_start[0], ax._dec_state())
 
     def _axis(self, axis: int) -> SimAxis:
