@@ -69,8 +69,9 @@ class MCCLMotion(MCCLSpeed):
             card, ch = divmod(ax.index, D.CHANNELS_PER_CARD)
             _check_mach(self._param(ch, card))
             new = self._axis_config(card, ch)
+            # (MCCL has no move ratio: MCC_SetENCInputRate keeps it right)
             changes = {k: getattr(new, k) for k in RECONFIGURABLE
-                       if getattr(new, k) != getattr(ax.config, k)}
+                       if k != "move_ratio" and getattr(new, k) != getattr(ax.config, k)}
             plan.append((ax.index, changes))
         for index, changes in plan:
             if changes:

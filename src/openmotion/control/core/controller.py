@@ -26,7 +26,7 @@ import threading
 from collections.abc import Callable, Collection, Sequence
 from typing import Any
 
-from ...config import MachineConfig, default_machine
+from ...config import ENCODER_MULTIPLIER, MachineConfig, default_machine
 from ...errors import MotionError, check_int, check_nonnegative
 from ...history import MotionHistory
 from ...hw.interface import Hardware, InputEdge
@@ -90,7 +90,8 @@ ConfigHook = Callable[[int, Any, bool], None]
 #: AxisConfig fields `Controller.reconfigure_axis` changes on a running machine.
 DECODER_FIELDS = ("encoder_mode", "swap_ab", "invert_a", "invert_b", "invert_z")
 RECONFIGURABLE = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed", "logic",
-                  "pulse_mode", "pulse_width_us", "encoder_lines_per_rev", *DECODER_FIELDS)
+                  "pulse_mode", "pulse_width_us", "encoder_lines_per_rev", "move_ratio",
+                  *DECODER_FIELDS)
 JumpObserver = Callable[["Controller", int, int, list[list[float]]], None]
 
 
@@ -422,14 +423,18 @@ class Controller:
     def set_encoder_mode(self, axis: int | str, mode: str) -> None:
         """Change how an axis's A/B encoder input is decoded (x1, x2, x4: "ab_x1" ..
         "ab_x4") on a running machine (MCC_SetENCInputRate): `reconfigure_axis` of
-        encoder_mode, limited to the A/B modes of an A/B input."""
+        encoder_mode, limited to the A/B modes of an A/B input. The same encoder then
+        gives new/old multiplier counts per command pulse: the move ratio (feedback
+        counts per command pulse, the error counter's scale) follows."""
         ax = self.axis(axis)
         if not isinstance(mode, str) or mode not in ("ab_x1", "ab_x2", "ab_x4"):
             raise MotionError(f"mode must be 'ab_x1', 'ab_x2' or 'ab_x4', got {mode!r}")
         if not ax.config.encoder_mode.startswith("ab"):
             raise MotionError(f"axis {ax.name}: encoder_mode {ax.config.encoder_mode!r} is "
                               "not an A/B input")
-        self.reconfigure_axis(ax.index, encoder_mode=mode)
+        k = ENCODER_MULTIPLIER[mode] / ENCODER_MULTIPLIER[ax.config.encoder_mode]
+        self.reconfigure_axis(ax.index, encoder_mode=mode,
+                              move_ratio=ax.config.move_ratio * k)
 
     def add_config_hook(self, hook: ConfigHook) -> None:
         """Call `hook(axis_index, new_config, commit)` when an axis is reconfigured
@@ -474,6 +479,8 @@ class Controller:
                 hook(ax.index, cfg, False)
             if decode:
                 setter(ax.index, cfg)
+            if cfg.move_ratio != ax.config.move_ratio:
+                ax.counters.set_move_ratio(cfg.move_ratio)
             ax.config = cfg
             ax._max_speed = min(cfg.max_speed_pps, MAX_PULSE_RATE)
             axes = list(self.config.axes)

@@ -433,6 +433,7 @@ class Group(GroupSettings):
         p = self._point("target", target, start if relative else None)
         if np.all(p == start):
             raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
+        self._check_soft_span(np.minimum(start, p), np.maximum(start, p), start, "move")
         specs = []
         tacc, tdec = self.ptp_times
         for k, a in enumerate(self.axes):

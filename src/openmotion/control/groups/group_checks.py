@@ -126,24 +126,31 @@ class GroupChecks(GroupEngine):
     def _check_soft_limits(self, el: PathElement) -> None:
         """Refuse (ERR_LIMIT) a path element that would take an axis past an enabled soft
         limit (further than where it starts), before it is queued."""
+        lo, hi = element_extent(el)
+        self._check_soft_span(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float),
+                              np.asarray(el.start, dtype=float), "path")
+
+    def _check_soft_span(self, lo: np.ndarray, hi: np.ndarray, start: np.ndarray,
+                         what: str) -> None:
+        """Refuse (ERR_LIMIT) a command whose axes sweep [lo, hi] (logical units) from
+        `start` when an axis would pass an enabled soft limit further than it starts."""
         from ..guard.safety import Safety
 
         safety = Safety.of(self._ctl)
         if safety is None or self._dry:
             return
-        lo, hi = element_extent(el)
         a_, b_ = lo * self._k, hi * self._k
         plo, phi = np.minimum(a_, b_), np.maximum(a_, b_)
-        start = np.asarray(el.start, dtype=float) * self._k
+        start = start * self._k
         for i, ax in enumerate(self.axes):
             lim = safety.soft.get(ax.index)
             if not lim.enabled:
                 continue
             if phi[i] > max(lim.plimit, start[i]) + 1e-9 * max(1.0, abs(lim.plimit)):
-                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the + "
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the {what} passes the + "
                                             f"soft limit {lim.plimit!r} (reaches {phi[i]:.6g})")
             if plo[i] < min(lim.nlimit, start[i]) - 1e-9 * max(1.0, abs(lim.nlimit)):
-                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the - "
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the {what} passes the - "
                                             f"soft limit {lim.nlimit!r} (reaches {plo[i]:.6g})")
 
     def _check_length(self, el: PathElement) -> None:
