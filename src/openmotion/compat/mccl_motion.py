@@ -153,12 +153,22 @@ class MCCLMotion(MCCLSpeed):
         caps), nothing changed."""
         n = _int("nInterpolateTime", nInterpolateTime, 1, 1000)
         ctl = self._ctl()
-        T = n / 1000.0
+        old = self._period
         try:
-            ctl.set_period(T)
+            ctl.set_period(n / 1000.0)
         except MotionError as err:
             raise Refused(D.COMMAND_NOTACCEPTED_ERR, str(err)) from None
-        self._period = T
+        try:
+            self._step_times(n / 1000.0)
+        except MotionError:  # a step time out of range at the new time: all back
+            ctl.set_period(old)
+            self._step_times(old)
+            raise
+        self._period = n / 1000.0
+        return D.NO_ERR
+
+    def _step_times(self, T: float) -> None:
+        """Every group's step counts (MCC_SetAccStep ...) as times at interpolation time T."""
         for gs in self._groups.values():
             g = gs.group
             g.set_acc_time(gs.acc_step * T)
@@ -168,7 +178,6 @@ class MCCLMotion(MCCLSpeed):
                 g.set_ptp_acc_time(gs.ptp_acc_step * T)
             if g._ptp_dec_time is not None:
                 g.set_ptp_dec_time(gs.ptp_dec_step * T)
-        return D.NO_ERR
 
     @_api
     def MCC_GetInterpolationTime(self) -> int:
