@@ -197,3 +197,25 @@ def test_s_ramps_overlap_exactly_and_a_deceleration_shape_apart_blends_too(dec_s
     flat = bool(np.allclose(speed[join], F, rtol=1e-9))
     assert flat == (dec_shape is None)
     assert speed[join].min() > 0.7 * F
+
+
+@pytest.mark.parametrize("kind", ["path", "mixed"])
+def test_virtual_jumps_give_the_same_blends_as_every_cycle(kind):
+    cmds = CORNER + [("line", [0, 10_000])] if kind == "path" else \
+        [("ptp", [10_000, 5_000]), ("line", [20_000, 5_000]), ("ptp", [0, 0])]
+
+    def once(jumps):
+        ctl = free_axes(2, period=0.005)
+        ctl.virtual_jumps = jumps
+        g = Group(ctl, ["x", "y"], feed=F, acc_time=TA)
+        g.enable_overlap_blend()
+        t0 = ctl.time
+        for c, p in cmds:
+            getattr(g, c)(p)
+        t1 = finish_group(ctl, g)
+        t = np.arange(t0, t1, 1e-3)
+        return t1 - t0, [ctl.history.sample(k, t).p for k in (0, 1)]
+    (d1, p1), (d2, p2) = once(True), once(False)
+    assert d1 == d2
+    for a, b in zip(p1, p2, strict=True):
+        assert np.array_equal(a, b)
