@@ -116,6 +116,8 @@ def test_s_curve_ramps_last_the_acc_and_dec_times(acc, dec):
     assert lib.MCC_SetFeedSpeed(20.0, 0) == 0
     assert lib.MCC_SetAccStep(acc, 0) == 0 and lib.MCC_SetDecStep(dec, 0) == 0
     assert lib.MCC_SetAccType("S", 0) == 0 and lib.MCC_GetAccType(0) == "S"
+    assert lib.MCC_GetDecType(0) == "T"       # a type of its own (default T)
+    assert lib.MCC_SetDecType("S", 0) == 0 and lib.MCC_GetDecType(0) == "S"
     t0 = lib.controller.time
     assert lib.MCC_Line(30, 0, 0, 0, 0, 0, 0) == 0
     assert lib.wait_motion(0)

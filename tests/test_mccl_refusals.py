@@ -50,7 +50,7 @@ def test_bad_group_index_is_refused_and_changes_nothing(name, args, group):
     ("MCC_SetAccStep", (0,)), ("MCC_SetAccStep", (2.5,)), ("MCC_SetDecStep", (-1,)),
     ("MCC_SetPtPAccStep", (0,)), ("MCC_SetOverSpeed", (0.0,)), ("MCC_SetOverSpeed", (201.0,)),
     ("MCC_SetPtPOverSpeed", (-1.0,)), ("MCC_SetUnit", (2,)), ("MCC_DelayMotion", (-1,)),
-    ("MCC_SetAccType", ("X",)), ("MCC_SetDecType", ("S",)),
+    ("MCC_SetAccType", ("X",)), ("MCC_SetDecType", ("Q",)),
     ("MCC_SetSysMaxSpeed", (0.0,)), ("MCC_Line", (math.inf, 0, 0, 0, 0, 0)),
     ("MCC_Line", (0, 0, 0, 0, 0, 0)), ("MCC_PtP", ("a", 0, 0, 0, 0, 0)),
     ("MCC_CircleXY", (1, 0, 5)), ("MCC_SetOverTravelCheck", (2, 0, 0, 0)),

@@ -87,6 +87,7 @@ MAPPING: dict[str, str] = {
     "group_settings": "groups", "groupdue": "groups", "groupexec": "groups",
     "groupjoin": "groups", "pathaxes": "groups", "pathexec": "groups",
     "pathpoints": "groups", "pathrun": "groups", "accuracy": "groups", "ptpblend": "groups",
+    "overlap": "groups", "pathmove": "groups",
     # manual motion
     "jog": "manual",
 }

@@ -65,9 +65,23 @@ def home_all() -> None:
         raise SystemExit(f"homing failed ({LIBRARY.last_error})")
 
 
+def retune() -> None:
+    """After homing, on the machine at rest: a finer interpolation time (2.6.4 I, "later
+    any time": 2 ms; the steps keep their counts), the X encoder read x2 (2.9), and a
+    narrower working interval for X set with MCC_SetMachParam + MCC_UpdateMachParam (2.4)."""
+    check(MCC_SetInterpolationTime(2), "MCC_SetInterpolationTime")  # noqa: F405
+    check(MCC_SetENCInputRate(2, 0, CARD_INDEX), "MCC_SetENCInputRate")  # noqa: F405
+    p = SYS_MACH_PARAM()  # noqa: F405
+    MCC_GetMachParam(p, 0, CARD_INDEX)  # noqa: F405
+    p.dfHighLimitOffset = 11.0                             # X up to 140 mm
+    check(MCC_SetMachParam(p, 0, CARD_INDEX), "MCC_SetMachParam")  # noqa: F405
+    check(MCC_UpdateMachParam(), "MCC_UpdateMachParam")  # noqa: F405
+
+
 def job() -> list[tuple[float, ...]]:
-    """A plate: rapid to the start, a blended contour with an arc and a circle, a dwell,
-    a hold and a continue, a feed override, in-position checked at the end."""
+    """A plate: rapid to the start, a blended contour with an arc and a circle (S-curve
+    acceleration, T deceleration: MCC_SetAccType / MCC_SetDecType), a dwell, a hold and a
+    continue, a feed override, in-position checked at the end."""
     out = []
     for g in (XY, Z):
         check(MCC_SetOverTravelCheck(1, 1, 1, 1, 0, 0, g), "MCC_SetOverTravelCheck")  # noqa: F405
@@ -78,12 +92,14 @@ def job() -> list[tuple[float, ...]]:
     check(MCC_SetFeedSpeed(20, XY), "MCC_SetFeedSpeed")  # noqa: F405
     check(MCC_SetAccStep(20, XY), "MCC_SetAccStep")  # noqa: F405
     check(MCC_SetDecStep(40, XY), "MCC_SetDecStep")  # noqa: F405
-    check(MCC_EnableBlend(XY), "MCC_EnableBlend")  # noqa: F405
+    check(MCC_SetAccType("S", XY), "MCC_SetAccType")  # noqa: F405
+    check(MCC_SetDecType("T", XY), "MCC_SetDecType")  # noqa: F405
+    check(MCC_EnableBlend(XY), "MCC_EnableBlend")     # the next starts as one decelerates  # noqa: F405
     check(MCC_Line(60, 10, 0, 0, 0, 0, XY), "MCC_Line")  # noqa: F405
     check(MCC_ArcXY(70, 20, 60, 30, XY), "MCC_ArcXY")     # half circle through (70, 20)  # noqa: F405
     check(MCC_Line(10, 30, 0, 0, 0, 0, XY), "MCC_Line")  # noqa: F405
     check(MCC_Line(10, 10, 0, 0, 0, 0, XY), "MCC_Line")  # noqa: F405
-    check(MCC_DelayMotion(100, XY), "MCC_DelayMotion")    # 100 x 5 ms dwell  # noqa: F405
+    check(MCC_DelayMotion(250, XY), "MCC_DelayMotion")    # 250 x 2 ms dwell  # noqa: F405
     check(MCC_CircleXY(20, 10, CIR_CCW, XY), "MCC_CircleXY")  # noqa: F405
     LIBRARY.advance(2.0)
     check(MCC_HoldMotion(XY), "MCC_HoldMotion")  # noqa: F405
@@ -111,16 +127,21 @@ def main() -> dict:
     cards = [SYS_CARD_CONFIG()]  # noqa: F405
     check(MCC_InitSystem(5, cards, 1), "MCC_InitSystem")  # noqa: F405
     home_all()
+    retune()
     held, end, status = job()
+    period = MCC_GetInterpolationTime()  # noqa: F405
+    refused = MCC_PtP(145, 10, 0, 0, 0, 0, XY)   # X beyond 151 - 11 = 140 mm  # noqa: F405
     result = {"held_at": held, "end": end, "in_position": status[0], "error": status[1],
-              "pulses": MCC_GetPulsePos(XY)[1:3], "time": LIBRARY.controller.time}  # noqa: F405
+              "pulses": MCC_GetPulsePos(XY)[1:3], "time": LIBRARY.controller.time,  # noqa: F405
+              "period_ms": period, "refused_at_145": refused}
     check(MCC_CloseSystem(), "MCC_CloseSystem")  # noqa: F405
     return result
 
 
 if __name__ == "__main__":
     r = main()
-    print(f"held at X={r['held_at'][0]:.3f} Y={r['held_at'][1]:.3f} mm")
+    print(f"held at X={r['held_at'][0]:.3f} Y={r['held_at'][1]:.3f} mm "
+          f"(interpolation time {r['period_ms']} ms; PtP to X=145 mm: {r['refused_at_145']})")
     print(f"end at X={r['end'][0]:.3f} Y={r['end'][1]:.3f} mm, pulses {r['pulses']}, "
           f"in position {r['in_position']:.0f}, error {r['error']:.0f}, "
           f"{r['time']:.2f} s")

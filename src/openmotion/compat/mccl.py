@@ -29,7 +29,7 @@ from openmotion.control.home.homing_modes import HomeConfig
 from openmotion.control.home.homing_sequence import HomeSequence
 from openmotion.control.loops.compensation import Compensation, PitchCompTable
 from openmotion.control.manual.jog import MAX_JOG_PULSES
-from openmotion.errors import check_nonnegative
+from openmotion.errors import MotionError, check_nonnegative
 
 from . import mccl_defs as D
 from .mccl_base import GroupSlot, Refused, _api, _int, _num
@@ -467,16 +467,27 @@ class MCCL(MCCLMotion):
 
     @_api
     def MCC_SetENCInputRate(self, wRate: int, wChannel: int, wCardIndex: int = 0) -> int:
-        """Encoder mode x1, x2 or x4 of an A/B encoder (default 4); set before
-        MCC_InitSystem (the card's configuration)."""
+        """Encoder mode x1, x2 or x4 of an A/B encoder (2.9, default 4), before or after
+        MCC_InitSystem. On an initialised machine it applies at once to the channel's
+        decoder (core `Controller.set_encoder_mode`): the count keeps its value and counts
+        x1/x2/x4 of the same encoder from then on (dwPPR is the count per revolution
+        after the mode: set it to match and MCC_UpdateMachParam). Only for an A/B input
+        (stEncoder.wType 0: else PARAMETER_ERR); refused while the channel moves
+        (COMMAND_NOTACCEPTED_ERR)."""
         r = _int("wRate", wRate, 1, 4)
         if r == 3:
             raise Refused(D.PARAMETER_ERR, "wRate must be 1, 2 or 4")
         ch = _int("wChannel", wChannel, 0, D.CHANNELS_PER_CARD - 1)
         card = _int("wCardIndex", wCardIndex, 0, D.MAX_CARD - 1)
         if self.controller is not None:
-            raise Refused(D.COMMAND_NOTACCEPTED_ERR, "set the encoder rate before "
-                                                     "MCC_InitSystem")
+            ax = self._axis(ch, card)
+            if self._param(ch, card).stEncoder.wType != 0:
+                raise Refused(D.PARAMETER_ERR, f"card {card} channel {ch}: the encoder "
+                                               "rate is for an A/B input (wType 0)")
+            try:
+                self.controller.set_encoder_mode(ax.index, f"ab_x{r}")
+            except MotionError as err:
+                raise Refused(D.COMMAND_NOTACCEPTED_ERR, str(err)) from None
         self._enc_rate[(card, ch)] = r
         return D.NO_ERR
 

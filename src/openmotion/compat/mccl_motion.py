@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from openmotion.control.groups import group as G
+from openmotion.errors import MotionError
 
 from . import mccl_defs as D
 from .mccl_base import GroupSlot, Refused, _api, _int, _num
@@ -48,21 +49,36 @@ class MCCLMotion(MCCLSpeed):
 
     @_api
     def MCC_UpdateMachParam(self) -> int:
-        """Apply parameters set after MCC_InitSystem: the working interval (soft limits),
-        homing and limit-switch settings. Parameters of the pulse output, the encoder,
-        the sensor logic and the mechanism ratio need a new MCC_InitSystem (the cards'
-        configuration): refused (PARAMETER_ERR) when they changed."""
+        """Apply the mechanism parameters set (MCC_SetMachParam) after MCC_InitSystem
+        (2.4): the mechanism ratio (dwPPR, dfPitch, dfGearRatio), wRPM, wPosToEncoderDir,
+        the pulse output format and width, the encoder format and its inversions, the
+        sensor logic of home and over-travel inputs (core `Controller.reconfigure_axis`),
+        the working interval (soft limits) and the homing settings. The counters keep
+        their pulses (positions in mm follow the new ratio). Every channel is checked
+        before any changes: a bad value is PARAMETER_ERR; while a group has commands
+        queued, running or held, or an axis moves, COMMAND_NOTACCEPTED_ERR."""
+        from openmotion.control.core.controller import RECONFIGURABLE
+
         ctl = self._ctl()
+        if not all(self._idle(gs) for gs in self._groups.values()) or \
+                any(a.is_moving for a in ctl.axes):
+            raise Refused(D.COMMAND_NOTACCEPTED_ERR, "the machine must be at rest (groups "
+                                                     "idle) to update its parameters")
+        plan = []
         for ax in ctl.axes:
             card, ch = divmod(ax.index, D.CHANNELS_PER_CARD)
+            _check_mach(self._param(ch, card))
             new = self._axis_config(card, ch)
-            keep = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed",
-                    "pulse_mode", "encoder_mode", "logic", "swap_ab", "invert_a",
-                    "invert_b", "invert_z")
-            if any(getattr(new, k) != getattr(ax.config, k) for k in keep):
-                raise Refused(D.PARAMETER_ERR, f"card {card} channel {ch}: mechanism, "
-                                               "pulse, encoder or sensor parameters "
-                                               "changed: call MCC_InitSystem again")
+            # (MCCL has no move ratio: MCC_SetENCInputRate keeps it right)
+            changes = {k: getattr(new, k) for k in RECONFIGURABLE
+                       if k != "move_ratio" and getattr(new, k) != getattr(ax.config, k)}
+            plan.append((ax.index, changes))
+        for index, changes in plan:
+            if changes:
+                try:
+                    ctl.reconfigure_axis(index, **changes)
+                except MotionError as err:
+                    raise Refused(D.PARAMETER_ERR, str(err)) from None
         for gs in self._groups.values():
             self._apply_soft_limits(gs)
         return D.NO_ERR
@@ -128,14 +144,40 @@ class MCCLMotion(MCCLSpeed):
 
     @_api
     def MCC_SetInterpolationTime(self, nInterpolateTime: int) -> int:
-        """The interpolation time (ms) is fixed by MCC_InitSystem in this library: the
-        same value is accepted, another one refused (COMMAND_NOTACCEPTED_ERR)."""
+        """The interpolation time, 1..1000 ms, after MCC_InitSystem (2.6.4 I: "set it
+        later any time"): applied at once between two cycles while the machine is at rest
+        (core `Controller.set_period`); the steps set before (MCC_SetAccStep ...) keep their
+        counts, so their times and the per-period pulse caps scale with it. While a group
+        has commands queued, running or held, or an axis moves, refused with
+        COMMAND_NOTACCEPTED_ERR (those commands were checked against the old time's
+        caps), nothing changed."""
         n = _int("nInterpolateTime", nInterpolateTime, 1, 1000)
-        self._ctl()
-        if abs(n / 1000.0 - self._period) > 1e-12:
-            raise Refused(D.COMMAND_NOTACCEPTED_ERR, "the interpolation time is set by "
-                                                     "MCC_InitSystem (close and init again)")
+        ctl = self._ctl()
+        old = self._period
+        try:
+            ctl.set_period(n / 1000.0)
+        except MotionError as err:
+            raise Refused(D.COMMAND_NOTACCEPTED_ERR, str(err)) from None
+        try:
+            self._step_times(n / 1000.0)
+        except MotionError:  # a step time out of range at the new time: all back
+            ctl.set_period(old)
+            self._step_times(old)
+            raise
+        self._period = n / 1000.0
         return D.NO_ERR
+
+    def _step_times(self, T: float) -> None:
+        """Every group's step counts (MCC_SetAccStep ...) as times at interpolation time T."""
+        for gs in self._groups.values():
+            g = gs.group
+            g.set_acc_time(gs.acc_step * T)
+            if g._dec_time is not None:
+                g.set_dec_time(gs.dec_step * T)
+            if g._ptp_acc_time is not None:
+                g.set_ptp_acc_time(gs.ptp_acc_step * T)
+            if g._ptp_dec_time is not None:
+                g.set_ptp_dec_time(gs.ptp_dec_step * T)
 
     @_api
     def MCC_GetInterpolationTime(self) -> int:

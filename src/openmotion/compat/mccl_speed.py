@@ -181,40 +181,41 @@ class MCCLSpeed(MCCLBase):
         return str(c).upper()
 
     def _update_shapes(self, gs: GroupSlot) -> None:
-        """The group's path shape from its acc type: S = s-factor 1 (2.6.3 I: a triangular
-        acceleration lasting the acceleration / deceleration time)."""
+        """The group's path shapes from its acc and dec types: S = s-factor 1 (2.6.3 I: a
+        triangular acceleration lasting the acceleration / deceleration time); a
+        deceleration type apart makes each command one move of its own (core pathmove)."""
         if gs.acc_type == "S":
             gs.group.set_path_shape("S", s_factor=1.0)
         else:
             gs.group.set_path_shape("T")
+        gs.group.set_path_dec_shape(None if gs.dec_type == gs.acc_type else gs.dec_type)
 
-    @_api
-    def MCC_SetAccType(self, cType: str, wGroupIndex: int = 0) -> int:
-        """General motion 'T' (trapezoid) or 'S' (S-curve); 2.6.3 I. The deceleration
-        follows the same shape in the core (MCC_SetDecType must match it)."""
-        gs = self._g(wGroupIndex)
-        t = self._type("cType", cType)
-        old = gs.acc_type
-        gs.acc_type = t
+    def _set_type(self, gs: GroupSlot, acc: str, dec: str) -> int:
+        old = gs.acc_type, gs.dec_type
+        gs.acc_type, gs.dec_type = acc, dec
         try:
             self._update_shapes(gs)
         except BaseException:
-            gs.acc_type = old
+            gs.acc_type, gs.dec_type = old
+            self._update_shapes(gs)
             raise
-        gs.dec_type = t
         return D.NO_ERR
 
     @_api
-    def MCC_SetDecType(self, cType: str, wGroupIndex: int = 0) -> int:
-        """The deceleration shape: the core plans one shape per path, so it must equal
-        the acceleration type (PARAMETER_ERR otherwise)."""
+    def MCC_SetAccType(self, cType: str, wGroupIndex: int = 0) -> int:
+        """General motion acceleration 'T' (trapezoid) or 'S' (S-curve, s-factor 1);
+        2.6.3 I. The deceleration keeps its own type (MCC_SetDecType, default 'T')."""
         gs = self._g(wGroupIndex)
-        t = self._type("cType", cType)
-        if t != gs.acc_type:
-            raise Refused(D.PARAMETER_ERR, "a different deceleration shape is not supported: "
-                                           "set MCC_SetAccType")
-        gs.dec_type = t
-        return D.NO_ERR
+        return self._set_type(gs, self._type("cType", cType), gs.dec_type)
+
+    @_api
+    def MCC_SetDecType(self, cType: str, wGroupIndex: int = 0) -> int:
+        """General motion deceleration 'T' or 'S' (2.6.3 I), for line, arc and circle
+        commands queued after it. When it differs from the acceleration type each command
+        runs as one move along its length with its two ramp shapes (core
+        `Group.set_path_dec_shape`)."""
+        gs = self._g(wGroupIndex)
+        return self._set_type(gs, gs.acc_type, self._type("cType", cType))
 
     @_api
     def MCC_GetAccType(self, wGroupIndex: int = 0) -> str:
@@ -260,16 +261,17 @@ class MCCLSpeed(MCCLBase):
     # ------------------------------------------------------------------ blending, override
     @_api
     def MCC_EnableBlend(self, wGroupIndex: int = 0) -> int:
-        """Velocity blending (2.6.3 II): corners between lines and arcs are rounded
-        within feed x acceleration time / 8 (the deviation of two overlapped ramps)."""
+        """Velocity blending (2.6.3 II) of the commands queued after it: the next command
+        starts when the running one begins to decelerate and the speeds add (line-line,
+        line-arc, arc-arc, point-to-point; core `Group.enable_overlap_blend`)."""
         gs = self._g(wGroupIndex)
-        g = gs.group
-        g.enable_blend(g._feed * g.acc_time / 8.0)
+        gs.group.enable_overlap_blend()
         gs.blend = True
         return D.NO_ERR
 
     @_api
     def MCC_DisableBlend(self, wGroupIndex: int = 0) -> int:
+        """Each command from rest to rest again (the running blend finishes)."""
         gs = self._g(wGroupIndex)
         gs.group.disable_blend()
         gs.blend = False

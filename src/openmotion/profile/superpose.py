@@ -18,14 +18,20 @@ from .segments import Profile, State
 
 def superpose(running: Profile, since: float, nxt: Profile, delay: float) -> Profile:
     """From time 0 = `since` seconds into `running`: `running`'s rest plus `nxt`'s
-    displacement, `nxt` starting `delay` seconds from now (at rest before). Both must end
-    at rest; the result starts at running's state at `since`."""
+    displacement, `nxt` starting `delay` seconds from now (at rest before). `running` must
+    end at rest and `nxt` start at rest; `nxt` may end moving (a first window of a longer
+    motion) when it ends after `running` does: the result then ends in its state. The
+    result starts at running's state at `since`."""
     s = check_finite("since", since)
     d = check_finite("delay", delay)
     if s < 0.0 or d < 0.0:
         raise MotionError(f"since and delay must be >= 0, got {since!r}, {delay!r}")
-    if running.end.v != 0.0 or nxt.end.v != 0.0 or nxt.start.v != 0.0:
-        raise MotionError("superpose needs moves that start (next) and end at rest")
+    if running.end.v != 0.0 or running.end.a != 0.0 or nxt.start.v != 0.0:
+        raise MotionError("superpose needs a running move that ends at rest and a next "
+                          "one that starts at rest")
+    moving = nxt.end.v != 0.0 or nxt.end.a != 0.0
+    if moving and d + nxt.duration < running.duration - s - 1e-12:
+        raise MotionError("a next move that ends moving must end after the running one")
     dur = max(running.duration - s, 0.0, d + nxt.duration)
     cuts = np.concatenate([[0.0], running.t0 - s, [running.duration - s],
                            nxt.t0 + d, [d, d + nxt.duration]])
@@ -51,7 +57,8 @@ def superpose(running: Profile, since: float, nxt: Profile, delay: float) -> Pro
     st = running.state_at(s)
     return Profile(t0=cuts, p0=p0, v0=v0, a0=a0, j=j, duration=dur,
                    start=State(float(p0[0]), st.v, st.a),
-                   end=State(nxt.end.p + (running.end.p - nxt.start.p)), dt=ends - cuts)
+                   end=State(nxt.end.p + (running.end.p - nxt.start.p), nxt.end.v,
+                             nxt.end.a), dt=ends - cuts)
 
 
 def deceleration_start(p: Profile) -> float:

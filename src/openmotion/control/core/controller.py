@@ -20,15 +20,17 @@ a thread; `stop_realtime()`; `with controller.start_realtime(): ...`; `cycle_sta
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 from collections.abc import Callable, Collection, Sequence
 from typing import Any
 
-from ...config import MachineConfig, default_machine
+from ...config import ENCODER_MULTIPLIER, MachineConfig, default_machine
 from ...errors import MotionError, check_int, check_nonnegative
 from ...history import MotionHistory
 from ...hw.interface import Hardware, InputEdge
 from ...recording import Recorder
+from ...units import MAX_PULSE_RATE
 from .axis import Axis
 from .clock import CycleStats, RealtimePacer, check_period
 from .events import EventLog
@@ -84,6 +86,13 @@ SampleHook = Callable[["Controller", float], None]
 FaultHook = Callable[[Axis, str], None]
 MotionCheck = Callable[[Axis, ActiveMotion], None]
 MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
+PeriodHook = Callable[[float, bool], None]
+ConfigHook = Callable[[int, Any, bool], None]
+#: AxisConfig fields `Controller.reconfigure_axis` changes on a running machine.
+DECODER_FIELDS = ("encoder_mode", "swap_ab", "invert_a", "invert_b", "invert_z")
+RECONFIGURABLE = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed", "logic",
+                  "pulse_mode", "pulse_width_us", "encoder_lines_per_rev", "move_ratio",
+                  *DECODER_FIELDS)
 JumpObserver = Callable[["Controller", int, int, list[list[float]]], None]
 
 
@@ -147,6 +156,8 @@ class Controller:
         self._fault_hooks: list[FaultHook] = []
         self._motion_checks: list[MotionCheck] = []
         self._motion_hooks: list[MotionHook] = []
+        self._period_hooks: list[PeriodHook] = []
+        self._config_hooks: list[ConfigHook] = []
         self._estop = False
         self._committed: float | None = None  # inside a cycle: the end its pulses reach
         #: cycles that raised (each one became a fault, see `step`)
@@ -376,6 +387,115 @@ class Controller:
         with self._lock:
             if hook in self._motion_hooks:
                 self._motion_hooks.remove(hook)
+
+    def add_period_hook(self, hook: PeriodHook) -> None:
+        """Call `hook(new_period, commit)` when the period changes (`set_period`): first
+        with commit False for every hook (raise MotionError to refuse the change), then
+        with commit True once it is made. Capabilities whose settings are per period (a
+        group's per-period pulse caps) subscribe here."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._period_hooks.append(hook)
+
+    def remove_period_hook(self, hook: PeriodHook) -> None:
+        with self._lock:
+            if hook in self._period_hooks:
+                self._period_hooks.remove(hook)
+
+    def set_period(self, seconds: float) -> None:
+        """Change the interpolation period (MCC_SetInterpolationTime, 1 ms .. 1 s) between
+        two cycles: the cycle grid goes on from now in steps of the new period. Refused
+        (MotionError, nothing changed) in real-time mode, while an axis moves (its motion
+        was checked against the old period's per-period limits) or when a period hook
+        refuses (a group with commands queued or running)."""
+        p = check_period(seconds)
+        with self._lock:
+            if self.realtime:
+                raise MotionError("period: cannot change while the real-time pacer runs")
+            for a in self.axes:
+                if a.is_moving:
+                    raise MotionError(f"period: cannot change while axis {a.name} moves")
+            hooks = list(self._period_hooks)
+            for hook in hooks:
+                hook(p, False)
+            self.period = p
+            self._t_origin = self._time - self._n * p
+            self._pacer = RealtimePacer(self.step, p, self._overran)
+            for hook in hooks:
+                hook(p, True)
+
+    def set_encoder_mode(self, axis: int | str, mode: str) -> None:
+        """Change how an axis's A/B encoder input is decoded (x1, x2, x4: "ab_x1" ..
+        "ab_x4") on a running machine (MCC_SetENCInputRate): `reconfigure_axis` of
+        encoder_mode, limited to the A/B modes of an A/B input. The same encoder then
+        gives new/old multiplier counts per command pulse: the move ratio (feedback
+        counts per command pulse, the error counter's scale) follows."""
+        ax = self.axis(axis)
+        if not isinstance(mode, str) or mode not in ("ab_x1", "ab_x2", "ab_x4"):
+            raise MotionError(f"mode must be 'ab_x1', 'ab_x2' or 'ab_x4', got {mode!r}")
+        if not ax.config.encoder_mode.startswith("ab"):
+            raise MotionError(f"axis {ax.name}: encoder_mode {ax.config.encoder_mode!r} is "
+                              "not an A/B input")
+        k = ENCODER_MULTIPLIER[mode] / ENCODER_MULTIPLIER[ax.config.encoder_mode]
+        self.reconfigure_axis(ax.index, encoder_mode=mode,
+                              move_ratio=ax.config.move_ratio * k)
+
+    def add_config_hook(self, hook: ConfigHook) -> None:
+        """Call `hook(axis_index, new_config, commit)` when an axis is reconfigured
+        (`reconfigure_axis`): first with commit False (raise MotionError to refuse), then
+        with commit True once it is made. A group whose units follow the machine
+        subscribes here."""
+        if not callable(hook):
+            raise MotionError(f"hook must be callable, got {hook!r}")
+        with self._lock:
+            self._config_hooks.append(hook)
+
+    def remove_config_hook(self, hook: ConfigHook) -> None:
+        with self._lock:
+            if hook in self._config_hooks:
+                self._config_hooks.remove(hook)
+
+    def reconfigure_axis(self, axis: int | str, **changes: Any) -> None:
+        """Change an axis's settings on a running machine while it is at rest (MCCL
+        MCC_UpdateMachParam after MCC_SetMachParam): the mechanism ratio (pulses_per_rev,
+        lead, gear_ratio), reverse, max_speed, the signal logic (`logic`: how the board
+        reads its inputs; the switches themselves stay as wired), the pulse output format
+        and the encoder decoding (encoder_mode, swap_ab, invert_a/b/z: the hardware's
+        `configure_decoder`). Counters keep their pulse values; what they mean in user
+        units follows the new ratio. Refused (MotionError, nothing changed) for other
+        fields, an invalid value, a moving axis, a config hook's refusal (a group with
+        commands) or hardware that cannot change its decoder."""
+        ax = self.axis(axis)
+        bad = sorted(set(changes) - set(RECONFIGURABLE))
+        if bad:
+            raise MotionError(f"{', '.join(bad)}: not changeable on a running machine "
+                              f"(changeable: {', '.join(RECONFIGURABLE)})")
+        cfg = dataclasses.replace(ax.config, **changes)  # validated (__post_init__)
+        decode = any(getattr(cfg, k) != getattr(ax.config, k) for k in DECODER_FIELDS)
+        setter = getattr(self.hardware, "configure_decoder", None)
+        if decode and setter is None:
+            raise MotionError("this hardware cannot change its encoder decoding")
+        with self._lock:
+            if ax.is_moving:
+                raise MotionError(f"axis {ax.name}: cannot be reconfigured while it moves")
+            hooks = list(self._config_hooks)
+            for hook in hooks:
+                hook(ax.index, cfg, False)
+            if decode:
+                setter(ax.index, cfg)
+            if cfg.move_ratio != ax.config.move_ratio:
+                ax.counters.set_move_ratio(cfg.move_ratio)
+            ax.config = cfg
+            ax._max_speed = min(cfg.max_speed_pps, MAX_PULSE_RATE)
+            axes = list(self.config.axes)
+            axes[ax.index] = cfg
+            self.config = dataclasses.replace(self.config, axes=tuple(axes))
+            self._nc[ax.index] = {s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm",
+                                              "inp", "rdy") if cfg.signal_logic(s) == "nc"}
+            self._emg_nc = any(a.signal_logic("emg") == "nc" for a in self.config.axes)
+            for hook in hooks:
+                hook(ax.index, cfg, True)
 
     def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
         for check in tuple(self._motion_checks):

@@ -32,7 +32,7 @@ from ...path import Arc, Arc3D, Line
 from ...profile.pcl import MoveSpec
 from ...units import AxisUnits
 from ..core.states import AxisState
-from . import pathrun
+from . import pathmove, pathrun
 from .group_checks import unit_names, unit_scales
 from .group_settings import PERIOD_PULSES_DEFAULT, PERIOD_PULSES_MAX, GroupSettings
 from .groupdue import group_due
@@ -208,6 +208,15 @@ class Group(GroupSettings):
             controller.add_fault_hook(self._on_axis_fault)
         if hasattr(controller, "add_motion_hook"):  # ... and to axes stopped directly
             controller.add_motion_hook(self._on_axis_motion)
+        if hasattr(controller, "add_period_hook"):  # per-period caps follow the period
+            controller.add_period_hook(self._on_period)
+        # the units each axis takes from the machine config follow its reconfiguration
+        self._units = [AxisUnits.from_axis(controller.config.axes[a.index]) for a in ax] \
+            if units is True else (list(units) if units is not False else None)
+        self._follows: tuple[int, bool] | None = None
+        self._old_max = 0.0  # (the reconfigured axis's speed before: _on_config)
+        if hasattr(controller, "add_config_hook"):
+            controller.add_config_hook(self._on_config)
 
     # ------------------------------------------------------------------ status
     @property
@@ -343,10 +352,64 @@ class Group(GroupSettings):
             self._ctl.remove_fault_hook(self._on_axis_fault)
         if hasattr(self._ctl, "remove_motion_hook"):
             self._ctl.remove_motion_hook(self._on_axis_motion)
+        if hasattr(self._ctl, "remove_period_hook"):
+            self._ctl.remove_period_hook(self._on_period)
+        if hasattr(self._ctl, "remove_config_hook"):
+            self._ctl.remove_config_hook(self._on_config)
         owners = OWNERS.get(self._ctl, {})
         for a in self.axes:
             if owners.get(a.index) is self:
                 del owners[a.index]
+
+    def _on_period(self, period: float, commit: bool) -> None:
+        """Controller period hook (set_period): refused while the group holds commands
+        (queued, running, held: checked against the old period's caps); then the
+        per-period pulse caps (MCCL 2.6.4: speed/T, acc/T^2) follow the new period."""
+        if not commit:
+            self._busy_for("period")
+            return
+        self._update_caps()
+
+    def _busy_for(self, what: str) -> None:
+        if self._run is not None or self._queue or self._held is not None or \
+                self._job is not None:
+            raise GroupError(ERR_STATE, f"{what}: group {'/'.join(self.names)} has "
+                                        "commands queued or running")
+
+    def _on_config(self, index: int, cfg: Any, commit: bool) -> None:
+        """Controller config hook (reconfigure_axis of one of the group's axes): refused
+        while the group holds commands; then its units (when they come from the machine),
+        speed and acceleration caps follow the axis's new settings."""
+        k = next((i for i, a in enumerate(self.axes) if a.index == index), None)
+        if k is None:
+            return
+        a = self.axes[k]
+        if not commit:
+            self._busy_for("reconfigure")
+            follows = self._units is not None and \
+                self._units[k] == AxisUnits.from_axis(a.config)
+            self._follows = (k, follows)
+            self._old_max = a.max_speed
+            return
+        if self._follows is not None and self._follows == (k, True) and \
+                self._units is not None:
+            self._units[k] = AxisUnits.from_axis(cfg)
+            self._k = np.array([u.sign * u.pulses_per_unit for u in self._units])
+            self._ppu = np.abs(self._k)
+            names = list(self._unit_names)
+            names[k] = cfg.unit
+            self._unit_names = tuple(names)
+        self._follows = None
+        if self._vmax_pps[k] >= self._old_max * (1 - 1e-12):  # the default: the axis's
+            self._vmax_pps[k] = a.max_speed
+        else:
+            self._vmax_pps[k] = min(self._vmax_pps[k], a.max_speed)
+        self._amax_pps[k] = cfg.max_accel * cfg.pulses_per_unit if cfg.max_accel > 0.0 \
+            else math.inf
+        self._sys_max = float(max(x.max_speed / p for x, p in
+                                  zip(self.axes, self._ppu, strict=True)))
+        self._update_caps()
+        self._tail = None
 
     # ------------------------------------------------------------------ settings
     # (feed, times, caps, blending, shapes, PtP: group_settings.py)
@@ -377,6 +440,7 @@ class Group(GroupSettings):
         p = self._point("target", target, start if relative else None)
         if np.all(p == start):
             raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
+        self._check_soft_span(np.minimum(start, p), np.maximum(start, p), start, "move")
         specs = []
         tacc, tdec = self.ptp_times
         for k, a in enumerate(self.axes):
@@ -499,9 +563,10 @@ class Group(GroupSettings):
         r, self._held = self._held, None
         t = self._ctl.time
         if r.plan is not None:  # from rest (with the StrVel jump again)
-            chain = r.plan.chain
-            self._launch(pathrun.start(chain, self._limits(chain, r.cmds[0].str_vel),
-                                       r.plan.tj, t, s0=r.plan.sprof.end.p), r.cmds, t)
+            chain, s0 = r.plan.chain, r.plan.sprof.end.p
+            lim = self._limits(chain, r.cmds[0].str_vel)
+            self._launch(pathmove.start(chain, r.plan.move, lim, t, s0) if r.plan.move
+                         else pathrun.start(chain, lim, r.plan.tj, t, s0=s0), r.cmds, t)
         elif r.kind == "ptp":
             self._launch_ptp(r.cmds[0], t)
         else:

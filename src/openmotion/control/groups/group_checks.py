@@ -20,6 +20,7 @@ from ...errors import MotionError, show
 from ...limits import PATH_LENGTH_MAX, PULSES_MAX, as_array
 from ...path.extent import element_extent
 from ...path.geometry import PathElement
+from ...profile.pcl import MoveSpec
 from ...units import AxisUnits
 from ..core.states import AxisState
 from .groupexec import (
@@ -125,24 +126,31 @@ class GroupChecks(GroupEngine):
     def _check_soft_limits(self, el: PathElement) -> None:
         """Refuse (ERR_LIMIT) a path element that would take an axis past an enabled soft
         limit (further than where it starts), before it is queued."""
+        lo, hi = element_extent(el)
+        self._check_soft_span(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float),
+                              np.asarray(el.start, dtype=float), "path")
+
+    def _check_soft_span(self, lo: np.ndarray, hi: np.ndarray, start: np.ndarray,
+                         what: str) -> None:
+        """Refuse (ERR_LIMIT) a command whose axes sweep [lo, hi] (logical units) from
+        `start` when an axis would pass an enabled soft limit further than it starts."""
         from ..guard.safety import Safety
 
         safety = Safety.of(self._ctl)
         if safety is None or self._dry:
             return
-        lo, hi = element_extent(el)
         a_, b_ = lo * self._k, hi * self._k
         plo, phi = np.minimum(a_, b_), np.maximum(a_, b_)
-        start = np.asarray(el.start, dtype=float) * self._k
+        start = start * self._k
         for i, ax in enumerate(self.axes):
             lim = safety.soft.get(ax.index)
             if not lim.enabled:
                 continue
             if phi[i] > max(lim.plimit, start[i]) + 1e-9 * max(1.0, abs(lim.plimit)):
-                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the + "
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the {what} passes the + "
                                             f"soft limit {lim.plimit!r} (reaches {phi[i]:.6g})")
             if plo[i] < min(lim.nlimit, start[i]) - 1e-9 * max(1.0, abs(lim.nlimit)):
-                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the path passes the - "
+                raise GroupError(ERR_LIMIT, f"axis {self.names[i]}: the {what} passes the - "
                                             f"soft limit {lim.nlimit!r} (reaches {plo[i]:.6g})")
 
     def _check_length(self, el: PathElement) -> None:
@@ -181,7 +189,19 @@ class GroupChecks(GroupEngine):
                                             f"its maximum acceleration "
                                             f"{self._in_units(k, self._amax[k], '/s^2')}")
         return self._push(_Cmd(-1, "path", elements=(el,), feed=feed, accel=accel,
-                               decel=decel, jerk=jerk, str_vel=sv), end)
+                               decel=decel, jerk=jerk, str_vel=sv,
+                               move=self._path_move(feed, sv)), end)
+
+    def _path_move(self, feed: float, str_vel: float) -> MoveSpec | None:
+        """The 1-D move a path command runs as when its deceleration shape differs from
+        its acceleration shape (pathmove.py), else None (it chains)."""
+        acc, dec = self.path_shapes  # type: ignore[attr-defined]
+        if acc == dec:
+            return None
+        if str_vel:
+            raise GroupError(ERR_ARGUMENT, "a path deceleration shape apart needs StrVel 0")
+        return MoveSpec(acc, 0.0, feed, self._acc_time, self.dec_time,
+                        dec_shape=dec)  # type: ignore[attr-defined]
 
     def _path_ramps(self, feed: float) -> tuple[float, float | None, float]:
         """(acceleration, deceleration or None = the same, jerk or 0 = T) of a path command

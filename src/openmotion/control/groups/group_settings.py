@@ -42,6 +42,9 @@ class GroupSettings(GroupChecks):
     _ptp_acc_time: float | None
     _ptp_dec_time: float | None
     _path_sfactor: float
+    _path_jerk: float
+    _path_dec_shape: str | None = None  # None: as the acceleration (set_path_dec_shape)
+    _overlap: bool = False              # time-overlap blending (enable_overlap_blend)
 
     def set_feed(self, feed: float) -> None:
         """MCC_SetFeedSpeed: vector speed (pps, or user units/s) of the following path
@@ -151,7 +154,42 @@ class GroupSettings(GroupChecks):
         self._blend = True
 
     def disable_blend(self) -> None:
+        """No blending: neither corner rounding nor the time-overlap blend."""
         self._blend = False
+        self._overlap = False
+
+    def enable_overlap_blend(self) -> None:
+        """MCCL's velocity blending (2.6.3 II): every command is planned on its own, from
+        rest to rest, and the next one starts when it begins its final deceleration; each
+        axis then follows the sum of both motions, so the deceleration of one and the
+        acceleration of the next overlap in time and their speeds add (line-line,
+        line-arc, arc-arc and point-to-point alike; control/groups/overlap.py). A blend that
+        would take an axis above its speed or acceleration cap is not made: those two
+        commands run one after the other. Replaces corner rounding (enable_blend)."""
+        self._blend = False
+        self._overlap = True
+
+    @property
+    def blend_mode(self) -> str:
+        """"off", "corner" (enable_blend: rounded within a tolerance) or "overlap"."""
+        return "overlap" if self._overlap else ("corner" if self._blend else "off")
+
+    def set_path_dec_shape(self, shape: str | None) -> None:
+        """MCC_SetDecType: the deceleration shape of the following path commands, "T" or
+        "S" (S with ramp times: a triangular deceleration lasting the deceleration time),
+        None = the path shape (set_path_shape). A command whose deceleration shape differs
+        from its acceleration shape runs alone as one move along its length
+        (control/groups/pathmove.py): it ends at rest (or blends in time into the next with
+        enable_overlap_blend), it joins no chain."""
+        if shape is not None and (not isinstance(shape, str) or shape not in ("T", "S")):
+            raise MotionError(f"shape must be 'T', 'S' or None, got {shape!r}")
+        self._path_dec_shape = shape
+
+    @property
+    def path_shapes(self) -> tuple[str, str]:
+        """(acceleration, deceleration) shape of the following path commands."""
+        acc = "S" if (self._path_sfactor or self._path_jerk) else "T"
+        return acc, (self._path_dec_shape or acc)
 
     def set_wait_in_position(self, on: bool) -> None:
         """MCCL 2.10.2: with in-position checks on (control.guard.inposition), each command

@@ -1,18 +1,19 @@
 """When a group's cycle hook may next act (Controller.add_cycle_hook(..., due=...)).
 
-`GroupEngine._cycle_step` acts on a few instants only: a queued command becoming due
-(the group idle or the running command ended), the end of a delay, the renewal of a path
+`GroupEngine._cycle_step` acts on a few instants only: a queued command becoming due (the
+group idle or the running command ended), the end of a delay, the renewal of a path
 window, the cycle in which the running chain has less than its reach ahead (a join), and
-the pre-blending of queued corners. Between them a running line or arc needs nothing from
-Python, so virtual time may jump (control/core/jump.py). `group_due` returns the earliest of
-those instants (a join in flight, real time: its install cycle); -inf ("every cycle")
-wherever the answer is not cheap and sure: pre-blending still to do, a group axis in
-ErrorStop or standing on a limit switch (the limit check depends on the velocity's sign
-cycle by cycle).
+the pre-blending of queued corners, the cycle a command blends in over the running one and
+the end of a blend's overlay when a hold or override waits for it. Between them a running
+line or arc needs nothing from Python, so virtual time may jump (control/core/jump.py).
+`group_due` returns the earliest of those instants (a join in flight, real time: its install
+cycle); -inf ("every cycle") wherever the answer is not cheap and sure: pre-blending still
+to do, a group axis in ErrorStop or standing on a limit switch (the limit check depends on
+the velocity's sign cycle by cycle).
 
 The join instant is found on the very cycle grid the hook sees, by evaluating the plan's
-`remaining(t)` at the cycle ends ahead (cached while the plan and the queue head stay
-the same), so the cycle found is the one the cycle-by-cycle run joins in.
+`remaining(t)` at the cycle ends ahead (cached while the plan and the queue head stay the
+same), so the cycle found is the one the cycle-by-cycle run joins in.
 """
 
 from __future__ import annotations
@@ -49,6 +50,10 @@ def group_due(g: Any, ctl: Controller) -> float:
         if r.kind == "delay" and g._queue:
             due = min(due, r.t_until - ctl.period)
         due = min(due, r.t_end - 1e-12)
+        if r.blend_at is not None and g._queue:  # the cycle the next command blends in
+            due = min(due, r.blend_at - ctl.period)
+        if r.deferred is not None and r.overlay_end is not None:  # a hold/override waits
+            due = min(due, r.overlay_end - 1e-12)
     elif state in (GroupState.MOVING, GroupState.IDLE):
         return -math.inf if g._queue or state is GroupState.MOVING else due
     if g._queue:

@@ -40,8 +40,8 @@ from ...profile.pcl import MoveSpec
 from ...profile.segments import Profile, State, delayed
 from ..core import planning
 from ..core.states import AxisState
+from . import overlap, pathmove, pathrun, ptpblend
 from . import pathexec as px
-from . import pathrun, ptpblend
 from .group_corners import LookaheadSettings
 from .groupjoin import AsyncJoin
 
@@ -97,6 +97,7 @@ class _Cmd:
     seconds: float = 0.0
     jerk: float = 0.0              # path jerk limit (0: T-curve)
     str_vel: float = 0.0           # StrVel: a path starts/ends with a jump from/to rest
+    move: MoveSpec | None = None   # path run alone as one move with its own ramp shapes
 
     @property
     def dec(self) -> float:
@@ -121,7 +122,9 @@ class _Run:
     t_until: float = 0.0
     target: np.ndarray | None = None
     window_end: float | None = None        # path: the axes' profiles end here (windowed)
-    blend_at: float | None = None          # ptp: when the next PtP may blend in (ptpblend)
+    blend_at: float | None = None          # when the next command may blend in (overlap)
+    overlay_end: float | None = None       # a blend: the previous command's rest ends here
+    deferred: str | None = None            # hold/override asked during the overlay
 
     @property
     def t_end(self) -> float:
@@ -249,8 +252,12 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             self._ended_at = r.t_until
             self._start_next(t, start=r.t_until)
             return
+        if r is not None and r.deferred is not None and r.overlay_end is not None and \
+                t >= r.overlay_end - 1e-12:  # a hold or override asked during the overlay
+            what, r.deferred = r.deferred, None
+            self._replan(r, hold=what == "hold")
         if r is not None and r.blend_at is not None and self._queue and \
-                r.blend_at < t + self._ctl.period - 1e-12 and self._blend_ptp(r, t):
+                r.blend_at < t + self._ctl.period - 1e-12 and self._blend_next(r, t):
             return
         if r is not None and t >= r.t_end - 1e-12 and (self._dry or not any(
                 a.is_moving for a in self.axes)):
@@ -286,15 +293,29 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             if len(self._queue) == n:  # no join this cycle
                 self._preblend()
 
-    def _blend_ptp(self, r: _Run, t: float) -> bool:
-        """Velocity blending (MCCL 2.6.3 II): the next PtP starts while this one's last
-        axis decelerates, each axis following the sum of both moves (control.groups.ptpblend)."""
+    def _blend_next(self, r: _Run, t: float) -> bool:
+        """Velocity blending (MCCL 2.6.3 II): the next command starts while the running one
+        decelerates, each axis following the sum of both motions: a PtP after a PtP
+        (any blend mode, control.groups.ptpblend), any pair with the time-overlap blend
+        (control.groups.overlap)."""
         cmd = self._queue[0]
-        if not self._blend or cmd.kind != "ptp" or self._wait_inpos or self._dry or \
-                self._state is not GroupState.MOVING:
+        overlap_on = self._overlap  # type: ignore[attr-defined]
+        if self._wait_inpos or self._dry or self._state is not GroupState.MOVING:
+            return False
+        if cmd.kind == "ptp":
+            if not (overlap_on or (self._blend and r.kind == "ptp")):
+                return False
+        elif cmd.kind != "path" or not overlap_on or cmd.str_vel:
             return False
         start, r.blend_at = r.blend_at, None  # one try: a refused blend runs them apart
-        if start is None or not ptpblend.start_blend(self, cmd, t, max(start, t)):
+        if start is None:
+            return False
+        if cmd.kind == "path":
+            if not overlap.start_path(self, r, cmd, t, max(start, t)):
+                return False
+            self._queue.popleft()
+            return True
+        if not ptpblend.start_blend(self, cmd, t, max(start, t)):
             return False
         self._queue.popleft()
         assert cmd.target is not None
@@ -328,20 +349,41 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         elif cmd.kind == "ptp":
             self._launch_ptp(cmd, t, 0.0 if start is None else start - t)
         else:
-            tj = jerk_window(cmd.window_accel, cmd.jerk) if cmd.jerk else 0.0
-            cmds = [cmd, *self._take(tj, cmd.elements[0].length, [cmd])]
-            chain = self._chain(cmds)
-            t_s = t if start is None else start
-            self._launch(pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t_s),
-                         cmds, t)
+            plan, cmds = self._plan_path(cmd, t if start is None else start)
+            self._launch(plan, cmds, t)
         self._state = GroupState.MOVING
+
+    def _alone(self, cmd: _Cmd) -> bool:
+        """Whether a path command is planned on its own (no chain): a 1-D move with its
+        own ramp shapes, or any path with the time-overlap blend on."""
+        return cmd.move is not None or self._overlap  # type: ignore[attr-defined]
+
+    def plan_alone(self, cmd: _Cmd, t: float, s0: float = 0.0) -> pathrun.PathPlan:
+        """`cmd` alone from rest at path position s0, starting at time t."""
+        chain = self._chain([cmd])
+        lim = self._limits(chain, cmd.str_vel)
+        if cmd.move is not None:
+            return pathmove.start(chain, cmd.move, lim, t, s0)
+        tj = jerk_window(cmd.window_accel, cmd.jerk) if cmd.jerk else 0.0
+        return pathrun.start(chain, lim, tj, t, s0)
+
+    def _plan_path(self, cmd: _Cmd, t: float) -> tuple[pathrun.PathPlan, list[_Cmd]]:
+        """The plan starting with `cmd` at time t, and the commands it holds: `cmd` alone,
+        or with the queued commands that join its chain."""
+        if self._alone(cmd):
+            return self.plan_alone(cmd, t), [cmd]
+        tj = jerk_window(cmd.window_accel, cmd.jerk) if cmd.jerk else 0.0
+        cmds = [cmd, *self._take(tj, cmd.elements[0].length, [cmd])]
+        chain = self._chain(cmds)
+        return pathrun.start(chain, self._limits(chain, cmd.str_vel), tj, t), cmds
 
     # ------------------------------------------------------------------ streaming
     def _joins(self, tj: float, cmd: _Cmd, str_vel: float = 0.0) -> bool:
         """Whether `cmd` can join a chain smoothed with window tj (0: a T chain) that starts
         and ends at `str_vel`: a path command of the same shape and StrVel whose own window
         fits in tj (its jerk stays bounded)."""
-        if cmd.kind != "path" or cmd.str_vel != str_vel or self._wait_inpos:
+        if cmd.kind != "path" or cmd.str_vel != str_vel or self._wait_inpos or \
+                self._alone(cmd):
             return False
         if tj == 0.0 or not cmd.jerk:
             return tj == 0.0 and not cmd.jerk
@@ -384,6 +426,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
                 self._job is not None:
             return
         plan = r.plan
+        if plan.move is not None or r.overlay_end is not None:
+            return  # a command run alone, or a time-overlap blend: no chain to join
         if t < plan.t0 or not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
             return  # (a plan starting later in this cycle joins from the next one)
         have = plan.remaining(t)
@@ -616,6 +660,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         cmds = [c for c in cmds if c.index >= first] or cmds[-1:]
         self._run = _Run("path", cmds, t, plan, profiles,
                          target=np.array(plan.chain.elements[-1].end))
+        if self._overlap and not self._dry:  # type: ignore[attr-defined]
+            self._run.blend_at = overlap.path_blend_at(self._run)
 
     def _run_profiles(self, profiles: list[Profile], str_vel: float = 0.0) -> None:
         """Start every axis's profile, or none: each is checked (soft limits, states)
@@ -643,6 +689,11 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         """Re-plan the running chain from now: a hold (to rest) or a new override."""
         assert r.plan is not None
         now = self._ctl.time
+        if r.overlay_end is not None and now < r.overlay_end - 1e-12:
+            # a time-overlap blend: the earlier command's rest still runs on every axis;
+            # the re-plan waits until it is over (at most its deceleration time)
+            r.deferred = "hold" if hold or r.deferred == "hold" else "override"
+            return
         t = max(now, r.plan.t0)  # (a plan that starts later in this cycle)
         if t >= r.plan.t_end:
             return
@@ -703,7 +754,8 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         r = self._run
         assert r is not None and r.plan is not None
         t = self._ctl.time
-        if t < r.plan.t0 or t >= r.plan.t_end:
+        if t < r.plan.t0 or t >= r.plan.t_end or \
+                (r.overlay_end is not None and t < r.overlay_end):
             return False
         try:
             plan = pathrun.replan(r.plan, t, limits=r.plan.limits, hold=True)

@@ -30,6 +30,7 @@ import numpy as np
 
 from ...errors import InfeasibleError
 from ...path.smoothing import fir_smooth
+from ...profile.pcl import MoveSpec
 from ...profile.segments import Profile, ProfileBuilder, State
 from . import pathexec as px
 
@@ -48,6 +49,7 @@ class PathPlan:
     limits: px.Limits
     a_min: float           # tangential deceleration every remaining element allows
     v_end: float = 0.0     # S path with StrVel: the raw speed past its end (0: ends at rest)
+    move: MoveSpec | None = None  # a command run alone as one move along it (pathmove.py)
 
     @property
     def t_end(self) -> float:
@@ -159,6 +161,10 @@ def replan(plan: PathPlan, t: float, *, chain: px.Chain | None = None,
     chain itself) with `limits` (default the plan's), or decelerating to rest (`hold`).
     Raises InfeasibleError when the new chain cannot be followed from the present speed
     (a join that comes too late); the caller then keeps the old plan."""
+    if plan.move is not None:  # a command run alone: its own 1-D re-plan (joins none)
+        from . import pathmove
+
+        return pathmove.replan(plan, t, limits=limits, hold=hold)
     chain = chain or plan.chain
     lim = limits or plan.limits
     tj = plan.tj

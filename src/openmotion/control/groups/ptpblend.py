@@ -61,13 +61,14 @@ def blended_profiles(engine: GroupEngine, cmd: _Cmd, t: float, start: float
             return None  # only moves that end at rest blend
         prof = superpose(m.profile.shifted(off), t - m.t_start,
                          empty_profile(old_end) if nxt is None else nxt, lead)
-        if not _within_caps(engine, k, prof):
+        if not within_caps(engine, k, prof):
             return None
         out.append(prof)
     return out
 
 
-def _within_caps(engine: GroupEngine, k: int, prof: Profile) -> bool:
+def within_caps(engine: GroupEngine, k: int, prof: Profile) -> bool:
+    """Whether axis k's profile stays within the group's speed and acceleration caps."""
     if not prof.n_segments:
         return True
     a = engine.axes[k]

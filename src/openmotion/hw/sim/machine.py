@@ -15,12 +15,13 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Collection, Sequence
 
 import numpy as np
 
-from openmotion.config import MachineConfig
+from openmotion.config import AxisConfig, MachineConfig
 from openmotion.errors import MotionError, check_finite, check_nonnegative
 from openmotion.hw.interface import (
     AXIS_INPUTS,
@@ -34,7 +35,7 @@ from openmotion.hw.interface import (
 
 from . import kernel
 from .cubic import Cubic
-from .encoder import EncoderWiring
+from .encoder import Decoder, EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
 from .piecequeue import PieceQueue
 from .pieces import JumpPiece
@@ -548,6 +549,27 @@ class SimMachine:
         return rec
 
     # -- internals ----------------------------------------------------------------------------
+    def configure_decoder(self, axis: int, cfg: AxisConfig) -> None:
+        """The board's decoding of an axis's encoder input from now on, as `cfg` sets it
+        (encoder_mode x1/x2/x4 or another signal mode, swap_ab, invert_a/b/z: HSL
+        pls_iptmode, MCCL MCC_SetENCInputRate / stEncoder): the encoder itself (its
+        wiring and resolution) stays, the count keeps its value and goes on as the new
+        settings decode it (a setting that differs from the wiring misreads it)."""
+        ax = self._axis(axis)
+        if not isinstance(cfg, AxisConfig):
+            raise MotionError(f"cfg must be an AxisConfig, got {type(cfg).__name__}")
+        old = ax.decoder
+        wiring = EncoderWiring(old.kind, old.upp, old.swap != ax.cfg.swap_ab,
+                               old.flip_a != ax.cfg.invert_a, old.flip_b != ax.cfg.invert_b,
+                               ax.z_flip != ax.cfg.invert_z)
+        new = Decoder(wiring, cfg, ax.y)
+        new.q, new.last_dir, new.count = old.q, old.last_dir, old.count
+        ax.decoder, ax.z_flip = new, wiring.invert_z != cfg.invert_z
+        ax.cfg = dataclasses.replace(ax.cfg, encoder_mode=cfg.encoder_mode,
+                                     swap_ab=cfg.swap_ab, invert_a=cfg.invert_a,
+                                     invert_b=cfg.invert_b, invert_z=cfg.invert_z)
+        ax.run_start = (ax.run_start[0], ax._dec_state())
+
     def _axis(self, axis: int) -> SimAxis:
         """Axis `axis` (checked), free to change (see `_axes`)."""
         return self._axes[self._index(axis)]
