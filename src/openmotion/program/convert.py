@@ -41,6 +41,7 @@ from .options import MM_PER_INCH, ROTARY_LETTERS
 from .orient import Orient
 from .probing import Probe, WaitInput
 from .source import GCodeError
+from .splines import SplineFeed
 
 #: Blend tolerance (machine units) standing for G64 without P.
 UNBOUNDED_BLEND = 1e12
@@ -217,6 +218,8 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             pos = end
         elif isinstance(cmd, canon.ArcMove):
             pos = _arc(cmd, scales, pos, opts, ops, feed_of)
+        elif isinstance(cmd, SplineFeed):
+            pos = _spline(cmd, scales, pos, opts, ops, feed_of)
         elif isinstance(cmd, canon.Dwell):
             ops.append(Op("delay", cmd.line, cmd.file, seconds=cmd.seconds, source=cmd))
         elif isinstance(cmd, canon.SetBlend):
@@ -252,6 +255,24 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         else:  # pragma: no cover - canon is closed
             raise _fail(cmd, f"unsupported command {type(cmd).__name__}")
     return ops
+
+
+def _spline(cmd: SplineFeed, scales: Scales, pos: np.ndarray, opts: ConvertOptions,
+            ops: list[Op], feed_of) -> np.ndarray:
+    """G5/G5.1/G5.2: chords within chord_tol, all at one feed (one look-ahead chain)."""
+    try:
+        pts = cmd.polyline(opts.chord_tol)
+    except ValueError as exc:
+        raise _fail(cmd, f"{exc}; raise chord_tol") from None
+    pts[0] = pos
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    end = pts[-1]
+    f = feed_of(cmd, end - pos, float(np.sum(seg)))
+    for k in range(1, len(pts)):
+        if seg[k - 1] > 0.0:
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(pts[k]), f,
+                          end=pts[k].copy(), source=cmd))
+    return end.copy()
 
 
 def _arc(cmd: canon.ArcMove, scales: Scales, pos: np.ndarray, opts: ConvertOptions,

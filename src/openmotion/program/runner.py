@@ -58,6 +58,7 @@ from .runrequests import answer, begin_request, on_probe_edge
 from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
 from .spindle import OrientMove, SpindleDrive, SyncMove
+from .splines import SplineFeed
 from .syncout import SyncedOutputs
 
 if TYPE_CHECKING:
@@ -253,7 +254,8 @@ class ProgramRunner:
         elif isinstance(program, Sequence):
             self._commands = list(program)
             bad_cmd = [c for c in self._commands
-                       if not isinstance(c, canon.Command | Probe | WaitInput | Orient)]
+                       if not isinstance(c, canon.Command | Probe | WaitInput | Orient
+                                                  | SplineFeed)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
