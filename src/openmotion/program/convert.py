@@ -37,6 +37,7 @@ from ..errors import MotionError
 from ..path import Arc, Direction
 from ..units import AxisUnits
 from . import canon
+from .analogout import AnalogOut
 from .options import MM_PER_INCH, ROTARY_LETTERS
 from .orient import Orient
 from .probing import Probe, WaitInput
@@ -50,7 +51,8 @@ UNBOUNDED_BLEND = 1e12
 @dataclass(frozen=True)
 class Op:
     """One runner operation. kind: line, arc, delay, blend, pause, end, output, action,
-    wait (M66; `source` the WaitInput), orient (M19; `source` the Orient). A probe move is
+    analog (M67/M68; `source` the AnalogOut), wait (M66; `source` the WaitInput), orient
+    (M19; `source` the Orient). A probe move is
     a line whose `source` is a Probe, a spindle-synchronised one (G33/G76) a line whose
     `source` is the SyncedFeed.
 
@@ -184,6 +186,9 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         elif isinstance(cmd, Orient):
             ops.append(Op("orient", cmd.line, cmd.file, seconds=cmd.timeout or 0.0,
                           text=f"M19 R{cmd.angle:g} P{cmd.mode}", barrier=True, source=cmd))
+        elif isinstance(cmd, AnalogOut):
+            ops.append(Op("analog", cmd.line, cmd.file, index=cmd.index, synced=cmd.synced,
+                          text=f"ao{cmd.index} = {cmd.value:g}", source=cmd))
         elif isinstance(cmd, WaitInput):
             ops.append(Op("wait", cmd.line, cmd.file, index=cmd.index, seconds=cmd.timeout,
                           source=cmd))

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 from . import canon, frame
+from .analogout import m67_m68
 from .arcmove import arc_move
 from .codes import G_GROUP, G_REFUSED, M_GROUP, M_REFUSED
 from .compmove import comp_motion
@@ -355,6 +356,8 @@ class Modal:
                                      self.opt.flood_output, line, file))
         if 5 in ms and ms[5][0] == 66:
             m66(self, b, ms[5][1], words, used, out)
+        elif 5 in ms and ms[5][0] in (67, 68):
+            m67_m68(self, b, ms[5][0], ms[5][1], words, used, out)
         elif 5 in ms:
             code, pos = ms[5]
             p = words.get("P")
