@@ -35,6 +35,7 @@ from openmotion.program import (
     compile_text,
 )
 from openmotion.program.probing import Probe
+from openmotion.program.rigidtap import RigidTap
 from openmotion.program.splines import SplineFeed
 
 DEFAULT_RS274 = "/opt/linuxcnc-rs274/rs274"
@@ -168,6 +169,11 @@ def parse_listing(listing: str) -> list[Motion]:
                 kind, feed = "sync", c.sync
             out.append(Motion(kind, tuple(end), feed, tol=tol, line=raw.strip()))
             c.pos = end
+        elif name == "RIGID_TAP":  # to X Y Z synchronised and back: the position stays
+            v = _nums(args)
+            end = c.machine([*v[:3], 0.0, 0.0, 0.0])
+            end[3:] = c.pos[3:]
+            out.append(Motion("tap", tuple(end), c.sync, tol=tol, line=raw.strip()))
         elif name == "NURBS_FEED":
             # rs274 prints only the number of control points: the end is unknown here
             # (programs print it with DEBUG #<_x> #<_y>); the feed is the current one
@@ -248,6 +254,8 @@ def openmotion_motions(text: str, options: GCodeOptions = OPTIONS) -> list[Motio
             out.append(Motion("feed", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0, tol=tol))
         elif isinstance(cmd, SyncedFeed):
             out.append(Motion("sync", tuple(cmd.end[:6]), cmd.pitch, tol=tol))
+        elif isinstance(cmd, RigidTap):
+            out.append(Motion("tap", tuple(cmd.end[:6]), cmd.pitch, tol=tol))
         elif isinstance(cmd, SplineFeed):
             out.append(Motion("spline", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0,
                               rotation=len(cmd.points), tol=tol))
@@ -285,7 +293,7 @@ def _moving(ms: list[Motion]) -> list[Motion]:
     out: list[Motion] = []
     last: tuple[float, ...] | None = (0.0,) * 6  # both start at the machine origin
     for m in ms:
-        if m.kind not in ("arc", "spline") and last is not None and all(  # 4 decimals
+        if m.kind not in ("arc", "spline", "tap") and last is not None and all(  # 4 decimals
                 abs(x - y) <= m.tol for x, y in zip(m.end, last, strict=True)):
             continue
         out.append(m)

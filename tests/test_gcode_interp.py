@@ -452,7 +452,6 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 
 
 @pytest.mark.parametrize("code, feature", [
-    ("G33.1 Z-1 K1", "G33.1"),
     ("G71 Q1", "roughing"), ("G96 S100", "surface speed"),
     ("G87 Z-1 R1 I1 J1 K1", "back boring"),
     ("M101", "user M-code"), ("M60", "pallet")])

@@ -8,7 +8,7 @@ from .cycles import REFUSED as CYCLE_REFUSED
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
 G_GROUP = {
     40: 0, 100: 0, 520: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
-    0: 1, 10: 1, 20: 1, 30: 1, 50: 1, 51: 1, 52: 1, 53: 1, 330: 1, 760: 1, 800: 1, 730: 1,
+    0: 1, 10: 1, 20: 1, 30: 1, 50: 1, 51: 1, 52: 1, 53: 1, 330: 1, 331: 1, 760: 1, 800: 1, 730: 1,
     740: 1, 810: 1, 820: 1,
     830: 1, 840: 1, 850: 1, 860: 1, 880: 1, 890: 1, 382: 1, 383: 1, 384: 1, 385: 1,
     170: 2, 180: 2, 190: 2,
@@ -26,7 +26,6 @@ G_GROUP = {
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
 G_REFUSED = {
-    331: "rigid tapping (G33.1) is not supported",
     700: "lathe finishing cycle (G70) is not supported",
     710: "lathe roughing cycle (G71) is not supported",
     720: "lathe roughing cycle (G72) is not supported",

@@ -41,6 +41,7 @@ from .analogout import AnalogOut
 from .options import MM_PER_INCH, ROTARY_LETTERS
 from .orient import Orient
 from .probing import Probe, WaitInput
+from .rigidtap import RigidTap
 from .source import GCodeError
 from .splines import SplineFeed
 
@@ -205,6 +206,18 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), min(f, sys_max),
                           end=end, source=cmd))
             pos = end
+        elif isinstance(cmd, RigidTap):
+            if rpm <= 0.0:
+                raise _fail(cmd, "G33.1 needs the spindle turning at S > 0")
+            # without spindle feedback: in at K x S, out at K x S x I (the runner with a
+            # spindle axis replaces both by the synchronised tap, rigidtap_run.py)
+            start, end = np.asarray(cmd.start, dtype=float), np.asarray(cmd.end, dtype=float)
+            f = cmd.pitch * rpm / 60.0
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), min(f, sys_max),
+                          end=end, source=cmd))
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(start),
+                          min(f * cmd.return_scale, sys_max), end=start, source=cmd))
+            pos = start
         elif isinstance(cmd, canon.Rapid | canon.Feed):
             end = np.asarray(cmd.end, dtype=float)
             d = end - pos

@@ -36,6 +36,7 @@ from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
 from .probing import PROBE_CODES, g38, m66
+from .rigidtap import g33_1
 from .splines import SPLINE_CODES, open_block_error, spline_move
 from .threading import g33, g76
 from .tooloffsets import set_tool_parameters, tool_length
@@ -611,6 +612,9 @@ class Modal:
                 raise b.error("canned cycles cannot be used with cutter compensation on",
                               gpos, gword)
             canned_cycle(self, b, mode, gpos, axes, words, used, out)
+            return
+        if mode == 331:
+            g33_1(self, b, gpos, axes, words, used, out)
             return
         if mode in (330, 760):
             if self.comp.side:

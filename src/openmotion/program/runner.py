@@ -55,6 +55,7 @@ from .options import AXIS_LETTERS, GCodeOptions
 from .orient import Orient
 from .parser import parse_program
 from .probing import Probe, WaitInput
+from .rigidtap import RigidTap
 from .runrequests import answer, begin_request, on_probe_edge
 from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
@@ -259,7 +260,7 @@ class ProgramRunner:
             self._commands = list(program)
             bad_cmd = [c for c in self._commands
                        if not isinstance(c, canon.Command | Probe | WaitInput | Orient
-                                                  | SplineFeed | AnalogOut)]
+                                                  | SplineFeed | AnalogOut | RigidTap)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
@@ -275,6 +276,7 @@ class ProgramRunner:
         self._stray_trip: str | None = None
         self.spindle: SpindleDrive | None = None
         self.sync_moves: list[SyncMove] = []  # G33/G76 passes run against the spindle
+        self.rigid_taps: list = []  # G33.1 taps run against the spindle (RigidTapMove)
         self._spindle_index: int | None = None
         if self.options.spindle_axis is not None:
             self._spindle_index = ctl.axis(self.options.spindle_axis).index
@@ -638,7 +640,8 @@ class ProgramRunner:
                 self._step_line = None
                 self._event("single_block", self._last_line, "block done")
                 return
-            synced = isinstance(op.source, canon.SyncedFeed) and self.spindle is not None
+            synced = isinstance(op.source, canon.SyncedFeed | RigidTap) \
+                and self.spindle is not None
             if isinstance(op.source, Probe) or op.kind in ("wait", "orient") or synced:
                 if not self._idle():
                     return
