@@ -35,6 +35,8 @@ from openmotion.program import (
     compile_text,
 )
 from openmotion.program.probing import Probe
+from openmotion.program.rigidtap import RigidTap
+from openmotion.program.splines import SplineFeed
 
 DEFAULT_RS274 = "/opt/linuxcnc-rs274/rs274"
 LETTERS = "XYZABC"
@@ -167,6 +169,17 @@ def parse_listing(listing: str) -> list[Motion]:
                 kind, feed = "sync", c.sync
             out.append(Motion(kind, tuple(end), feed, tol=tol, line=raw.strip()))
             c.pos = end
+        elif name == "RIGID_TAP":  # to X Y Z synchronised and back: the position stays
+            v = _nums(args)
+            end = c.machine([*v[:3], 0.0, 0.0, 0.0])
+            end[3:] = c.pos[3:]
+            out.append(Motion("tap", tuple(end), c.sync, tol=tol, line=raw.strip()))
+        elif name == "NURBS_FEED":
+            # rs274 prints only the number of control points: the end is unknown here
+            # (programs print it with DEBUG #<_x> #<_y>); the feed is the current one
+            n = int(_nums(args.split(",")[0])[0])
+            out.append(Motion("spline", (math.nan,) * 6, c.linear_feed * (
+                c.rpm if c.per_rev else 1.0), rotation=n, tol=tol, line=raw.strip()))
         elif name == "ARC_FEED":
             v = _nums(args)
             pname, i1, i2, ih = c.plane
@@ -241,6 +254,11 @@ def openmotion_motions(text: str, options: GCodeOptions = OPTIONS) -> list[Motio
             out.append(Motion("feed", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0, tol=tol))
         elif isinstance(cmd, SyncedFeed):
             out.append(Motion("sync", tuple(cmd.end[:6]), cmd.pitch, tol=tol))
+        elif isinstance(cmd, RigidTap):
+            out.append(Motion("tap", tuple(cmd.end[:6]), cmd.pitch, tol=tol))
+        elif isinstance(cmd, SplineFeed):
+            out.append(Motion("spline", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0,
+                              rotation=len(cmd.points), tol=tol))
         elif isinstance(cmd, Probe):
             out.append(Motion("probe", tuple(cmd.end[:6]), cmd.feed_per_s * 60.0, tol=tol))
         elif isinstance(cmd, ArcMove):
@@ -275,7 +293,7 @@ def _moving(ms: list[Motion]) -> list[Motion]:
     out: list[Motion] = []
     last: tuple[float, ...] | None = (0.0,) * 6  # both start at the machine origin
     for m in ms:
-        if m.kind != "arc" and last is not None and all(  # rs274 rounds to 4 decimals
+        if m.kind not in ("arc", "spline", "tap") and last is not None and all(  # 4 decimals
                 abs(x - y) <= m.tol for x, y in zip(m.end, last, strict=True)):
             continue
         out.append(m)
@@ -298,6 +316,8 @@ def compare(ours: list[Motion], theirs: list[Motion], feed_rel: float = 1e-6) ->
             continue
         if any(abs(x - y) > tol for x, y in zip(a.end, b.end, strict=True)):
             diffs.append(f"{where}: end {a.end} != {b.end}")
+        if a.kind == "spline" and a.rotation != b.rotation:
+            diffs.append(f"{where}: {a.rotation} control points != {b.rotation}")
         if a.kind == "arc":
             if a.plane != b.plane or a.rotation != b.rotation:
                 diffs.append(f"{where}: arc {a.plane} {a.rotation} != {b.plane} {b.rotation}")

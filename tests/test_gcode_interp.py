@@ -452,10 +452,9 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 
 
 @pytest.mark.parametrize("code, feature", [
-    ("G5 X1 I1 J1 P1 Q1", "spline"), ("G5.2 X1", "NURBS"), ("G33.1 Z-1 K1", "G33.1"),
     ("G71 Q1", "roughing"), ("G96 S100", "surface speed"),
     ("G87 Z-1 R1 I1 J1 K1", "back boring"),
-    ("M67", "analog"), ("M101", "user M-code"), ("M60", "pallet")])
+    ("M101", "user M-code"), ("M60", "pallet")])
 def test_unsupported_features_are_named_before_any_motion(code, feature):
     e = err(f"G0 X5 Y5\nG1 X6 F100\n{code}\n")
     assert e.line == 3 and e.column == 1 and feature in str(e)

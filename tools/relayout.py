@@ -79,6 +79,7 @@ MAPPING: dict[str, str] = {
     "compare": "trigger", "compare_due": "trigger", "compare_io": "trigger",
     "compare_jobs": "trigger", "compare_math": "trigger",
     "compare_scope": "trigger", "pso": "trigger", "hsl_trigger": "trigger",
+    "analog": "trigger",
     # homing and latch
     "homing": "home", "homing_modes": "home", "homing_sequence": "home", "latch": "home",
     "pulserule": "home",

@@ -231,6 +231,14 @@ def build_parser() -> argparse.ArgumentParser:
                    "feed / acc-time)")
     r.add_argument("--feed-override", type=float, default=100.0,
                    help="feed override in %% of the programmed feed (1 .. 200)")
+    r.add_argument("--probe-input", metavar="di<n>",
+                   help="board input the G38.x probe is wired to (a simulated probe)")
+    r.add_argument("--probe-box", action="append", metavar="'X10:50 Y8:38 Z:20'",
+                   help="a box of the workpiece the simulated probe touches, machine units "
+                   "(repeat for more boxes; an empty bound is unbounded)")
+    r.add_argument("--spindle-axis", metavar="NAME",
+                   help="axis that is the spindle (M3/M4/M5, G33, G76, G33.1, G95, G96); "
+                   "added as a simulated spindle when the machine has none")
     from .remote.ui_cmd import add_parser as add_ui_parser  # `openmotion ui` (remote/)
 
     add_ui_parser(sub, _FMT)

@@ -154,6 +154,31 @@ class TimedOutputHardware(Protocol):
         t in the past or a bad signal/level; nothing is scheduled then."""
 
 
+@runtime_checkable
+class AnalogOutputHardware(Protocol):
+    """Optional extension: board analog outputs `ao<n>` (a DAC: volts, or the unit the
+    board's range is given in), as LinuxCNC's motion.analog-out-NN pins that M67/M68 drive.
+
+    The control layer checks `isinstance(hw, AnalogOutputHardware)`; a back end without
+    analog outputs simply lacks these methods.
+    """
+
+    @property
+    def n_analog_outputs(self) -> int:
+        """Number of analog outputs (channels 0 .. n - 1)."""
+
+    @property
+    def analog_range(self) -> tuple[float, float]:
+        """The (lowest, highest) value a channel can hold."""
+
+    def write_analog(self, channel: int, value: float) -> None:
+        """Set channel `channel` to `value` now. MotionError for a channel out of range or
+        a value that is not finite or outside `analog_range`; nothing changes then."""
+
+    def read_analog_output(self, channel: int) -> float:
+        """The value channel `channel` holds now."""
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class PieceBlock:
     """Many timed pieces at once: `rows` is an (n, 6) float array (numpy), row k the piece

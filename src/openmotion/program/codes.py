@@ -8,7 +8,8 @@ from .cycles import REFUSED as CYCLE_REFUSED
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
 G_GROUP = {
     40: 0, 100: 0, 520: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
-    0: 1, 10: 1, 20: 1, 30: 1, 330: 1, 760: 1, 800: 1, 730: 1, 740: 1, 810: 1, 820: 1,
+    0: 1, 10: 1, 20: 1, 30: 1, 50: 1, 51: 1, 52: 1, 53: 1, 330: 1, 331: 1, 760: 1, 800: 1, 730: 1,
+    740: 1, 810: 1, 820: 1,
     830: 1, 840: 1, 850: 1, 860: 1, 880: 1, 890: 1, 382: 1, 383: 1, 384: 1, 385: 1,
     170: 2, 180: 2, 190: 2,
     900: 3, 910: 3,
@@ -25,9 +26,6 @@ G_GROUP = {
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
 G_REFUSED = {
-    50: "cubic spline G5 is not supported", 51: "quadratic B-spline G5.1 is not supported",
-    52: "NURBS G5.2 is not supported", 53: "NURBS G5.3 is not supported",
-    331: "rigid tapping (G33.1) is not supported",
     700: "lathe finishing cycle (G70) is not supported",
     710: "lathe roughing cycle (G71) is not supported",
     720: "lathe roughing cycle (G72) is not supported",
@@ -41,9 +39,7 @@ M_REFUSED = {
     51: "spindle override control (M51) is not supported",
     52: "adaptive feed (M52) is not supported", 53: "feed stop control (M53) is not supported",
     60: "pallet change (M60) is not supported",
-    67: "synchronized analog output (M67) is not supported",
-    68: "analog output (M68) is not supported",
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 19: 7, 7: 8, 8: 8, 9: 8,
-           62: 5, 63: 5, 64: 5, 65: 5, 66: 5, 98: 11, 99: 11, 61: 6,
+           62: 5, 63: 5, 64: 5, 65: 5, 66: 5, 67: 5, 68: 5, 98: 11, 99: 11, 61: 6,
            70: 12, 71: 12, 72: 12, 73: 12}

@@ -37,10 +37,13 @@ from ..errors import MotionError
 from ..path import Arc, Direction
 from ..units import AxisUnits
 from . import canon
+from .analogout import AnalogOut
 from .options import MM_PER_INCH, ROTARY_LETTERS
 from .orient import Orient
 from .probing import Probe, WaitInput
+from .rigidtap import RigidTap
 from .source import GCodeError
+from .splines import SplineFeed
 
 #: Blend tolerance (machine units) standing for G64 without P.
 UNBOUNDED_BLEND = 1e12
@@ -49,7 +52,8 @@ UNBOUNDED_BLEND = 1e12
 @dataclass(frozen=True)
 class Op:
     """One runner operation. kind: line, arc, delay, blend, pause, end, output, action,
-    wait (M66; `source` the WaitInput), orient (M19; `source` the Orient). A probe move is
+    analog (M67/M68; `source` the AnalogOut), wait (M66; `source` the WaitInput), orient
+    (M19; `source` the Orient). A probe move is
     a line whose `source` is a Probe, a spindle-synchronised one (G33/G76) a line whose
     `source` is the SyncedFeed.
 
@@ -183,6 +187,9 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         elif isinstance(cmd, Orient):
             ops.append(Op("orient", cmd.line, cmd.file, seconds=cmd.timeout or 0.0,
                           text=f"M19 R{cmd.angle:g} P{cmd.mode}", barrier=True, source=cmd))
+        elif isinstance(cmd, AnalogOut):
+            ops.append(Op("analog", cmd.line, cmd.file, index=cmd.index, synced=cmd.synced,
+                          text=f"ao{cmd.index} = {cmd.value:g}", source=cmd))
         elif isinstance(cmd, WaitInput):
             ops.append(Op("wait", cmd.line, cmd.file, index=cmd.index, seconds=cmd.timeout,
                           source=cmd))
@@ -199,6 +206,18 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), min(f, sys_max),
                           end=end, source=cmd))
             pos = end
+        elif isinstance(cmd, RigidTap):
+            if rpm <= 0.0:
+                raise _fail(cmd, "G33.1 needs the spindle turning at S > 0")
+            # without spindle feedback: in at K x S, out at K x S x I (the runner with a
+            # spindle axis replaces both by the synchronised tap, rigidtap_run.py)
+            start, end = np.asarray(cmd.start, dtype=float), np.asarray(cmd.end, dtype=float)
+            f = cmd.pitch * rpm / 60.0
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), min(f, sys_max),
+                          end=end, source=cmd))
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(start),
+                          min(f * cmd.return_scale, sys_max), end=start, source=cmd))
+            pos = start
         elif isinstance(cmd, canon.Rapid | canon.Feed):
             end = np.asarray(cmd.end, dtype=float)
             d = end - pos
@@ -217,6 +236,8 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             pos = end
         elif isinstance(cmd, canon.ArcMove):
             pos = _arc(cmd, scales, pos, opts, ops, feed_of)
+        elif isinstance(cmd, SplineFeed):
+            pos = _spline(cmd, scales, pos, opts, ops, feed_of)
         elif isinstance(cmd, canon.Dwell):
             ops.append(Op("delay", cmd.line, cmd.file, seconds=cmd.seconds, source=cmd))
         elif isinstance(cmd, canon.SetBlend):
@@ -252,6 +273,24 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         else:  # pragma: no cover - canon is closed
             raise _fail(cmd, f"unsupported command {type(cmd).__name__}")
     return ops
+
+
+def _spline(cmd: SplineFeed, scales: Scales, pos: np.ndarray, opts: ConvertOptions,
+            ops: list[Op], feed_of) -> np.ndarray:
+    """G5/G5.1/G5.2: chords within chord_tol, all at one feed (one look-ahead chain)."""
+    try:
+        pts = cmd.polyline(opts.chord_tol)
+    except ValueError as exc:
+        raise _fail(cmd, f"{exc}; raise chord_tol") from None
+    pts[0] = pos
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    end = pts[-1]
+    f = feed_of(cmd, end - pos, float(np.sum(seg)))
+    for k in range(1, len(pts)):
+        if seg[k - 1] > 0.0:
+            ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(pts[k]), f,
+                          end=pts[k].copy(), source=cmd))
+    return end.copy()
 
 
 def _arc(cmd: canon.ArcMove, scales: Scales, pos: np.ndarray, opts: ConvertOptions,

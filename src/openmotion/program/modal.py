@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 from . import canon, frame
+from .analogout import m67_m68
 from .arcmove import arc_move
 from .codes import G_GROUP, G_REFUSED, M_GROUP, M_REFUSED
 from .compmove import comp_motion
@@ -35,6 +36,8 @@ from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
 from .probing import PROBE_CODES, g38, m66
+from .rigidtap import g33_1
+from .splines import SPLINE_CODES, open_block_error, spline_move
 from .threading import g33, g76
 from .tooloffsets import set_tool_parameters, tool_length
 from .words import Word, feed_length, fmt
@@ -354,6 +357,8 @@ class Modal:
                                      self.opt.flood_output, line, file))
         if 5 in ms and ms[5][0] == 66:
             m66(self, b, ms[5][1], words, used, out)
+        elif 5 in ms and ms[5][0] in (67, 68):
+            m67_m68(self, b, ms[5][0], ms[5][1], words, used, out)
         elif 5 in ms:
             code, pos = ms[5]
             p = words.get("P")
@@ -427,7 +432,8 @@ class Modal:
             if self.motion not in CYCLES and (1 in gs or axes):
                 self.cycle.initial = None  # a series of cycles ends at any other motion
             if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")) or (
-                    (1 in gs or self.polar_inc is not None) and self.motion in CYCLES):
+                    (1 in gs or self.polar_inc is not None) and self.motion in CYCLES) or (
+                    1 in gs and self.motion in (52, 53)):
                 self._motion(b, gs, axes, words, used, out, machine=g0 is not None)
                 used.update(axes)
         if 11 in ms and ms[11][0] == 98:
@@ -446,6 +452,7 @@ class Modal:
             if code in (0, 1):
                 out.append(canon.Pause(code == 1, line, file))
             else:
+                open_block_error(self, b, ms[4][1], f"M{code}")
                 comp_off(self)
                 out.append(canon.End(code == 30, line, file))
                 self.ended = True
@@ -588,6 +595,13 @@ class Modal:
             raise b.error("axis words without a motion mode (G0, G1, G2 or G3)", w.pos,
                           fmt(next(iter(axes)), w.value))
         gword = f"G{mode / 10:g}"
+        if mode not in (52, 53):
+            open_block_error(self, b, gpos, gword)
+        if mode in SPLINE_CODES:
+            if machine:
+                raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
+            spline_move(self, b, mode, gpos, axes, words, used, out)
+            return
         if machine:
             if mode not in (0, 10):
                 raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
@@ -598,6 +612,9 @@ class Modal:
                 raise b.error("canned cycles cannot be used with cutter compensation on",
                               gpos, gword)
             canned_cycle(self, b, mode, gpos, axes, words, used, out)
+            return
+        if mode == 331:
+            g33_1(self, b, gpos, axes, words, used, out)
             return
         if mode in (330, 760):
             if self.comp.side:

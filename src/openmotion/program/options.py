@@ -49,6 +49,7 @@ class GCodeOptions:
         Z-only tools not in it.
     n_outputs: M62-M65 P must be in [0, n_outputs).
     n_inputs / n_analog_inputs: M66 P / M66 E must be below them (digital, analog inputs).
+    n_analog_outputs: M67/M68 E must be below it (LinuxCNC's default 4 analog outputs).
     spindle_output / mist_output / flood_output: outputs carried by Spindle/Coolant.
     block_delete: skip lines starting with '/' (the block-delete switch is on).
     keep_comments: also emit plain comments as Message(kind="comment").
@@ -69,6 +70,7 @@ class GCodeOptions:
     n_outputs: int = 16
     n_inputs: int = 16
     n_analog_inputs: int = 4
+    n_analog_outputs: int = 4
     spindle_output: int | None = None
     mist_output: int | None = None
     flood_output: int | None = None
@@ -160,6 +162,7 @@ class GCodeOptions:
         check_int("n_outputs", self.n_outputs, 0)
         check_int("n_inputs", self.n_inputs, 0)
         check_int("n_analog_inputs", self.n_analog_inputs, 0)
+        check_int("n_analog_outputs", self.n_analog_outputs, 0)
         for name in ("spindle_output", "mist_output", "flood_output"):
             _opt_index(name, getattr(self, name))
         for name, lo in (("max_call_depth", 1), ("max_blocks", 1),

@@ -46,7 +46,12 @@ def run_job(args: argparse.Namespace) -> int:
     path = Path(args.program)
     if not path.is_file():
         raise MotionError(f"program {str(path)!r}: no such file")
+    spindle = getattr(args, "spindle_axis", None)
+    cfg = with_spindle(cfg, spindle)
+    probe_input = getattr(args, "probe_input", None)
+    boxes = parse_probe_boxes(getattr(args, "probe_box", None) or [], probe_input)
     ctl = Controller(cfg)
+    probe = attach_probe(ctl, probe_input)
     ctl.enable_all()
     if path.suffix in (".toml", ".csv"):
         table = PointTable.load(path)
@@ -57,8 +62,11 @@ def run_job(args: argparse.Namespace) -> int:
         sets_g54 = sets_work_offset(path.read_text(encoding="utf-8", errors="replace"))
     params = {} if sets_g54 else work_origin(ctl)
     run = ProgramRunner(ctl, program,  # type: ignore[arg-type]
-                        options=RunOptions(repeat=args.repeat, acc_time=float(acc_time)),
+                        options=RunOptions(repeat=args.repeat, acc_time=float(acc_time),
+                                           probe_input=probe_input, spindle_axis=spindle),
                         file=str(path), gcode={"parameters": params})
+    if probe is not None:
+        place_boxes(probe, run, boxes)
     if not run.ops:
         raise MotionError(f"{path}: the program holds no moves or actions, nothing to run")
     if params:
@@ -117,6 +125,80 @@ def load_machine_arg(path: str, what: str):
         raise MotionError(f"{os.fspath(path)}: the machine has no axes (add an [axes.<name>] "
                           "table per axis)")
     return cfg
+
+
+def with_spindle(cfg, name: str | None):
+    """`--spindle-axis NAME`: the machine's axis NAME drives M3/M4/M5, G33/G76/G33.1, G95
+    and G96; a machine without it gets a simulated spindle of that name (hw/sim/spindle.py:
+    servo with a 4096-count encoder and an index)."""
+    from dataclasses import replace
+
+    from ..hw.sim.spindle import spindle_axis
+
+    if name is None:
+        return cfg
+    if not isinstance(name, str) or not name.strip():
+        raise MotionError(f"--spindle-axis must be an axis name, got {name!r}")
+    if any(a.name == name for a in cfg.axes):
+        return cfg
+    return replace(cfg, axes=(*cfg.axes, spindle_axis(name)))
+
+
+_BOX = re.compile(r"([XYZABCUVW])(-?[\d.eE+-]*):(-?[\d.eE+-]*)$")
+
+
+def parse_probe_boxes(texts: list[str], probe_input: str | None
+                      ) -> list[dict[str, tuple[float, float]]]:
+    """`--probe-box "X10:50 Y8:38 Z:20"` (machine units; an empty bound is unbounded):
+    one box of the simulated workpiece the probe touches."""
+    if texts and probe_input is None:
+        raise MotionError("--probe-box needs --probe-input (the board input of the probe)")
+    out = []
+    for text in texts:
+        box: dict[str, tuple[float, float]] = {}
+        for part in text.upper().split():
+            m = _BOX.match(part)
+            try:
+                lo = float(m.group(2)) if m and m.group(2) else -math.inf
+                hi = float(m.group(3)) if m and m.group(3) else math.inf
+            except ValueError:
+                m = None
+            if m is None or m.group(1) in box or not lo < hi:
+                raise MotionError(f"--probe-box {text!r}: each part must be <axis letter>"
+                                  f"<lo>:<hi> with lo < hi (machine units), got {part!r}")
+            box[m.group(1)] = (lo, hi)
+        if not box:
+            raise MotionError(f"--probe-box {text!r} names no axis (e.g. 'X10:50 Z:20')")
+        out.append(box)
+    return out
+
+
+def attach_probe(ctl, probe_input: str | None):
+    """`--probe-input di<n>`: a simulated touch probe on that board input."""
+    from ..hw.sim.machine import SimMachine
+    from ..hw.sim.probe import SimProbe
+
+    if probe_input is None:
+        return None
+    if not isinstance(ctl.hardware, SimMachine):
+        return None
+    return SimProbe.attach(ctl.hardware, probe_input)
+
+
+def place_boxes(probe, run: ProgramRunner,
+                boxes: list[dict[str, tuple[float, float]]]) -> None:
+    """The --probe-box workpiece in the probe's load positions (command pulses)."""
+    ppu = dict(zip(run.letters, run.scales.ppu, strict=True))
+    axis = dict(zip(run.letters, run.axis_indices, strict=True))
+    placed = []
+    for box in boxes:
+        bad = [L for L in box if L not in axis]
+        if bad:
+            raise MotionError(f"--probe-box: axis {bad[0]} is not one of the program's "
+                              f"axes ({''.join(run.letters)})")
+        placed.append({axis[L]: tuple(sorted((lo * ppu[L], hi * ppu[L])))
+                       for L, (lo, hi) in box.items()})
+    probe.place(placed)
 
 
 _COMMENT = re.compile(r"\([^)]*\)|;.*")

@@ -48,17 +48,20 @@ import numpy as np
 from ..errors import MotionError, show
 from ..units import AxisUnits
 from . import canon
+from .analogout import AnalogOut
 from .convert import ConvertOptions, Op, Scales, convert
 from .interp import Interpreter, Session, compile_text
 from .options import AXIS_LETTERS, GCodeOptions
 from .orient import Orient
 from .parser import parse_program
 from .probing import Probe, WaitInput
+from .rigidtap import RigidTap
 from .runrequests import answer, begin_request, on_probe_edge
 from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
 from .spindle import OrientMove, SpindleDrive, SyncMove
-from .syncout import SyncedOutputs
+from .splines import SplineFeed
+from .syncout import SyncedAnalog, SyncedOutputs
 
 if TYPE_CHECKING:
     from ..control.core.controller import Controller
@@ -209,6 +212,7 @@ class ProgramRunner:
                  *, axes: Mapping[str, int | str] | None = None,
                  options: RunOptions | None = None, gcode: Mapping[str, object] | None = None,
                  file: str = "", compare: CompareEngine | None = None) -> None:
+        from ..control.trigger.analog import AnalogOutputs
         from ..control.trigger.compare import CompareEngine
 
         if compare is not None and (not isinstance(compare, CompareEngine)
@@ -234,6 +238,8 @@ class ProgramRunner:
         self._gextra.setdefault("n_outputs", ctl.config.digital_outputs)
         self._gextra.setdefault("n_inputs", ctl.config.digital_inputs)
         self._gextra.setdefault("n_analog_inputs", 0)  # no analog inputs in the hardware
+        self.analog = AnalogOutputs(ctl)
+        self._gextra.setdefault("n_analog_outputs", self.analog.count)
         if "soft_limits" not in self._gextra:  # moves past the EL switches fail to compile
             lims = []
             for k, i in zip(self.letters, self.axis_indices, strict=True):
@@ -253,7 +259,8 @@ class ProgramRunner:
         elif isinstance(program, Sequence):
             self._commands = list(program)
             bad_cmd = [c for c in self._commands
-                       if not isinstance(c, canon.Command | Probe | WaitInput | Orient)]
+                       if not isinstance(c, canon.Command | Probe | WaitInput | Orient
+                                                  | SplineFeed | AnalogOut | RigidTap)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
@@ -269,6 +276,7 @@ class ProgramRunner:
         self._stray_trip: str | None = None
         self.spindle: SpindleDrive | None = None
         self.sync_moves: list[SyncMove] = []  # G33/G76 passes run against the spindle
+        self.rigid_taps: list = []  # G33.1 taps run against the spindle (RigidTapMove)
         self._spindle_index: int | None = None
         if self.options.spindle_axis is not None:
             self._spindle_index = ctl.axis(self.options.spindle_axis).index
@@ -293,6 +301,7 @@ class ProgramRunner:
         self._cursor = self._pass.start
         self.synced = SyncedOutputs(ctl, self.axis_indices, compare, self._set_output,
                                     self._record_synced)
+        self.synced_analog = SyncedAnalog(self._write_analog)
         self._pushed = 0
         self._last_line = 0
         self._step_line: int | None = None
@@ -322,6 +331,7 @@ class ProgramRunner:
         self.commands = cmds
         ops = convert(cmds, self.scales, start, ConvertOptions(
             self.options.rapid_ratio, self.options.feed_mode, self.options.chord_tol))
+        self._check_analog(cmds)
         return _Pass(ops, start.copy())
 
     def _live_pass(self, start: np.ndarray) -> _Pass:
@@ -342,7 +352,18 @@ class ProgramRunner:
         for c in chunk:
             if isinstance(c, canon.Spindle):
                 self._rpm = c.speed if c.on else 0.0
+        self._check_analog(chunk)
         return ops
+
+    def _check_analog(self, cmds: Sequence[object]) -> None:
+        """M67/M68 values against the board's range, before anything moves."""
+        for c in cmds:
+            if isinstance(c, AnalogOut):
+                try:
+                    self.analog.check(c.index, c.value)
+                except MotionError as exc:
+                    raise GCodeError(f"M{67 if c.synced else 68}: {exc}", line=c.line,
+                                     file=c.file) from None
 
     @property
     def ops(self) -> list[Op]:
@@ -466,6 +487,11 @@ class ProgramRunner:
         self.synced.levels[index] = level
         self._event(kind, op.line, f"do{index} = {int(level)}", index=index, level=level)
 
+    def _write_analog(self, op: Op) -> None:
+        assert isinstance(op.source, AnalogOut)
+        self.analog.set(op.source.index, op.source.value)
+        self._event("analog_output", op.line, op.text, index=op.index)
+
     def _record_synced(self, t: float, op: Op, index: int, level: bool) -> None:
         self.events.append(RunEvent(t, "sync_output", op.line, f"do{index} = {int(level)}",
                                     index=index, level=level))
@@ -522,7 +548,7 @@ class ProgramRunner:
 
         g = self.group
         assert g is not None
-        if g.state is GroupState.ERROR or self.synced.armed:
+        if g.state is GroupState.ERROR or self.synced.armed or self.synced_analog.armed:
             return -math.inf
         if self._request is not None or self._stray_trip is not None \
                 or self.spindle is not None:
@@ -537,13 +563,13 @@ class ProgramRunner:
         p = self._pass
         opts = self.options
         if p.pc >= len(p.ops):
-            return self._idle() and not self.synced.armed
+            return self._idle() and not self.synced.armed and not self.synced_analog.armed
         if g.queue_length >= opts.window:
             return False
         op = p.ops[p.pc]
         if opts.single_block and self._step_line is not None and op.line != self._step_line:
             return self._idle()
-        if op.kind in ("line", "arc", "delay", "output") or (
+        if op.kind in ("line", "arc", "delay", "output") or (op.kind == "analog" and op.synced) or (
                 op.kind == "action" and not op.barrier):
             return True
         return self._idle()
@@ -583,6 +609,7 @@ class ProgramRunner:
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
         self.synced.fire(g.current_index, self._idle_past)
+        self.synced_analog.fire(g.current_index, self._idle_past)
         if self.state is not RunState.RUNNING:
             return
         try:
@@ -613,7 +640,8 @@ class ProgramRunner:
                 self._step_line = None
                 self._event("single_block", self._last_line, "block done")
                 return
-            synced = isinstance(op.source, canon.SyncedFeed) and self.spindle is not None
+            synced = isinstance(op.source, canon.SyncedFeed | RigidTap) \
+                and self.spindle is not None
             if isinstance(op.source, Probe) or op.kind in ("wait", "orient") or synced:
                 if not self._idle():
                     return
@@ -630,6 +658,14 @@ class ProgramRunner:
                     self._cursor = op.target
                 if op.kind != "delay":
                     self.synced.bind(idx, self.starts_of[idx])
+                    self.synced_analog.bind(idx)
+            elif op.kind == "analog":
+                if op.synced:
+                    self.synced_analog.pending.append(op)
+                else:  # M68: after the motion before it (LinuxCNC's task waits for it)
+                    if not self._idle():
+                        return
+                    self._write_analog(op)
             elif op.kind == "output":
                 if op.synced:
                     self.synced.pending.append(op)
@@ -666,7 +702,8 @@ class ProgramRunner:
             self._last_line = op.line
             if opts.single_block:
                 self._step_line = op.line
-        if p.pc >= len(p.ops) and self._idle() and not self.synced.armed:
+        if p.pc >= len(p.ops) and self._idle() and not self.synced.armed \
+                and not self.synced_analog.armed:
             self._end_of_pass()
 
     def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
@@ -692,6 +729,7 @@ class ProgramRunner:
 
     def _end_of_pass(self) -> None:
         self.synced.flush()
+        self.synced_analog.flush()
         self.passes_done += 1
         if self.passes_done >= self.options.repeat:
             self._finish(RunState.DONE, f"{self.passes_done} pass(es) done")

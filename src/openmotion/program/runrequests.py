@@ -9,10 +9,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import MotionError
 from . import canon
 from .convert import Op
 from .orient import Orient
 from .probing import InputResult, Probe, ProbeResult, WaitInput
+from .rigidtap import RigidTap
+from .rigidtap_run import RigidTapMove
 from .runwait import InputWait, ProbeMove
 from .spindle import OrientMove, SyncMove
 
@@ -51,6 +54,27 @@ def begin_request(run: ProgramRunner, g: Group, op: Op) -> None:
     elif isinstance(op.source, WaitInput):
         run._request = InputWait(run._ctl, op.source)
         run._event("wait", op.line, f"M66 P{op.index} L{op.source.mode}")
+    elif isinstance(op.source, RigidTap):
+        assert run.spindle is not None
+        drive = run.spindle
+        if drive.rpm == 0.0:
+            raise MotionError("G33.1 needs the spindle turning")
+        cmd = canon.Spindle(True, drive.rpm > 0.0, abs(drive.rpm), None, op.line, op.file)
+        vmax = float(np.max(run.scales.vmax_units))
+
+        def push_tap(end: np.ndarray, feed: float, line: int, src: Op = op) -> int:
+            run._pushed += 1
+            g.set_feed(feed)
+            idx = g.line(end)
+            run._line_of[idx] = line
+            run.op_of[idx] = src
+            run.starts_of[idx] = run._positions()
+            return idx
+
+        run._request = RigidTapMove(drive, g, op.source, cmd, vmax, push_tap)
+        run._event("action", op.line, f"G33.1 rigid tap K{op.source.pitch:g}")
+        run._pass.pc += 1  # the way back (the second op) is part of the tap
+        op = run._pass.ops[run._pass.pc]
     elif isinstance(op.source, Orient):
         if run.spindle is None:
             run._event("action", op.line, f"{op.text}: no spindle axis (ignored)")
@@ -99,6 +123,15 @@ def answer(run: ProgramRunner, g: Group) -> bool:
     """A probe or wait in progress: True once its answer is in and the rest of the
     program (up to the next request) is queued as ops."""
     req = run._request
+    if isinstance(req, RigidTapMove):
+        done = req.poll(run.scales.ppu)
+        if done:
+            run.rigid_taps.append(req)
+            run._event("tap_end", run._last_line, f"rigid tap: overrun {req.overrun_in:.4g} "
+                       f"past the end, {req.overrun_out:.4g} past the start (machine units)")
+            req.close()
+            run._request = None
+        return done
     if isinstance(req, SyncMove | OrientMove):
         done = req.poll(run.scales.ppu) if isinstance(req, SyncMove) else req.poll()
         if done:

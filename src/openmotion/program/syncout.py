@@ -131,3 +131,33 @@ class SyncedOutputs:
         self.armed.remove(a)
         self.levels[n] = level
         self._record(t, a.op, n, level)
+
+
+class SyncedAnalog:
+    """The runner's M67 bookkeeping: an analog write bound to the next queued move, made
+    in the cycle that move starts (LinuxCNC applies synchronised outputs at the start of
+    the next motion segment, at its servo-cycle resolution; `write(op)` does the write)."""
+
+    def __init__(self, write: Callable[[Op], None]) -> None:
+        self._write = write
+        self.pending: list[Op] = []
+        self.armed: list[tuple[int, Op]] = []
+
+    def bind(self, index: int) -> None:
+        """The move with group index `index` was queued: pending writes wait for it."""
+        self.armed.extend((index, op) for op in self.pending)
+        self.pending.clear()
+
+    def fire(self, current: int, idle_past: Callable[[int], bool]) -> None:
+        """Once per cycle (see SyncedOutputs.fire): write those whose move started."""
+        for item in list(self.armed):
+            index, op = item
+            if 0 <= index <= current or (current < 0 and idle_past(index)):
+                self.armed.remove(item)
+                self._write(op)
+
+    def flush(self) -> None:
+        """End of a pass: M67 with no motion after them are written now."""
+        for op in self.pending:
+            self._write(op)
+        self.pending.clear()

@@ -34,6 +34,7 @@ from openmotion.hw.interface import (
 )
 
 from . import kernel
+from .analog import SimAnalogOutputs
 from .cubic import Cubic
 from .encoder import Decoder, EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
@@ -48,7 +49,7 @@ from .switches import Switch
 SWITCH_SIGNALS = ("pel", "mel", "org", "sd", "ltc")
 
 
-class SimMachine:
+class SimMachine(SimAnalogOutputs):
     """A simulated multi-axis machine implementing `openmotion.hw.interface.Hardware`.
 
     `wiring` optionally overrides the physical encoder of some axes (axis -> EncoderWiring)
