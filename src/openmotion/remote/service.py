@@ -1,6 +1,7 @@
 """The machine behind the remote API: a Controller on the simulator, paced in real time on a
 background thread, plus what the pages need around it (jogs with a deadman, repeats, the
-scope, the program, homing runs, the machine file and its UI sidecar, config_version).
+scope, the program, homing runs, the machine file with its responses and homing tables,
+config_version).
 
 Threads: the real-time pacer runs `Controller.step`; every change to the controller holds
 `ctl.lock` (the lock every cycle runs under), and the server runs commands one at a time
@@ -20,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..config import MachineConfig, default_machine, dumps_machine
+from ..config_toml import load_machine_settings
 from ..control.core.clock import RealtimePacer
 from ..control.core.controller import Controller
 from ..control.core.states import AxisState
@@ -35,7 +37,6 @@ from .interface import (
     check_responses,
     default_responses,
     load_sidecar,
-    save_sidecar,
     sidecar_path,
     split_changes,
 )
@@ -67,12 +68,7 @@ class MachineService:
         self._listeners: list[Listener] = []
         self.events: deque[dict[str, Any]] = deque(maxlen=EVENT_KEEP)
         self.hook_errors: deque[str] = deque(maxlen=100)   # failures in the cycle hook
-        side = load_sidecar(sidecar_path(self.file)) if self.file else \
-            {"interface": {}, "home": {}}
-        self.responses = {a.name: check_responses(
-            f"interface.{a.name}", side["interface"].get(a.name, {}), default_responses())
-            for a in self.config.axes}
-        self._home_user = dict(side["home"])
+        self.responses, self._home_user = _settings_of(self.file, self.config)
         self._pacer: RealtimePacer | None = None
         self._build(self.config, scope=None)
 
@@ -88,7 +84,10 @@ class MachineService:
         for ax in ctl.axes:
             base = default_home(ax)
             user = self._home_user.get(ax.name)
-            self.homes[ax.name] = home_from_user(ax, base, user) if user else base
+            try:
+                self.homes[ax.name] = home_from_user(ax, base, user) if user else base
+            except MotionError as exc:   # a machine file's [axes.<name>.home] table
+                raise MotionError(f"axes.{ax.name}.home: {exc}") from None
         self.homings: dict[int, Homing] = {}
         self.jogs = JogRegistry(ctl)
         self.repeats = RepeatRegistry(ctl)
@@ -300,13 +299,10 @@ class MachineService:
     def load(self, path: str) -> None:
         p = Path(path)
         cfg = load_machine_arg(path, "path")
-        side = load_sidecar(sidecar_path(p))
-        resp = {a.name: check_responses(f"interface.{a.name}",
-                                        side["interface"].get(a.name, {}),
-                                        default_responses()) for a in cfg.axes}
+        resp, home = _settings_of(p, cfg)
         self._check_at_rest("loading a machine")
         old = (self.responses, self._home_user)
-        self.responses, self._home_user = resp, dict(side["home"])
+        self.responses, self._home_user = resp, home
         try:
             self.rebuild(cfg)
         except Exception:
@@ -321,7 +317,12 @@ class MachineService:
         self.save(self.file)
         return self.file
 
-    def save(self, path: str | Path | None = None) -> tuple[Path, Path]:
+    def settings(self) -> dict[str, dict[str, Any]]:
+        """The responses and homing settings of every axis, as the machine file keeps them."""
+        return {a.name: {"responses": self.responses[a.name],
+                         "home": self._home_user.get(a.name, {})} for a in self.config.axes}
+
+    def save(self, path: str | Path | None = None) -> Path:
         p = Path(path) if path is not None else self.file
         if p is None:
             raise MotionError("path is required: the server has no machine file yet")
@@ -330,13 +331,13 @@ class MachineService:
         if not p.parent.is_dir():
             raise MotionError(f"path {str(p)!r}: folder {str(p.parent)!r} does not exist")
         try:
-            atomic_write(p, dumps_machine(self.config))
-            side = sidecar_path(p)
-            save_sidecar(side, self.responses, self._home_user)
+            atomic_write(p, dumps_machine(self.config, self.settings()))
+            # an old sidecar's settings are in the machine file now: it would only mislead
+            sidecar_path(p).unlink(missing_ok=True)
         except OSError as exc:
             raise MotionError(f"path {str(p)!r}: cannot write ({exc.strerror or exc})") from None
         self.file = p
-        return p, side
+        return p
 
     # ------------------------------------------------------------------ homing
     def start_home(self, axis: Any) -> None:
@@ -383,6 +384,27 @@ class MachineService:
                     ax.stop(tdec)
             if axis is None:
                 self.jogs.stop_all("stop command")
+
+
+def _settings_of(file: Path | None, cfg: MachineConfig
+                 ) -> tuple[dict[str, dict[str, Any]], dict[str, dict[str, Any]]]:
+    """(responses, homing settings) per axis from the machine file's [axes.<n>.responses]
+    and [axes.<n>.home] tables; an axis without them takes an old `<stem>.ui.toml` sidecar's
+    tables if there is one (read once: the next save folds them into the machine file)."""
+    saved = load_machine_settings(file) if file is not None else {}
+    side = load_sidecar(sidecar_path(file)) if file is not None else \
+        {"interface": {}, "home": {}}
+    responses, homes = {}, {}
+    for a in cfg.axes:
+        mine = saved.get(a.name, {"responses": default_responses(), "home": {}})
+        if mine["responses"] == default_responses() and a.name in side["interface"]:
+            mine = {**mine, "responses": check_responses(
+                f"interface.{a.name}", side["interface"][a.name], default_responses())}
+        responses[a.name] = mine["responses"]
+        home = mine["home"] or dict(side["home"].get(a.name, {}))
+        if home:
+            homes[a.name] = home
+    return responses, homes
 
 
 def _check_speed(factor: Any) -> float:
