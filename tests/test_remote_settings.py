@@ -1,6 +1,7 @@
 """Settings through the API: interface I/O and homing validated, saved to the machine file
-(responses and homing in its own tables) and loaded back, an old UI sidecar migrated; two clients, commands serialised, and the refusal of
-a command carrying an outdated config_version."""
+(responses and homing in its own tables) and loaded back, an old UI sidecar migrated; two
+clients, commands serialised, and the refusal of a command carrying an outdated
+config_version."""
 
 from __future__ import annotations
 
