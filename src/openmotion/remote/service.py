@@ -129,6 +129,13 @@ class MachineService:
     def _on_event(self, ev: Any) -> None:
         """Inside the cycle (event-log callback): keep and push the event; never raises."""
         try:
+            if ev.kind == "home_done" and ev.axis in self.homings:
+                # Motion Creator's Home leaves every counter at the home, the target
+                # recorder too: the HSL library does not clear it (manual 4.4: "users need
+                # to manually maintain it ... after a home move completes") and the tool
+                # is the application that does. Same cycle as `done`: one status push.
+                cnt = self.ctl.axes[ev.axis].counters
+                cnt.reset_target(float(cnt.command))
             name = None if ev.axis is None else self.ctl.axes[ev.axis].name
             pos = None
             if ev.position is not None and ev.axis is not None:
