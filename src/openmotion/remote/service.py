@@ -41,6 +41,7 @@ from .interface import (
     split_changes,
 )
 from .programs import ProgramSession
+from .pso import PsoSession
 from .repeat import RepeatRegistry
 from .scope import Scope, Trigger
 from .workdir import WorkFolder
@@ -97,6 +98,8 @@ class MachineService:
                 self.scope.configure(scope["channels"], scope["divider"], scope["seconds"],
                                      Trigger(**scope["trigger"]))
         self.program = ProgramSession(ctl)
+        self.pso = PsoSession(ctl)   # compare jobs start anew with the machine
+        self.program.path.firing_sources.append(self.pso.firings)
         self._cmp_time = [-1.0] * len(ctl.axes)
         if ctl.safety is not None:
             ctl.safety.cmp.on_event(self._on_compare)
