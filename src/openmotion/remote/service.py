@@ -13,6 +13,7 @@ off and is reported in `hook_errors`, the cycle goes on.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import threading
 import time
 from collections import deque
@@ -44,6 +45,7 @@ from .programs import ProgramSession
 from .pso import PsoSession
 from .repeat import RepeatRegistry
 from .scope import Scope, Trigger
+from .tuning import Tuning, check_loop_changes
 from .workdir import WorkFolder
 
 MAX_SPEED = 20.0
@@ -99,6 +101,7 @@ class MachineService:
                                      Trigger(**scope["trigger"]))
         self.program = ProgramSession(ctl)
         self.pso = PsoSession(ctl)   # compare jobs start anew with the machine
+        self.tuning = Tuning(ctl)
         self.program.path.firing_sources.append(self.pso.firings)
         self._cmp_time = [-1.0] * len(ctl.axes)
         if ctl.safety is not None:
@@ -106,7 +109,8 @@ class MachineService:
         ctl.events.on_event(self._on_event)
         self._parts: list[tuple[str, Callable[[float], None]]] = [
             ("deadman", lambda t: self.jogs.check()), ("repeat", self.repeats.step),
-            ("scope", self.scope.sample), ("path", self.program.path.sample)]
+            ("scope", self.scope.sample), ("path", self.program.path.sample),
+            ("tuning", self.tuning.sample)]
         ctl.add_cycle_hook(self._on_cycle)
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
@@ -298,6 +302,22 @@ class MachineService:
         self._bump()
         return self.autosave()
 
+    def set_loop(self, ax: Any, changes: Any) -> Path | None:
+        """New servo loop gains for `ax`: applied to the running loop at once (no rebuild)
+        and saved in the machine file's [axes.<name>.loop] table."""
+        cfg = self.config.axis(ax.name)
+        new = check_loop_changes(cfg.loop, ax.name, changes)
+        live = self.ctl.servo_loops.get(ax.name)
+        with self.ctl.lock:
+            if live is None:
+                raise MotionError(f"axis {ax.name}: no servo loop runs in the controller")
+            if self.tuning.busy():
+                raise MotionError("a tuning run is in progress: wait for it or stop it")
+            live.retune(new)
+            self.config = self.config.with_axis(dataclasses.replace(cfg, loop=new))
+        self._bump()
+        return self.autosave()
+
     def set_home(self, axis: Any, changes: Any) -> Path | None:
         ax = self.ctl.axis(axis)
         new = home_from_user(ax, self.homes[ax.name], changes)
@@ -372,6 +392,7 @@ class MachineService:
         with self.ctl.lock:
             self.jogs.stop_all("emergency stop")
             self.repeats.stop_all("emergency stop")
+            self.tuning.abort("emergency stop")
             self.program.abort_if_running()
             for h in self.homings.values():
                 if h.running:
@@ -385,6 +406,9 @@ class MachineService:
             axes = self.ctl.axes if axis is None else (self.ctl.axis(axis),)
             for ax in axes:
                 self.repeats.stop(ax.index, "stop command")
+                run = self.tuning.run
+                if run is not None and run.axis == ax.index:
+                    self.tuning.abort("stop command")
                 h = self.homings.get(ax.index)
                 if h is not None and h.running:
                     h.abort()

@@ -8,12 +8,13 @@ import * as machine from "./pages/machine.js";
 import * as iface from "./pages/interface.js";
 import * as operation from "./pages/operation.js";
 import * as homing from "./pages/homing.js";
+import * as tuning from "./pages/tuning.js";
 import * as scope from "./pages/scope.js";
 import * as pathPage from "./pages/path.js";
 import * as program from "./pages/program.js";
 import * as simulation from "./pages/simulation.js";
 
-const PAGES = { machine, interface: iface, operation, homing, scope, path: pathPage, program, simulation };
+const PAGES = { machine, interface: iface, operation, homing, tuning, scope, path: pathPage, program, simulation };
 
 // Commands that must work whatever the tab's configuration version (safety first): they are
 // sent without config_version, so a stale tab can always stop the machine.
