@@ -94,3 +94,20 @@ def test_bad_pso_setups_are_refused_and_start_nothing(machine, params, message):
     with pytest.raises(RemoteError, match=message):
         m.call("pso.set", **params)
     assert m.call("pso.get") == {"jobs": [], "firings": 0}
+
+
+def test_points_job_fires_once_per_point_within_its_window(machine):
+    svc, m = machine
+    m.call("axis.servo", axis="y", on=True)
+    here = m.status["axes"]["y"]["position"]
+    pts = [[here + 5.0], [here + 10.0]]
+    r = m.call("pso.set", kind="points", axes=["y"], output=4, points=pts, window=0.5)
+    assert r["job"]["remaining"] == 2
+    m.call("axis.move", axis="y", kind="relative", distance=15.0, max_vel=50.0, tacc=0.05)
+    d = _path_until(m, lambda d: len([f for f in d["firings"] if f["kind"] == "PSO"]) >= 2
+                    and not m.status["axes"]["y"]["moving"])
+    pso = [f for f in d["firings"] if f["kind"] == "PSO"]
+    assert len(pso) == 2 and all(f["output"] == 4 for f in pso)
+    for f, p in zip(pso, pts, strict=True):
+        assert abs(f["point"][0] - p[0]) <= 0.5 + 1e-6
+    assert m.call("pso.get")["jobs"][0]["remaining"] == 0

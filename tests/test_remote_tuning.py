@@ -163,3 +163,18 @@ def test_settling_is_none_when_the_error_never_stays_in_the_band():
     err = np.array([5, 4, 3, 2, 1, 0, 0, 0, 0, 0, 3.0])
     assert _settling(t, err, 0.5, 0.0) is None
     assert _settling(t, err[:-1], 0.5, 0.0) == pytest.approx(0.5)
+
+
+def test_a_running_loop_keeps_its_sample_rate():
+    import dataclasses
+
+    from openmotion.config import load_machine as load
+    from openmotion.control import Controller
+    from openmotion.errors import MotionError
+
+    ctl = Controller(load(EXAMPLE))
+    loop = ctl.servo_loops["x"]
+    with pytest.raises(MotionError, match="samples_per_cycle must stay 2"):
+        loop.retune(dataclasses.replace(loop.config, samples_per_cycle=1))
+    loop.retune(dataclasses.replace(loop.config, compensator="pid", kp=0.01))
+    assert loop.config.compensator == "pid" and type(loop.compensator).__name__ == "PIDFF"

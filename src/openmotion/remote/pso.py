@@ -102,8 +102,10 @@ class PsoSession:
         info = dict(self._jobs[job_id])
         eng = self.engine
         job = eng.jobs.get(job_id) if eng is not None else None
-        endless = info["kind"] == "distance"
-        info["remaining"] = None if job is None or endless else job.remaining
+        if info["kind"] == "distance":
+            info["remaining"] = None        # endless: every `every` while the axes move
+        else:                               # a finished table job leaves the engine
+            info["remaining"] = 0 if job is None else job.remaining
         info["active"] = job is not None and not job.done
         return info
 
