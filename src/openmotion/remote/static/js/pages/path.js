@@ -100,7 +100,7 @@ function $(sel, r) { return r.querySelector(sel); }
 function buildPso(box) {
   if (!app.info) return;
   const names = app.info.axes.map((a) => a.name);
-  const unit = (app.info.axes[0] || {}).unit || "";
+  const unit = "user units";   // of the axes named (mm, degree, pulse ...)
   const nOut = app.info.digital_outputs || 0;
   fsPso = new FieldSet(box, [
     { name: "kind", label: "Fire", kind: "select", value: "distance", options: [["distance", "every distance"], ["points", "at points"]] },
