@@ -111,3 +111,26 @@ def test_points_job_fires_once_per_point_within_its_window(machine):
     for f, p in zip(pso, pts, strict=True):
         assert abs(f["point"][0] - p[0]) <= 0.5 + 1e-6
     assert m.call("pso.get")["jobs"][0]["remaining"] == 0
+
+
+def test_hsl_comparator_firings_are_marked_on_a_programs_path(machine):
+    """A general comparator (HSL CMP, safety.cmp) set by a script on the controller: its
+    firing appears on the path at the exact crossing, as kind CMP."""
+    svc, m = machine
+    for ax in ("x", "y", "z", "u"):
+        m.call("axis.servo", axis=ax, on=True)
+    start = m.status["axes"]["x"]["command"]
+    level = start + 50_000 if start < 100_000 else start - 50_000
+    with svc.ctl.lock:
+        svc.ctl.safety.cmp.set_general_comparator("x", "command",
+                                                  ">" if level > start else "<", "event",
+                                                  float(level))
+    m.call("program.load", text="G21 G90\nG0 X0 Y0\nG1 X10 F1200\nM2\n")
+    m.call("program.run", feed_override=100.0)
+    assert m.wait(lambda s: s["program"]["state"] == "done", 60.0), m.status["program"]
+    d = _path_until(m, lambda d: any(f["kind"] == "CMP" for f in d["firings"]))
+    cmp = [f for f in d["firings"] if f["kind"] == "CMP"]
+    assert len(cmp) >= 1
+    assert cmp[0]["point"][0] == pytest.approx(level / 1000.0, abs=0.01)   # 1000 pulses/mm
+    with svc.ctl.lock:
+        svc.ctl.safety.cmp.clear_general_comparator("x")

@@ -391,9 +391,9 @@ class PathRecorder:
                     firings.append({"t": ev.t, "kind": "M62/M63",
                                     "point": np.round(self._p[all_idx[k]], 6).tolist(),
                                     "output": ev.index, "level": ev.level})
-            for src in self.firing_sources:   # PSO: exact positions from the engine's log
+            for src in self.firing_sources:   # PSO / CMP: exact positions of the firing
                 for f in src(t_lo, t_hi):
-                    firings.append({"t": f["t"], "kind": "PSO",
+                    firings.append({"t": f["t"], "kind": f.get("kind", "PSO"),
                                     "point": self._point_of(f["pulses"]),
                                     "output": f["output"], "level": f["level"]})
             firings.sort(key=lambda f: f["t"])

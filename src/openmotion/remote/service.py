@@ -103,6 +103,8 @@ class MachineService:
         self.pso = PsoSession(ctl)   # compare jobs start anew with the machine
         self.tuning = Tuning(ctl)
         self.program.path.firing_sources.append(self.pso.firings)
+        self._cmp_firings: deque[dict[str, Any]] = deque(maxlen=EVENT_KEEP)
+        self.program.path.firing_sources.append(self._comparator_firings)
         self._cmp_time = [-1.0] * len(ctl.axes)
         if ctl.safety is not None:
             ctl.safety.cmp.on_event(self._on_compare)
@@ -127,11 +129,21 @@ class MachineService:
                 self.hook_errors.append(f"{name}: {type(exc).__name__}: {exc}")
 
     def _on_compare(self, ev: Any) -> None:
-        """Inside the cycle (comparator callback): never raises."""
+        """Inside the cycle (comparator callback): never raises. Lights CMP and keeps the
+        firing, with every axis's position at its exact time, for the path view."""
         with contextlib.suppress(Exception):
             axis = getattr(ev, "axis", None)
             if isinstance(axis, int) and 0 <= axis < len(self._cmp_time):
                 self._cmp_time[axis] = self.ctl.time
+            hist = self.ctl.history
+            pulses = [float(hist.position_at(a, ev.time)) for a in range(len(self.ctl.axes))]
+            self._cmp_firings.append({"t": float(ev.time), "output": -1, "level": True,
+                                      "pulses": pulses, "kind": "CMP",
+                                      "comparator": ev.comparator})
+
+    def _comparator_firings(self, t_lo: float, t_hi: float) -> list[dict[str, Any]]:
+        """The HSL comparators' (safety.cmp) firings with t_lo < t <= t_hi."""
+        return [f for f in tuple(self._cmp_firings) if t_lo < f["t"] <= t_hi]
 
     def _on_event(self, ev: Any) -> None:
         """Inside the cycle (event-log callback): keep and push the event; never raises."""

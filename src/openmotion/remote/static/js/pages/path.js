@@ -79,14 +79,16 @@ async function poll() {
     if (d.firings && d.firings.length) {
       firings = firings.concat(d.firings);
       view.setMarkers(firings.map((f) => ({ x: f.point[0], y: f.point[1] ?? 0, z: f.point[2] ?? 0,
-        colour: f.kind === "PSO" ? "#c0c" : "#e80" })));
+        colour: f.kind === "M62/M63" ? "#e80" : "#c0c" })));   // PSO / CMP: compare firings
     }
     next = d.next;
     const first = (Array.isArray(axes) ? axes[0] : String(axes)[0] || "x").toLowerCase();
     const unit = (Array.isArray(d.units) ? d.units[0] : d.units) || (app.axisInfo(first) || {}).unit;
     $("#path-vmax", root).textContent = ` (0 … ${num(d.vmax ?? view.vmax, 3)} ${unit || ""}/s)`;
-    const nPso = firings.filter((f) => f.kind === "PSO").length;
-    info.textContent = `${pts.x.length} points · ${firings.length} firings (${nPso} PSO, ${firings.length - nPso} M62/M63) · axes ${Array.isArray(axes) ? axes.join("") : axes}`;
+    const nSync = firings.filter((f) => f.kind === "M62/M63").length;
+    const nCmp = firings.filter((f) => f.kind === "CMP").length;
+    const nPso = firings.length - nSync - nCmp;
+    info.textContent = `${pts.x.length} points · ${firings.length} firings (${nPso} PSO, ${nCmp ? `${nCmp} CMP, ` : ""}${nSync} M62/M63) · axes ${Array.isArray(axes) ? axes.join("") : axes}`;
     marker();
   } catch (err) {
     info.textContent = `path: ${err.message}`;
