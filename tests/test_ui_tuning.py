@@ -82,6 +82,9 @@ def test_gains_are_applied_saved_and_the_step_response_shown(page, server):
     page.wait_for_selector("#tune-state:has-text('step of 150')", timeout=30_000)
     _done(page)
     assert "rise" in page.inner_text("#tune-figure-table")
+    # the middle chart shows the loop's output (duty) for a step
+    page.wait_for_selector("#tune-chart-1[data-kind=duty]")
+    assert page.evaluate("window.openmotion.tuneCharts[1].t.length") > 10
     # a stepper axis has no loop in the controller: the page says so, the move still runs
     page.select_option("#axis-select", "y")
     page.wait_for_selector("#tune-no-loop")

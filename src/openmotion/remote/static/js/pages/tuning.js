@@ -94,7 +94,7 @@ function render() {
   }
   stateBox = el("div", { id: "tune-state", "data-state": "idle" }, "no run yet");
   figBox = el("div", { id: "tune-figures" });
-  const boxes = [0, 1, 2].map((k) => el("div", { class: "chart", id: `tune-chart-${k}` }));
+  const boxes = [0, 1, 2].map((k) => el("div", { class: "chart", id: `tune-chart-${k}`, "data-kind": k === 1 ? "velocity" : null }));
   root.replaceChildren(el("div", { class: "grid" }, movePanel, loopPanel,
     el("div", { class: "panel wide" }, el("h3", {}, "Result"), stateBox, figBox, ...boxes)));
   charts = [
@@ -181,10 +181,25 @@ function showResult(r) {
   const t = r.t;
   const dur = t.length ? t[t.length - 1] - t[0] : 1;
   const step = r.kind === "step";
+  setMiddleChart(step ? "duty" : "velocity");
   const sets = step
-    ? [[r.columns.command, r.columns.actual], [[], []], [r.columns.error]]
+    ? [[r.columns.command, r.columns.actual], [r.columns.duty.map((d) => d * 100)], [r.columns.error]]
     : [[r.columns.command, r.columns.actual], [r.columns.velocity_command, r.columns.velocity_actual], [r.columns.error]];
   charts.forEach((c, i) => { c.setWindow(Math.max(dur, 0.001)); c.setData(t, sets[i]); });
+  app.tuneCharts = charts;
+}
+
+/** The middle chart: velocities of a test move, or the amplifier duty of a step. */
+function setMiddleChart(kind) {
+  const box = root.querySelector("#tune-chart-1");
+  if (!box || box.dataset.kind === kind) return;
+  box.dataset.kind = kind;
+  if (charts[1]) charts[1].destroy();
+  box.replaceChildren();
+  const unit = info.unit;
+  charts[1] = kind === "duty"
+    ? new LiveChart(box, { channels: [{ key: "duty", label: "amplifier duty", unit: "%" }], windowS: 1, height: 200, title: "loop output" })
+    : new LiveChart(box, { channels: [{ key: "velocity_command", label: "commanded", unit: `${unit}/s` }, { key: "velocity_actual", label: "actual", unit: `${unit}/s` }], windowS: 1, height: 200, title: "velocity" });
 }
 
 function figures(r) {
