@@ -20,15 +20,18 @@ KEYS = ["axis", "kind", "position", "distance", "velocity", "max_vel", "str_vel"
         "factor", "channels", "divider", "seconds", "trigger", "since", "max_points",
         "text", "name", "first", "percent", "feed_override", "single_block", "repeat",
         "rate_hz", "fields", "subscription", "command", "feedback", "target", "start",
-        "end", "config_version", "speed_range", "reason", "max"]
+        "end", "config_version", "speed_range", "reason", "max", "amplitude", "duration_s",
+        "back", "settle_s", "band", "output", "every", "points", "window", "pulse_s", "axes"]
 VALUES = st.one_of(
     st.none(), st.booleans(), st.integers(-10**12, 10**12),
     st.floats(allow_nan=False, allow_infinity=False, width=32),
     st.sampled_from(["x", "y", "u", "w", "", "relative", "absolute", "velocity", "S", "T",
-                     "pel", "decel", "jog-1", "x.command", "G1 X1 F100\nM2\n", "G9999"]),
-    st.lists(st.sampled_from(["x.command", "y.velocity", "nope", 3]), max_size=3),
+                     "pel", "decel", "jog-1", "x.command", "G1 X1 F100\nM2\n", "G9999",
+                     "move", "step", "points", "di.3", "do.99"]),
+    st.lists(st.sampled_from(["x.command", "y.velocity", "nope", 3, "x", "di.2"]), max_size=3),
+    st.lists(st.lists(st.floats(-1e3, 1e3, width=32), max_size=3), max_size=3),
     st.dictionaries(st.sampled_from(["pulse_mode", "responses", "logic", "max_vel", "mode",
-                                     "channel", "el"]),
+                                     "channel", "el", "k", "kp", "compensator"]),
                     st.one_of(st.integers(-3, 3), st.text(max_size=4),
                               st.dictionaries(st.sampled_from(["el", "pel", "sd"]),
                                               st.sampled_from(["nc", "decel", 1, True])),

@@ -44,7 +44,9 @@ def test_svon_lamp_follows_servo_on(machine):
 
 def test_homing_done_arrives_with_the_counters_cleared(machine):
     """No push shows homing `done` before the counters read their home values: the state
-    and the counters change in one cycle under the controller's lock, one snapshot."""
+    and the counters change in one cycle under the controller's lock, one snapshot. The
+    target recorder too: the UI's Home resets it (the HSL library leaves it to the
+    application, manual 4.4), while a Homing run by the library alone keeps it."""
     svc, m = machine
     m.call("axis.servo", axis="x", on=True)
     m.call("axis.move", axis="x", kind="absolute", position=20.0, max_vel=100.0, tacc=0.05)
@@ -60,12 +62,32 @@ def test_homing_done_arrives_with_the_counters_cleared(machine):
         if msg.get("method") != "notify_status_update":
             continue
         d = msg["params"][0].get("axes", {}).get("x", {})
-        view.update({k: v for k, v in d.items() if k in ("command", "feedback", "error")})
+        view.update({k: v for k, v in d.items() if k in ("command", "error", "target")})
         if d.get("homing", {}).get("state") == "done":
             assert view.get("command") == 0 and view.get("error", 0) == 0, d
+            assert view.get("target") == 0, d
             break
     else:
         raise AssertionError("no push carried homing done")
+    assert svc.ctl.axis("x").counters.target == 0.0
+
+
+def test_the_library_homing_alone_keeps_the_target_recorder():
+    from openmotion.config import default_machine
+    from openmotion.control import Controller
+    from openmotion.control.home.homing import Homing
+    from openmotion.control.home.homing_modes import HomeConfig
+
+    ctl = Controller(default_machine())
+    ax = ctl.axis("x")
+    ax.enable()
+    ax.move_relative(20000, max_vel=50000, tacc=0.05)
+    ctl.run_until(lambda: not ax.is_moving, timeout=20.0)
+    h = Homing(ctl, "x", HomeConfig(mode=0, direction=-1, str_vel=4000.0, max_vel=40000.0))
+    h.start()
+    ctl.run_until(lambda: not h.running, timeout=60.0)
+    assert h.done and ax.counters.command == 0
+    assert ax.counters.target != 0.0     # HSL: "the target position recorder will not"
 
 
 def test_home_get_draws_another_mode_without_applying_it(machine):

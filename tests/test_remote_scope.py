@@ -3,6 +3,7 @@ from a sample number, trigger window, derived acceleration, decimation, CSV, bad
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from openmotion.control import Controller
@@ -115,3 +116,84 @@ def test_bad_setups_are_refused_and_the_old_one_stays(ctl, kw, words):
     with pytest.raises(MotionError, match=words):
         sc.configure(args["channels"], args["divider"], args["seconds"], args["trigger"])
     assert sc.channels == ["y.command"] and sc.version == 1
+
+
+def test_board_lines_are_channels(ctl):
+    sc = Scope(ctl, ["di.3", "do.5", "x.io.svon"], 1, 1.0,
+               Trigger("do.5", "rising", 0.5, 0.08))
+    _attach(ctl, sc)
+    ctl.advance(0.05)
+    ctl.hardware.scenario.set_input("di3", True)
+    ctl.advance(0.05)
+    t_out = ctl.time
+    ctl.hardware.write_output(None, "do5", True)
+    ctl.advance(0.05)
+    d = sc.data(-1, 10**6)
+    di, do = d["columns"]["di.3"], d["columns"]["do.5"]
+    assert set(di) == {0.0, 1.0} and di[0] == 0.0 and di[-1] == 1.0
+    assert do[0] == 0.0 and do[-1] == 1.0
+    assert d["triggered_at"] == pytest.approx(t_out + ctl.period, abs=1e-9)
+    names = {c["name"] for c in __import__("openmotion.remote.scope", fromlist=["x"])
+             .channel_names(ctl)}
+    assert {"di.0", "di.15", "do.0", "do.15"} <= names
+    for bad, why in (("di.16", r"di line must be a number in \[0, 15\]"),
+                     ("do.x", "do line must be a number"), ("di.-1", "di line")):
+        with pytest.raises(MotionError, match=why):
+            Scope(ctl, [bad], 1, 1.0)
+
+
+class _CycleBetweenSlices:
+    """A lock that lets one control cycle's sample run each time a read releases it: what
+    the real-time thread does when it waits on the scope's lock. Counts the holds."""
+
+    def __init__(self, scope, ctl):
+        import threading
+
+        self._lock = threading.Lock()
+        self.scope, self.ctl = scope, ctl
+        self.holds = 0
+        self.reading = False
+        self.cycles = 0
+
+    def __enter__(self):
+        self._lock.acquire()
+        self.holds += 1
+
+    def __exit__(self, *exc):
+        self._lock.release()
+        if self.reading:          # the cycle gets the lock between two slices of the read
+            self.reading = False
+            self.ctl._time_for_test = getattr(self.ctl, "_time_for_test", 1000.0) + 0.001
+            self.scope.sample(self.ctl._time_for_test)
+            self.cycles += 1
+            self.reading = True
+
+
+def test_a_long_read_is_copied_in_slices_and_lets_the_cycle_run(ctl):
+    from openmotion.remote import scope as scope_mod
+
+    sc = Scope(ctl, [f"x.{q}" for q in ("command", "velocity", "error", "state")] +
+               [f"di.{k}" for k in range(12)], 1, 600.0)
+    cap = sc.cap
+    assert cap == 600_000 and len(sc.channels) == 16
+    # a full 600 s history, written straight into the ring (filling it cycle by cycle
+    # would take minutes): sample k at time k ms, every column = k
+    k = np.arange(cap, dtype=float)
+    sc._t[:] = k * 0.001
+    sc._buf[:] = k[:, None]
+    sc.n = cap
+    lock = _CycleBetweenSlices(sc, ctl)
+    sc._lock = lock
+    lock.reading = True
+    d = sc.data(-1, 10**7)
+    lock.reading = False
+    slices = -(-cap // scope_mod.SLICE_ROWS)
+    assert lock.holds >= slices           # never the whole ring under one hold
+    assert lock.cycles >= slices - 1      # and a cycle ran between every two slices
+    t = np.array(d["t"])
+    assert np.all(np.diff(t) > 0)         # still one consistent, ordered history
+    # the cycles overwrote the oldest rows while the read went on: those were copied first
+    col = np.array(d["columns"]["x.command"])
+    assert len(col) == d["next"] - d["start"]
+    assert col[0] * 1000 == pytest.approx(d["start"], abs=1e-6)
+    assert d["next"] == cap               # the end the read started from

@@ -1,6 +1,7 @@
 """Settings through the API: interface I/O and homing validated, saved to the machine file
-(and its UI sidecar) and loaded back; two clients, commands serialised, and the refusal of
-a command carrying an outdated config_version."""
+(responses and homing in its own tables) and loaded back, an old UI sidecar migrated; two
+clients, commands serialised, and the refusal of a command carrying an outdated
+config_version."""
 
 from __future__ import annotations
 
@@ -9,8 +10,9 @@ import threading
 import pytest
 
 from openmotion.config import load_machine
+from openmotion.config_toml import load_machine_settings
 from openmotion.remote import ReloadError, RemoteError
-from openmotion.remote.interface import load_sidecar, sidecar_path
+from openmotion.remote.interface import sidecar_path
 from openmotion.remote.service import MachineService
 from remote_kit import at_rest, client, machine_file, served
 
@@ -44,9 +46,10 @@ def test_interface_change_is_validated_saved_and_loaded_back(tmp_path):
         assert res["interface"]["pulse_mode"] == "cw_ccw"
         ax = load_machine(path).axis("x")
         assert (ax.pulse_mode, ax.move_ratio, ax.logic["org"]) == ("cw_ccw", 2.0, "nc")
-        side = load_sidecar(sidecar_path(path))
-        assert side["interface"]["x"]["el"] == "decel"
-        assert side["interface"]["x"]["sd"]["enabled"] is True
+        saved = load_machine_settings(path)["x"]["responses"]   # in the machine file itself
+        assert saved["el"] == "decel" and saved["sd"]["enabled"] is True
+        assert "[axes.x.responses]" in path.read_text()
+        assert not sidecar_path(path).exists()
         assert svc.ctl.safety.settings("x").el_decelerate
         # responses only: applied live, no rebuild
         ctl = svc.ctl
@@ -54,6 +57,8 @@ def test_interface_change_is_validated_saved_and_loaded_back(tmp_path):
             "responses": {"alm": "decel"}})
         assert svc.ctl is ctl and svc.ctl.axis("y").alarm_decelerate
         m.call("home.set", axis="x", config_version=3, changes={"mode": 2, "max_vel": 30.0})
+        home = load_machine_settings(path)["x"]["home"]
+        assert home["mode"] == 2 and home["max_vel"] == pytest.approx(30.0)
     # a new server on the same file has every setting back
     svc2 = MachineService(file=path)
     try:
@@ -64,6 +69,33 @@ def test_interface_change_is_validated_saved_and_loaded_back(tmp_path):
         assert svc2.homes["x"].max_vel == pytest.approx(30.0 * 1000)
     finally:
         svc2.shutdown()
+
+
+def test_an_old_ui_sidecar_is_read_and_folded_into_the_machine_file(tmp_path):
+    path = machine_file(tmp_path)
+    side = sidecar_path(path)
+    side.write_text('[interface.x]\nel = "decel"\n[home.x]\nmode = 3\nmax_vel = 25.0\n')
+    with served(file=path) as (svc, th), client(th) as m:
+        assert svc.ctl.safety.settings("x").el_decelerate and svc.homes["x"].mode == 3
+        assert m.call("interface.get", axis="x")["responses"]["el"] == "decel"
+        m.call("machine.save")
+        assert not side.exists()
+        saved = load_machine_settings(path)["x"]
+        assert saved["responses"]["el"] == "decel" and saved["home"]["mode"] == 3
+    svc2 = MachineService(file=path)
+    try:
+        assert svc2.ctl.safety.settings("x").el_decelerate and svc2.homes["x"].mode == 3
+    finally:
+        svc2.shutdown()
+
+
+def test_a_bad_home_table_in_the_machine_file_is_refused_naming_it(tmp_path):
+    from openmotion.errors import MotionError
+
+    path = machine_file(tmp_path)
+    path.write_text(path.read_text() + "\n[axes.x.home]\nmode = 99\n")
+    with pytest.raises(MotionError, match=r"axes\.x\.home: mode must be 0\.\.12"):
+        MachineService(file=path)
 
 
 def test_machine_save_gives_the_in_memory_machine_a_file(tmp_path):

@@ -122,6 +122,7 @@ def browser(server: Server | External) -> Iterator[object]:
 def page(browser: object, server: Server | External) -> Iterator[object]:
     """A fresh tab on the UI, connected (lamp green) and showing the operation page."""
     ctx = browser.new_context(viewport={"width": 1400, "height": 1000})   # type: ignore[attr-defined]
+    ctx.set_default_timeout(30_000)      # every Playwright wait, unless a test asks for more
     pg = ctx.new_page()
     errors: list[str] = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
@@ -142,11 +143,16 @@ def status(pg: object, expr: str) -> object:
     return pg.evaluate(f"() => {{ const s = window.openmotion.status; return {expr}; }}")  # type: ignore[attr-defined]
 
 
-def wait_status(pg: object, cond: str, timeout_s: float = 10) -> None:
-    """Wait until the JS condition `cond` on the live status `s` holds."""
+#: the shortest wait for a state: a loaded CI machine can be slow, never wait less
+MIN_WAIT_S = 20.0
+
+
+def wait_status(pg: object, cond: str, timeout_s: float = MIN_WAIT_S) -> None:
+    """Wait until the JS condition `cond` on the live status `s` holds (at least
+    MIN_WAIT_S; wait only for states that persist, never for a passing one)."""
     pg.wait_for_function(   # type: ignore[attr-defined]
         f"() => {{ const s = window.openmotion.status; return Boolean(s && ({cond})); }}",
-        timeout=timeout_s * 1000)
+        timeout=max(timeout_s, MIN_WAIT_S) * 1000)
 
 
 def shot(pg: object, name: str) -> None:

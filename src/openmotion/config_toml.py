@@ -3,6 +3,11 @@
 Layout: top-level name / cycle_s / digital_inputs / digital_outputs, then one [axes.<name>]
 table per axis in controller order, with nested [axes.<name>.logic], [axes.<name>.drive]
 (and [axes.<name>.drive.motor]), [axes.<name>.loop] and [axes.<name>.pel|mel|org|sd].
+Two more tables per axis hold what a commissioning tool sets up (Motion Creator's I/O and
+home dialogs): [axes.<name>.responses] (end-limit / alarm stop modes, ERC, SD, INP, RDY)
+and [axes.<name>.home] (homing settings in user units). They are not part of MachineConfig
+(the mechanism); `machine_settings_from_dict` / `loads_machine_settings` /
+`load_machine_settings` read them and `dumps_machine(cfg, settings)` writes them.
 Every key is checked: an unknown key is an error naming it. Switch position / width /
 hysteresis are written in the axis's USER units in the file (a person measures switches in
 mm or degrees) and converted to command pulses on load, back on save; `reverse` flips the
@@ -28,13 +33,17 @@ from openmotion.config import (
 )
 from openmotion.errors import MotionError
 
-__all__ = ["dumps_machine", "load_machine", "loads_machine", "machine_from_dict",
-           "machine_to_dict", "save_machine"]
+__all__ = ["HOME_KEYS", "RESPONSE_KEYS", "check_home_table", "check_responses",
+           "default_responses", "dumps_machine", "load_machine", "load_machine_settings",
+           "loads_machine", "loads_machine_settings", "machine_from_dict",
+           "machine_settings_from_dict", "machine_to_dict", "save_machine"]
 
 _TOP_KEYS = ("name", "cycle_s", "digital_inputs", "digital_outputs", "axes")
 _AXIS_TABLES = ("logic", "drive", "loop") + SWITCHES
-_AXIS_KEYS = tuple(f for f in AxisConfig.__dataclass_fields__ if f != "name")
-_AXIS_SCALARS = tuple(k for k in _AXIS_KEYS if k not in _AXIS_TABLES)
+_SETTING_TABLES = ("responses", "home")
+_CONFIG_KEYS = tuple(f for f in AxisConfig.__dataclass_fields__ if f != "name")
+_AXIS_KEYS = _CONFIG_KEYS + _SETTING_TABLES
+_AXIS_SCALARS = tuple(k for k in _CONFIG_KEYS if k not in _AXIS_TABLES)
 _DRIVE_KEYS = tuple(DriveConfig.__dataclass_fields__)
 _SWITCH_KEYS = tuple(SwitchConfig.__dataclass_fields__)
 _MOTOR_KEYS = tuple(DCMotorConfig.__dataclass_fields__)
@@ -146,6 +155,146 @@ def _axis_from_toml(name: str, data: dict[str, Any]) -> AxisConfig:
     return replace(base, **switches)
 
 
+# -- [axes.<name>.responses] and [axes.<name>.home] -------------------------------------
+RESPONSE_KEYS = ("el", "el_enabled", "el_direction_sensitive", "alm", "erc_width_s", "sd",
+                 "inp", "rdy")
+SD_KEYS = ("enabled", "latched", "stop")
+STOP_MODES = ("immediate", "decel")
+MAX_ERC_S = 1.0
+#: homing settings in the axis's user units (speeds unit/s, offsets unit, times s)
+HOME_KEYS = ("mode", "direction", "str_vel", "max_vel", "tacc", "tdec", "ez_count",
+             "org_offset", "home_offset", "final", "el_stop", "auto_search", "timeout_s")
+_HOME_NUMBERS = ("str_vel", "max_vel", "tacc", "tdec", "org_offset", "home_offset",
+                 "timeout_s")
+
+
+def default_responses() -> dict[str, Any]:
+    """The responses of an axis nobody configured (the HSL power-on defaults)."""
+    return {"el": "immediate", "el_enabled": True, "el_direction_sensitive": True,
+            "alm": "immediate", "erc_width_s": 0.0,
+            "sd": {"enabled": False, "latched": False, "stop": False},
+            "inp": False, "rdy": False}
+
+
+def _bool(path: str, v: Any) -> bool:
+    if not isinstance(v, bool):
+        raise MotionError(f"{path} must be true or false, got {v!r}")
+    return v
+
+
+def _known(path: str, table: Any, allowed: tuple[str, ...]) -> dict[str, Any]:
+    if not isinstance(table, dict):
+        raise MotionError(f"{path} must be a table, got {table!r}")
+    _check_keys(path, table, allowed)
+    return table
+
+
+def check_responses(path: str, changes: Any, old: dict[str, Any]) -> dict[str, Any]:
+    """`old` with `changes` applied, every value checked (messages name `path.key`)."""
+    _known(path, changes, RESPONSE_KEYS)
+    new = {k: (dict(v) if isinstance(v, dict) else v) for k, v in old.items()}
+    for k, v in changes.items():
+        p = f"{path}.{k}"
+        if k in ("el", "alm"):
+            if v not in STOP_MODES:
+                raise MotionError(f"{p} must be one of {', '.join(STOP_MODES)}; got {v!r}")
+            new[k] = v
+        elif k == "erc_width_s":
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or \
+                    not 0.0 <= v <= MAX_ERC_S:
+                raise MotionError(f"{p} must be a number in [0, {MAX_ERC_S:g}] s "
+                                  f"(0 = no ERC pulse), got {v!r}")
+            new[k] = float(v)
+        elif k == "sd":
+            _known(p, v, SD_KEYS)
+            new["sd"] = {**new["sd"], **{s: _bool(f"{p}.{s}", x) for s, x in v.items()}}
+        else:
+            new[k] = _bool(p, v)
+    return new
+
+
+def check_home_table(path: str, table: Any) -> dict[str, Any]:
+    """The keys and value types of a home table (user units). The rules that need the
+    homing model (mode numbers, speed order, ranges) are applied by HomeConfig when the
+    settings are used: `openmotion.remote.homeconf.home_from_user`."""
+    _known(path, table, HOME_KEYS)
+    out: dict[str, Any] = {}
+    for k, v in table.items():
+        p = f"{path}.{k}"
+        if k in _HOME_NUMBERS:
+            out[k] = _real(p, v)
+        elif k in ("direction", "ez_count"):
+            if isinstance(v, bool) or not isinstance(v, int):
+                raise MotionError(f"{p} must be an integer, got {v!r}")
+            out[k] = v
+        elif k == "auto_search":
+            out[k] = _bool(p, v)
+        elif k == "mode":
+            if isinstance(v, bool) or not isinstance(v, (int, str)):
+                raise MotionError(f"{p} must be a mode number 0..12 or an mccl_* name, "
+                                  f"got {v!r}")
+            out[k] = v
+        else:   # final, el_stop
+            if not isinstance(v, str):
+                raise MotionError(f"{p} must be a string, got {v!r}")
+            out[k] = v
+    return out
+
+
+def machine_settings_from_dict(data: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Per axis {"responses": full responses, "home": the home table as written (may be
+    empty)} from the parsed layout; axes without the tables get the defaults."""
+    _table("machine file", data)
+    out: dict[str, dict[str, Any]] = {}
+    for name, a in _table("axes", data.get("axes", {})).items():
+        a = _table(f"axes.{name}", a)
+        resp = check_responses(f"axes.{name}.responses", a.get("responses", {}),
+                               default_responses())
+        home = check_home_table(f"axes.{name}.home", a.get("home", {}))
+        out[str(name)] = {"responses": resp, "home": home}
+    return out
+
+
+def loads_machine_settings(text: str) -> dict[str, dict[str, Any]]:
+    """The responses and home tables of machine-file text (see machine_settings_from_dict);
+    the machine part is validated too (loads_machine)."""
+    import tomllib
+
+    cfg = loads_machine(text)
+    data = tomllib.loads(text)
+    settings = machine_settings_from_dict(data)
+    return {a.name: settings[a.name] for a in cfg.axes}
+
+
+def load_machine_settings(path: str | os.PathLike[str]) -> dict[str, dict[str, Any]]:
+    """Read a machine file's responses and home tables (OSError if it cannot be read)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise MotionError(f"path must be a str or path, got {path!r}")
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    try:
+        return loads_machine_settings(text)
+    except MotionError as e:
+        raise MotionError(f"{os.fspath(path)}: {e}") from None
+
+
+def _settings_tables(name: str, settings: dict[str, dict[str, Any]] | None
+                     ) -> dict[str, Any]:
+    """The responses / home tables to write for axis `name` (defaults left out)."""
+    if not settings or name not in settings:
+        return {}
+    s = _known(f"settings.{name}", settings[name], _SETTING_TABLES)
+    out: dict[str, Any] = {}
+    resp = check_responses(f"axes.{name}.responses", s.get("responses", {}),
+                           default_responses())
+    if resp != default_responses():
+        out["responses"] = resp
+    home = check_home_table(f"axes.{name}.home", s.get("home", {}))
+    if home:
+        out["home"] = home
+    return out
+
+
 def machine_from_dict(data: dict[str, Any]) -> MachineConfig:
     """Build a MachineConfig from the parsed TOML layout (see the module docstring)."""
     _table("machine file", data)
@@ -153,11 +302,15 @@ def machine_from_dict(data: dict[str, Any]) -> MachineConfig:
     axes_t = _table("axes", data.get("axes", {}))
     axes = tuple(_axis_from_toml(str(n), a) for n, a in axes_t.items())
     kw = {k: data[k] for k in _TOP_KEYS[:-1] if k in data}
-    return MachineConfig(axes=axes, **kw)
+    cfg = MachineConfig(axes=axes, **kw)
+    machine_settings_from_dict(data)   # the responses / home tables are checked on load too
+    return cfg
 
 
-def machine_to_dict(cfg: MachineConfig) -> dict[str, Any]:
-    """The TOML layout of `cfg` (switches in user units); inverse of machine_from_dict."""
+def machine_to_dict(cfg: MachineConfig, settings: dict[str, dict[str, Any]] | None = None
+                    ) -> dict[str, Any]:
+    """The TOML layout of `cfg` (switches in user units) and, per axis named in `settings`,
+    its responses / home tables; inverse of machine_from_dict + machine_settings_from_dict."""
     if not isinstance(cfg, MachineConfig):
         raise MotionError(f"cfg must be a MachineConfig, got {cfg!r}")
     axes: dict[str, Any] = {}
@@ -181,6 +334,7 @@ def machine_to_dict(cfg: MachineConfig) -> dict[str, Any]:
                 t[sw] = {"position": _exact_units(s.position, signed),
                          "width": _exact_units(s.width, signed),
                          "hysteresis": _exact_units(s.hysteresis, ax.pulses_per_unit)}
+        t.update(_settings_tables(ax.name, settings))
         axes[ax.name] = t
     return {"name": cfg.name, "cycle_s": cfg.cycle_s, "digital_inputs": cfg.digital_inputs,
             "digital_outputs": cfg.digital_outputs, "axes": axes}
@@ -211,17 +365,20 @@ def load_machine(path: str | os.PathLike[str]) -> MachineConfig:
         raise MotionError(f"{os.fspath(path)}: {e}") from None
 
 
-def dumps_machine(cfg: MachineConfig) -> str:
-    """TOML text for `cfg`; loads_machine(dumps_machine(cfg)) == cfg."""
+def dumps_machine(cfg: MachineConfig, settings: dict[str, dict[str, Any]] | None = None
+                  ) -> str:
+    """TOML text for `cfg` (and the axes' responses / home tables from `settings`);
+    loads_machine(dumps_machine(cfg)) == cfg."""
     import tomli_w
 
-    return _HEADER + tomli_w.dumps(machine_to_dict(cfg))
+    return _HEADER + tomli_w.dumps(machine_to_dict(cfg, settings))
 
 
-def save_machine(cfg: MachineConfig, path: str | os.PathLike[str]) -> None:
+def save_machine(cfg: MachineConfig, path: str | os.PathLike[str],
+                 settings: dict[str, dict[str, Any]] | None = None) -> None:
     """Write `cfg` to a TOML file (the text is built first: a bad cfg writes nothing)."""
     if not isinstance(path, (str, os.PathLike)):
         raise MotionError(f"path must be a str or path, got {path!r}")
-    text = dumps_machine(cfg)
+    text = dumps_machine(cfg, settings)
     with open(path, "w", encoding="utf-8") as f:
         f.write(text)

@@ -4,8 +4,10 @@ plus the responses (EL / ALM stop modes, ERC, SD, INP, RDY) that live in control
 
 `split_changes` checks a partial change against the rules and splits it into a new
 AxisConfig (validated by the config dataclass itself) and new responses; `apply_responses`
-puts responses on a controller. The UI sidecar file `<machine>.ui.toml` keeps the responses
-and the homing settings next to the machine file (they are not machine-file keys).
+puts responses on a controller. The responses and the homing settings are saved in the
+machine file itself ([axes.<name>.responses], [axes.<name>.home]: config_toml); the UI
+sidecar `<machine>.ui.toml` of earlier versions is still read (`load_sidecar`) and folded
+into the machine file at its next save.
 """
 
 from __future__ import annotations
@@ -17,9 +19,15 @@ import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import tomli_w
-
 from ..config import ENCODER_MODES, LOGIC_SIGNALS, PULSE_MODES, SIGNAL_LOGIC, AxisConfig
+from ..config_toml import (
+    MAX_ERC_S,
+    RESPONSE_KEYS,
+    SD_KEYS,
+    STOP_MODES,
+    check_responses,
+    default_responses,
+)
 from ..errors import MotionError
 
 if TYPE_CHECKING:
@@ -27,18 +35,6 @@ if TYPE_CHECKING:
 
 CONFIG_FIELDS = ("pulse_mode", "pulse_width_us", "encoder_mode", "invert_a", "invert_b",
                  "invert_z", "swap_ab", "reverse", "move_ratio")
-RESPONSE_KEYS = ("el", "el_enabled", "el_direction_sensitive", "alm", "erc_width_s", "sd",
-                 "inp", "rdy")
-SD_KEYS = ("enabled", "latched", "stop")
-STOP_MODES = ("immediate", "decel")
-MAX_ERC_S = 1.0
-
-
-def default_responses() -> dict[str, Any]:
-    return {"el": "immediate", "el_enabled": True, "el_direction_sensitive": True,
-            "alm": "immediate", "erc_width_s": 0.0,
-            "sd": {"enabled": False, "latched": False, "stop": False},
-            "inp": False, "rdy": False}
 
 
 def choices() -> dict[str, Any]:
@@ -58,12 +54,6 @@ def interface_of(cfg: AxisConfig, responses: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _bool(path: str, v: Any) -> bool:
-    if not isinstance(v, bool):
-        raise MotionError(f"{path} must be true or false, got {v!r}")
-    return v
-
-
 def _keys(path: str, table: Any, allowed: tuple[str, ...]) -> dict[str, Any]:
     if not isinstance(table, dict):
         raise MotionError(f"{path} must be an object, got {table!r}")
@@ -71,31 +61,6 @@ def _keys(path: str, table: Any, allowed: tuple[str, ...]) -> dict[str, Any]:
         if k not in allowed:
             raise MotionError(f"{path}.{k}: unknown key; valid keys: {', '.join(allowed)}")
     return table
-
-
-def check_responses(path: str, changes: dict[str, Any], old: dict[str, Any]
-                    ) -> dict[str, Any]:
-    """`old` with `changes` applied, every value checked (messages name `path.key`)."""
-    _keys(path, changes, RESPONSE_KEYS)
-    new = {k: (dict(v) if isinstance(v, dict) else v) for k, v in old.items()}
-    for k, v in changes.items():
-        p = f"{path}.{k}"
-        if k in ("el", "alm"):
-            if v not in STOP_MODES:
-                raise MotionError(f"{p} must be one of {', '.join(STOP_MODES)}; got {v!r}")
-            new[k] = v
-        elif k == "erc_width_s":
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or \
-                    not 0.0 <= v <= MAX_ERC_S:
-                raise MotionError(f"{p} must be a number in [0, {MAX_ERC_S:g}] s "
-                                  f"(0 = no ERC pulse), got {v!r}")
-            new[k] = float(v)
-        elif k == "sd":
-            _keys(p, v, SD_KEYS)
-            new["sd"] = {**new["sd"], **{s: _bool(f"{p}.{s}", x) for s, x in v.items()}}
-        else:
-            new[k] = _bool(p, v)
-    return new
 
 
 def split_changes(cfg: AxisConfig, responses: dict[str, Any], changes: Any
@@ -129,13 +94,19 @@ def apply_responses(ctl: Controller, axis: int, r: dict[str, Any]) -> None:
     safety.set_rdy_check(axis, r["rdy"])
 
 
-# -- the UI sidecar file ----------------------------------------------------------------
+__all__ = ["CONFIG_FIELDS", "MAX_ERC_S", "RESPONSE_KEYS", "SD_KEYS", "STOP_MODES",
+           "apply_responses", "atomic_write", "check_responses", "choices",
+           "default_responses", "interface_of", "load_sidecar", "sidecar_path",
+           "split_changes"]
+
+
+# -- the UI sidecar file of earlier versions (read only) --------------------------------
 def sidecar_path(machine_file: Path) -> Path:
     return machine_file.with_name(machine_file.stem + ".ui.toml")
 
 
 def load_sidecar(path: Path) -> dict[str, Any]:
-    """The sidecar's tables ({"interface": {axis: responses}, "home": {axis: {...}}});
+    """The old sidecar's tables ({"interface": {axis: responses}, "home": {axis: {...}}});
     empty when there is no file. A malformed file is a MotionError naming it."""
     if not path.is_file():
         return {"interface": {}, "home": {}}
@@ -159,8 +130,3 @@ def atomic_write(path: Path, text: str) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-
-
-def save_sidecar(path: Path, interface: dict[str, Any], home: dict[str, Any]) -> None:
-    atomic_write(path, "# openmotion ui: interface responses and homing settings\n"
-                 + tomli_w.dumps({"interface": interface, "home": home}))

@@ -59,6 +59,6 @@ def renamed(exc: MotionError, names: dict[str, str]) -> MotionError:
 
 def load_all() -> dict[str, Method]:
     """Import the handler modules (they register themselves) and return the table."""
-    from . import methods_machine, methods_motion, methods_program  # noqa: F401
+    from . import methods_machine, methods_motion, methods_program, methods_tuning  # noqa: F401
 
     return METHODS

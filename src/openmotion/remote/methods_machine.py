@@ -93,8 +93,8 @@ def machine_config(ctx: Context, p: Params) -> dict[str, Any]:
 def machine_save(ctx: Context, p: Params) -> dict[str, Any]:
     path = p.string("path", None)
     p.done()
-    f, side = ctx.svc.save(None if path is None else ctx.svc.workdir.resolve("path", path))
-    return {"file": str(f), "sidecar": str(side)}
+    f = ctx.svc.save(None if path is None else ctx.svc.workdir.resolve("path", path))
+    return {"file": str(f)}
 
 
 @method("machine.load")

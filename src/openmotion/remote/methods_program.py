@@ -102,6 +102,45 @@ def path_get(ctx: Context, p: Params) -> dict[str, Any]:
         return ctx.svc.program.path.path(since, n)
 
 
+# -- PSO / compare jobs (their firings are drawn on the path) -------------------------------
+@method("pso.set")
+def pso_set(ctx: Context, p: Params) -> dict[str, Any]:
+    kind = p.choice("kind", ("distance", "points"))
+    axes = p.list("axes")
+    output = p.integer("output", lo=0)
+    pulse_s = p.number("pulse_s", 0.001)
+    every = p.number("every", None) if kind == "distance" else None
+    start = p.number("start", None) if kind == "distance" else None
+    points = p.list("points") if kind == "points" else None
+    window = p.number("window", None) if kind == "points" else None
+    p.done()
+    svc = ctx.svc
+    if not all(isinstance(a, (str, int)) and not isinstance(a, bool) for a in axes):
+        raise MotionError(f"axes must be a list of axis names, got {axes!r}")
+    idx = [svc.ctl.axis(a).index for a in axes]
+    with svc.ctl.lock:
+        job = svc.pso.add(kind, idx, output, pulse_s, every=every, start=start,
+                          points=points, window=window)
+        if not svc.program.active:
+            svc.program.path.follow(idx)   # the path view follows these axes
+    return {"job": job, **svc.pso.info()}
+
+
+@method("pso.clear")
+def pso_clear(ctx: Context, p: Params) -> dict[str, Any]:
+    p.done()
+    with ctx.svc.ctl.lock:
+        ctx.svc.pso.clear()
+    return ctx.svc.pso.info()
+
+
+@method("pso.get", command=False)
+def pso_get(ctx: Context, p: Params) -> dict[str, Any]:
+    p.done()
+    with ctx.svc.ctl.lock:
+        return ctx.svc.pso.info()
+
+
 # -- scope ----------------------------------------------------------------------------------
 @method("scope.channels", command=False)
 def scope_channels(ctx: Context, p: Params) -> dict[str, Any]:

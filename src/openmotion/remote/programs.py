@@ -5,8 +5,9 @@ Loading compiles the whole program at once (errors name the line before anything
 with the same G54 origin rule as `openmotion run`. The preview is the toolpath of the
 compiled operations (arcs as chords) decimated to a point budget, so a 20 MB program
 stays responsive in the browser. `PathRecorder` samples the running group's position inside
-the control cycle into a bounded buffer; `path()` adds the speed and the synchronized output
-firings (M62/M63, compare / PSO) for the path view.
+the control cycle into a bounded buffer (a program's run, or, outside programs, the axes a
+PSO job watches while they move); `path()` adds the speed and the firings for the path
+view: the program's synchronized outputs (M62/M63) and the compare engine's (PSO) firings.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import contextlib
 import dataclasses
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -86,6 +88,12 @@ class ProgramSession:
         if r is not None and r.state in (RunState.RUNNING, RunState.PAUSED):
             raise MotionError(f"cannot {what} while the program is {r.state.value}; "
                               "abort it first")
+
+    @property
+    def active(self) -> bool:
+        """A program runs (or is paused)."""
+        r = self.runner
+        return r is not None and r.state in (RunState.RUNNING, RunState.PAUSED)
 
     # ------------------------------------------------------------------ running
     def run(self, *, feed_override: float, single_block: bool, optional_stop: bool,
@@ -265,7 +273,8 @@ def _bounds(pts: np.ndarray) -> dict[str, list[float]]:
 
 
 class PathRecorder:
-    """The running program's tool position every PATH_EVERY_S of control time (bounded)."""
+    """The tool position every PATH_EVERY_S of control time (bounded): a program's run
+    (`start`), or the motion of some axes outside programs (`follow`)."""
 
     def __init__(self, ctl: Controller) -> None:
         self.ctl = ctl
@@ -275,24 +284,58 @@ class PathRecorder:
         self._t = np.zeros(PATH_CAPACITY)
         self._p = np.zeros((PATH_CAPACITY, 3))
         self.n = 0
-        self._closed = False
+        self._closed = True
         self._cols: list[tuple[int, int, float]] = []
+        self._names: list[str] = []
+        self._moving = False
+        self._t_start = -math.inf   # firings before the path began are not its own
+        #: more firings for the path: fn(t_lo, t_hi) -> [{"t", "output", "level",
+        #: "pulses": every axis's Axis.position}] (the PSO session registers one)
+        self.firing_sources: list[Callable[[float, float], list[dict[str, Any]]]] = []
 
     def start(self, runner: ProgramRunner) -> None:
         self.runner = runner
         self.n = 0
         self._tick = 0
         self._closed = False
+        self._t_start = self.ctl.time
         axes = runner.axis_indices
         self._cols = [(k, axes[runner.letters.index(c)], float(runner.scales.ppu[
             runner.letters.index(c)])) for k, c in enumerate(_XYZ) if c in runner.letters]
+        self._names = list(runner.letters)
+
+    def follow(self, axes: list[int]) -> None:
+        """Record `axes` (1..3: the view's X, Y, Z) whenever one of them moves, until a
+        program starts. A new set of axes starts a new path; the same set goes on."""
+        names = [self.ctl.axes[a].name for a in axes]
+        if self.runner is None and not self._closed and names == self._names:
+            return
+        self.runner = None
+        self.n = 0
+        self._tick = 0
+        self._closed = False
+        self._moving = False
+        self._t_start = self.ctl.time
+        self._names = names
+        self._cols = []
+        for k, a in enumerate(axes[:3]):
+            u = self.ctl.axes[a].units
+            self._cols.append((k, a, float(u.sign * u.pulses_per_unit)))
 
     def sample(self, t: float) -> None:
-        r = self.runner
-        if r is None or self._closed:
+        if self._closed:
             return
-        if r.state not in (RunState.RUNNING, RunState.PAUSED) and not any(
-                self.ctl.axes[i].is_moving for _k, i, _p in self._cols):
+        r = self.runner
+        moving = any(self.ctl.axes[i].is_moving for _k, i, _p in self._cols)
+        if r is None:                  # following axes: record while they move
+            if moving != self._moving or (self.n == 0 and not moving):
+                self._moving = moving
+                self._tick = 0
+                self._record(t)        # where a motion starts and ends
+                return
+            if not moving:
+                return
+        elif r.state not in (RunState.RUNNING, RunState.PAUSED) and not moving:
             self._record(t)      # the end point (after an abort: at rest); every firing
             self._closed = True  # lies within the samples
             return
@@ -310,6 +353,12 @@ class PathRecorder:
             self._p[i, k] = axes[idx].position / ppu
         self.n += 1
 
+    def _point_of(self, pulses: np.ndarray) -> list[float]:
+        pt = [0.0, 0.0, 0.0]
+        for k, idx, ppu in self._cols:
+            pt[k] = round(float(pulses[idx]) / ppu, 6)
+        return pt
+
     def path(self, since: int, max_points: int) -> dict[str, Any]:
         n = self.n
         first = max(0, n - PATH_CAPACITY)
@@ -325,24 +374,32 @@ class PathRecorder:
         sel = np.arange(len(t))
         if len(t) > max_points:
             sel = np.unique(np.linspace(0, len(t) - 1, max_points).astype(int))
-        firings = []
+        firings: list[dict[str, Any]] = []
         r = self.runner
-        if r is not None and n > first:
+        if n > first:
             # the firings after the point before `start` up to the last point returned (the
             # recorder takes a last point when the run ends), so reading on with since=next
             # gives each firing exactly once
             t_lo = self._t[(start - 1) % PATH_CAPACITY] if start > first else -np.inf
+            t_lo = max(t_lo, self._t_start)
             t_hi = t[-1] if len(t) else t_lo
             all_idx = np.arange(first, n) % PATH_CAPACITY
             all_t = self._t[all_idx]
-            for ev in r.events:
+            for ev in r.events if r is not None else ():
                 if ev.kind == "sync_output" and t_lo < ev.t <= t_hi:
                     k = int(np.clip(np.searchsorted(all_t, ev.t), 0, len(all_t) - 1))
-                    firings.append({"t": ev.t,
+                    firings.append({"t": ev.t, "kind": "M62/M63",
                                     "point": np.round(self._p[all_idx[k]], 6).tolist(),
                                     "output": ev.index, "level": ev.level})
+            for src in self.firing_sources:   # PSO / CMP: exact positions of the firing
+                for f in src(t_lo, t_hi):
+                    firings.append({"t": f["t"], "kind": f.get("kind", "PSO"),
+                                    "point": self._point_of(f["pulses"]),
+                                    "output": f["output"], "level": f["level"]})
+            firings.sort(key=lambda f: f["t"])
         vmax = float(speed.max()) if len(speed) else 0.0
-        return {"axes": "".join(r.letters) if r is not None else "", "first": first,
+        axes_out: Any = "".join(r.letters) if r is not None else list(self._names)
+        return {"axes": axes_out, "first": first,
                 "next": n, "t": np.round(t[sel], 6).tolist(),
                 "points": np.round(p[sel], 6).tolist(),
                 "speed": np.round(speed[sel], 6).tolist(), "firings": firings, "vmax": vmax}

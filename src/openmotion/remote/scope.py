@@ -2,7 +2,9 @@
 
 A channel is `<axis>.<quantity>`: command, feedback (user units), velocity (user units/s),
 acceleration (user units/s^2, the difference of successive velocity samples), error
-(following error, counts), state (AxisState code) or `io.<lamp>` (0/1, logical level).
+(following error, counts), state (AxisState code) or `io.<lamp>` (0/1, logical level); or
+a general line of the board, `di.<n>` (input, electrical level) / `do.<n>` (output, the
+level written), 0/1.
 The cycle stores raw values only (pulses, counts, the I/O word: one list per sample); units
 and derived channels are computed when the data is read, so sampling stays cheap.
 
@@ -10,6 +12,11 @@ Trigger: mode "level" (the value is at or above `level`), "rising" / "falling" (
 `level`), "none" (free running). Armed, the scope keeps `pre_s` seconds before the trigger,
 fills the rest of the history after it and stops. The history stays until the next
 `configure` or `arm`, so any client can read it (`data`, `csv`).
+
+Reading never holds the cycle for long: the ring is copied in slices of SLICE_ROWS rows,
+the lock (which the cycle's `sample` takes too) taken once per slice, oldest slice first,
+so a 600 s x 16 channel read lets the cycle run between its slices; rows the cycle
+overwrote before their slice was copied are left out (the read starts later).
 """
 
 from __future__ import annotations
@@ -36,6 +43,8 @@ TRIGGER_MODES = ("none", "level", "rising", "falling")
 MAX_CHANNELS = 16
 MAX_SAMPLES = 600_000
 FLUSH_ROWS = 64
+SLICE_ROWS = 4096   # rows copied per lock hold by a read (16 channels: ~0.5 MB, ~0.1 ms)
+BOARD = ("di", "do")
 DEFAULT_QUANTITIES = ("command", "velocity", "acceleration", "error")
 
 
@@ -59,6 +68,9 @@ def channel_names(ctl: Controller) -> list[dict[str, str]]:
                  "acceleration": f"{u}/s^2", "error": "counts", "state": "code"}
         out += [{"name": f"{ax.name}.{q}", "unit": units[q]} for q in QUANTITIES]
         out += [{"name": f"{ax.name}.io.{lamp}", "unit": "0/1"} for lamp in LAMPS]
+    out += [{"name": f"di.{k}", "unit": "0/1"} for k in range(ctl.config.digital_inputs)]
+    if hasattr(ctl.hardware, "read_output"):
+        out += [{"name": f"do.{k}", "unit": "0/1"} for k in range(ctl.config.digital_outputs)]
     return out
 
 
@@ -128,16 +140,37 @@ class Scope:
 
     def _parse(self, name: Any) -> tuple[Any, str]:
         if not isinstance(name, str) or "." not in name:
-            raise MotionError(f"channel must be '<axis>.<quantity>', got {name!r}")
+            raise MotionError(f"channel must be '<axis>.<quantity>', 'di.<n>' or 'do.<n>', "
+                              f"got {name!r}")
         axis, q = name.split(".", 1)
+        if axis in BOARD:
+            return None, self._board_line(name, axis, q)
         ax = self.ctl.axis(axis)
         if q in QUANTITIES or (q.startswith("io.") and q[3:] in LAMPS):
             return ax, q
         raise MotionError(f"channel {name!r}: quantity must be one of "
                           f"{', '.join(QUANTITIES)} or io.<{'|'.join(LAMPS)}>")
 
+    def _board_line(self, name: str, kind: str, number: str) -> str:
+        """'di3' / 'do3' for channel di.3 / do.3 (a line of the board)."""
+        ctl = self.ctl
+        count = ctl.config.digital_inputs if kind == "di" else ctl.config.digital_outputs
+        if not (number.isdigit() and int(number) < count):
+            raise MotionError(f"channel {name!r}: {kind} line must be a number in "
+                              f"[0, {count - 1}]" if count else
+                              f"channel {name!r}: the machine has no {kind} lines")
+        if kind == "do" and not hasattr(ctl.hardware, "read_output"):
+            raise MotionError(f"channel {name!r}: this hardware does not report its outputs")
+        return f"{kind}{int(number)}"
+
     def _getter(self, ax: Any, q: str) -> Callable[[], float]:
         ctl = self.ctl
+        if ax is None:   # a board line: di<n> / do<n>
+            hw = ctl.hardware
+            if q.startswith("di"):
+                return lambda: 1.0 if hw.read_input(q) else 0.0
+            read_out = hw.read_output
+            return lambda: 1.0 if read_out(None, q) else 0.0
         if q == "command":
             return lambda: ax.position
         if q in ("velocity", "acceleration"):
@@ -219,6 +252,8 @@ class Scope:
 
     # ------------------------------------------------------------------ reading
     def _convert_one(self, ax: Any, q: str, raw: float) -> float:
+        if ax is None:
+            return raw
         u = ax.units
         if q == "command":
             return raw / (u.sign * u.pulses_per_unit)
@@ -233,6 +268,9 @@ class Scope:
         cols = {}
         for k, (name, (ax, q)) in enumerate(zip(self.channels, self._specs, strict=True)):
             col = raw[:, k]
+            if ax is None:     # board line: 0/1 as sampled
+                cols[name] = col
+                continue
             if q == "acceleration":
                 before = col[0] if prev_row is None else prev_row[k]
                 col = np.diff(col, prepend=before) / self.dt
@@ -254,23 +292,52 @@ class Scope:
         self._buf[idx] = self._pend
         self._pend_t, self._pend = [], []
 
-    def _slice(self, since: int) -> tuple[int, int, np.ndarray, np.ndarray, np.ndarray | None]:
-        """Samples [start, n) in time order (copies), and the row before start."""
-        self._flush()
-        first = self._first()
-        start = first if since < 0 else min(max(since, first), self.n)
-        idx = np.arange(start, self.n) % self.cap
-        prev = self._buf[(start - 1) % self.cap].copy() if start > first else None
-        return start, self.n, self._t[idx].copy(), self._buf[idx].copy(), prev
+    def _read(self, since: int) -> tuple[int, int, int, float | None, np.ndarray,
+                                          np.ndarray, np.ndarray | None]:
+        """(version, start, end, triggered_at, t, raw, row before start): samples
+        [start, end) in time order, copied SLICE_ROWS rows per lock hold (module
+        docstring). A configure / arm during the read starts it again on the new ring."""
+        while True:
+            with self._lock:
+                self._flush()
+                version, end, trig = self.version, self.n, self.triggered_at
+                first = self._first()
+                start = first if since < 0 else min(max(since, first), end)
+            t_parts: list[np.ndarray] = []
+            r_parts: list[np.ndarray] = []
+            prev: np.ndarray | None = None
+            a = start
+            restart = False
+            while a < end:
+                with self._lock:
+                    if self.version != version:
+                        restart = True
+                        break
+                    oldest = self._first()
+                    if a < oldest:          # overwritten before its slice was copied
+                        t_parts, r_parts, prev = [], [], None
+                        a = start = oldest
+                    b = min(end, a + SLICE_ROWS)
+                    if a == start and a > oldest:
+                        prev = self._buf[(a - 1) % self.cap].copy()
+                    idx = np.arange(a, b) % self.cap
+                    t_parts.append(self._t[idx])        # fancy indexing copies
+                    r_parts.append(self._buf[idx])
+                a = b
+            if restart:
+                continue
+            width = len(self.channels)
+            t = np.concatenate(t_parts) if t_parts else np.zeros(0)
+            raw = np.concatenate(r_parts) if r_parts else np.zeros((0, width))
+            return version, start, end, trig, t, raw, prev
 
     def _first(self) -> int:
         return max(self._floor, self.n - self.cap)
 
     def data(self, since: int = -1, max_points: int = 5000) -> dict[str, Any]:
+        version, start, end, trig, t, raw, prev = self._read(since)
         with self._lock:
-            start, end, t, raw, prev = self._slice(since)
             first = self._first()
-            version, trig = self.version, self.triggered_at
         cols = self._columns(t, raw, prev)
         t_out, cols = _decimate(t, cols, max_points)
         return {"scope_version": version, "first": first, "start": start, "next": end,
@@ -278,8 +345,7 @@ class Scope:
                 "triggered_at": trig}
 
     def csv(self, start: float | None = None, end: float | None = None) -> str:
-        with self._lock:
-            _s, _e, t, raw, prev = self._slice(-1)
+        _v, _s, _e, _tr, t, raw, prev = self._read(-1)
         cols = self._columns(t, raw, prev)
         mask = np.ones(len(t), bool)
         if start is not None:

@@ -1,6 +1,7 @@
 """The machine behind the remote API: a Controller on the simulator, paced in real time on a
 background thread, plus what the pages need around it (jogs with a deadman, repeats, the
-scope, the program, homing runs, the machine file and its UI sidecar, config_version).
+scope, the program, homing runs, the machine file with its responses and homing tables,
+config_version).
 
 Threads: the real-time pacer runs `Controller.step`; every change to the controller holds
 `ctl.lock` (the lock every cycle runs under), and the server runs commands one at a time
@@ -12,6 +13,7 @@ off and is reported in `hook_errors`, the cycle goes on.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import threading
 import time
 from collections import deque
@@ -20,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ..config import MachineConfig, default_machine, dumps_machine
+from ..config_toml import load_machine_settings
 from ..control.core.clock import RealtimePacer
 from ..control.core.controller import Controller
 from ..control.core.states import AxisState
@@ -35,13 +38,14 @@ from .interface import (
     check_responses,
     default_responses,
     load_sidecar,
-    save_sidecar,
     sidecar_path,
     split_changes,
 )
 from .programs import ProgramSession
+from .pso import PsoSession
 from .repeat import RepeatRegistry
 from .scope import Scope, Trigger
+from .tuning import Tuning, check_loop_changes
 from .workdir import WorkFolder
 
 MAX_SPEED = 20.0
@@ -67,12 +71,7 @@ class MachineService:
         self._listeners: list[Listener] = []
         self.events: deque[dict[str, Any]] = deque(maxlen=EVENT_KEEP)
         self.hook_errors: deque[str] = deque(maxlen=100)   # failures in the cycle hook
-        side = load_sidecar(sidecar_path(self.file)) if self.file else \
-            {"interface": {}, "home": {}}
-        self.responses = {a.name: check_responses(
-            f"interface.{a.name}", side["interface"].get(a.name, {}), default_responses())
-            for a in self.config.axes}
-        self._home_user = dict(side["home"])
+        self.responses, self._home_user = _settings_of(self.file, self.config)
         self._pacer: RealtimePacer | None = None
         self._build(self.config, scope=None)
 
@@ -88,7 +87,10 @@ class MachineService:
         for ax in ctl.axes:
             base = default_home(ax)
             user = self._home_user.get(ax.name)
-            self.homes[ax.name] = home_from_user(ax, base, user) if user else base
+            try:
+                self.homes[ax.name] = home_from_user(ax, base, user) if user else base
+            except MotionError as exc:   # a machine file's [axes.<name>.home] table
+                raise MotionError(f"axes.{ax.name}.home: {exc}") from None
         self.homings: dict[int, Homing] = {}
         self.jogs = JogRegistry(ctl)
         self.repeats = RepeatRegistry(ctl)
@@ -98,13 +100,19 @@ class MachineService:
                 self.scope.configure(scope["channels"], scope["divider"], scope["seconds"],
                                      Trigger(**scope["trigger"]))
         self.program = ProgramSession(ctl)
+        self.pso = PsoSession(ctl)   # compare jobs start anew with the machine
+        self.tuning = Tuning(ctl)
+        self.program.path.firing_sources.append(self.pso.firings)
+        self._cmp_firings: deque[dict[str, Any]] = deque(maxlen=EVENT_KEEP)
+        self.program.path.firing_sources.append(self._comparator_firings)
         self._cmp_time = [-1.0] * len(ctl.axes)
         if ctl.safety is not None:
             ctl.safety.cmp.on_event(self._on_compare)
         ctl.events.on_event(self._on_event)
         self._parts: list[tuple[str, Callable[[float], None]]] = [
             ("deadman", lambda t: self.jogs.check()), ("repeat", self.repeats.step),
-            ("scope", self.scope.sample), ("path", self.program.path.sample)]
+            ("scope", self.scope.sample), ("path", self.program.path.sample),
+            ("tuning", self.tuning.sample)]
         ctl.add_cycle_hook(self._on_cycle)
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
@@ -121,15 +129,32 @@ class MachineService:
                 self.hook_errors.append(f"{name}: {type(exc).__name__}: {exc}")
 
     def _on_compare(self, ev: Any) -> None:
-        """Inside the cycle (comparator callback): never raises."""
+        """Inside the cycle (comparator callback): never raises. Lights CMP and keeps the
+        firing, with every axis's position at its exact time, for the path view."""
         with contextlib.suppress(Exception):
             axis = getattr(ev, "axis", None)
             if isinstance(axis, int) and 0 <= axis < len(self._cmp_time):
                 self._cmp_time[axis] = self.ctl.time
+            hist = self.ctl.history
+            pulses = [float(hist.position_at(a, ev.time)) for a in range(len(self.ctl.axes))]
+            self._cmp_firings.append({"t": float(ev.time), "output": -1, "level": True,
+                                      "pulses": pulses, "kind": "CMP",
+                                      "comparator": ev.comparator})
+
+    def _comparator_firings(self, t_lo: float, t_hi: float) -> list[dict[str, Any]]:
+        """The HSL comparators' (safety.cmp) firings with t_lo < t <= t_hi."""
+        return [f for f in tuple(self._cmp_firings) if t_lo < f["t"] <= t_hi]
 
     def _on_event(self, ev: Any) -> None:
         """Inside the cycle (event-log callback): keep and push the event; never raises."""
         try:
+            if ev.kind == "home_done" and ev.axis in self.homings:
+                # Motion Creator's Home leaves every counter at the home, the target
+                # recorder too: the HSL library does not clear it (manual 4.4: "users need
+                # to manually maintain it ... after a home move completes") and the tool
+                # is the application that does. Same cycle as `done`: one status push.
+                cnt = self.ctl.axes[ev.axis].counters
+                cnt.reset_target(float(cnt.command))
             name = None if ev.axis is None else self.ctl.axes[ev.axis].name
             pos = None
             if ev.position is not None and ev.axis is not None:
@@ -289,6 +314,22 @@ class MachineService:
         self._bump()
         return self.autosave()
 
+    def set_loop(self, ax: Any, changes: Any) -> Path | None:
+        """New servo loop gains for `ax`: applied to the running loop at once (no rebuild)
+        and saved in the machine file's [axes.<name>.loop] table."""
+        cfg = self.config.axis(ax.name)
+        new = check_loop_changes(cfg.loop, ax.name, changes)
+        live = self.ctl.servo_loops.get(ax.name)
+        with self.ctl.lock:
+            if live is None:
+                raise MotionError(f"axis {ax.name}: no servo loop runs in the controller")
+            if self.tuning.busy():
+                raise MotionError("a tuning run is in progress: wait for it or stop it")
+            live.retune(new)
+            self.config = self.config.with_axis(dataclasses.replace(cfg, loop=new))
+        self._bump()
+        return self.autosave()
+
     def set_home(self, axis: Any, changes: Any) -> Path | None:
         ax = self.ctl.axis(axis)
         new = home_from_user(ax, self.homes[ax.name], changes)
@@ -300,13 +341,10 @@ class MachineService:
     def load(self, path: str) -> None:
         p = Path(path)
         cfg = load_machine_arg(path, "path")
-        side = load_sidecar(sidecar_path(p))
-        resp = {a.name: check_responses(f"interface.{a.name}",
-                                        side["interface"].get(a.name, {}),
-                                        default_responses()) for a in cfg.axes}
+        resp, home = _settings_of(p, cfg)
         self._check_at_rest("loading a machine")
         old = (self.responses, self._home_user)
-        self.responses, self._home_user = resp, dict(side["home"])
+        self.responses, self._home_user = resp, home
         try:
             self.rebuild(cfg)
         except Exception:
@@ -321,7 +359,12 @@ class MachineService:
         self.save(self.file)
         return self.file
 
-    def save(self, path: str | Path | None = None) -> tuple[Path, Path]:
+    def settings(self) -> dict[str, dict[str, Any]]:
+        """The responses and homing settings of every axis, as the machine file keeps them."""
+        return {a.name: {"responses": self.responses[a.name],
+                         "home": self._home_user.get(a.name, {})} for a in self.config.axes}
+
+    def save(self, path: str | Path | None = None) -> Path:
         p = Path(path) if path is not None else self.file
         if p is None:
             raise MotionError("path is required: the server has no machine file yet")
@@ -330,13 +373,13 @@ class MachineService:
         if not p.parent.is_dir():
             raise MotionError(f"path {str(p)!r}: folder {str(p.parent)!r} does not exist")
         try:
-            atomic_write(p, dumps_machine(self.config))
-            side = sidecar_path(p)
-            save_sidecar(side, self.responses, self._home_user)
+            atomic_write(p, dumps_machine(self.config, self.settings()))
+            # an old sidecar's settings are in the machine file now: it would only mislead
+            sidecar_path(p).unlink(missing_ok=True)
         except OSError as exc:
             raise MotionError(f"path {str(p)!r}: cannot write ({exc.strerror or exc})") from None
         self.file = p
-        return p, side
+        return p
 
     # ------------------------------------------------------------------ homing
     def start_home(self, axis: Any) -> None:
@@ -361,6 +404,7 @@ class MachineService:
         with self.ctl.lock:
             self.jogs.stop_all("emergency stop")
             self.repeats.stop_all("emergency stop")
+            self.tuning.abort("emergency stop")
             self.program.abort_if_running()
             for h in self.homings.values():
                 if h.running:
@@ -374,6 +418,9 @@ class MachineService:
             axes = self.ctl.axes if axis is None else (self.ctl.axis(axis),)
             for ax in axes:
                 self.repeats.stop(ax.index, "stop command")
+                run = self.tuning.run
+                if run is not None and run.axis == ax.index:
+                    self.tuning.abort("stop command")
                 h = self.homings.get(ax.index)
                 if h is not None and h.running:
                     h.abort()
@@ -383,6 +430,27 @@ class MachineService:
                     ax.stop(tdec)
             if axis is None:
                 self.jogs.stop_all("stop command")
+
+
+def _settings_of(file: Path | None, cfg: MachineConfig
+                 ) -> tuple[dict[str, dict[str, Any]], dict[str, dict[str, Any]]]:
+    """(responses, homing settings) per axis from the machine file's [axes.<n>.responses]
+    and [axes.<n>.home] tables; an axis without them takes an old `<stem>.ui.toml` sidecar's
+    tables if there is one (read once: the next save folds them into the machine file)."""
+    saved = load_machine_settings(file) if file is not None else {}
+    side = load_sidecar(sidecar_path(file)) if file is not None else \
+        {"interface": {}, "home": {}}
+    responses, homes = {}, {}
+    for a in cfg.axes:
+        mine = saved.get(a.name, {"responses": default_responses(), "home": {}})
+        if mine["responses"] == default_responses() and a.name in side["interface"]:
+            mine = {**mine, "responses": check_responses(
+                f"interface.{a.name}", side["interface"][a.name], default_responses())}
+        responses[a.name] = mine["responses"]
+        home = mine["home"] or dict(side["home"].get(a.name, {}))
+        if home:
+            homes[a.name] = home
+    return responses, homes
 
 
 def _check_speed(factor: Any) -> float:

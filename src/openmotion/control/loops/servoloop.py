@@ -112,10 +112,29 @@ class ServoLoop:
                               "yet sampled or tripped); a step needs a closed loop")
         self.bias += c
 
+    def retune(self, loop: LoopConfig) -> None:
+        """Tuning: run the loop with `loop`'s gains and following-error limit from the next
+        sample (the compensator starts from rest; the set-point and its bias are kept).
+        The sample rate is fixed while the loop runs: samples_per_cycle must not change."""
+        if not isinstance(loop, LoopConfig):
+            raise MotionError(f"loop must be a LoopConfig, got {type(loop).__name__}")
+        if loop.samples_per_cycle != self.config.samples_per_cycle:
+            raise MotionError(f"samples_per_cycle must stay {self.config.samples_per_cycle} "
+                              f"on a running loop, got {loop.samples_per_cycle}")
+        comp, full = make_compensator(loop, self.sample_period)
+        fe = loop.following_error
+        self.compensator, self.full_scale = comp, full
+        self.monitor = FollowingErrorMonitor(fe) if math.isfinite(fe) else None
+        self.config = loop
+
     # ------------------------------------------------------------------ tracing
     def start_trace(self) -> None:
         """Record every sample from now: time, command, feedback (counts), duty."""
         self._trace = []
+
+    def stop_trace(self) -> None:
+        """Stop recording (what was recorded is dropped: read `trace()` first)."""
+        self._trace = None
 
     def trace(self) -> dict[str, np.ndarray]:
         """The recorded samples as arrays t, command, feedback, duty (empty if none)."""

@@ -8,23 +8,25 @@ import * as machine from "./pages/machine.js";
 import * as iface from "./pages/interface.js";
 import * as operation from "./pages/operation.js";
 import * as homing from "./pages/homing.js";
+import * as tuning from "./pages/tuning.js";
 import * as scope from "./pages/scope.js";
 import * as pathPage from "./pages/path.js";
 import * as program from "./pages/program.js";
 import * as simulation from "./pages/simulation.js";
 
-const PAGES = { machine, interface: iface, operation, homing, scope, path: pathPage, program, simulation };
+const PAGES = { machine, interface: iface, operation, homing, tuning, scope, path: pathPage, program, simulation };
 
 // Commands that must work whatever the tab's configuration version (safety first): they are
 // sent without config_version, so a stale tab can always stop the machine.
-const NEVER_STALE = new Set(["machine.estop", "axis.stop", "jog.stop", "program.abort",
+const NEVER_STALE = new Set(["machine.estop", "axis.stop", "jog.stop", "program.abort", "pso.clear",
   "program.pause", "home.abort", "sim.estop", "scope.pause"]);
 // Commands that take config_version (the server refuses unknown parameters on queries).
 const COMMANDS = new Set(["interface.set", "home.set", "machine.load", "machine.save", "machine.reset",
   "axis.servo", "axis.reset", "axis.move", "axis.repeat", "axis.change_speed", "axis.change_position",
   "axis.set_position", "axis.reset_position", "home.start", "jog.start", "jog.step",
   "program.load", "program.run", "program.resume", "program.single_block", "program.feed_override",
-  "sim.trip_limit", "sim.alarm", "sim.speed", "scope.configure", "scope.run", "scope.arm"]);
+  "sim.trip_limit", "sim.alarm", "sim.speed", "scope.configure", "scope.run", "scope.arm",
+  "pso.set", "pso.clear", "tune.run", "tune.gains"]);
 
 class App extends EventTarget {
   constructor() {

@@ -206,10 +206,10 @@ export class PathView {
     g.strokeStyle = "rgba(60,60,60,0.55)";
     g.stroke(done);
     // markers
-    g.fillStyle = "#000";
     for (const m of this.markers) {
       const a = m.x * r[0] + m.y * r[1] + (m.z || 0) * r[2];
       const b = m.x * u[0] + m.y * u[1] + (m.z || 0) * u[2];
+      g.fillStyle = m.colour || "#000";
       g.beginPath();
       g.arc(X(a), Y(b), 2.5, 0, 2 * Math.PI);
       g.fill();

@@ -1,6 +1,6 @@
 // Interface I/O and pulse I/O per axis (Motion Creator 5.3.2 / 5.3.3): signal logic and
 // responses, pulse output and input modes, move ratio. Validated here, saved by the server
-// into the machine file (and its UI sidecar) with `interface.set`.
+// into the machine file (the responses in its [axes.<name>.responses] table) with `interface.set`.
 
 import { el, button } from "../dom.js";
 import { FieldSet } from "../fields.js";
@@ -125,7 +125,7 @@ function build() {
   const msg = el("div", { class: "form-error", id: "if-error", role: "alert" });
   root.replaceChildren(
     el("div", { class: "row" }, el("b", {}, `Axis ${loadedAxis}`),
-      button("Save config", () => save(saved, msg), { id: "if-save", class: "primary", title: "writes the machine file (and its UI sidecar)" }),
+      button("Save config", () => save(saved, msg), { id: "if-save", class: "primary", title: "writes the machine file" }),
       button("Reload", () => load(), { id: "if-reload", title: "read the settings back from the server" }),
       button("Next axis", () => app.nextAxis()),
       el("a", { href: "#operation" }, "Operate →"), saved, msg),

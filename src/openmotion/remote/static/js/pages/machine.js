@@ -68,7 +68,7 @@ async function save(result) {
   const params = v.path && v.path !== app.info.file ? { path: v.path } : {};
   try {
     const r = await app.call("machine.save", params);
-    fileMsg = `saved ${r.file}${r.sidecar ? ` and ${r.sidecar}` : ""}`;
+    fileMsg = `saved ${r.file}`;
     result.textContent = fileMsg;
     typedPath = null;
     if (params.path) await app.reloadConfig();

@@ -58,8 +58,15 @@ function build() {
   picks = new Map();
   const groups = new Map();
   const quantities = [];
+  const board = new Map();   // general lines: di.<n> / do.<n>, a table of their own
   for (const c of all) {
     const dot = c.name.indexOf(".");
+    const head = dot > 0 ? c.name.slice(0, dot) : "";
+    if (head === "di" || head === "do") {
+      if (!board.has(head)) board.set(head, []);
+      board.get(head).push(c);
+      continue;
+    }
     const g = dot > 0 ? c.name.slice(0, dot) : "";
     const q = dot > 0 ? c.name.slice(dot + 1) : c.name;
     if (!groups.has(g)) groups.set(g, new Map());
@@ -82,7 +89,21 @@ function build() {
     }
     table.append(row);
   }
-  const pickBox = el("div", { id: "scope-picks", style: "overflow-x:auto" }, table);
+  const lines = el("table", { class: "kv picks", id: "scope-board-picks" },
+    el("tr", {}, el("th", { title: "general inputs (di) and outputs (do) of the board" }, "line"),
+      ...(board.get("di") || board.get("do") || []).map((c, k) => el("th", {}, String(k)))));
+  for (const [g, chans] of board) {
+    const row = el("tr", {}, el("th", { title: g === "di" ? "general inputs (electrical level)" : "general outputs (level written)" }, g.toUpperCase()));
+    for (const c of chans) {
+      const box = el("input", { type: "checkbox", value: c.name, title: `${c.name} (0/1)` });
+      box.checked = chosen.has(c.name);
+      picks.set(c.name, box);
+      row.append(el("td", {}, box));
+    }
+    lines.append(row);
+  }
+  const pickBox = el("div", { id: "scope-picks", style: "overflow-x:auto" }, table,
+    board.size ? lines : "");
   const pickErr = el("div", { class: "form-error", id: "scope-pick-error" });
   const trig = cfg.trigger || {};
   fsCfg = new FieldSet(el("div", { id: "scope-cfg" }), [

@@ -58,7 +58,8 @@ function build() {
     panel("E-stop", el("div", { class: "row" }, press, release,
       button("Reset axes", () => app.call("machine.reset").catch(() => {}), { id: "sim-reset" })), estopBox,
       el("p", { class: "small muted" }, "The red E-STOP button in the header is the software E-stop (machine.estop); this one is the EMG input of the simulated machine.")),
-    panel("General inputs (click to switch) and outputs (M62-M65)", dis, el("div", { style: "height:8px" }), dos),
+    el("div", { class: "panel wide" }, el("h3", {}, "General inputs (click to switch) and outputs (M62-M65)"),
+      dis, el("div", { style: "height:8px" }), dos),
     panel("Time", fsSpeed.container,
       el("div", { class: "row" }, button("Apply", () => speed(), { id: "sim-speed-apply" }),
         ...[[1, "Real time"], [5, "×5"], [20, "×20"]].map(([f, label]) =>
