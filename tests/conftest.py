@@ -31,6 +31,18 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "long: a heavy run, reduced unless --long is given")
 
 
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Browser tests first (a stable sort: module order kept). They are the longest and
+    run one after another on a module's server, so under xdist (`--dist worksteal`, set in
+    pyproject.toml) they start at once and the short tests fill the other worker around
+    them, instead of the browser modules running alone at the end."""
+    def browser_first(item: pytest.Item) -> int:
+        names = getattr(item, "fixturenames", ())
+        return 0 if "page" in names or "browser" in names else 1
+
+    items.sort(key=browser_first)
+
+
 @pytest.fixture
 def fuzz_long(request: pytest.FixtureRequest) -> bool:
     """True when the suite was started with --fuzz-long."""
