@@ -157,6 +157,7 @@ class CompareEngine:
         self._plan_key: tuple[int, int, int] | None = None  # what _plan_axes was made for
         self._plan_axes: list[int] = []
         self._timers: dict[int, Any] = {}
+        self._prune_due = False  # a job finished: drop unused MPOS error models
         controller.add_cycle_hook(self._on_cycle, due=self._due)
         if self.timed:
             controller.add_pre_advance_hook(self._pre_advance, due=self._due)
@@ -243,6 +244,22 @@ class CompareEngine:
             job = self._jobs.pop(job_id, None)
             if job is not None:
                 job.active = False
+                self._prune_mpos()
+
+    def _prune_mpos(self) -> None:
+        """Keep the MPOS error model only for axes an active MPOS job compares (a later
+        MPOS job starts it again from the error at its arming, as the first one did)."""
+        if not self._mpos_err:
+            return
+        used: set[int] = set()
+        for j in self._jobs.values():
+            if isinstance(j, WindowJob):
+                if j.kind == "mpos":
+                    used.update(j.axes)
+            elif getattr(j.source, "kind", "") == "mpos":
+                used.add(j.source.axis)  # type: ignore[attr-defined]
+        for a in [a for a in self._mpos_err if a not in used]:
+            del self._mpos_err[a]
 
     def clear(self) -> None:
         for k in list(self._jobs):
@@ -378,6 +395,7 @@ class CompareEngine:
             if job.done:
                 self._jobs.pop(job.id, None)
                 job.active = False
+                self._prune_due = True  # (after this cycle's error model update)
         return rows
 
     def _positions(self, rows: list[tuple[float, int, int, float, int, int]]) -> Array:
@@ -503,6 +521,9 @@ class CompareEngine:
         if not self.timed:
             self._vectors_end(ta, t1)
         self._mpos_err.update(self._mpos_e1)
+        if self._prune_due:
+            self._prune_due = False
+            self._prune_mpos()
         pos = [self._positions(rows)] if rows else []
         if self._pre_rows:
             rows = self._pre_rows + rows
