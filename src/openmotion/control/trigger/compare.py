@@ -1,7 +1,7 @@
 """Compare engine: position-compare triggers located exactly on the analytic motion.
 
 (Jobs, sources and actions live in compare_jobs.py and are re-exported here; the solvers
-in compare_math.py / compare_roots.py; outputs and the event log in compare_io.py.)
+in compare_math.py, compiled in openmotion._compare; outputs and the event log in compare_io.py.)
 
 Attached to a Controller through a cycle hook. At the end of each cycle [t0, t1] it takes
 the motion just executed from the MotionHistory and finds, for every active job, every
