@@ -348,6 +348,18 @@ class CompareEngine:
             r = self._ranges[src] = track_range(self.track(src), *self._win)
         return r
 
+    def window_inputs(self, axes: tuple[int, ...], kind: str
+                      ) -> tuple[list[Track], list[tuple[float, float]]]:
+        """The tracks and ranges of `axes` in frame `kind` over this cycle (cached per
+        cycle: jobs on the same axes share them)."""
+        key = (axes, kind)
+        hit = self._windows.get(key)
+        if hit is None:
+            srcs = [AxisSource(a, kind) for a in axes]
+            hit = self._windows[key] = ([self.track(s) for s in srcs],
+                                        [self.track_range(s) for s in srcs])
+        return hit
+
     def reachable(self, src: AxisSource, level: float) -> bool:
         """Can the source touch `level` in this cycle? (skips the exact solver if not)"""
         lo, hi = self.track_range(src)
@@ -369,6 +381,8 @@ class CompareEngine:
         self._tracks = {}
         self._ranges: dict[AxisSource, tuple[float, float]] = {}
         self._vcycles = {}
+        self._windows: dict[tuple[tuple[int, ...], str],
+                            tuple[list[Track], list[tuple[float, float]]]] = {}
 
     def _scan(self, pre: bool | None, ta: float, t1: float
               ) -> list[tuple[float, int, int, float, int, int]]:
