@@ -4,18 +4,23 @@ Three job kinds: 1-D tables on an axis (a point every 20 pulses), vector distanc
 20 pulses of path), 2-D window points (maxerr 5) along the path. Two axes move a straight
 line at 100,000 pps for 0.5 s; the CPU time (time.process_time, so the figures hold on a
 loaded machine) spent inside the engine's hooks (pre-advance and cycle hook) is measured,
-beside issue 13's goal (16 jobs <= 200 us per cycle).
-Run: python bench/bench_compare.py
+beside issue 13's goal (16 jobs <= 200 us per cycle). With --oracle each row also runs on
+the plain-Python solvers (tests/compare_oracle.py, what the engine ran before they were
+compiled) in the same run, and prints the ratio.
+Run: python bench/bench_compare.py [--oracle]
 """
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
 from openmotion.config import AxisConfig, MachineConfig
 from openmotion.control import Controller
+from openmotion.control.trigger import compare_math
 from openmotion.control.trigger.compare import (
     AxisSource,
     CompareEngine,
@@ -76,13 +81,34 @@ def run(kind: str, n_jobs: int) -> tuple[float, int]:
     return spent / (c.cycles - n0), len(eng.log)
 
 
+def on_oracle(kind: str, n_jobs: int) -> tuple[float, int]:
+    """`run` with the plain-Python solvers in place of the compiled ones."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+    import compare_oracle
+
+    compare_oracle.set_gauss(compare_math._GL_X, compare_math._GL_W)
+    built = compare_math._ck
+    compare_math._ck = compare_oracle
+    try:
+        return run(kind, n_jobs)
+    finally:
+        compare_math._ck = built
+
+
 def main() -> None:
-    print(f"{'kind':8s} {'jobs':>4s} {'us/cycle':>9s} {'firings':>8s} {'goal':>6s}")
+    oracle = "--oracle" in sys.argv
+    head = f"{'kind':8s} {'jobs':>4s} {'us/cycle':>9s} {'firings':>8s} {'goal':>6s}"
+    print(head + (f" {'python us':>10s} {'ratio':>6s}" if oracle else ""))
     for kind in ("axis", "vector", "window"):
         for n in (1, 4, 16):
             cost, fired = run(kind, n)
             goal = "" if n != 16 else ("met" if cost <= 200e-6 else "no")
-            print(f"{kind:8s} {n:4d} {cost * 1e6:9.1f} {fired:8d} {goal:>6s}")
+            row = f"{kind:8s} {n:4d} {cost * 1e6:9.1f} {fired:8d} {goal:>6s}"
+            if oracle:
+                ref, ref_fired = on_oracle(kind, n)
+                assert ref_fired == fired, "the oracle fired differently"
+                row += f" {ref * 1e6:10.1f} {ref / cost:5.1f}x"
+            print(row)
 
 
 if __name__ == "__main__":

@@ -156,6 +156,38 @@ def test_a_pso_table_with_timer_pulses_stays_identical():
                 eng.output(0).edges, z.vector_moved(0) if hasattr(z, "vector_moved") else 0)
     res, cycles, crossed = both(run, cfg)
     assert len(res[0]["index"]) == 8 and len(res[1]) > 8
-    # ZPso keeps VECTOR_MOVED of its BASE axes, which the engine accumulates cycle by cycle:
-    # while it does, every cycle runs (compare_due.py); the results stay identical
-    assert crossed == 0
+    # ZPso keeps VECTOR_MOVED of its BASE axes, which the engine accumulates cycle by cycle
+    # while they move (every cycle runs then, compare_due.py); the rests between the lines
+    # jump, and the results stay identical
+    assert crossed > 0.5 * 8 * 250
+
+
+def test_path_length_jobs_and_finished_mpos_jobs_jump_at_rest():
+    from helpers import free_axes, start_line
+    from openmotion.control.trigger.compare import VectorSource, every_distance
+    from openmotion.control.trigger.pso import ZPso
+
+    cfg = free_axes(2).config
+
+    def run(ctl: Controller) -> object:
+        eng = CompareEngine(ctl)
+        z = ZPso(eng)
+        z.base(0, 1)
+        z.table(0, 100.0, 300.0, 900.0, 5000.0)
+        z.hw_timer(2, 3000, 1000, 2, 0, 1)
+        t3 = z.hw_pswitch2(3, 0, 1, 0, 3)       # VECTOR_MOVED table: toggles do0
+        t7 = z.hw_pswitch2(7, 1, 0, 0, 3)       # each point starts the timer on do1
+        dist = eng.add(every_distance(VectorSource((0, 1)), 250.0, Pulse(2, 1e-4)))
+        mpos = eng.add(LevelJob(AxisSource(0, "mpos"), [400.0, 800.0], Toggle(3)))
+        for p in ([1200.0, 0.0], [1200.0, 900.0], [0.0, 0.0]):
+            start = [ctl.axes[i].position for i in (0, 1)]
+            assert start_line(ctl, start, p, v=30_000.0)
+            assert ctl.wait_motion_done(timeout=30)
+            ctl.advance(0.3)  # at rest: VECTOR_MOVED stands still, the MPOS job is done
+        return ({k: v.tolist() for k, v in eng.log.arrays().items()},
+                [eng.output(o).edges for o in range(4)], z.vector_moved(),
+                [j in eng.jobs for j in (t3, t7, dist, mpos)], eng.jobs[dist].index)
+    res, cycles, crossed = both(run, cfg)
+    assert res[3] == [True, True, True, False] and res[4] > 10  # (5000 is out of reach)
+    assert len(res[0]["time"]) > 20
+    assert crossed > 0.5 * 2 * 300  # the last two rests at least

@@ -250,29 +250,138 @@ typedef struct {
     Py_ssize_t cap;
 } Scratch;
 
-static int reserve(Scratch *s, Py_ssize_t n)
+/* The events of level_events(direction 0) one at a time, in time order, with each root
+ * refined only when asked (`Stream`): a root inside a monotone piece is first known by its
+ * bracket and a rigorous lower bound of the time refine() will return. */
+typedef struct {
+    int exact;           /* 1: `time` is the event; 0: a root still to refine */
+    double time;         /* exact time, or the lower bound */
+    double c, v, a, j, u, w, tk;
+    int su;
+} Pend;
+
+typedef struct {
+    const Trk *T;
+    double level, t, t1;
+    Py_ssize_t k;
+    int q, nc;
+    double cuts[4], c, p, v, a, j, tk, end;
+    int have_left, s_left, ends_at_t1, rec_open, done;
+    double f_end;
+    Pend pend[3];
+    int head, npend;
+} Stream;
+
+static void stream_init(Stream *S, const Trk *T, double level, double t, double t1)
 {
-    if (n <= s->cap) return 0;
-    double *b = realloc(s->buf, (size_t)n * sizeof(double));
-    if (b == NULL) { PyErr_NoMemory(); return -1; }
-    s->buf = b;
-    s->cap = n;
+    memset(S, 0, sizeof *S);
+    S->T = T; S->level = level; S->t = t; S->t1 = t1; S->f_end = 1.0;
+    while (S->k + 1 < T->n && T->ts[S->k + 1] <= t) S->k++;
+}
+
+/* a lower bound of tk + refine(c, v, a, j, u, w, su, tk): the position must travel |f(u)|
+ * (less the rounding noise of the polynomial) at no more than the piece's largest speed */
+static double root_lower_bound(double c, double v, double a, double j, double u, double w,
+                               double fu, double tk)
+{
+    double sc = fabs(c) + fabs(w * v) + fabs(w * w * a / 2.0) + fabs(w * w * w * j / 6.0);
+    double noise = 64.0 * EPS * sc;
+    double vm = pymax(fabs(v + u * (a + u * j / 2.0)), fabs(v + w * (a + w * j / 2.0)));
+    if (j != 0.0) {
+        double xv = -a / j;
+        if (u < xv && xv < w) vm = pymax(vm, fabs(v + xv * (a + xv * j / 2.0)));
+    }
+    vm = vm * (1.0 + 1e-9) + 1e-300;
+    double tol = 2.0 * EPS * (fabs(tk) + fabs(w));
+    double d = (fabs(fu) - 2.0 * noise) / vm * (1.0 - 1e-9) - 8.0 * tol - 4.0 * EPS * w;
+    if (!(d > 0.0)) d = 0.0;
+    if (d > w - u) d = w - u;
+    double lb = tk + (u + d);
+    double base = tk + u;  /* refine never returns below u */
+    return lb > base ? lb - 4.0 * EPS * fabs(lb) : base;
+}
+
+/* fill S->pend with the next piece's events; 0 when there are none left */
+static int stream_fill(Stream *S)
+{
+    const Trk *T = S->T;
+    S->head = S->npend = 0;
+    while (!S->done) {
+        if (!S->rec_open) {
+            if (S->k >= T->n) { S->done = 1; break; }
+            double tk = T->ts[S->k];
+            if (tk > S->t1) { S->done = 1; break; }
+            S->tk = tk;
+            S->end = S->k + 1 < T->n ? T->ts[S->k + 1] : INFINITY;
+            double xa = pymax(S->t - tk, 0.0), xb = pymin(S->end, S->t1) - tk;
+            S->p = T->p0[S->k]; S->v = T->v0[S->k]; S->a = T->a0[S->k]; S->j = T->j[S->k];
+            S->c = S->p - S->level;
+            double r[2], in[2];
+            int nr = velocity_roots(S->v, S->a, S->j, r), ni = 0;
+            for (int q = 0; q < nr; q++)
+                if (xa < r[q] && r[q] < xb) in[ni++] = r[q];
+            if (ni == 2 && in[1] < in[0]) { double x = in[0]; in[0] = in[1]; in[1] = x; }
+            S->nc = 0;
+            S->cuts[S->nc++] = xa;
+            for (int q = 0; q < ni; q++) S->cuts[S->nc++] = in[q];
+            S->cuts[S->nc++] = xb;
+            S->q = 0;
+            S->rec_open = 1;
+        }
+        if (S->q + 1 >= S->nc) { S->rec_open = 0; S->k++; continue; }
+        double u = S->cuts[S->q], w = S->cuts[S->q + 1];
+        S->q++;
+        if (!(w > u)) continue;
+        double c = S->c, v = S->v, a = S->a, j = S->j, tk = S->tk;
+        double fu = snapped(c, v, a, j, u, S->level, S->p);
+        double fw = snapped(c, v, a, j, w, S->level, S->p);
+        int su = isign(fu), sw = isign(fw);
+        if (!S->have_left) {
+            S->have_left = 1;
+            S->s_left = su;
+        } else if ((S->s_left < 0 && 0 <= fu) || (S->s_left > 0 && 0 >= fu)) {
+            Pend *e = &S->pend[S->npend++];
+            e->exact = 1;
+            e->time = tk + u;
+        }
+        if (su * sw < 0) {
+            Pend *e = &S->pend[S->npend++];
+            e->exact = 0;
+            e->c = c; e->v = v; e->a = a; e->j = j; e->u = u; e->w = w; e->tk = tk;
+            e->su = su;
+            e->time = root_lower_bound(c, v, a, j, u, w, fu, tk);
+        }
+        S->s_left = sw != 0 ? sw : su;
+        S->f_end = fw;
+        S->ends_at_t1 = S->end >= S->t1;
+        if (S->npend) return 1;
+    }
+    if (S->done == 1) {
+        S->done = 2;  /* the window-end arrival, once */
+        if (S->ends_at_t1 && S->f_end == 0.0 && S->have_left && S->s_left != 0) {
+            Pend *e = &S->pend[S->npend++];
+            e->exact = 1;
+            e->time = S->t1;
+            return 1;
+        }
+    }
     return 0;
 }
 
 /* compare_math.first_inside: the first time in [t, t1] every track is within +-maxerr of
- * its centre. Returns 1 and *x, 0 for none, -1 on error. lo/hi: each track's range. */
+ * its centre. Returns 1 and *x, 0 for none, -1 on error. lo/hi: each track's range.
+ * The candidates (t, and every crossing of c - maxerr and c + maxerr) are tested in time
+ * order as by the eager version (all crossings, sorted): each level's events come in
+ * order from its Stream, and a root is refined only while its lower bound is the
+ * smallest pending one, so the same first candidate inside is found with fewer roots. */
 static int first_inside(const Trk *T, int na, const double *centre, double maxerr, double t,
                         double t1, const double *lo, const double *hi, Scratch *sc,
                         double *x_out)
 {
+    (void)sc;
     double lim[MAX_AXES];
-    Py_ssize_t need = 1;
-    for (int i = 0; i < na; i++) need += 2 * max_events(T[i].n);
-    if (reserve(sc, need) < 0) return -1;
-    double *cand = sc->buf;
-    Py_ssize_t m = 0;
-    cand[m++] = t;
+    Stream st[2 * MAX_AXES];
+    int ns = 0;
     for (int i = 0; i < na; i++) {
         double c = centre[i];
         double slack = 1e-9 * (fabs(c) + maxerr + 1.0);
@@ -281,19 +390,32 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
         double lv[2] = {c - maxerr, c + maxerr};
         for (int q = 0; q < 2; q++) {
             if (!(lo[i] - slack <= lv[q] && lv[q] <= hi[i] + slack)) continue;
-            m += level_events(&T[i], lv[q], t, t1, 0, 0, cand + m);
+            stream_init(&st[ns], &T[i], lv[q], t, t1);
+            if (stream_fill(&st[ns])) ns++;
         }
     }
-    /* stable insertion sort (few candidates): equal times keep their first entry */
-    for (Py_ssize_t a = 1; a < m; a++) {
-        double key = cand[a];
-        Py_ssize_t b = a - 1;
-        while (b >= 0 && key < cand[b]) { cand[b + 1] = cand[b]; b--; }
-        cand[b + 1] = key;
+    if (t <= t1) {
+        int ok = 1;
+        for (int i = 0; i < na && ok; i++)
+            ok = fabs(position(&T[i], t) - centre[i]) <= lim[i];
+        if (ok) { *x_out = t; return 1; }
     }
-    for (Py_ssize_t a = 0; a < m; a++) {
-        double x = cand[a];
-        if (a > 0 && x == cand[a - 1]) continue;
+    int live = ns;
+    while (live > 0) {
+        int best = -1;
+        for (int s = 0; s < ns; s++) {
+            if (st[s].head >= st[s].npend) continue;
+            if (best < 0 || st[s].pend[st[s].head].time < st[best].pend[st[best].head].time)
+                best = s;
+        }
+        Pend *e = &st[best].pend[st[best].head];
+        if (!e->exact) {
+            e->time = e->tk + refine(e->c, e->v, e->a, e->j, e->u, e->w, e->su, e->tk);
+            e->exact = 1;
+            continue;  /* it may no longer be the smallest */
+        }
+        double x = e->time;
+        if (++st[best].head >= st[best].npend && !stream_fill(&st[best])) live--;
         if (!(t <= x && x <= t1)) continue;
         int ok = 1;
         for (int i = 0; i < na && ok; i++)

@@ -1,7 +1,7 @@
 """Compare engine: position-compare triggers located exactly on the analytic motion.
 
 (Jobs, sources and actions live in compare_jobs.py and are re-exported here; the solvers
-in compare_math.py / compare_roots.py; outputs and the event log in compare_io.py.)
+in compare_math.py, compiled in openmotion._compare; outputs and the event log in compare_io.py.)
 
 Attached to a Controller through a cycle hook. At the end of each cycle [t0, t1] it takes
 the motion just executed from the MotionHistory and finds, for every active job, every
@@ -157,6 +157,7 @@ class CompareEngine:
         self._plan_key: tuple[int, int, int] | None = None  # what _plan_axes was made for
         self._plan_axes: list[int] = []
         self._timers: dict[int, Any] = {}
+        self._prune_due = False  # a job finished: drop unused MPOS error models
         controller.add_cycle_hook(self._on_cycle, due=self._due)
         if self.timed:
             controller.add_pre_advance_hook(self._pre_advance, due=self._due)
@@ -243,6 +244,22 @@ class CompareEngine:
             job = self._jobs.pop(job_id, None)
             if job is not None:
                 job.active = False
+                self._prune_mpos()
+
+    def _prune_mpos(self) -> None:
+        """Keep the MPOS error model only for axes an active MPOS job compares (a later
+        MPOS job starts it again from the error at its arming, as the first one did)."""
+        if not self._mpos_err:
+            return
+        used: set[int] = set()
+        for j in self._jobs.values():
+            if isinstance(j, WindowJob):
+                if j.kind == "mpos":
+                    used.update(j.axes)
+            elif getattr(j.source, "kind", "") == "mpos":
+                used.add(j.source.axis)  # type: ignore[attr-defined]
+        for a in [a for a in self._mpos_err if a not in used]:
+            del self._mpos_err[a]
 
     def clear(self) -> None:
         for k in list(self._jobs):
@@ -331,6 +348,18 @@ class CompareEngine:
             r = self._ranges[src] = track_range(self.track(src), *self._win)
         return r
 
+    def window_inputs(self, axes: tuple[int, ...], kind: str
+                      ) -> tuple[list[Track], list[tuple[float, float]]]:
+        """The tracks and ranges of `axes` in frame `kind` over this cycle (cached per
+        cycle: jobs on the same axes share them)."""
+        key = (axes, kind)
+        hit = self._windows.get(key)
+        if hit is None:
+            srcs = [AxisSource(a, kind) for a in axes]
+            hit = self._windows[key] = ([self.track(s) for s in srcs],
+                                        [self.track_range(s) for s in srcs])
+        return hit
+
     def reachable(self, src: AxisSource, level: float) -> bool:
         """Can the source touch `level` in this cycle? (skips the exact solver if not)"""
         lo, hi = self.track_range(src)
@@ -352,6 +381,8 @@ class CompareEngine:
         self._tracks = {}
         self._ranges: dict[AxisSource, tuple[float, float]] = {}
         self._vcycles = {}
+        self._windows: dict[tuple[tuple[int, ...], str],
+                            tuple[list[Track], list[tuple[float, float]]]] = {}
 
     def _scan(self, pre: bool | None, ta: float, t1: float
               ) -> list[tuple[float, int, int, float, int, int]]:
@@ -378,6 +409,7 @@ class CompareEngine:
             if job.done:
                 self._jobs.pop(job.id, None)
                 job.active = False
+                self._prune_due = True  # (after this cycle's error model update)
         return rows
 
     def _positions(self, rows: list[tuple[float, int, int, float, int, int]]) -> Array:
@@ -503,6 +535,9 @@ class CompareEngine:
         if not self.timed:
             self._vectors_end(ta, t1)
         self._mpos_err.update(self._mpos_e1)
+        if self._prune_due:
+            self._prune_due = False
+            self._prune_mpos()
         pos = [self._positions(rows)] if rows else []
         if self._pre_rows:
             rows = self._pre_rows + rows

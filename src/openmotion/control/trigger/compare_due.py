@@ -9,9 +9,14 @@ happen from the present motion of the compared axes:
   the axis is at distance d from the level (or outside the window by d), and its command
   speed never exceeds v_max (the largest |v| any segment of its profile reaches), so no
   hit comes before now + d / v_max (with margins, so the bound is never late);
-- anything whose state moves every cycle (VECTOR_MOVED, speed PWMs, MPOS jobs, whose
-  following-error model is interpolated between cycle ends, a line with a late edge) or a
-  job kind not known here: every cycle (-inf).
+- a tracked path length (VECTOR_MOVED, ZPso keeps one for its BASE) and the jobs on it:
+  nothing while all its axes stand still (their last command record started and has no
+  motion), every cycle while one moves: the length is accumulated cycle by cycle, and one
+  integral over several cycles would round differently;
+- anything whose state moves every cycle (speed PWMs, whose duty list grows each cycle;
+  active MPOS jobs, whose following-error model is interpolated between cycle ends; a line
+  with a late edge or a level the physical line does not show yet) or a job kind not known
+  here: every cycle (-inf). The error model is kept only while an MPOS job is active.
 
 The cycles jumped over are then exactly the ones the engine would have scanned without a
 hit; the landing cycle is scanned over (previous cycle end, landing] as cycle by cycle,
@@ -26,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compare_jobs import AxisSource, CompareJob, LevelJob, WindowJob
+from .compare_jobs import AxisSource, CompareJob, LevelJob, VectorSource, WindowJob
 
 if TYPE_CHECKING:
     from .compare import CompareEngine
@@ -35,9 +40,12 @@ if TYPE_CHECKING:
 
 def engine_due(eng: CompareEngine) -> float:
     """Earliest time the engine's hooks may act (see the module docstring)."""
-    if eng._vectors or eng._pwms or eng._mpos_err:
+    if eng._pwms or eng._mpos_err:
         return -math.inf
     now = eng.ctl.time
+    for src in eng._vectors:  # VECTOR_MOVED stays put while its axes stand still
+        if not all(_at_rest(eng, a, now) for a in src.axes):
+            return -math.inf
     due = math.inf
     for line in eng._lines.values():
         due = min(due, _line_due(line, now))
@@ -49,9 +57,20 @@ def engine_due(eng: CompareEngine) -> float:
     return due
 
 
+def _at_rest(eng: CompareEngine, axis: int, now: float) -> bool:
+    """Does the axis's command stand still from `now` on (its last record started by now
+    and has no velocity, acceleration or jerk)? Then every later cycle's track is constant
+    until a command or hook appends motion, which happens only in cycles that run."""
+    h = eng.ctl.history
+    if h.end_time(axis) > now:
+        return False
+    rec = h.record_at(axis, now)
+    return rec is not None and rec[2] == 0.0 and rec[3] == 0.0 and rec[4] == 0.0
+
+
 def _line_due(line: OutputLine, now: float) -> float:
-    if line._late or line._hold:
-        return -math.inf
+    if line._late or line._hold or line.level_at(now) != line._written:
+        return -math.inf  # the next cycle writes the physical line
     ts = line._t  # time-ordered
     k = bisect.bisect_right(ts, now)
     return ts[k] if k < len(ts) else math.inf
@@ -68,6 +87,8 @@ def _job_due(eng: CompareEngine, job: CompareJob, now: float) -> float:
                    for a, c in zip(job.axes, centre, strict=True))
     if isinstance(job, LevelJob):
         src = job.source
+        if isinstance(src, VectorSource):  # (engine_due: its axes stand still)
+            return math.inf
         if not isinstance(src, AxisSource) or src.kind != "dpos":
             return -math.inf
         lvl = job.value

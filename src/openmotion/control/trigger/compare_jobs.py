@@ -331,9 +331,7 @@ class WindowJob(CompareJob):
             return []
         if self.index >= self.size:
             return []
-        srcs = [AxisSource(a, self.kind) for a in self.axes]
-        tracks = [eng.track(s) for s in srcs]
-        ranges = [eng.track_range(s) for s in srcs]
+        tracks, ranges = eng.window_inputs(self.axes, self.kind)
         found = window_scan(tracks, ranges, self.points, self.maxerr, self.index, ta, t1)
         k0 = self.index
         self.index += len(found)

@@ -6,7 +6,7 @@ history of each cycle [t0, t1] into tracks in the compared frame (command counte
 feedback model) and asks three questions, each answered between cycles, not at cycle ends:
 
 - `first_crossing`: the first time after `t` the track reaches a level (a compare value),
-  with the events of MotionHistory.crossings (compare_roots.level_events);
+  with the events of MotionHistory.crossings (the compiled level_events);
 - `VectorCycle`: the accumulated path length s(t) (ZMotion VECTOR_MOVED) over the cycle and
   the time it reaches a given distance;
 - `first_inside`: the first time all axes are within +-maxerr of a point (2-D/3-D tables).
