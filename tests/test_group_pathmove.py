@@ -121,17 +121,25 @@ def test_hold_decelerates_with_the_deceleration_shape_and_continue_ends_exactly(
     assert g.axes[0].position == 60_000.0
 
 
-def test_override_changes_the_speed_at_the_commands_rate():
-    ctl, g = group(acc="T", dec="S")
+@pytest.mark.parametrize("acc,dec", [("T", "S"), ("S", "T")])
+def test_override_changes_the_speed_at_the_commands_rate_and_keeps_the_shapes(acc, dec):
+    ctl, g = group(acc=acc, dec=dec)
     g.line([80_000, 0])
     ctl.advance(0.5)
     t_ov = ctl.time
     g.set_override(50.0)
     ctl.advance(0.3)
-    _, v, _ = path_speed(ctl, t_ov + TA / 2 + 0.01, ctl.time)
-    assert np.allclose(v, F / 2, rtol=1e-9)       # F/2 reached within TA/2
-    finish_group(ctl, g)
+    # slowing down: the deceleration's rate and shape, F/2 reached within TD/2
+    t, v, a = path_speed(ctl, t_ov, ctl.time)
+    assert np.allclose(v[t > t_ov + TD / 2 + 0.01], F / 2, rtol=1e-9)
+    ramp = a[(t > t_ov + 1e-4) & (t < t_ov + TD / 2 - 1e-4)]
+    assert ramp.max() == pytest.approx(2 * F / TD if dec == "S" else F / TD, rel=2e-3)
+    t_end = finish_group(ctl, g)
     assert g.axes[0].position == 80_000.0
+    # the final deceleration keeps the deceleration shape: T at F/TD, S peaking at 2F/TD
+    t, v, a = path_speed(ctl, t_end - TD / 2 - 0.02, t_end)
+    final = a[v > 1e-6]
+    assert final.max() == pytest.approx(2 * F / TD if dec == "S" else F / TD, rel=2e-3)
 
 
 def test_refusals_change_nothing():

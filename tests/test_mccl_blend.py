@@ -90,3 +90,28 @@ def test_a_ptp_beyond_the_working_interval_is_refused_at_the_call():
     assert lib.MCC_PtP(hi - 1.0, 0, 0, 0, 0, 0, 0) >= 0
     assert lib.wait_motion(0, 60)
     assert lib.MCC_GetCurPos(0)[1] == pytest.approx(hi - 1.0)
+
+
+@pytest.mark.parametrize("shape", ["T", "S"])
+def test_figure_9_one_constant_speed_region_runs_into_the_next(shape):
+    # "after the first constant speed region directly ... accelerate continuously to the
+    # second constant speed region": 20 mm/s, then 10 mm/s on the same line
+    lib = open_lib(period_ms=5)
+    assert lib.MCC_SetAccType(shape, 0) == 0 and lib.MCC_SetDecType(shape, 0) == 0
+    assert lib.MCC_EnableBlend(0) == 0
+    t0 = lib.controller.time
+    assert lib.MCC_SetFeedSpeed(20.0, 0) == 0
+    assert lib.MCC_Line(10, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.MCC_SetFeedSpeed(10.0, 0) == 0
+    assert lib.MCC_Line(20, 0, 0, 0, 0, 0, 0) >= 0
+    assert lib.wait_motion(0, 60)
+    assert lib.MCC_GetCurPos(0)[1] == 20.0
+    t = np.arange(t0, lib.controller.time, 1e-4)
+    v = lib.controller.history.sample(0, t).v / PPMM
+    first = np.nonzero(v >= 20.0 * (1 - 1e-9))[0][-1]      # end of the 20 mm/s region
+    second = first + np.nonzero(v[first:] <= 10.0 * (1 + 1e-9))[0][0]
+    # the 20 -> 10 mm/s change takes one ramp time (20 x 5 ms), never below 10 mm/s
+    assert t[second] - t[first] == pytest.approx(0.1, abs=3e-4)
+    assert np.all(np.diff(v[first:second + 1]) <= 1e-9)
+    cruise2 = (t > t[second] + 1e-3) & (t < t[second] + 0.3)
+    assert np.allclose(v[cruise2], 10.0, rtol=1e-9)

@@ -9,8 +9,10 @@ position s(t) is a PCL move (`MoveSpec` with `dec_shape`) from rest at its start
 at its end, at its feed times the override, capped by the element's own speed limits (the
 look-ahead's: axis speeds, centripetal acceleration on arcs). Its ramps keep the
 command's rates (feed / acceleration time), so a slower cap gives shorter ramps, as on a
-chain. Hold, override and continue are the same 1-D operations an axis move has
-(`velocity.decel_stop`, `onthefly.change_speed`, a new move from the held position). It
+chain. Hold, override and continue are 1-D operations as on an axis move: a hold is
+`velocity.decel_stop` with the deceleration shape; an override a ramp to the new speed at
+the command's rate (the acceleration shape up, the deceleration shape down), a cruise and
+the final deceleration with its shape; continue a new move from the held position. It
 joins no chain: it ends at rest, or blends into the next command in time (overlap.py).
 
 The result is a `PathPlan` with `move` set (tj = 0, raw = the executed s(t)), so the
@@ -25,11 +27,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...errors import InfeasibleError, MotionError
+from ...errors import MotionError
 from ...path import speed_caps
-from ...profile import onthefly, velocity
+from ...profile import velocity
 from ...profile.pcl import MoveSpec
-from ...profile.segments import Profile, ProfileBuilder
+from ...profile.segments import Profile, ProfileBuilder, State
 from ..core import planning
 from . import pathexec as px
 from .pathrun import PathPlan
@@ -93,13 +95,31 @@ def replan(plan: PathPlan, t: float, *, limits: px.Limits | None = None,
         v_new = _cap(plan.chain, spec, lim)
         if v == 0.0 or abs(v_new - v) <= 1e-12 * spec.max_vel:
             return replace(plan, limits=lim)
-        tacc = spec.tacc * abs(v_new - v) / spec.max_vel
-        try:
-            full = onthefly.change_speed(sp, u, _at_speed(spec, max(v, v_new)), v_new,
-                                         tacc, target=plan.chain.length).profile
-        except InfeasibleError:
+        rest = _to_speed(st, v_new, spec, plan.chain.length)
+        if rest is None:  # too close to the end: it finishes at its speed
             return replace(plan, limits=lim)
+        return _plan(plan.chain, rest, t, lim, spec)
     return _plan(plan.chain, tail(full, u), t, lim, spec)
+
+
+def _to_speed(st: State, v_new: float, spec: MoveSpec, length: float) -> Profile | None:
+    """From state `st` (time 0): a ramp to v_new at the command's rate with its shape (the
+    acceleration's when faster, the deceleration's when slower), a cruise, the final
+    deceleration with the deceleration shape ending exactly on `length`; None when the
+    ramp and the final deceleration do not fit in what is left."""
+    up = v_new > abs(st.v)
+    shape = spec.shape if up else (spec.dec_shape or spec.shape)
+    t_ramp = (spec.tacc if up else spec.tdec) * abs(v_new - abs(st.v)) / spec.max_vel
+    ramp = velocity.velocity_ramp(st, v_new, max(t_ramp, 1e-9), shape=shape)
+    at = _at_speed(spec, v_new)
+    cruise = length - ramp.end.p - velocity.stop_distance(at, v_new)
+    if cruise < -1e-9 * max(1.0, length):
+        return None
+    b = ProfileBuilder(ramp.end.p, v_new, 0.0)
+    if cruise > 0.0:
+        b.segment(cruise / v_new, 0.0, accel=0.0, label="cruise")
+    velocity.append_stop(b, at)
+    return ramp.splice(ramp.duration, b.build(end_p=length, end_v=0.0))
 
 
 def tail(p: Profile, u: float) -> Profile:
