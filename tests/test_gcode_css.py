@@ -44,6 +44,15 @@ def test_g96_in_inches_is_feet_per_minute_and_refuses_without_s():
         compile_text("G21 S100\nG96 M3\nM2\n", OPTIONS)
 
 
+def test_m72_restoring_g96_or_g95_tells_the_runner():
+    cmds = compile_text("G21 G96 S100 D2000 M3\nM70\nG97 S500 G95 F0.1\nM72\nM2\n",
+                        OPTIONS)
+    modes = [(type(c).__name__, getattr(c, "per_s_unit", getattr(c, "per_rev", None)))
+             for c in cmds if isinstance(c, SpindleMode | FeedMode)]
+    assert modes == [("SpindleMode", 1000.0), ("FeedMode", True), ("SpindleMode", 0.0),
+                     ("SpindleMode", 1000.0), ("FeedMode", False)]
+
+
 def test_g95_in_g96_plans_with_the_rpm_at_each_moves_start():
     cmds = compile_text("G21 G18 G0 X20 Z0\nG96 S100 D3000 M3\nG95 F0.1\nG1 Z-5\nX10\n"
                         "G94 F100 G1 Z0\nM2\n", OPTIONS)
