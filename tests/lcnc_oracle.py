@@ -291,9 +291,11 @@ def _moving(ms: list[Motion]) -> list[Motion]:
     """Drop straight moves that end where the last motion ended (LinuxCNC emits some,
     e.g. G28's intermediate leg without axis words; the planner discards them)."""
     out: list[Motion] = []
-    last: tuple[float, ...] | None = (0.0,) * 6  # both start at the machine origin
+    last: tuple[float, ...] = (0.0,) * 6  # both start at the machine origin
     for m in ms:
-        if m.kind not in ("arc", "spline", "tap") and last is not None and all(  # 4 decimals
+        # rs274 does not print where a NURBS ends: a move after it is never dropped
+        after_spline = bool(out) and out[-1].kind == "spline"
+        if m.kind not in ("arc", "spline", "tap") and not after_spline and all(  # 4 decimals
                 abs(x - y) <= m.tol for x, y in zip(m.end, last, strict=True)):
             continue
         out.append(m)

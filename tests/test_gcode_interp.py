@@ -343,7 +343,7 @@ def test_soft_limits_caught_before_motion():
         ("G1 X1 F10 I5", "I5", "not used"),
         ("G0 X1 R2", "R2", "not used"),
         ("G41 G19", "G41", "XY (G17) or XZ (G18)"),
-        ("G96 S100", "G96", "constant surface speed"),
+        ("G96 M3", "G96", "S word missing with G96"),
         ("G1.5 X1", "G1.5", "unsupported"),
         ("M99", "M99", "restarts it forever"),
         ("M97", "M97", "unsupported M-code"),
@@ -452,7 +452,7 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 
 
 @pytest.mark.parametrize("code, feature", [
-    ("G71 Q1", "roughing"), ("G96 S100", "surface speed"),
+    ("G71 Q1", "roughing"),
     ("G87 Z-1 R1 I1 J1 K1", "back boring"),
     ("M101", "user M-code"), ("M60", "pallet")])
 def test_unsupported_features_are_named_before_any_motion(code, feature):

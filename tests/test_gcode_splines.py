@@ -104,6 +104,7 @@ def test_spline_ends_and_messages_match_linuxcnc():
      "must follow a G5"),
     ("G21 F100 G5.2 X1 Y1 P1\nX2 Y0 P1\nG1 X5\nG5.3\nM2\n", "not closed with G5.3"),
     ("G21 F100 G5.2 X1 Y1 P1\nX2 Y0 P1\nM2\n", "not closed with G5.3"),
+    ("G21 F100 G5.2 X1 Y1 P1\nX2 Y0 P1\n", "before the end of the program"),
     ("G21 G5.2 X1 Y1 P1\n", "0 feedrate"),
     ("G21 F100 G5.2 X1 Y1\nX2 Y0 P1\nG5.3\nM2\n", "positive weight"),
     ("G21 G93 G5.2 X1 Y1 P1 F1\nX2 Y0 P1\nG5.3 F1\nM2\n", "inverse time"),

@@ -15,7 +15,7 @@ G_GROUP = {
     900: 3, 910: 3,
     901: 4, 911: 4,
     930: 5, 940: 5, 950: 5,
-    970: 14,
+    960: 14, 970: 14,
     200: 6, 210: 6,
     400: 7, 410: 7, 420: 7, 411: 7, 421: 7,
     430: 8, 431: 8, 432: 8, 490: 8,
@@ -29,7 +29,6 @@ G_REFUSED = {
     700: "lathe finishing cycle (G70) is not supported",
     710: "lathe roughing cycle (G71) is not supported",
     720: "lathe roughing cycle (G72) is not supported",
-    960: "constant surface speed (G96) is not supported",
     **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
 }
 #: Why some well-known M-codes are refused.

@@ -38,6 +38,7 @@ from ..path import Arc, Direction
 from ..units import AxisUnits
 from . import canon
 from .analogout import AnalogOut
+from .css import FeedMode, SpindleMode
 from .options import MM_PER_INCH, ROTARY_LETTERS
 from .orient import Orient
 from .probing import Probe, WaitInput
@@ -161,6 +162,14 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
     sys_max = float(np.max(vmax))
     ops: list[Op] = []
     pos = np.asarray(start, dtype=float) / scales.ppu  # machine units
+    css: SpindleMode | None = None  # G96 in force
+    s_word = rpm  # the S number (G96: the surface speed)
+
+    def rpm_now() -> float:
+        """Commanded rpm at the current point (G96: from X)."""
+        if css is None or rpm == 0.0:
+            return rpm
+        return css.rpm(s_word, float(pos[css.x_axis])) if css.x_axis < len(pos) else rpm
 
     def feed_of(cmd: canon.Command, delta: np.ndarray, length: float) -> float:
         """Group feed (units/s) for a move of `length` (vector of all axes) by `delta`."""
@@ -198,21 +207,21 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             length = float(np.linalg.norm(end - pos))
             if length == 0.0:
                 continue
-            if rpm <= 0.0:
+            if rpm <= 0.0 or not math.isfinite(rpm_now()):
                 raise _fail(cmd, "a synchronised move (G33/G76) needs the spindle turning "
                                  "at S > 0")
             # no spindle feedback on this path: the nominal speed pitch x S
-            f = cmd.pitch * rpm / 60.0
+            f = cmd.pitch * rpm_now() / 60.0
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), min(f, sys_max),
                           end=end, source=cmd))
             pos = end
         elif isinstance(cmd, RigidTap):
-            if rpm <= 0.0:
+            if rpm <= 0.0 or not math.isfinite(rpm_now()):
                 raise _fail(cmd, "G33.1 needs the spindle turning at S > 0")
             # without spindle feedback: in at K x S, out at K x S x I (the runner with a
             # spindle axis replaces both by the synchronised tap, rigidtap_run.py)
             start, end = np.asarray(cmd.start, dtype=float), np.asarray(cmd.end, dtype=float)
-            f = cmd.pitch * rpm / 60.0
+            f = cmd.pitch * rpm_now() / 60.0
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), min(f, sys_max),
                           end=end, source=cmd))
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(start),
@@ -253,8 +262,15 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         elif isinstance(cmd, canon.SetOutput):
             ops.append(Op("output", cmd.line, cmd.file, index=cmd.index, level=cmd.level,
                           synced=cmd.synced, source=cmd))
+        elif isinstance(cmd, SpindleMode):
+            css = cmd if cmd.per_s_unit > 0.0 else None
+            ops.append(Op("action", cmd.line, cmd.file, text="G96 constant surface speed"
+                          if css else "G97 rpm mode", barrier=True, source=cmd))
+        elif isinstance(cmd, FeedMode):
+            ops.append(Op("feedmode", cmd.line, cmd.file, synced=cmd.per_rev, source=cmd))
         elif isinstance(cmd, canon.Spindle):
             rpm = cmd.speed if cmd.on else 0.0
+            s_word = cmd.speed
             outs = () if cmd.output is None else ((cmd.output, cmd.on),)
             txt = f"spindle {'on' if cmd.on else 'off'} S{cmd.speed:g}"
             ops.append(Op("action", cmd.line, cmd.file, text=txt, outputs=outs, barrier=True,

@@ -16,6 +16,7 @@ GCodeError (line, column, word) and no command list exists, so nothing can move.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Generator
 from dataclasses import dataclass, field
 
@@ -29,7 +30,9 @@ from .params import Parameters
 from .parser import MAX_LINES, Block, Program, parse_program
 from .probing import Request, Result, apply_result, preview_result
 from .source import GCodeError, decode_program, read_program
+from .splines import open_block_error
 
+_NURBS = re.compile(r"G\s*0*5\s*\.\s*2", re.IGNORECASE)
 _OPENERS = {"SUB": "ENDSUB", "IF": "ENDIF", "WHILE": "ENDWHILE", "DO": "WHILE",
             "REPEAT": "ENDREPEAT"}
 _LOOPS = ("WHILE", "DO", "REPEAT")
@@ -386,6 +389,8 @@ class Interpreter:
                 pc = flow.end[head] if blocks[head].oword.keyword == "DO" else head  # type: ignore
             else:  # pragma: no cover - parser admits only the keywords above
                 raise b.error(f"unknown O-word {kw}", o.pos, f"O{o.label}")
+        if blocks and not modal.ended:  # the program's end without M2/M30
+            open_block_error(modal, blocks[min(pc, n) - 1], 0, "the end of the program")
         return out
 
 
@@ -532,7 +537,8 @@ def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon
         raise GCodeError(f"program is {len(text)} characters, more than the limit of "
                          f"{options.max_bytes}", file=file)
     lines = text.splitlines()
-    if len(lines) <= MAX_LINES:  # plain word lines skip the Block (fastpath.py)
+    # a G5.2 block must be closed: only the general path checks the program's end
+    if len(lines) <= MAX_LINES and not _NURBS.search(text):  # fastpath.py: plain lines
         return compile_plain(lines, options, file, lambda: _compile_full(text, options, file))
     return _compile_full(text, options, file)
 

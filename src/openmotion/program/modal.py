@@ -24,6 +24,7 @@ from .arcmove import arc_move
 from .codes import G_GROUP, G_REFUSED, M_GROUP, M_REFUSED
 from .compmove import comp_motion
 from .coords import offset_command
+from .css import FeedMode, g96, nominal_rpm
 from .cuttercomp import CutterComp, comp_off, comp_on
 from .cycles import CYCLES, CycleState, canned_cycle
 from .expr import EvalError, Node
@@ -295,6 +296,8 @@ class Modal:
         if 5 in gs:  # LinuxCNC: G94 and G95 always clear F; G93 needs F on each line
             code = gs[5][0]
             self.inverse_time = code == 930
+            if self.per_rev != (code == 950):
+                out.append(FeedMode(code == 950, line, file))
             self.per_rev = code == 950
             if code != 930:
                 self.feed = self.feed_lin = self.feed_ang = 0.0
@@ -319,6 +322,8 @@ class Modal:
             if self.spindle_on and 7 not in ms:
                 out.append(canon.Spindle(True, self.spindle_cw, self.speed,
                                          self.opt.spindle_output, line, file))
+        if 14 in gs:  # G96/G97 after S (S is the surface speed of G96)
+            g96(self, b, gs[14][0], gs[14][1], words, used, out)
         t = words.get("T")
         if t is not None:
             used.add("T")
@@ -573,10 +578,12 @@ class Modal:
         commanded spindle speed S (no spindle feedback on this path)."""
         if not self.per_rev:
             return f / 60.0
-        if not self.spindle_on or self.speed <= 0.0:
+        rpm = nominal_rpm(self)
+        if not self.spindle_on or self.speed <= 0.0 or not math.isfinite(rpm):
             raise b.error(f"{gword} in G95 (feed per revolution) needs the spindle turning "
-                          "at S > 0", gpos, gword)
-        return f * self.speed / 60.0
+                          "at S > 0" + (" (G96 at X0 without D: no rpm limit)"
+                                        if not math.isfinite(rpm) else ""), gpos, gword)
+        return f * rpm / 60.0
 
     def _rotary_only(self, start: list[float], end: list[float]) -> bool:
         """True when only rotary axes move (LinuxCNC then feeds at the angular rate)."""

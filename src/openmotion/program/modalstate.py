@@ -11,10 +11,11 @@ SetBlend records of whatever changed, so the runtime follows.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from . import canon
+from .css import FeedMode, SpindleMode
 from .parser import Block
 
 if TYPE_CHECKING:
@@ -58,6 +59,14 @@ def restore(m: Modal, s: SavedState, b: Block, out: list[canon.Command]) -> None
     m.params.set_number(5220, float(m.coord))
     m.update_offsets()
     line, file = b.line, b.file
+    if before["css"] != m.css:  # G96/G97 restored: the runner's spindle follows it
+        if isinstance(m.css, SpindleMode):
+            out.append(replace(m.css, line=line, file=file))
+        else:
+            x = m.letters.get("X")
+            out.append(SpindleMode(0.0, 0.0, x[0] if x else 0, 0.0, line, file))
+    if before["per_rev"] != m.per_rev:
+        out.append(FeedMode(bool(m.per_rev), line, file))
     if any(before[f] != s.values[f] for f in ("spindle_on", "spindle_cw", "speed")):
         out.append(canon.Spindle(m.spindle_on, m.spindle_cw, m.speed, m.opt.spindle_output,
                                  line, file))

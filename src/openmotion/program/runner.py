@@ -39,7 +39,7 @@ import dataclasses
 import math
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 from typing import TYPE_CHECKING
 
@@ -50,12 +50,14 @@ from ..units import AxisUnits
 from . import canon
 from .analogout import AnalogOut
 from .convert import ConvertOptions, Op, Scales, convert
+from .css import FeedMode, SpindleMode
 from .interp import Interpreter, Session, compile_text
 from .options import AXIS_LETTERS, GCodeOptions
 from .orient import Orient
 from .parser import parse_program
 from .probing import Probe, WaitInput
 from .rigidtap import RigidTap
+from .runfeed import ceiling_rps, follow_per_rev, planned_rps, x_reader
 from .runrequests import answer, begin_request, on_probe_edge
 from .runwait import InputWait, ProbeMove
 from .source import GCodeError, read_program
@@ -260,7 +262,8 @@ class ProgramRunner:
             self._commands = list(program)
             bad_cmd = [c for c in self._commands
                        if not isinstance(c, canon.Command | Probe | WaitInput | Orient
-                                                  | SplineFeed | AnalogOut | RigidTap)]
+                                                  | SplineFeed | AnalogOut | RigidTap
+                                                  | SpindleMode | FeedMode)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
@@ -277,6 +280,10 @@ class ProgramRunner:
         self.spindle: SpindleDrive | None = None
         self.sync_moves: list[SyncMove] = []  # G33/G76 passes run against the spindle
         self.rigid_taps: list = []  # G33.1 taps run against the spindle (RigidTapMove)
+        self._per_rev = False  # feeding a G95 stretch
+        self._per_rev_ops: dict[int, float] = {}  # group index -> planned spindle rps
+        self._feed_pct = 100.0  # override the G95 follower set last
+        self._feed_tick = 0
         self._spindle_index: int | None = None
         if self.options.spindle_axis is not None:
             self._spindle_index = ctl.axis(self.options.spindle_axis).index
@@ -569,7 +576,8 @@ class ProgramRunner:
         op = p.ops[p.pc]
         if opts.single_block and self._step_line is not None and op.line != self._step_line:
             return self._idle()
-        if op.kind in ("line", "arc", "delay", "output") or (op.kind == "analog" and op.synced) or (
+        if op.kind in ("line", "arc", "delay", "output", "feedmode") or (
+                op.kind == "analog" and op.synced) or (
                 op.kind == "action" and not op.barrier):
             return True
         return self._idle()
@@ -605,6 +613,8 @@ class ProgramRunner:
             return
         if self.spindle is not None:
             self.spindle.sample(t)
+            if self._request is None:
+                follow_per_rev(self, g)
         self._trace_t.append(t)
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
@@ -650,7 +660,14 @@ class ProgramRunner:
                 self._last_line = op.line
                 return
             if op.kind in ("line", "arc", "delay"):
+                planned = planned_rps(self, op) if (
+                    self._per_rev and self.spindle is not None and op.kind != "delay") else 0.0
+                if planned > 0.0:  # G95: planned at the highest speed, the override scales
+                    ceiling = ceiling_rps(self, planned)
+                    op = replace(op, feed=op.feed * ceiling / planned)
                 idx = self._push(g, op)
+                if planned > 0.0:
+                    self._per_rev_ops[idx] = ceiling
                 self._line_of[idx] = op.line
                 self.op_of[idx] = op
                 if op.target is not None:
@@ -659,6 +676,8 @@ class ProgramRunner:
                 if op.kind != "delay":
                     self.synced.bind(idx, self.starts_of[idx])
                     self.synced_analog.bind(idx)
+            elif op.kind == "feedmode":
+                self._per_rev = op.synced
             elif op.kind == "analog":
                 if op.synced:
                     self.synced_analog.pending.append(op)
@@ -685,6 +704,9 @@ class ProgramRunner:
                 elif op.kind == "action":
                     if isinstance(op.source, canon.Spindle) and self.spindle is not None:
                         self.spindle.apply(op.source)
+                    elif isinstance(op.source, SpindleMode) and self.spindle is not None:
+                        k = op.source.x_axis
+                        self.spindle.set_mode(op.source, x_reader(self, k))
                     for index, level in op.outputs:
                         self._set_output(op, index, level, "output")
                     self._event("action", op.line, op.text)

@@ -31,6 +31,7 @@ from ..control.groups.group import GroupState
 from ..control.home.latch import capture
 from ..errors import MotionError
 from . import canon
+from .css import SpindleMode
 from .orient import Orient
 
 if TYPE_CHECKING:
@@ -60,6 +61,10 @@ class SpindleDrive:
         self._samples: deque[tuple[float, float]] = deque(maxlen=_SPEED_WINDOW)
         self._pending: float | None = None  # velocity to start once a reversal stopped
         self.rpm = 0.0  # commanded, signed (+ clockwise)
+        self.css: SpindleMode | None = None  # G96 in force
+        self._x_now = None  # G96: reads the tool's machine X
+        self._cmd: canon.Spindle | None = None  # the M3/M4/S in force
+        self._css_tick = 0
         self.axis.fix_speed_range(self.axis.max_speed)  # speed changes up to the maximum
         ctl.add_edge_hook(self._on_edge, signals=("ez",))
 
@@ -80,11 +85,47 @@ class SpindleDrive:
         return float(self.axis.counters.feedback_unwrapped())
 
     def sample(self, t: float) -> None:
-        """Once per cycle: remember the count (for the measured speed)."""
+        """Once per cycle: remember the count (for the measured speed); in G96 follow the
+        tool's X every few cycles."""
         self._samples.append((t, self.count()))
         if self._pending is not None and self.axis.state is AxisState.STANDSTILL:
             v, self._pending = self._pending, None
             self.axis.move_velocity(v, tacc=self.acc_time)
+        self._css_tick += 1
+        if self.css is not None and self._cmd is not None and self._cmd.on \
+                and self._css_tick >= 4 and self.axis.state is AxisState.CONTINUOUS_MOTION:
+            self._css_tick = 0
+            want = self.target_rpm(self._cmd)
+            if abs(want - abs(self.rpm)) > 2e-3 * max(abs(self.rpm), 1.0):
+                self._css_change(want)
+
+    def _css_change(self, rpm: float) -> None:
+        """A small G96 speed change: at the spindle's full acceleration (max rpm per
+        acc_time), not a whole acc_time ramp, so the speed keeps up with X."""
+        ax = self.axis
+        v = rpm / 60.0 * self.counts_per_rev / ax.counters.move_ratio
+        dv = abs(abs(v) - abs(ax.velocity))
+        tacc = max(4.0 * self.ctl.period, self.acc_time * dv / ax.max_speed)
+        ax.change_speed(abs(v), tacc)
+        self.rpm = rpm if self.rpm >= 0.0 else -rpm
+
+    def set_mode(self, mode: SpindleMode, x_now) -> None:
+        """G96 (follow X through `x_now()`, machine units) or G97."""
+        self.css = mode if mode.per_s_unit > 0.0 else None
+        self._x_now = x_now
+        if self._cmd is not None and self._cmd.on:
+            self.apply(self._cmd)
+
+    @property
+    def max_rpm(self) -> float:
+        return self.axis.max_speed * self.axis.counters.move_ratio * 60.0 / self.counts_per_rev
+
+    def target_rpm(self, cmd: canon.Spindle) -> float:
+        """The rpm the command asks for now (G96: at the tool's X, limited by D and by the
+        spindle's maximum, as LinuxCNC limits it)."""
+        if self.css is None or self._x_now is None:
+            return cmd.speed
+        return min(self.css.rpm(cmd.speed, float(self._x_now())), self.max_rpm)
 
     def revs_per_s(self) -> float:
         """Measured speed (signed revolutions per second) over the last cycles."""
@@ -111,7 +152,9 @@ class SpindleDrive:
     # -- commands ------------------------------------------------------------------------
     def apply(self, cmd: canon.Spindle) -> None:
         """M3 / M4 / M5 / S: start, change, reverse or stop the spindle."""
-        rpm = (cmd.speed if cmd.clockwise else -cmd.speed) if cmd.on else 0.0
+        self._cmd = cmd
+        speed = self.target_rpm(cmd)
+        rpm = (speed if cmd.clockwise else -speed) if cmd.on else 0.0
         ax = self.axis
         self.rpm = rpm
         self._pending = None
