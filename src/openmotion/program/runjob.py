@@ -21,7 +21,7 @@ from pathlib import Path
 from ..errors import MotionError
 from .points import PointTable
 from .progress import RunProgress
-from .report import format_summary, summarize, write_report
+from .report import format_summary, g54_origin, summarize, write_report
 from .runner import ProgramRunner, RunOptions, RunState
 
 #: Controller time (s) between progress updates in virtual time.
@@ -86,7 +86,10 @@ def run_job(args: argparse.Namespace) -> int:
     bar.status("writing the report ...")
     options = (f"machine '{cfg.name}' ({''.join(run.letters)}), acceleration time "
                f"{acc_time:g} s, feed override {override:g} %, {args.repeat} pass(es)")
-    report = write_report(run, args.out, path.stem, options)
+    # drawn in program coordinates: G54 as the job set it (the program's own G10 offsets
+    # are not followed: then machine coordinates)
+    origin = g54_origin(run, params) if not sets_g54 else None
+    report = write_report(run, args.out, path.stem, options, origin)
     print(f"report: {report}")
     if getattr(args, "report", False):
         import webbrowser
