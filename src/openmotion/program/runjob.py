@@ -64,14 +64,14 @@ def run_job(args: argparse.Namespace) -> int:
     if params:
         print("G54 origin at the middle of the travel: " + ", ".join(
             f"#{k} = {v:g}" for k, v in sorted(params.items())), file=sys.stderr)
-    print(f"{path}: {len(run.commands)} commands, {len(run.ops)} moves/actions on "
-          f"{''.join(run.letters)} of machine '{cfg.name}', acceleration time "
-          f"{acc_time:g} s, feed override {override:g} %", file=sys.stderr)
-    run.start()
-    if override != 100.0 and run.group is not None:
-        run.group.set_override(float(override))  # before the first cycle: the whole job
     bar = RunProgress(ctl, run)
-    with _CtrlC() as stop:
+    with _CtrlC() as stop:  # from here on Ctrl-C stops the job cleanly
+        print(f"{path}: {len(run.commands)} commands, {len(run.ops)} moves/actions on "
+              f"{''.join(run.letters)} of machine '{cfg.name}', acceleration time "
+              f"{acc_time:g} s, feed override {override:g} %", file=sys.stderr)
+        run.start()
+        if override != 100.0 and run.group is not None:
+            run.group.set_override(float(override))  # before the first cycle: the whole job
         _drive(ctl, run, stop, args.realtime, bar)
         if stop.pressed and run.state in (RunState.RUNNING, RunState.PAUSED):
             line = run.current_line
