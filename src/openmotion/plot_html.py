@@ -74,9 +74,12 @@ def trace_page(t: NDArray[Any], velocity: Mapping[str, NDArray[Any]],
     from .program.report_html import screen_indices
 
     n_rows = 2 + bool(lanes)
+    lane_px = max(160, 26 * len(lanes))  # one readable label per lane
+    heights = [300, 220, lane_px][:n_rows]
     fig = make_subplots(rows=n_rows, cols=1, shared_xaxes=True, vertical_spacing=0.04,
-                        row_heights=[3, 2, 2][:n_rows],
-                        subplot_titles=["velocity", "position", "I/O and state"][:n_rows])
+                        row_heights=[h / sum(heights) for h in heights],
+                        subplot_titles=["velocity", "position",
+                                        "I/O (off/on) and state (hover: its name)"][:n_rows])
     for row, series in ((1, velocity), (2, position)):
         for name, y in series.items():
             keep = screen_indices(np.asarray(y, dtype=float))
@@ -95,14 +98,10 @@ def trace_page(t: NDArray[Any], velocity: Mapping[str, NDArray[Any]],
         fig.add_trace(go.Scatter(x=_f32(t[keep]), y=_f32(y), name=label, text=hover,
                                  hoverinfo="text+x", line={"shape": "hv"}, showlegend=False),
                       row=3, col=1)
-        if len(names) == 2:
-            ticks += [lane * 1.5, lane * 1.5 + 1]
-            text += [f"{label} {names[0]}", f"{label} {names[1]}"]
-        else:
-            ticks.append(lane * 1.5 + 0.5)
-            text.append(label)
+        ticks.append(lane * 1.5 + 0.5)
+        text.append(label)
     if lanes:
         fig.update_yaxes(tickvals=ticks, ticktext=text, row=3, col=1)
     fig.update_xaxes(title_text="time (s)", row=n_rows, col=1)
-    fig.update_layout(height=300 * n_rows + 120, legend={"orientation": "h"})
+    fig.update_layout(height=sum(heights) + 60 * n_rows + 120, legend={"orientation": "h"})
     return _page(path, title, "", fig)
