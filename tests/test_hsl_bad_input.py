@@ -64,8 +64,15 @@ def state(hsl: HslLibrary) -> tuple:
     return tuple(out)
 
 
+_FRESH = [0]
+
+
 def fresh() -> HslLibrary:
-    gc.collect()  # controllers are cycles holding large plans: free the last one now
+    # controllers are cycles holding large plans: free the last ones now and then (a full
+    # collection in a loaded test worker costs up to a second; every 8th keeps memory low)
+    _FRESH[0] += 1
+    if _FRESH[0] % 8 == 0:
+        gc.collect()
     hsl = HslLibrary.simulated(2)
     hsl.HSL_initial(0)
     return hsl

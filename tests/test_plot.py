@@ -38,10 +38,12 @@ def assert_png(path) -> None:
 
 
 def assert_html(path, title: str) -> None:
+    """An interactive plotly page (the run report's style), plotly.js beside it."""
     text = path.read_text(encoding="utf-8")
     assert text.startswith("<!DOCTYPE html>")
-    assert "<svg" in text and "</svg>" in text and "<?xml" not in text
+    assert "Plotly.newPlot" in text and "<script src='plotly.min.js'>" in text
     assert f"<title>{title}</title>" in text
+    assert (path.parent / "plotly.min.js").stat().st_size > 1_000_000
 
 
 def test_plot_profile_png_and_html(tmp_path) -> None:

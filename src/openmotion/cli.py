@@ -255,6 +255,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         text = flag_names(str(exc)) if args.command == "profile" else str(exc)
         print(f"openmotion: error: {text}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C outside a run's own handling (setup, a 2nd press)
+        print("openmotion: interrupted (Ctrl-C)", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

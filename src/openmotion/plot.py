@@ -7,15 +7,13 @@ Operation Menu, "Show Velocity Curve", Figure 5-6) with position and I/O lanes b
 
 Figures are built with `matplotlib.figure.Figure` directly (the Agg canvas), never pyplot,
 so nothing opens a window or touches global pyplot state. Every function returns the paths
-it wrote: the image (.png/.svg/.pdf), and an .html page with the SVG figure embedded when the
-path ends with .html or `html=True`.
+it wrote: the image (.png/.svg/.pdf), and an interactive .html page (plotly, plot_html.py:
+zoom, pan, hover, the run report's style) when the path ends with .html or `html=True`.
 """
 
 from __future__ import annotations
 
-import html as _html
-import io
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -42,26 +40,16 @@ def _check_path(path: str | Path) -> Path:
     return p
 
 
-def _write(fig: Figure, path: Path, html: bool, title: str) -> list[Path]:
-    """Save `fig` as the image `path` and/or as an .html page with inline SVG."""
+def _write(fig: Figure, path: Path, html: bool, page: Callable[[Path], Path]) -> list[Path]:
+    """Save `fig` as the image `path` and/or, through `page`, the interactive .html page
+    (plot_html.py: plotly, in the run report's style)."""
     written: list[Path] = []
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() != ".html":
         fig.savefig(path, dpi=100)
         written.append(path)
     if html or path.suffix.lower() == ".html":
-        page = path.with_suffix(".html")
-        buf = io.StringIO()
-        fig.savefig(buf, format="svg")
-        svg = buf.getvalue()
-        svg = svg[svg.find("<svg"):]  # drop the XML prolog and doctype: inline SVG
-        page.write_text(
-            "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">"
-            f"<title>{_html.escape(title)}</title></head>\n<body>\n"
-            f"<h1>{_html.escape(title)}</h1>\n{svg}\n</body></html>\n",
-            encoding="utf-8",
-        )
-        written.append(page)
+        written.append(page(path.with_suffix(".html")))
     return written
 
 
@@ -90,10 +78,19 @@ def plot_profile(profile: Profile, path: str | Path, title: str | None = None, *
     title = "Motion profile" if title is None else str(title)
     t = profile_times(profile, n)
     s = profile.sample(t)
-    fig = Figure(figsize=(9, 8), layout="constrained")
-    axs = fig.subplots(4, 1, sharex=True)
     rows = (("position [pulse]", s.p), ("velocity [pulse/s]", s.v),
             ("acceleration [pulse/s²]", s.a), ("jerk [pulse/s³]", s.j))
+    subtitle = f"distance {profile.distance:g} pulses, duration {profile.duration:g} s"
+
+    def page(out: Path) -> Path:
+        from .plot_html import profile_page
+
+        return profile_page(t, rows, profile.t0[1:], out, title, subtitle)
+
+    if p.suffix.lower() == ".html":
+        return [page(p)]
+    fig = Figure(figsize=(9, 8), layout="constrained")
+    axs = fig.subplots(4, 1, sharex=True)
     for ax, (label, y) in zip(axs, rows, strict=True):
         ax.plot(t, y, lw=1.2)
         ax.set_ylabel(label)
@@ -102,7 +99,7 @@ def plot_profile(profile: Profile, path: str | Path, title: str | None = None, *
             ax.axvline(tk, color="0.85", lw=0.6, zorder=0)
     axs[-1].set_xlabel("time [s]")
     fig.suptitle(f"{title} — distance {profile.distance:g}, duration {profile.duration:g} s")
-    return _write(fig, p, html, title)
+    return _write(fig, p, html, page)
 
 
 # ---------------------------------------------------------------------------- traces
@@ -210,7 +207,25 @@ def plot_trace(recorder_arrays: Mapping[str, Any] | Recorder, path: str | Path,
         _io_lanes(axs[2], t, arr, sel, names)
     axs[-1].set_xlabel("time [s]")
     fig.suptitle(title)
-    return _write(fig, p, html, title)
+
+    def page(out: Path) -> Path:
+        from .plot_html import trace_page
+
+        vel, pos = {}, {}
+        for a in sel:
+            k, u = scale[a], units[a]
+            if "cmd_vel" in arr:
+                vel[f"{names[a]} [{u}/s]"] = arr["cmd_vel"][:, a] / k
+            elif "cmd_pos" in arr and t.size > 1:
+                vel[f"{names[a]} [{u}/s]"] = np.gradient(arr["cmd_pos"][:, a], t) / k
+            if "cmd_pos" in arr:
+                pos[f"{names[a]} command [{u}]"] = arr["cmd_pos"][:, a] / k
+            if "fb_pos" in arr:
+                pos[f"{names[a]} feedback [{u}]"] = arr["fb_pos"][:, a] / k
+        return trace_page(t, vel, pos, _lanes(arr, sel, names),
+                          (ax_v.get_ylabel(), ax_p.get_ylabel()), out, title)
+
+    return _write(fig, p, html, page)
 
 
 def _axis_labels(machine: MachineConfig | None, n: int
@@ -221,6 +236,32 @@ def _axis_labels(machine: MachineConfig | None, n: int
     unit = {"degree": "deg"}
     return ([a.name.upper() for a in machine.axes], [a.pulses_per_unit for a in machine.axes],
             [unit.get(a.unit, a.unit) for a in machine.axes])
+
+
+def _lanes(arr: Mapping[str, NDArray[Any]], sel: list[int], names: list[str]
+           ) -> list[tuple[str, NDArray[Any], list[str]]]:
+    """The I/O and state lanes as data: (label, level index per sample, level names)."""
+    from .control.core.controller import IO_BITS, STATE_CODES
+
+    signal = {bit: sig for sig, bit in IO_BITS}
+    state_name = {code: st.value for st, code in STATE_CODES.items()}
+    out: list[tuple[str, NDArray[Any], list[str]]] = []
+    if "io" in arr:
+        for a in sel:
+            word = arr["io"][:, a].astype(np.int64)
+            used = int(np.bitwise_or.reduce(word)) if word.size else 0
+            for b in range(64):
+                if used >> b & 1 and len(out) < MAX_IO_LANES:
+                    out.append((f"{names[a]} {signal.get(b, f'bit {b}')}", (word >> b) & 1,
+                                ["off", "on"]))
+    if "state" in arr:
+        for a in sel:
+            s = arr["state"][:, a].astype(int)
+            codes = sorted(set(s.tolist()))
+            rank = {c: i for i, c in enumerate(codes)}
+            out.append((f"{names[a]} state", np.array([rank[c] for c in s]),
+                        [state_name.get(c, str(c)) for c in codes]))
+    return out
 
 
 def _io_lanes(ax: Any, t: NDArray[Any], arr: Mapping[str, NDArray[Any]],

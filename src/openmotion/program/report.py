@@ -10,6 +10,8 @@ deviation from the corner, not from one side), the I/O events and faults.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -118,17 +120,34 @@ def format_summary(s: RunSummary) -> str:
     return "\n".join(out)
 
 
+def g54_origin(run: ProgramRunner, parameters: Mapping[int, float]) -> dict[str, float]:
+    """Program zero of G54 per runner axis letter (machine units) from the numbered
+    parameters the job ran with (#5221 + the letter's place in XYZABCUVW; 0 when unset)."""
+    from .options import AXIS_LETTERS
+
+    return {k: float(parameters.get(5221 + AXIS_LETTERS.index(k), 0.0)) for k in run.letters}
+
+
 def write_report(run: ProgramRunner, out_dir: str | Path, name: str = "report",
-                 options: str = "") -> Path:
-    """Write `<out_dir>/<name>.html`, the interactive report (report_html.py: summary,
-    plotly figures, events; plotly.min.js beside it); its path. `options`: a line on the
-    machine and run options shown above the summary."""
+                 options: str = "", origin: Mapping[str, float] | None = None) -> Path:
+    """Write `<out_dir>/<name>.html`, the interactive report (report_html.py figures,
+    report_page.py page; plotly.min.js beside it); its path. `options`: a line on the
+    machine and run options shown above the summary. `origin`: program zero per axis
+    letter in machine units (`g54_origin`): positions are drawn in program coordinates;
+    None: in machine coordinates."""
     if not isinstance(name, str) or not name or "/" in name or "\\" in name:
         raise MotionError(f"name must be a plain file name, got {name!r}")
-    from .report_html import write_html
+    if origin is not None and (not isinstance(origin, Mapping) or any(
+            k not in run.letters or not isinstance(v, float | int) or isinstance(v, bool)
+            or not math.isfinite(v) for k, v in origin.items())):
+        raise MotionError(f"origin must map the program's axis letters "
+                          f"{''.join(run.letters)} to finite positions, got {origin!r}")
+    from .report_page import write_page
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     s = summarize(run)
     err, _ = contour_errors(run)
-    return write_html(run, s, format_summary(s), err, out / f"{name}.html", options)
+    zero = None if origin is None else np.array([float(origin.get(k, 0.0))
+                                                 for k in run.letters])
+    return write_page(run, s, format_summary(s), err, out / f"{name}.html", options, zero)

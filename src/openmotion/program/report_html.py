@@ -1,10 +1,13 @@
 """The interactive run report: one HTML page of plotly figures (zoom, pan, hover).
 
-Figures: the path in machine coordinates (XY, and 3-D when a third linear axis moves) with
-rapids dashed and feeds coloured by the programmed feed, the travel box and the worst
-contour error marked; path speed, programmed against actual; per moving axis position,
-velocity, acceleration and jerk against time; contour error against time; outputs as
-off/on lanes; the summary and the event table on top of them.
+Figures: the path in program coordinates (machine position minus the G54 origin the job
+ran with; XY, and 3-D when a third linear axis moves) with rapids dashed and feeds coloured
+by the programmed feed, the stretches where each output was on drawn over it, the
+soft-limit box (the travel between the limit switches) and the worst contour error marked;
+path speed, commanded (programmed feed times the override) against executed; per moving
+axis position, velocity, acceleration and jerk against time; contour error against time;
+outputs as off/on lanes. report_page.py puts the summary, the extents table, the event
+table and the program listing (linked to the path both ways) around them.
 
 Traces are decimated to what a screen shows (`screen_indices`: per pixel column the first,
 lowest, highest and last sample), so a 100k-line program gives a page of the same size as a
@@ -14,15 +17,12 @@ page itself stays small and the report folder works offline.
 
 from __future__ import annotations
 
-import html
 import math
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 if TYPE_CHECKING:
-    from .report import RunSummary
     from .runner import ProgramRunner
 
 #: Pixel columns a trace is drawn at (a wide figure); at most 4 samples kept per column.
@@ -51,6 +51,24 @@ def screen_indices(y: np.ndarray, n: int = SCREEN_POINTS) -> np.ndarray:
     return np.unique(np.concatenate(keep))
 
 
+#: At most this many extra samples (the first and last of every command) are kept on the
+#: path so a click on a listing line finds its stretch even when it is shorter than a pixel.
+MAX_BOUNDARY_POINTS = 20_000
+
+
+def path_indices(pos: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """`screen_indices` of the path plus the first and last sample of every command (when
+    there are at most MAX_BOUNDARY_POINTS of them), so every line has points to show."""
+    keep = screen_indices(pos)
+    if len(idx) < 2:
+        return keep
+    change = np.nonzero(np.diff(idx) != 0)[0]
+    edges = np.concatenate([change, change + 1])
+    if edges.size <= MAX_BOUNDARY_POINTS:
+        keep = np.union1d(keep, edges)
+    return keep
+
+
 def _f32(x: np.ndarray) -> np.ndarray:
     """Drawn data as float32 (plotly embeds it as binary: half the bytes, 7 digits)."""
     return np.asarray(x, dtype=np.float32)
@@ -66,7 +84,10 @@ def _derivatives(t: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, ...]:
     return v, a, j
 
 
-def _figures(run: ProgramRunner, err: np.ndarray) -> list[tuple[str, object]]:
+def _figures(run: ProgramRunner, err: np.ndarray,
+             origin: np.ndarray | None = None) -> list[tuple[str, object]]:
+    """The report's figures, (heading, plotly figure) in page order. `origin`: machine
+    position of program zero per runner axis (None: drawn in machine coordinates)."""
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
 
@@ -81,74 +102,98 @@ def _figures(run: ProgramRunner, err: np.ndarray) -> list[tuple[str, object]]:
     v, a, j = _derivatives(t, pos)
     moving = [k for k in range(pos.shape[1]) if np.ptp(pos[:, k]) > 1e-9]
     lin = [k for k in moving if not rot[k]]
-    # ---- path: rapids dashed, feeds coloured by the programmed feed (units/min)
+    # ---- path in program coordinates: rapids dashed, feeds coloured by the programmed
+    # feed (units/min), output-on stretches over it, soft-limit box, worst contour error
     rapid = np.array([bool(getattr(run.op_of.get(int(i)), "rapid", False)) for i in idx])
     cutting = np.array([run.op_of.get(int(i)) is not None for i in idx]) & ~rapid
     feed = np.array([60.0 * float(getattr(run.op_of.get(int(i)), "feed", 0.0)) for i in idx])
+    off = np.zeros(pos.shape[1]) if origin is None else np.asarray(origin, dtype=float)
+    frame = "machine" if origin is None else "program"
+    ppos = pos - off
     if len(lin) >= 2:
-        ax_x, ax_y = lin[0], lin[1]
-        three = len(lin) >= 3
+        cols = lin[:3]
         fig = go.Figure()
-        keep = screen_indices(pos[:, lin])
-        p, r, f, ti = _f32(pos[keep]), ~cutting[keep], _f32(feed[keep]), idx[keep]
-        lines = [run.line_of(int(i)) for i in ti]
+        keep = path_indices(ppos[:, lin], idx)
+        p, r, f = _f32(ppos[keep]), ~cutting[keep], _f32(feed[keep])
+        lines = np.array([run.line_of(int(i)) for i in idx[keep]], dtype=np.int32)
         hover = [f"line {ln}, feed {fe:g} {units}/min" for ln, fe in zip(lines, f, strict=True)]
-        cut = np.where(r, np.nan, 1.0)
-        rap = np.where(r, 1.0, np.nan)
         cuts = f[~r]
         lo, hi = (float(cuts.min()), float(cuts.max())) if cuts.size else (0.0, 1.0)
         if hi - lo <= 1e-6 * max(abs(hi), 1.0):  # one feed: a scale from 0 to it
             lo, hi = 0.0, max(hi, 1.0)
         scale = {"colorscale": "Viridis", "cmin": lo, "cmax": max(hi, lo + 1e-9),
                  "colorbar": {"title": f"feed ({units}/min)"}}  # the cuts' feeds only
-        labels = {"x": f"{run.letters[ax_x]} ({units}, machine)",
-                  "y": f"{run.letters[ax_y]} ({units}, machine)"}
+        three = len(cols) == 3
+        kind = go.Scatter3d if three else go.Scatter
+
+        def xyz(pts: np.ndarray) -> dict[str, object]:
+            return dict(zip("xyz", (pts[:, c] for c in cols), strict=False))
+
+        # output-on stretches first: the path's colours are drawn over them
+        for n, on in output_levels(run, t[keep]).items():
+            fig.add_trace(kind(**xyz(p * np.where(on, 1.0, np.nan)[:, None]), mode="lines",
+                               name=f"do{n} on", hoverinfo="skip", opacity=0.4,
+                               line={"width": 12 if three else 10,
+                                     "color": _COLOURS[(n + 3) % len(_COLOURS)]}))
+        fig.add_trace(kind(**xyz(p * np.where(r, 1.0, np.nan)[:, None]), mode="lines",
+                           name="rapid", customdata=lines, text=hover, hoverinfo="text",
+                           line={"dash": "dash", "color": "#999"}))
         if three:
-            ax_z = lin[2]
-            fig.add_trace(go.Scatter3d(
-                x=p[:, ax_x] * rap, y=p[:, ax_y] * rap, z=p[:, ax_z] * rap, mode="lines",
-                name="rapid", line={"dash": "dash", "color": "#999"}, hoverinfo="skip"))
-            fig.add_trace(go.Scatter3d(
-                x=p[:, ax_x] * cut, y=p[:, ax_y] * cut, z=p[:, ax_z] * cut, mode="lines",
-                name="feed", text=hover, hoverinfo="text+x+y+z",
-                line={"color": f, "width": 4, **scale}))
-            fig.update_layout(scene={"xaxis_title": labels["x"], "yaxis_title": labels["y"],
-                                     "zaxis_title": f"{run.letters[ax_z]} ({units}, machine)",
-                                     "aspectmode": "data"})
+            fig.add_trace(kind(**xyz(p * np.where(r, np.nan, 1.0)[:, None]), mode="lines",
+                               name="feed", customdata=lines, text=hover,
+                               hoverinfo="text+x+y+z", line={"color": f, "width": 4, **scale}))
         else:
-            fig.add_trace(go.Scatter(x=p[:, ax_x] * rap, y=p[:, ax_y] * rap, mode="lines",
-                                     name="rapid", line={"dash": "dash", "color": "#999"}))
-            fig.add_trace(go.Scatter(
-                x=p[:, ax_x] * cut, y=p[:, ax_y] * cut, mode="markers+lines", name="feed",
-                text=hover, line={"color": "#bbb", "width": 1},
-                marker={"color": f, "size": 4, **scale}))
-            _travel_box(fig, run, ax_x, ax_y)
-            if np.any(np.isfinite(err)):
-                w = int(np.nanargmax(err))
-                fig.add_trace(go.Scatter(
-                    x=[pos[w, ax_x]], y=[pos[w, ax_y]], mode="markers", name="worst contour "
-                    f"error {err[w]:.4g} {units} (line {run.line_of(int(idx[w]))})",
-                    marker={"symbol": "x", "size": 14, "color": "red"}))
-            fig.update_xaxes(title=labels["x"])
-            fig.update_yaxes(title=labels["y"], scaleanchor="x", scaleratio=1)
-        fig.update_layout(height=620, legend={"orientation": "h"})
+            fig.add_trace(kind(**xyz(p * np.where(r, np.nan, 1.0)[:, None]),
+                               mode="markers+lines", name="feed", customdata=lines,
+                               text=hover, line={"color": "#bbb", "width": 1},
+                               marker={"color": f, "size": 4, **scale}))
+        box = soft_limit_box(run, [int(c) for c in cols], off)
+        if box is not None:
+            # a part (its cuts) far smaller than the travel is a dot inside the box: the box
+            # is then listed in the legend (one click shows it) but not drawn at first
+            span = np.nanmax(box[:, cols], axis=0) - np.nanmin(box[:, cols], axis=0)
+            part = ppos[cutting][:, cols] if cutting.any() else ppos[:, cols]
+            small = bool(np.all(np.ptp(part, axis=0) < 0.2 * span))
+            fig.add_trace(kind(**xyz(box), mode="lines", name="soft limits (travel)",
+                               hoverinfo="skip", visible="legendonly" if small else True,
+                               line={"dash": "dot", "color": "#c33"}))
+        if np.any(np.isfinite(err)):
+            w = int(np.nanargmax(err))
+            fig.add_trace(kind(**xyz(ppos[w:w + 1]), mode="markers", name="worst contour "
+                               f"error {err[w]:.4g} {units} (line {run.line_of(int(idx[w]))})",
+                               marker={"symbol": "x", "size": 8 if three else 14,
+                                       "color": "red"}))
+        fig.add_trace(kind(**xyz(np.zeros((0, pos.shape[1]))), mode="lines",
+                           name="selected line", hoverinfo="skip",
+                           line={"color": "#e6007e", "width": 6 if three else 4}))
+        labels = [f"{run.letters[c]} ({units}, {frame})" for c in cols]
+        if three:
+            fig.update_layout(scene={"xaxis_title": labels[0], "yaxis_title": labels[1],
+                                     "zaxis_title": labels[2], "aspectmode": "data"})
+        else:
+            fig.update_xaxes(title=labels[0])
+            fig.update_yaxes(title=labels[1], scaleanchor="x", scaleratio=1)
+        fig.update_layout(height=620, legend={"orientation": "h"}, clickmode="event")
         figs.append(("Path", fig))
-    # ---- path speed: programmed feed (times the override it ran at) against actual
+    # ---- path speed: commanded (programmed feed times the override) against executed
     if lin:
+        ovr = run.group.override / 100.0 if run.group is not None else 1.0
         speed = np.linalg.norm(v[:, lin], axis=1) * 60.0
         keep = screen_indices(np.column_stack([speed, feed]))
         fig = go.Figure()
-        fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(np.where(cutting, feed, np.nan)[keep]),
-                                 name="programmed feed", line={"shape": "hv", "dash": "dot"}))
+        fig.add_trace(go.Scatter(x=_f32(tt[keep]),
+                                 y=_f32(np.where(cutting, feed * ovr, np.nan)[keep]),
+                                 name=f"commanded feed (programmed x {ovr * 100:g} %)",
+                                 line={"shape": "hv", "dash": "dot"}))
         fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(speed[keep]),
-                                 name="actual path speed"))
+                                 name="executed path speed"))
         fig.update_layout(height=320, xaxis_title="time (s)",
                           yaxis_title=f"speed ({units}/min)", legend={"orientation": "h"})
         figs.append(("Path speed", fig))
     # ---- per moving axis: position, velocity, acceleration, jerk
     if moving:
-        rows = [("position", pos, ""), ("velocity", v, "/s"), ("acceleration", a, "/s²"),
-                ("jerk", j, "/s³")]
+        rows = [(f"position ({frame})", ppos, ""), ("velocity", v, "/s"),
+                ("acceleration", a, "/s²"), ("jerk", j, "/s³")]
         fig = make_subplots(rows=4, cols=1, shared_xaxes=True, vertical_spacing=0.04,
                             subplot_titles=[r[0] for r in rows])
         for row, (_, data, per) in enumerate(rows, start=1):
@@ -198,62 +243,46 @@ def _figures(run: ProgramRunner, err: np.ndarray) -> list[tuple[str, object]]:
 _COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
 
 
-def _travel_box(fig: object, run: ProgramRunner, ax_x: int, ax_y: int) -> None:
-    """The machine's travel (limit switch edges) as a dotted rectangle."""
+def output_levels(run: ProgramRunner, times: np.ndarray) -> dict[int, np.ndarray]:
+    """Per output channel that changed during the run: its level (bool) at `times`
+    (controller time, as the trace)."""
+    out: dict[int, np.ndarray] = {}
+    for n in sorted({e.index for e in run.events if e.index is not None}):
+        ev = sorted((e for e in run.events if e.index == n), key=lambda e: e.t)
+        at = np.array([e.t for e in ev])
+        lv = np.array([bool(e.level) for e in ev])
+        k = np.searchsorted(at, times, side="right") - 1
+        out[n] = np.where(k >= 0, lv[np.maximum(k, 0)], False)
+    return out
+
+
+def soft_limits(run: ProgramRunner) -> list[tuple[float, float] | None]:
+    """Per runner axis: the travel between its limit switches (machine units), the range
+    the runner refuses moves beyond; None when the axis has no switch."""
     from .runner import travel_limits
 
     ctl = run.group._ctl if run.group is not None else None
     if ctl is None:
-        return
-    lx = travel_limits(ctl, run.axis_indices[ax_x])
-    ly = travel_limits(ctl, run.axis_indices[ax_y])
-    if lx is None or ly is None or not all(map(math.isfinite, (*lx, *ly))):
-        return
-    fig.add_shape(type="rect", x0=lx[0], x1=lx[1], y0=ly[0], y1=ly[1],  # type: ignore[attr-defined]
-                  line={"dash": "dot", "color": "#c33"}, name="travel")
+        return [None] * len(run.letters)
+    return [travel_limits(ctl, i) for i in run.axis_indices]
 
 
-def _events_table(run: ProgramRunner, limit: int = 2000) -> str:
-    rows = [f"<tr><td>{e.t - run.t_start:.4f}</td><td>{html.escape(e.kind)}</td>"
-            f"<td>{e.line}</td><td>{html.escape(e.text)}</td></tr>"
-            for e in run.events[:limit]]
-    if len(run.events) > limit:
-        rows.append(f"<tr><td colspan=4>... {len(run.events) - limit} more</td></tr>")
-    return "\n".join(rows)
-
-
-_STYLE = ("body{font-family:system-ui,sans-serif;margin:1.5em auto;max-width:1200px}"
-          "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 8px;"
-          "text-align:left}pre{background:#f6f6f6;padding:.8em}h2{margin-top:1.5em}")
-
-
-def write_html(run: ProgramRunner, summary: RunSummary, summary_text: str, err: np.ndarray,
-               path: Path, options: str = "") -> Path:
-    """Write the page to `path` and plotly.min.js beside it; the page's path."""
-    title = html.escape(run.file or "program")
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>openmotion run: "
-             f"{title}</title><script src='plotly.min.js'></script><style>{_STYLE}</style>"
-             f"</head><body><h1>openmotion run: {title}</h1>"]
-    if options:
-        parts.append(f"<p>{html.escape(options)}</p>")
-    parts.append(f"<pre>{html.escape(summary_text)}</pre>")
-    for heading, fig in _figures(run, err):
-        parts.append(f"<h2>{html.escape(heading)}</h2>")
-        parts.append(fig.to_html(full_html=False, include_plotlyjs=False,  # type: ignore[attr-defined]
-                                 config={"displaylogo": False, "responsive": True}))
-    parts.append("<h2>Events</h2><table><tr><th>t (s)</th><th>kind</th><th>line</th>"
-                 f"<th>what</th></tr>{_events_table(run)}</table></body></html>")
-    path.write_text("\n".join(parts), encoding="utf-8")
-    write_plotly_js(path.parent)
-    return path
-
-
-def write_plotly_js(folder: Path) -> Path:
-    """plotly.min.js in `folder` (once: an existing copy of the same size is kept)."""
-    from plotly.offline import get_plotlyjs
-
-    js = get_plotlyjs()
-    out = folder / "plotly.min.js"
-    if not (out.exists() and out.stat().st_size == len(js.encode("utf-8"))):
-        out.write_text(js, encoding="utf-8")
-    return out
+def soft_limit_box(run: ProgramRunner, cols: list[int], off: np.ndarray) -> np.ndarray | None:
+    """The soft-limit box of axes `cols` (2 or 3) as a polyline (NaN rows split edges), in
+    the drawn frame; None when one of them has an open side."""
+    lims = soft_limits(run)
+    sel = [lims[c] for c in cols]
+    if any(s is None or not all(map(math.isfinite, s)) for s in sel):
+        return None
+    lo = np.array([s[0] for s in sel]) - off[cols]  # type: ignore[index]
+    hi = np.array([s[1] for s in sel]) - off[cols]  # type: ignore[index]
+    n = len(cols)
+    corner = [lo + (hi - lo) * np.array([(k >> b) & 1 for b in range(n)]) for k in range(2 ** n)]
+    rows: list[np.ndarray] = []
+    for a in range(2 ** n):  # every edge: corners differing in one coordinate
+        for b in range(n):
+            if not a >> b & 1:
+                rows += [corner[a], corner[a | 1 << b], np.full(n, np.nan)]
+    box = np.full((len(rows), len(run.letters)), np.nan)
+    box[:, cols] = np.array(rows)
+    return box

@@ -21,7 +21,7 @@ from pathlib import Path
 from ..errors import MotionError
 from .points import PointTable
 from .progress import RunProgress
-from .report import format_summary, summarize, write_report
+from .report import format_summary, g54_origin, summarize, write_report
 from .runner import ProgramRunner, RunOptions, RunState
 
 #: Controller time (s) between progress updates in virtual time.
@@ -72,14 +72,14 @@ def run_job(args: argparse.Namespace) -> int:
     if params:
         print("G54 origin at the middle of the travel: " + ", ".join(
             f"#{k} = {v:g}" for k, v in sorted(params.items())), file=sys.stderr)
-    print(f"{path}: {len(run.commands)} commands, {len(run.ops)} moves/actions on "
-          f"{''.join(run.letters)} of machine '{cfg.name}', acceleration time "
-          f"{acc_time:g} s, feed override {override:g} %", file=sys.stderr)
-    run.start()
-    if override != 100.0 and run.group is not None:
-        run.group.set_override(float(override))  # before the first cycle: the whole job
     bar = RunProgress(ctl, run)
-    with _CtrlC() as stop:
+    with _CtrlC() as stop:  # from here on Ctrl-C stops the job cleanly
+        print(f"{path}: {len(run.commands)} commands, {len(run.ops)} moves/actions on "
+              f"{''.join(run.letters)} of machine '{cfg.name}', acceleration time "
+              f"{acc_time:g} s, feed override {override:g} %", file=sys.stderr)
+        run.start()
+        if override != 100.0 and run.group is not None:
+            run.group.set_override(float(override))  # before the first cycle: the whole job
         _drive(ctl, run, stop, args.realtime, bar)
         if stop.pressed and run.state in (RunState.RUNNING, RunState.PAUSED):
             line = run.current_line
@@ -94,7 +94,10 @@ def run_job(args: argparse.Namespace) -> int:
     bar.status("writing the report ...")
     options = (f"machine '{cfg.name}' ({''.join(run.letters)}), acceleration time "
                f"{acc_time:g} s, feed override {override:g} %, {args.repeat} pass(es)")
-    report = write_report(run, args.out, path.stem, options)
+    # drawn in program coordinates: G54 as the job set it (the program's own G10 offsets
+    # are not followed: then machine coordinates)
+    origin = g54_origin(run, params) if not sets_g54 else None
+    report = write_report(run, args.out, path.stem, options, origin)
     print(f"report: {report}")
     if getattr(args, "report", False):
         import webbrowser
