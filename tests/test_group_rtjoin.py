@@ -128,10 +128,19 @@ def test_virtual_time_never_uses_the_worker(monkeypatch):
     assert g.async_joins == 0 and g._jobs is None
 
 
-def _in_flight(ctl: Controller, g: Group) -> None:
-    """Wait for a join in flight once the stream is well under way."""
-    assert _wait(ctl, lambda: g._job is not None and g.current_index > 50), \
-        "no join went in flight"
+def _in_flight(ctl: Controller, g: Group, action: Callable[[], object]) -> object:
+    """Run `action()` in the first cycle with a join in flight once the stream is well under
+    way, and return its result. A cycle hook, not a poll from this thread: a join is in
+    flight for a few cycles only, and a loaded machine could let a poll miss every one."""
+    box: dict = {}
+
+    def catch(c: Controller, t: float) -> None:
+        if "result" not in box and g._job is not None and g.current_index > 50:
+            box["result"] = action()
+
+    ctl.add_cycle_hook(catch)
+    assert _wait(ctl, lambda: "result" in box), "no join went in flight"
+    return box["result"]
 
 
 def _indices(g: Group) -> list[int]:
@@ -143,11 +152,13 @@ def _indices(g: Group) -> list[int]:
 
 def test_hold_and_continue_while_a_join_is_in_flight():
     ctl, g, pts, info = _setup()
+    def hold() -> list[int]:
+        taken = [c.index for c in g._job.new]
+        g.hold()
+        return taken
+
     with ctl.start_realtime():
-        _in_flight(ctl, g)
-        with ctl.lock:
-            taken = [c.index for c in g._job.new]
-            g.hold()
+        taken = _in_flight(ctl, g, hold)
         assert _wait(ctl, lambda: g.state is GroupState.HELD)
         with ctl.lock:
             assert g._job is None
@@ -165,14 +176,16 @@ def test_hold_and_continue_while_a_join_is_in_flight():
 @pytest.mark.parametrize("change", ["override", "corner velocity"])
 def test_override_or_settings_while_a_join_is_in_flight(change):
     ctl, g, pts, info = _setup()
+    def change_it() -> object:
+        job = g._job
+        if change == "override":
+            g.set_override(60.0)
+        else:  # the join was planned with other corners: it is planned again
+            g.set_corner_velocity(5.0)
+        return job
+
     with ctl.start_realtime():
-        _in_flight(ctl, g)
-        with ctl.lock:
-            job = g._job
-            if change == "override":
-                g.set_override(60.0)
-            else:  # the join was planned with other corners: it is planned again
-                g.set_corner_velocity(5.0)
+        job = _in_flight(ctl, g, change_it)
         assert _wait(ctl, lambda: g._job is not job)
         assert _wait(ctl, lambda: info["fed"] == N and _done(g)())
     assert g.state is GroupState.IDLE and g.error_code == 0
@@ -182,14 +195,19 @@ def test_override_or_settings_while_a_join_is_in_flight(change):
 
 def test_abort_while_a_join_is_in_flight_drops_its_commands():
     ctl, g, pts, info = _setup()
+    seen: set[int] = set()
+    aborted = {"yes": False}
+    ctl.add_cycle_hook(lambda c, t: seen.add(g.current_index) if aborted["yes"] else None)
+
+    def abort() -> set[int]:
+        taken = {c.index for c in g._job.new}
+        g.abort()
+        info["stop"] = True  # the program is given up: the feeder stops too
+        aborted["yes"] = True
+        return taken
+
     with ctl.start_realtime():
-        _in_flight(ctl, g)
-        seen: set[int] = set()
-        with ctl.lock:
-            taken = {c.index for c in g._job.new}
-            g.abort()
-            info["stop"] = True  # the program is given up: the feeder stops too
-            ctl.add_cycle_hook(lambda c, t: seen.add(g.current_index))
+        taken = _in_flight(ctl, g, abort)
         assert _wait(ctl, lambda: g.state is GroupState.IDLE
                      and not any(a.is_moving for a in g.axes))
         time.sleep(0.05)  # more cycles: nothing the join had taken comes back
