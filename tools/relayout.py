@@ -71,6 +71,7 @@ MAPPING: dict[str, str] = {
     "planning": "core", "realtime": "core", "states": "core",
     # safety reactions
     "safety": "guard", "softlimits": "guard", "comparators": "guard", "inposition": "guard",
+    "responses": "guard",
     # servo and compensation
     "servo": "loops", "servoloop": "loops", "compensation": "loops",
     # card models
@@ -82,7 +83,7 @@ MAPPING: dict[str, str] = {
     "analog": "trigger",
     # homing and latch
     "homing": "home", "homing_modes": "home", "homing_sequence": "home", "latch": "home",
-    "pulserule": "home",
+    "pulserule": "home", "homeconf": "home",
     # groups and path execution
     "group": "groups", "group_checks": "groups", "group_corners": "groups",
     "group_settings": "groups", "groupdue": "groups", "groupexec": "groups",

@@ -1,103 +1,16 @@
-"""Homing settings in the API's user units <-> control.home.homing_modes.HomeConfig (pulses).
+"""Homing settings in user units: the API's names for control.home.homeconf (no logic
+here; the conversion and its checks live in the control layer)."""
 
-The API shows speeds in user units/s and offsets in user units; HomeConfig holds pps and
-pulses. `home_from_user` builds (and so validates) a HomeConfig; `home_to_user` is its
-inverse; `sequence` lists the phases of a mode for the front end's drawing.
-"""
+from ..control.home.homeconf import (
+    MODES,
+    USER_KEYS,
+    choices,
+    default_home,
+    home_configs,
+    home_from_user,
+    home_to_user,
+    sequence,
+)
 
-from __future__ import annotations
-
-import dataclasses
-from typing import TYPE_CHECKING, Any
-
-from ..control.home.homing_modes import EL_STOPS, FINALS, HSL_MODES, MCCL_TYPES, HomeConfig
-from ..errors import MotionError
-
-if TYPE_CHECKING:
-    from ..control.core.axis import Axis
-
-USER_KEYS = ("mode", "direction", "str_vel", "max_vel", "tacc", "tdec", "ez_count",
-             "org_offset", "home_offset", "final", "el_stop", "auto_search", "timeout_s")
-MODES: list[int | str] = [*HSL_MODES, *(f"mccl_{k}" for k in MCCL_TYPES)]
-
-
-def default_home(ax: Axis) -> HomeConfig:
-    """Home towards -1 on ORG (mode 0) at 2 % / 20 % of the axis's maximum safe speed."""
-    vmax = ax.units.max_speed_pps
-    return HomeConfig(mode=0, direction=-1, str_vel=vmax * 0.02, max_vel=vmax * 0.2, tacc=0.1)
-
-
-def home_to_user(ax: Axis, c: HomeConfig) -> dict[str, Any]:
-    ppu = ax.units.pulses_per_unit
-    return {"mode": c.mode, "direction": c.direction, "str_vel": c.str_vel / ppu,
-            "max_vel": c.max_vel / ppu, "tacc": c.tacc,
-            "tdec": c.tacc if c.tdec is None else c.tdec, "ez_count": c.ez_count,
-            "org_offset": c.org_offset / ppu,
-            "home_offset": float(ax.units.to_units(c.home_offset)), "final": c.final,
-            "el_stop": c.el_stop, "auto_search": c.auto_search, "timeout_s": c.timeout_s}
-
-
-def home_from_user(ax: Axis, old: HomeConfig, changes: Any) -> HomeConfig:
-    """`old` with `changes` (user units) applied; MotionError naming the key otherwise."""
-    if not isinstance(changes, dict):
-        raise MotionError(f"changes must be an object, got {changes!r}")
-    for k in changes:
-        if k not in USER_KEYS:
-            raise MotionError(f"changes.{k}: unknown key; valid keys: {', '.join(USER_KEYS)}")
-    ppu = ax.units.pulses_per_unit
-    kw: dict[str, Any] = {}
-    for k, v in changes.items():
-        if k in ("str_vel", "max_vel", "org_offset"):
-            kw[k] = _num(k, v) * ppu
-        elif k == "home_offset":
-            kw[k] = float(round(float(ax.units.to_pulses(_num(k, v)))))
-        else:
-            kw[k] = v
-    for name in ("str_vel", "max_vel"):
-        if name in kw:   # the axis's maximum safe speed, refused in the user's units
-            ax.check_speed(name, _num(name, changes[name]), units=True)
-    try:
-        return dataclasses.replace(old, **kw)   # HomeConfig checks every field (pulses)
-    except MotionError as exc:
-        passed = {k: kw.get(k, getattr(old, k)) for k in _PULSE_KEYS}
-        raise MotionError(_in_user_units(str(exc), ax, passed)) from None
-
-
-#: HomeConfig fields held in pulses (speeds in pps): the API gives them in user units.
-_PULSE_KEYS = ("str_vel", "max_vel", "org_offset", "home_offset")
-
-
-def _in_user_units(message: str, ax: Axis, pulses: dict[str, Any]) -> str:
-    """HomeConfig's refusal quotes the pulse values this module passed it: put back the
-    user-unit values they came from (each value quoted as repr, as HomeConfig does)."""
-    ppu, unit = ax.units.pulses_per_unit, ax.units.unit
-    for k, v in pulses.items():
-        if not isinstance(v, (int, float)) or isinstance(v, bool) or v == 0:
-            continue
-        user = float(ax.units.to_units(v)) if k == "home_offset" else v / ppu
-        text = f"{user:.6g} {unit}/s" if k in ("str_vel", "max_vel") else f"{user:.6g} {unit}"
-        message = message.replace(repr(v), text)
-    return message
-
-
-def _num(name: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise MotionError(f"{name} must be a number, got {v!r}")
-    return float(v)
-
-
-def choices() -> dict[str, Any]:
-    return {"mode": MODES, "direction": [1, -1], "final": list(FINALS),
-            "el_stop": list(EL_STOPS), "ez_count": [0, 15]}
-
-
-def sequence(ax: Axis, c: HomeConfig) -> list[dict[str, Any]]:
-    """The phases of the selected mode: what the front end draws."""
-    ppu = ax.units.pulses_per_unit
-    out = []
-    for ph in c.phases():
-        out.append({"phase": ph.name, "signal": ph.signal, "edge": ph.edge,
-                    "direction": ph.direction * c.direction,
-                    "speed": c.speed(ph.speed) / ppu, "reaction": ph.then,
-                    "mark": ph.mark})
-    return out
+__all__ = ["MODES", "USER_KEYS", "choices", "default_home", "home_configs", "home_from_user",
+           "home_to_user", "sequence"]

@@ -4,10 +4,10 @@ plus the responses (EL / ALM stop modes, ERC, SD, INP, RDY) that live in control
 
 `split_changes` checks a partial change against the rules and splits it into a new
 AxisConfig (validated by the config dataclass itself) and new responses; `apply_responses`
-puts responses on a controller. The responses and the homing settings are saved in the
-machine file itself ([axes.<name>.responses], [axes.<name>.home]: config_toml); the UI
-sidecar `<machine>.ui.toml` of earlier versions is still read (`load_sidecar`) and folded
-into the machine file at its next save.
+(control.guard.responses, re-exported) puts responses on a controller. The responses and
+the homing settings are saved in the machine file itself ([axes.<name>.responses],
+[axes.<name>.home]: config_toml); the UI sidecar `<machine>.ui.toml` of earlier versions
+is still read (`load_sidecar`) and folded into the machine file at its next save.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import os
 import tempfile
 import tomllib
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..config import ENCODER_MODES, LOGIC_SIGNALS, PULSE_MODES, SIGNAL_LOGIC, AxisConfig
 from ..config_toml import (
@@ -28,10 +28,8 @@ from ..config_toml import (
     check_responses,
     default_responses,
 )
+from ..control.guard.responses import apply_responses
 from ..errors import MotionError
-
-if TYPE_CHECKING:
-    from ..control.core.controller import Controller
 
 CONFIG_FIELDS = ("pulse_mode", "pulse_width_us", "encoder_mode", "invert_a", "invert_b",
                  "invert_z", "swap_ab", "reverse", "move_ratio")
@@ -78,20 +76,6 @@ def split_changes(cfg: AxisConfig, responses: dict[str, Any], changes: Any
     new_cfg = dataclasses.replace(cfg, **kw) if kw else cfg   # validates every field
     new_resp = check_responses(f"{path}.responses", changes.get("responses", {}), responses)
     return new_cfg, new_resp
-
-
-def apply_responses(ctl: Controller, axis: int, r: dict[str, Any]) -> None:
-    """Put the responses of one axis on the controller's safety layer."""
-    safety = ctl.safety
-    if safety is None:
-        raise MotionError("the controller has no safety layer")
-    safety.set_el(axis, r["el"])
-    safety.set_limit_check(axis, r["el_enabled"], direction_sensitive=r["el_direction_sensitive"])
-    safety.set_alm(axis, r["alm"])
-    safety.set_erc(axis, r["erc_width_s"])
-    safety.set_sd(axis, r["sd"]["enabled"], latched=r["sd"]["latched"], stop=r["sd"]["stop"])
-    safety.set_inp(axis, r["inp"])
-    safety.set_rdy_check(axis, r["rdy"])
 
 
 __all__ = ["CONFIG_FIELDS", "MAX_ERC_S", "RESPONSE_KEYS", "SD_KEYS", "STOP_MODES",

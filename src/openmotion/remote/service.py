@@ -26,12 +26,13 @@ from ..config_toml import load_machine_settings
 from ..control.core.clock import RealtimePacer
 from ..control.core.controller import Controller
 from ..control.core.states import AxisState
+from ..control.guard.responses import apply_machine_responses
 from ..control.home.homing import Homing
 from ..control.home.homing_modes import HomeConfig
 from ..errors import MotionError
 from ..program.runjob import load_machine_arg
 from .deadman import JogRegistry
-from .homeconf import default_home, home_from_user, home_to_user
+from .homeconf import home_configs, home_from_user, home_to_user
 from .interface import (
     apply_responses,
     atomic_write,
@@ -81,16 +82,8 @@ class MachineService:
         self.ctl = ctl
         self.config = config
         self.estop_reason: str | None = None   # software E-stop latched until machine.reset
-        for ax in ctl.axes:
-            apply_responses(ctl, ax.index, self.responses[ax.name])
-        self.homes: dict[str, HomeConfig] = {}
-        for ax in ctl.axes:
-            base = default_home(ax)
-            user = self._home_user.get(ax.name)
-            try:
-                self.homes[ax.name] = home_from_user(ax, base, user) if user else base
-            except MotionError as exc:   # a machine file's [axes.<name>.home] table
-                raise MotionError(f"axes.{ax.name}.home: {exc}") from None
+        apply_machine_responses(ctl, self.responses)
+        self.homes: dict[str, HomeConfig] = home_configs(ctl, self._home_user)
         self.homings: dict[int, Homing] = {}
         self.jogs = JogRegistry(ctl)
         self.repeats = RepeatRegistry(ctl)
