@@ -13,13 +13,18 @@ try:
 except PackageNotFoundError:  # running from a source tree that was never installed
     __version__ = "0+unknown"
 
-__all__ = ["Controller", "MotionError", "__version__", "default_machine", "load_machine"]
+__all__ = ["Controller", "MotionError", "__version__", "default_machine", "load_machine",
+           "open_machine"]
 
 from .config import default_machine, load_machine
 from .errors import MotionError
 
 
 def __getattr__(name: str) -> Any:
+    if name == "open_machine":   # a machine file -> a Controller obeying all of it
+        from .machine_file import open_machine
+
+        return open_machine
     if name == "Controller":
         from .control import Controller
 

@@ -166,10 +166,16 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 def cmd_config(args: argparse.Namespace) -> int:
     from .config import default_machine, dumps_machine
-    from .program.runjob import load_machine_arg
+    from .machine_file import check_machine_settings
+    from .program.runjob import read_machine_arg
 
-    cfg = load_machine_arg(args.file, "machine file") if args.file else default_machine()
-    print(dumps_machine(cfg), end="")
+    cfg, settings = (read_machine_arg(args.file, "machine file") if args.file
+                     else (default_machine(), {}))
+    try:   # the home tables' mode rules need the axes (units, speeds): the UI's own check
+        check_machine_settings(cfg, settings)
+    except MotionError as exc:
+        raise MotionError(f"{args.file}: {exc}") from None
+    print(dumps_machine(cfg, settings), end="")
     print(f"# OK: machine '{cfg.name}' with {len(cfg.axes)} axes is valid", file=sys.stderr)
     return 0
 

@@ -33,6 +33,7 @@ def run_job(args: argparse.Namespace) -> int:
     axes decelerate along the path, the summary and report cover what ran)."""
     from ..config import default_machine
     from ..control import Controller
+    from ..machine_file import apply_machine_settings
 
     if isinstance(args.repeat, bool) or not isinstance(args.repeat, int) or args.repeat < 1:
         raise MotionError(f"--repeat must be an integer >= 1, got {args.repeat!r}")
@@ -42,7 +43,8 @@ def run_job(args: argparse.Namespace) -> int:
     override = getattr(args, "feed_override", 100.0)
     if not (isinstance(override, float | int) and 1.0 <= override <= 200.0):
         raise MotionError(f"--feed-override must be in [1, 200] %, got {override!r}")
-    cfg = load_machine_arg(args.machine, "--machine") if args.machine else default_machine()
+    cfg, settings = (read_machine_arg(args.machine, "--machine") if args.machine
+                     else (default_machine(), {}))
     path = Path(args.program)
     if not path.is_file():
         raise MotionError(f"program {str(path)!r}: no such file")
@@ -51,6 +53,10 @@ def run_job(args: argparse.Namespace) -> int:
     probe_input = getattr(args, "probe_input", None)
     boxes = parse_probe_boxes(getattr(args, "probe_box", None) or [], probe_input)
     ctl = Controller(cfg)
+    try:   # the file's stop responses (e.g. decelerate on a limit) and home tables
+        apply_machine_settings(ctl, settings)
+    except MotionError as exc:
+        raise MotionError(f"{args.machine}: {exc}") from None
     probe = attach_probe(ctl, probe_input)
     ctl.enable_all()
     if path.suffix in (".toml", ".csv"):
@@ -81,6 +87,8 @@ def run_job(args: argparse.Namespace) -> int:
         if override != 100.0 and run.group is not None:
             run.group.set_override(float(override))  # before the first cycle: the whole job
         _drive(ctl, run, stop, args.realtime, bar)
+        if run.state is RunState.ERROR:   # a fault's decelerating stop (e.g. the machine
+            _axes_to_rest(ctl, args.realtime)   # file's el = "decel") ends before the summary
         if stop.pressed and run.state in (RunState.RUNNING, RunState.PAUSED):
             line = run.current_line
             run.abort()  # decelerating stop along the path
@@ -112,22 +120,19 @@ def run_job(args: argparse.Namespace) -> int:
 def load_machine_arg(path: str, what: str):
     """load_machine with messages naming the flag or argument `what` (no raw [Errno 2]), and
     refusing a machine without axes (nothing could run on it)."""
-    from ..config import load_machine
+    return read_machine_arg(path, what)[0]
 
-    try:
-        cfg = load_machine(path)
-    except FileNotFoundError:
-        raise MotionError(f"{what} {path!r}: no such file") from None
-    except IsADirectoryError:
-        raise MotionError(f"{what} {path!r} is a folder, not a TOML machine file") from None
-    except OSError as exc:
-        raise MotionError(f"{what} {path!r}: cannot read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError:
-        raise MotionError(f"{what} {path!r} is not a UTF-8 TOML text file") from None
+
+def read_machine_arg(path: str, what: str):
+    """The machine and its per-axis settings (responses, home tables) of `path`, checked as
+    `load_machine_arg` does."""
+    from ..machine_file import read_machine_file
+
+    cfg, settings = read_machine_file(path, what)
     if not cfg.axes:
         raise MotionError(f"{os.fspath(path)}: the machine has no axes (add an [axes.<name>] "
                           "table per axis)")
-    return cfg
+    return cfg, settings
 
 
 def with_spindle(cfg, name: str | None):
@@ -275,6 +280,21 @@ def _drive(ctl, run: ProgramRunner, stop: _CtrlC, realtime: bool, bar: RunProgre
     while run.state is RunState.RUNNING and not stop.pressed:
         ctl.run_until(lambda: run.state is not RunState.RUNNING or stop.pressed, _CHUNK)
         bar.update()
+
+
+def _axes_to_rest(ctl, realtime: bool, limit: float = 120.0) -> None:
+    """After a fault: let axes still stopping (a decelerating fault stop) come to rest (at
+    most `limit` s machine time), so the summary and report show where they stopped."""
+    def at_rest() -> bool:
+        return not any(ax.is_moving for ax in ctl.axes)
+
+    if realtime:
+        with ctl.start_realtime():
+            t_end = time.monotonic() + limit
+            while not at_rest() and time.monotonic() < t_end:
+                time.sleep(0.01)
+    elif not at_rest():
+        ctl.run_until(at_rest, limit)
 
 
 def _settle(ctl, run: ProgramRunner, realtime: bool, limit: float = 120.0) -> None:

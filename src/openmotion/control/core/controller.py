@@ -179,6 +179,9 @@ class Controller:
         #: loops (name -> ServoLoop) and the motion I/O reactions (a `Safety`, or None)
         self.servo_loops: dict[str, Any] = {}
         self.safety: Any = None
+        #: homing settings a machine file gave (axis name -> control.home HomeConfig;
+        #: filled by openmotion.machine_file.open_machine, empty otherwise)
+        self.home_settings: dict[str, Any] = {}
         wanted = {"safety": safety}
         for name, attach in _ATTACHMENTS:
             setattr(self, name, attach(self, wanted.get(name, True)))
