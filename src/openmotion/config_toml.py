@@ -7,7 +7,8 @@ Two more tables per axis hold what a commissioning tool sets up (Motion Creator'
 home dialogs): [axes.<name>.responses] (end-limit / alarm stop modes, ERC, SD, INP, RDY)
 and [axes.<name>.home] (homing settings in user units). They are not part of MachineConfig
 (the mechanism); `machine_settings_from_dict` / `loads_machine_settings` /
-`load_machine_settings` read them and `dumps_machine(cfg, settings)` writes them.
+`load_machine_settings` read them and `dumps_machine(cfg, settings)` writes them;
+openmotion.machine_file applies them to a controller (open_machine, run, config).
 Every key is checked: an unknown key is an error naming it. Switch position / width /
 hysteresis are written in the axis's USER units in the file (a person measures switches in
 mm or degrees) and converted to command pulses on load, back on save; `reverse` flips the
@@ -215,8 +216,8 @@ def check_responses(path: str, changes: Any, old: dict[str, Any]) -> dict[str, A
 
 def check_home_table(path: str, table: Any) -> dict[str, Any]:
     """The keys and value types of a home table (user units). The rules that need the
-    homing model (mode numbers, speed order, ranges) are applied by HomeConfig when the
-    settings are used: `openmotion.remote.homeconf.home_from_user`."""
+    homing model and the axis (mode numbers, speed order, ranges) are checked by
+    `openmotion.control.home.homeconf.home_configs` (config, run, open_machine, the UI)."""
     _known(path, table, HOME_KEYS)
     out: dict[str, Any] = {}
     for k, v in table.items():
