@@ -129,3 +129,10 @@ def test_a_refused_setting_changes_nothing(tmp_path):
         apply_machine_settings(ctl, {"w": {"responses": {}}})
     assert [ctl.safety.settings(i) for i in range(len(ctl.axes))] == before
     assert ctl.safety.settings("x").el_decelerate is False
+
+
+def test_without_a_safety_layer_only_default_responses_are_accepted(tmp_path):
+    plain = openmotion.open_machine(machine(tmp_path), safety=False)
+    assert plain.safety is None
+    with pytest.raises(MotionError, match="no safety layer"):
+        openmotion.open_machine(machine(tmp_path, DECEL, "d.toml"), safety=False)

@@ -39,7 +39,8 @@ def apply_machine_responses(ctl: Controller, responses: dict[str, Any]) -> None:
     """Apply per-axis responses {axis name: responses (partial tables allowed: the rest
     are the defaults)}, e.g. from config_toml.load_machine_settings. Everything is checked
     first (names, keys, values: a MotionError naming `axes.<name>.responses.<key>`), so a
-    refusal leaves the controller as it was. Axes not named keep their responses."""
+    refusal leaves the controller as it was. Axes not named keep their responses. On a
+controller without a safety layer (safety=False) only the defaults are accepted."""
     if not isinstance(responses, dict):
         raise MotionError(f"responses must be a dict of axis name -> table, got {responses!r}")
     names = {ax.name: ax.index for ax in ctl.axes}
@@ -50,7 +51,8 @@ def apply_machine_responses(ctl: Controller, responses: dict[str, Any]) -> None:
                               f"axes: {', '.join(names)}")
         checked[names[name]] = check_responses(f"axes.{name}.responses", table,
                                                default_responses())
-    if checked:
-        _safety(ctl)
+    if ctl.safety is None and all(r == default_responses() for r in checked.values()):
+        return   # nothing to put on a controller built with safety=False
+    _safety(ctl)
     for index, r in checked.items():
         apply_responses(ctl, index, r)
