@@ -25,10 +25,9 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
 - G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
   until resume(). M2/M30: end of one pass; `repeat` passes in all.
 - M64/M65: output set when the runner reaches the command (immediately, not waiting for the
-  motion queued before it). M62/M63: set at the exact position where the next motion
-  command starts (syncout.py: a compare-engine window on that corner, or the cycle in which
-  the move starts from rest). M3/M4/M5, M7/M8/M9: wait for the motion to end, then set
-  their outputs. M6: logged, ignored. (MSG)/(DEBUG): logged.
+  motion queued before it). M62/M63: set at the exact instant the group starts the next
+  motion command (syncout.py: Group.start_time, through a compare-engine job).
+  M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs. M6: logged, ignored. (MSG)/(DEBUG): logged.
 - pause() holds the path (decelerating along it), resume() continues, abort() stops along
   the path and drops the rest; single_block pauses after every source line.
 """
@@ -403,6 +402,7 @@ class ProgramRunner:
                                         self.options.spindle_acc_time)
         self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._ctl.add_jump_observer(self._on_jump)
+        self.synced.attach(self.group.start_time)
         if self.options.probe_input is not None:
             self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
 
@@ -489,10 +489,14 @@ class ProgramRunner:
     def _event(self, kind: str, line: int, text: str, **kw: object) -> None:
         self.events.append(RunEvent(self._ctl.time, kind, line, text, **kw))  # type: ignore[arg-type]
 
-    def _set_output(self, op: Op, index: int, level: bool, kind: str) -> None:
+    def _set_output(self, op: Op, index: int, level: bool, kind: str,
+                    t: float | None = None) -> None:
+        """Write output `index` now; the event at `t` (default now: an M62/M63 whose move
+        started earlier in the cycle carries that instant)."""
         self._ctl.hardware.write_output(None, f"do{index}", level)
         self.synced.levels[index] = level
-        self._event(kind, op.line, f"do{index} = {int(level)}", index=index, level=level)
+        self.events.append(RunEvent(self._ctl.time if t is None else t, kind, op.line,
+                                    f"do{index} = {int(level)}", index=index, level=level))
 
     def _write_analog(self, op: Op) -> None:
         assert isinstance(op.source, AnalogOut)
@@ -515,6 +519,7 @@ class ProgramRunner:
         self._event(state.value, self.current_line, text)
         self._ctl.remove_cycle_hook(self._on_cycle)
         self._ctl.remove_jump_observer(self._on_jump)
+        self.synced.detach()
         if self.options.probe_input is not None:
             self._ctl.remove_edge_hook(self._on_probe_edge)
         if self.group is not None:
@@ -700,7 +705,6 @@ class ProgramRunner:
                         g.disable_blend()
                     else:
                         g.enable_blend(op.tolerance)
-                    self.synced.set_blend(op.tolerance, float(np.max(np.abs(self.scales.ppu))))
                 elif op.kind == "action":
                     if isinstance(op.source, canon.Spindle) and self.spindle is not None:
                         self.spindle.apply(op.source)
