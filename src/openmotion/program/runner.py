@@ -27,7 +27,8 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
 - M64/M65: output set when the runner reaches the command (immediately, not waiting for the
   motion queued before it). M62/M63: set at the exact instant the group starts the next
   motion command (syncout.py: Group.start_time, through a compare-engine job).
-  M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs. M6: logged, ignored. (MSG)/(DEBUG): logged.
+  M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs. M6: logged,
+  ignored. (MSG)/(DEBUG): logged.
 - pause() holds the path (decelerating along it), resume() continues, abort() stops along
   the path and drops the rest; single_block pauses after every source line.
 """
