@@ -316,6 +316,7 @@ class ProgramRunner:
         self._trace_t: list[float] = []
         self._trace_i: list[int] = []
         self._trace_p: list[list[float]] = []
+        self._trace_a: list[list[float]] = []  # actual (feedback) positions, pulses
 
     # ------------------------------------------------------------------ compile
     def _positions(self) -> np.ndarray:
@@ -474,6 +475,12 @@ class ProgramRunner:
         p = np.array(self._trace_p, dtype=float).reshape(len(t), len(self.letters))
         return t, idx, p / self.scales.ppu
 
+    def actual_trace(self) -> np.ndarray:
+        """Per cycle of the run (the rows of `trace`): the group axes' actual (feedback)
+        positions in machine units; trace()[2] minus this is the following error."""
+        a = np.array(self._trace_a, dtype=float).reshape(len(self._trace_t), len(self.letters))
+        return a / self.scales.ppu
+
     def line_of(self, index: int) -> int:
         """Source line of a group command index (0 if unknown)."""
         return self._line_of.get(index, 0)
@@ -589,17 +596,18 @@ class ProgramRunner:
         return self._idle()
 
     def _on_jump(self, ctl: Controller, first: int, last: int,
-                 positions: list[list[float]]) -> None:
+                 positions: list[list[float]], actual: list[list[float]]) -> None:
         """A jump crossed cycles first..last: their trace rows, as `_on_cycle` records."""
         g = self.group
         assert g is not None
         idx = [ax.index for ax in g.axes]
         origin, period = ctl._t_origin, ctl.period
-        for k, row in zip(range(first, last + 1), positions, strict=True):
+        for k, row, act in zip(range(first, last + 1), positions, actual, strict=True):
             t = origin + k * period
             self._trace_t.append(t)
             self._trace_i.append(g.index_at(t))
             self._trace_p.append([row[i] for i in idx])
+            self._trace_a.append([act[i] for i in idx])
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         from ..control.groups.group import GroupError, GroupState
@@ -624,6 +632,7 @@ class ProgramRunner:
         self._trace_t.append(t)
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
+        self._trace_a.append([ax.counters.actual() for ax in g.axes])
         self.synced.fire(g.current_index, self._idle_past)
         self.synced_analog.fire(g.current_index, self._idle_past)
         if self.state is not RunState.RUNNING:

@@ -20,8 +20,8 @@ encoder index pulses with nobody latching them, are dropped), and
 finishes that landing cycle exactly as `Controller.step` finishes a cycle. The cycles in
 between are the ones that would have been no-ops, so counters, events, histories and
 outputs are identical (tests/test_jump_equivalence.py runs both ways). Jump observers
-(`Controller.add_jump_observer`) get the command positions of the crossed cycles, so a
-per-cycle record (the program runner's trace) stays complete.
+(`Controller.add_jump_observer`) get the command and actual (feedback) positions of the
+crossed cycles, so a per-cycle record (the program runner's trace) stays complete.
 
 Jumping is off, and every cycle runs, while anything needs each cycle: a sample hook (a
 servo loop closed in Python), a pre-advance or cycle hook without a due function, a
@@ -160,12 +160,13 @@ def jump(ctl: Controller, land: int) -> None:
                 raise
             ends.append(p1v1)
         rec = ctl.recorder
-        run = hw.run_cycles(origin, period, n, stop, wake, trace=rec is not None)
+        run = hw.run_cycles(origin, period, n, stop, wake,
+                            trace=rec is not None or bool(ctl._jump_observers))
         last = run.cycle < stop or run.edges or stop >= land
         if rec is not None:  # the landing cycle is recorded by _finish_cycle
             record_trace(ctl, movers, ends, n, run.trace[:run.cycle - n - (1 if last else 0)])
         if ctl._jump_observers:
-            _observe(ctl, n, run.cycle - 1 if last else stop, movers, ends)
+            _observe(ctl, n, run.cycle - 1 if last else stop, movers, ends, run.trace)
         if last:
             break
         n = stop
@@ -216,8 +217,9 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
 
 
 def _observe(ctl: Controller, n: int, last: int, movers: list,
-             ends: list[np.ndarray]) -> None:
-    """Hand the jump observers the command positions of the crossed cycles n+1..last."""
+             ends: list[np.ndarray], trace: np.ndarray) -> None:
+    """Hand the jump observers the command and actual (feedback, `Counters.actual_from`
+    of the back end's readback `trace`) positions of the crossed cycles n+1..last."""
     if last <= n:
         return
     rows = [[ax.position] * (last - n) for ax in ctl.axes]
@@ -225,5 +227,9 @@ def _observe(ctl: Controller, n: int, last: int, movers: list,
         off = ax.counters._cmd_off  # Axis.position = raw position + this offset
         rows[ax.index] = (p1v1[:last - n, 0] + off).tolist()
     positions = [list(r) for r in zip(*rows, strict=True)]
+    tr = trace[:last - n]
+    act = np.stack([np.asarray(ax.counters.actual_from(tr[:, ax.index, 0], tr[:, ax.index, 1]),
+                               dtype=float) for ax in ctl.axes], axis=1)
+    actual = act.tolist()
     for obs in tuple(ctl._jump_observers):
-        obs(ctl, n + 1, last, positions)
+        obs(ctl, n + 1, last, positions, actual)
