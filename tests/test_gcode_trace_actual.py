@@ -4,6 +4,8 @@ jumps over cycles (jump observers) or runs them one by one."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
@@ -61,3 +63,17 @@ def test_actual_is_the_encoder_at_each_cycle_end_and_jumps_change_nothing():
     np.testing.assert_array_equal(cmd2, cmd)
     np.testing.assert_array_equal(fast.actual_trace(), act)
     assert n_fast == n_ref and crossed > 100  # the fast run did jump
+
+
+def test_report_plots_the_following_error_of_each_moving_axis(tmp_path):
+    from openmotion.program.report import following_errors, write_report
+
+    _, run, _, _, _ = _run(True)
+    fe = following_errors(run)
+    np.testing.assert_array_equal(fe, run.trace()[2] - run.actual_trace())
+    html = write_report(run, tmp_path, "servo").read_text()
+    assert "<h2>Following error</h2>" in html
+    start = html.index("<h2>Following error</h2>")
+    section = html[start:html.index("<h2>", start + 5)]
+    names = re.findall(r'"name":\s*"([^"]*)"', section)
+    assert names == ["X (mm)", "Y (mm)"]  # Z does not move
