@@ -84,6 +84,12 @@ def contour_errors(run: ProgramRunner) -> tuple[np.ndarray, np.ndarray]:
     return err, idx
 
 
+def following_errors(run: ProgramRunner) -> np.ndarray:
+    """Per trace cycle and group axis: commanded minus actual (feedback) position, machine
+    units (deg on rotary axes); rows as `run.trace()`."""
+    return run.trace()[2] - run.actual_trace()
+
+
 def summarize(run: ProgramRunner) -> RunSummary:
     """Figures of a finished (or stopped) run."""
     t, idx, pos = run.trace()

@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .report import following_errors
+
 if TYPE_CHECKING:
     from .runner import ProgramRunner
 
@@ -222,6 +224,18 @@ def _figures(run: ProgramRunner, err: np.ndarray,
         fig.update_layout(height=300, xaxis_title="time (s)",
                           yaxis_title=f"contour error ({units})")
         figs.append(("Contour error", fig))
+    # ---- following error (commanded - actual) per moving axis
+    if moving:
+        fe = following_errors(run)
+        fig = go.Figure()
+        for k in moving:
+            keep = screen_indices(fe[:, k])
+            fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(fe[keep, k]),
+                                     name=f"{run.letters[k]} ({unit_of[k]})",
+                                     line={"color": _COLOURS[k % len(_COLOURS)]}))
+        fig.update_layout(height=300, xaxis_title="time (s)", legend={"orientation": "h"},
+                          yaxis_title="following error (commanded - actual)")
+        figs.append(("Following error", fig))
     # ---- outputs: off/on lanes
     io_ev = [e for e in run.events if e.index is not None]
     if io_ev:

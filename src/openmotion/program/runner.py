@@ -25,10 +25,10 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
 - G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
   until resume(). M2/M30: end of one pass; `repeat` passes in all.
 - M64/M65: output set when the runner reaches the command (immediately, not waiting for the
-  motion queued before it). M62/M63: set at the exact position where the next motion
-  command starts (syncout.py: a compare-engine window on that corner, or the cycle in which
-  the move starts from rest). M3/M4/M5, M7/M8/M9: wait for the motion to end, then set
-  their outputs. M6: logged, ignored. (MSG)/(DEBUG): logged.
+  motion queued before it). M62/M63: set at the exact instant the group starts the next
+  motion command (syncout.py: Group.start_time, through a compare-engine job).
+  M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs. M6: logged,
+  ignored. (MSG)/(DEBUG): logged.
 - pause() holds the path (decelerating along it), resume() continues, abort() stops along
   the path and drops the rest; single_block pauses after every source line.
 """
@@ -316,6 +316,7 @@ class ProgramRunner:
         self._trace_t: list[float] = []
         self._trace_i: list[int] = []
         self._trace_p: list[list[float]] = []
+        self._trace_a: list[list[float]] = []  # actual (feedback) positions, pulses
 
     # ------------------------------------------------------------------ compile
     def _positions(self) -> np.ndarray:
@@ -403,6 +404,7 @@ class ProgramRunner:
                                         self.options.spindle_acc_time)
         self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._ctl.add_jump_observer(self._on_jump)
+        self.synced.attach(self.group.start_time)
         if self.options.probe_input is not None:
             self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
 
@@ -473,6 +475,12 @@ class ProgramRunner:
         p = np.array(self._trace_p, dtype=float).reshape(len(t), len(self.letters))
         return t, idx, p / self.scales.ppu
 
+    def actual_trace(self) -> np.ndarray:
+        """Per cycle of the run (the rows of `trace`): the group axes' actual (feedback)
+        positions in machine units; trace()[2] minus this is the following error."""
+        a = np.array(self._trace_a, dtype=float).reshape(len(self._trace_t), len(self.letters))
+        return a / self.scales.ppu
+
     def line_of(self, index: int) -> int:
         """Source line of a group command index (0 if unknown)."""
         return self._line_of.get(index, 0)
@@ -489,10 +497,14 @@ class ProgramRunner:
     def _event(self, kind: str, line: int, text: str, **kw: object) -> None:
         self.events.append(RunEvent(self._ctl.time, kind, line, text, **kw))  # type: ignore[arg-type]
 
-    def _set_output(self, op: Op, index: int, level: bool, kind: str) -> None:
+    def _set_output(self, op: Op, index: int, level: bool, kind: str,
+                    t: float | None = None) -> None:
+        """Write output `index` now; the event at `t` (default now: an M62/M63 whose move
+        started earlier in the cycle carries that instant)."""
         self._ctl.hardware.write_output(None, f"do{index}", level)
         self.synced.levels[index] = level
-        self._event(kind, op.line, f"do{index} = {int(level)}", index=index, level=level)
+        self.events.append(RunEvent(self._ctl.time if t is None else t, kind, op.line,
+                                    f"do{index} = {int(level)}", index=index, level=level))
 
     def _write_analog(self, op: Op) -> None:
         assert isinstance(op.source, AnalogOut)
@@ -515,6 +527,7 @@ class ProgramRunner:
         self._event(state.value, self.current_line, text)
         self._ctl.remove_cycle_hook(self._on_cycle)
         self._ctl.remove_jump_observer(self._on_jump)
+        self.synced.detach()
         if self.options.probe_input is not None:
             self._ctl.remove_edge_hook(self._on_probe_edge)
         if self.group is not None:
@@ -583,17 +596,18 @@ class ProgramRunner:
         return self._idle()
 
     def _on_jump(self, ctl: Controller, first: int, last: int,
-                 positions: list[list[float]]) -> None:
+                 positions: list[list[float]], actual: list[list[float]]) -> None:
         """A jump crossed cycles first..last: their trace rows, as `_on_cycle` records."""
         g = self.group
         assert g is not None
         idx = [ax.index for ax in g.axes]
         origin, period = ctl._t_origin, ctl.period
-        for k, row in zip(range(first, last + 1), positions, strict=True):
+        for k, row, act in zip(range(first, last + 1), positions, actual, strict=True):
             t = origin + k * period
             self._trace_t.append(t)
             self._trace_i.append(g.index_at(t))
             self._trace_p.append([row[i] for i in idx])
+            self._trace_a.append([act[i] for i in idx])
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         from ..control.groups.group import GroupError, GroupState
@@ -618,6 +632,7 @@ class ProgramRunner:
         self._trace_t.append(t)
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
+        self._trace_a.append([ax.counters.actual() for ax in g.axes])
         self.synced.fire(g.current_index, self._idle_past)
         self.synced_analog.fire(g.current_index, self._idle_past)
         if self.state is not RunState.RUNNING:
@@ -700,7 +715,6 @@ class ProgramRunner:
                         g.disable_blend()
                     else:
                         g.enable_blend(op.tolerance)
-                    self.synced.set_blend(op.tolerance, float(np.max(np.abs(self.scales.ppu))))
                 elif op.kind == "action":
                     if isinstance(op.source, canon.Spindle) and self.spindle is not None:
                         self.spindle.apply(op.source)

@@ -1,44 +1,81 @@
 """M62/M63 for the program runner: an output switched where the next motion starts.
 
 An M62/M63 read by the runner waits (`pending`) until the next line/arc is queued; it is
-then bound to that move (`bind`). While the move before it runs, a compare-engine window job
-(control/trigger/compare.py, `WindowJob` on the command positions of the program's axes) is armed on
-the corner where the bound move starts, +-1e-6 pulse, or +-the blend tolerance in pulses
-with G64 P (`set_blend`); the engine switches the output at the exact crossing time, inside
-the cycle (timed hardware). A move that starts from rest starts on a cycle boundary and the
-output is set in that cycle (`fire`, also exact); a corner the window missed (or G64
-without P, which has no bound) falls back to the cycle in which the move starts.
+then bound to that move (`bind`). "Where the next motion starts" is the instant the group
+starts executing that command: the first instant `Group.index_at` reports it, found on the
+chain position of the command's first element (`Group.start_time`). Never a point of the
+path: a move that ends where it began (a full circle, a helix back over its XY start, a
+move along axes outside the plane) passes its end point at its start as well, so a
+position window on the corner fired when the move before it began.
+
+While the move before the bound one runs, a `_StartJob` is armed in the compare engine
+(control/trigger/compare.py): the engine scans command-position jobs before the hardware
+advances over a cycle, so on timed hardware the output switches at the exact instant inside
+the cycle, and a re-plan inside the cycle re-runs the scan. The start time of the coming
+cycle is taken once, before the hardware runs (`ahead`, a pre-advance hook: the group's
+plan then covers the cycle; after the cycle the group may already have re-planned from its
+end). A start the job did not report (a move that began from rest in the group's hook at a
+cycle end, or an engine whose cycle hook runs after the runner's) is set by `fire` at the
+recorded exact time.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..control.trigger.compare import WindowJob
 from .convert import Op
 
 if TYPE_CHECKING:
     from ..control.core.controller import Controller
     from ..control.trigger.compare import CompareEngine
+    from ..control.trigger.compare_jobs import Action
+
+#: start_time(index, t0, t1): Group.start_time of the runner's group
+StartTime = Callable[[int, float, float], "float | None"]
 
 
 @dataclass
 class _Armed:
-    """An M62/M63 bound to the move `index` that starts at `corner` (pulses) after `prev`."""
+    """An M62/M63 bound to the move `index` (starting at `corner`, pulses) after `prev`."""
 
     index: int
     op: Op
     corner: np.ndarray
     prev: int | None
-    tol: float | None
-    job: object = None
+    t_start: float | None = None  # the exact start of `index`, once a cycle covered it
+    job: _StartJob | None = None
 
 
-#: set_output(op, index, level, kind): the runner writes the output now and logs it.
-SetOutput = Callable[[Op, int, bool, str], None]
+class _StartJob(WindowJob):
+    """A compare job that fires once, when the group starts a command (`when(ta, t1)`:
+    its start time in (ta, t1], or None). A dpos WindowJob on the program's axes to the
+    engine (scanned before the hardware advances, undone and re-run on a re-plan) whose
+    window never excludes: the engine's due bound never lets a cycle be jumped."""
+
+    def __init__(self, axes: Sequence[int], corner: np.ndarray, action: Action,
+                 when: Callable[[float, float], float | None], name: str) -> None:
+        super().__init__(axes, corner[None, :], 1e300, action, name=name)
+        self._when = when
+
+    def scan(self, eng: CompareEngine, ta: float, t1: float) -> list[tuple[float, int, float]]:
+        ta = max(ta, self.t_armed)
+        if ta > t1 or self.index >= self.size:
+            return []
+        t = self._when(ta, t1)
+        if t is None:
+            return []
+        self.index += 1
+        return [(max(t, ta), 0, 0.0)]
+
+
+#: set_output(op, index, level, kind, t): the runner writes the output now and logs it at t.
+SetOutput = Callable[[Op, int, bool, str, float], None]
 #: record(t, op, index, level): the engine switched the output at time t; the runner logs it.
 Record = Callable[[float, Op, int, bool], None]
 
@@ -54,33 +91,53 @@ class SyncedOutputs:
         self._compare = compare
         self._set_output = set_output
         self._record = record
+        self._start_time: StartTime | None = None
         self.pending: list[Op] = []      # read, waiting for the next move to be queued
         self.armed: list[_Armed] = []    # bound to a queued move that has not started
         self.levels: dict[int, bool] = {}  # the runner's view of every output it wrote
         self._prev: int | None = None    # group index of the last queued line/arc
-        self._tol: float | None = 1e-6   # window half-width, pulses; None: no window
 
-    def set_blend(self, tolerance: float | None, ppu_max: float) -> None:
-        """G61 (None) or G64 P tolerance (machine units; >= 1e9: G64 without P). A corner
-        rounded within tol is within tol * |pulses/unit| pulses on each axis: the window
-        uses the largest scale `ppu_max`."""
-        if tolerance is None:
-            self._tol = 1e-6
-        else:
-            self._tol = float(tolerance) * ppu_max + 1e-6 if tolerance < 1e9 else None
+    def attach(self, start_time: StartTime) -> None:
+        """The run starts: `start_time` is its group's; the pre-advance hook is added."""
+        self._start_time = start_time
+        self._ctl.add_pre_advance_hook(self.ahead, due=self._ahead_due)
+
+    def detach(self) -> None:
+        self._ctl.remove_pre_advance_hook(self.ahead)
+
+    def _ahead_due(self, ctl: Controller) -> float:
+        return -math.inf if self.armed else math.inf
+
+    def ahead(self, ctl: Controller, t0: float, t1: float) -> None:
+        """Before the hardware runs (t0, t1]: the start time of each armed move the
+        group's plan starts in that cycle."""
+        for a in self.armed:
+            if a.t_start is None:
+                a.t_start = self._start_in(a, t0, t1)
+
+    def _start_in(self, a: _Armed, t0: float, t1: float) -> float | None:
+        return None if self._start_time is None else self._start_time(a.index, t0, t1)
+
+    def _when(self, a: _Armed) -> Callable[[float, float], float | None]:
+        def when(ta: float, t1: float) -> float | None:
+            if a.t_start is None and self._ctl.time < t1:  # the engine's pre-advance ran first
+                a.t_start = self._start_in(a, ta, t1)
+            t = a.t_start
+            return t if t is not None and t <= t1 else None
+        return when
 
     def bind(self, index: int, start: np.ndarray) -> None:
         """A line/arc with group index `index` starting at `start` (pulses) was queued:
-        the pending M62/M63 switch where it starts."""
+        the pending M62/M63 switch when it starts."""
         for op in self.pending:
-            self.armed.append(_Armed(index, op, start, self._prev, self._tol))
+            self.armed.append(_Armed(index, op, start, self._prev))
         self.pending.clear()
         self._prev = index
 
     def flush(self) -> None:
         """End of a pass: M62/M63 with no motion after them are set now."""
         for op in self.pending:
-            self._set_output(op, op.index, op.level, "sync_output")
+            self._set_output(op, op.index, op.level, "sync_output", self._ctl.time)
         self.pending.clear()
 
     def fire(self, current: int, idle_past: Callable[[int], bool]) -> None:
@@ -89,17 +146,20 @@ class SyncedOutputs:
         for a in list(self.armed):
             started = 0 <= a.index <= current or (current < 0 and idle_past(a.index))
             job = a.job
-            if job is not None and job.hits > 0:  # type: ignore[attr-defined]
+            if job is not None and job.hits > 0:
                 self._fired(a)
                 continue
-            if started:  # from rest (cycle boundary) or the window was missed
+            if started:  # the job has not reported it (see the module docstring)
                 if job is not None:
-                    self._engine().remove(job.id)  # type: ignore[attr-defined]
+                    self._engine().remove(job.id)
                 self.armed.remove(a)
-                self._set_output(a.op, a.op.index, a.op.level, "sync_output")
+                t = self._ctl.time if a.t_start is None else a.t_start
+                self._set_output(a.op, a.op.index, a.op.level, "sync_output", t)
+                if job is not None:  # keep the engine's waveform in step
+                    self._engine().output(a.op.index).set(t, a.op.level)
                 continue
-            if job is None and a.prev is not None and a.tol is not None and current >= a.prev:
-                self._arm_window(a)
+            if job is None and (a.prev is None or current >= a.prev):
+                self._arm(a)
 
     def _engine(self) -> CompareEngine:
         from ..control.trigger.compare import CompareEngine
@@ -108,8 +168,8 @@ class SyncedOutputs:
             self._compare = CompareEngine(self._ctl)
         return self._compare
 
-    def _arm_window(self, a: _Armed) -> None:
-        from ..control.trigger.compare import SetLevel, WindowJob
+    def _arm(self, a: _Armed) -> None:
+        from ..control.trigger.compare import SetLevel
 
         eng = self._engine()
         n = a.op.index
@@ -117,17 +177,17 @@ class SyncedOutputs:
         known = self.levels.get(n, False)
         if line.level_at(self._ctl.time) != known:  # an M64/M65 written around the engine
             line.set(self._ctl.time, known)
-        assert a.tol is not None
-        job = WindowJob(self._axes, a.corner[None, :], a.tol, SetLevel(n, a.op.level),
+        job = _StartJob(self._axes, a.corner, SetLevel(n, a.op.level), self._when(a),
                         name=f"M6{2 if a.op.level else 3} line {a.op.line}")
         eng.add(job)
         a.job = job
 
     def _fired(self, a: _Armed) -> None:
         n, level = a.op.index, a.op.level
+        assert a.job is not None
         edges = [t for t, lv in self._engine().output(n).edges if lv == level]
         t = edges[-1] if edges else self._ctl.time
-        self._engine().remove(a.job.id)  # type: ignore[attr-defined]
+        self._engine().remove(a.job.id)
         self.armed.remove(a)
         self.levels[n] = level
         self._record(t, a.op, n, level)

@@ -93,7 +93,7 @@ DECODER_FIELDS = ("encoder_mode", "swap_ab", "invert_a", "invert_b", "invert_z")
 RECONFIGURABLE = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed", "logic",
                   "pulse_mode", "pulse_width_us", "encoder_lines_per_rev", "move_ratio",
                   *DECODER_FIELDS)
-JumpObserver = Callable[["Controller", int, int, list[list[float]]], None]
+JumpObserver = Callable[["Controller", int, int, list[list[float]], list[list[float]]], None]
 
 
 class Controller:
@@ -320,11 +320,13 @@ class Controller:
                     self._pre_dues.pop(hook, None)
 
     def add_jump_observer(self, observer: JumpObserver) -> None:
-        """Call `observer(controller, first, last, positions)` when a jump (control/core/jump.py)
-        crosses cycles first..last without running their hooks: `positions[i]` holds every
-        axis's command position (pulses) at the end of cycle first + i, exactly as those
-        cycles would have left it. A hook that records something every cycle (a trace)
-        fills the crossed cycles from it and can declare a `due`."""
+        """Call `observer(controller, first, last, positions, actual)` when a jump
+        (control/core/jump.py) crosses cycles first..last without running their hooks:
+        `positions[i]` holds every axis's command position (pulses) at the end of cycle
+        first + i, exactly as those cycles would have left it, and `actual[i]` every axis's
+        `counters.actual()` (the feedback position in the command frame) there. A hook
+        that records something every cycle (a trace) fills the crossed cycles from it and
+        can declare a `due`."""
         if not callable(observer):
             raise MotionError(f"observer must be callable, got {observer!r}")
         with self._lock:

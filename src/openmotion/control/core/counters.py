@@ -170,6 +170,17 @@ class Counters:
         off = np.array([c._fb_off for c in counters], dtype=np.int64)
         return wrap28(np.where(internal, pulses_out, encoder) + off)
 
+    def actual(self) -> float:
+        """The feedback position in the command-counter frame: the encoder (or the output
+        pulses) through the move ratio, plus the command offset, so `Axis.position -
+        actual()` is the following error in pulses whatever the counters were set to."""
+        self._fresh()
+        return self._cmd_off + self._encoder / self._ratio
+
+    def actual_from(self, pulses_out, encoder):
+        """`actual()` for raw hardware totals (ints or int arrays: a jump's readback)."""
+        return self._cmd_off + (pulses_out if self._fb_internal else encoder) / self._ratio
+
     def set_feedback(self, value: int) -> None:
         self._fresh()
         self._fb_off = _check_count("position", value) - self._encoder

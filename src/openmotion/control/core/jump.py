@@ -22,8 +22,8 @@ between are the ones that would have been no-ops, so counters, events, histories
 outputs are identical (tests/test_jump_equivalence.py runs both ways). A motion's pieces
 are computed ahead to its end and kept on it (`_ahead`), so a landing re-queues rows
 already made for the axes still moving. Jump observers
-(`Controller.add_jump_observer`) get the command positions of the crossed cycles, so a
-per-cycle record (the program runner's trace) stays complete.
+(`Controller.add_jump_observer`) get the command and actual (feedback) positions of the
+crossed cycles, so a per-cycle record (the program runner's trace) stays complete.
 
 Jumping is off, and every cycle runs, while anything needs each cycle: a sample hook (a
 servo loop closed in Python), a pre-advance or cycle hook without a due function, a
@@ -176,7 +176,8 @@ def jump(ctl: Controller, land: int) -> None:
                 raise
             ends.append(p1v1)
         rec = ctl.recorder
-        run = hw.run_cycles(origin, period, n, stop, wake, trace=rec is not None)
+        run = hw.run_cycles(origin, period, n, stop, wake,
+                            trace=rec is not None or bool(ctl._jump_observers))
         if run.cycle == ctl._n:  # real time: returned before its first cycle (realtime.py)
             for ax in movers:
                 hw.clear_queue(ax.index)
@@ -185,7 +186,7 @@ def jump(ctl: Controller, land: int) -> None:
         if rec is not None:  # the landing cycle is recorded by _finish_cycle
             record_trace(ctl, movers, ends, n, run.trace[:run.cycle - n - (1 if last else 0)])
         if ctl._jump_observers:
-            _observe(ctl, n, run.cycle - 1 if last else stop, movers, ends)
+            _observe(ctl, n, run.cycle - 1 if last else stop, movers, ends, run.trace)
         if last:
             break
         n = stop
@@ -287,8 +288,9 @@ def _nc_words(ctl: Controller) -> np.ndarray:
 
 
 def _observe(ctl: Controller, n: int, last: int, movers: list,
-             ends: list[np.ndarray]) -> None:
-    """Hand the jump observers the command positions of the crossed cycles n+1..last."""
+             ends: list[np.ndarray], trace: np.ndarray) -> None:
+    """Hand the jump observers the command and actual (feedback, `Counters.actual_from`
+    of the back end's readback `trace`) positions of the crossed cycles n+1..last."""
     if last <= n:
         return
     rows = [[ax.position] * (last - n) for ax in ctl.axes]
@@ -296,5 +298,9 @@ def _observe(ctl: Controller, n: int, last: int, movers: list,
         off = ax.counters._cmd_off  # Axis.position = raw position + this offset
         rows[ax.index] = (p1v1[:last - n, 0] + off).tolist()
     positions = [list(r) for r in zip(*rows, strict=True)]
+    tr = trace[:last - n]
+    act = np.stack([np.asarray(ax.counters.actual_from(tr[:, ax.index, 0], tr[:, ax.index, 1]),
+                               dtype=float) for ax in ctl.axes], axis=1)
+    actual = act.tolist()
     for obs in tuple(ctl._jump_observers):
-        obs(ctl, n + 1, last, positions)
+        obs(ctl, n + 1, last, positions, actual)

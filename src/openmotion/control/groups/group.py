@@ -17,6 +17,7 @@ set_max_pulse_speed/acc stay in pulses (as their MCCL names say).
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import math
 from collections import deque
@@ -257,6 +258,37 @@ class Group(GroupSettings):
             idx = r.cmds[0].index
         self._index_memo = (t, r, r.plan, idx)
         return idx
+
+    def start_time(self, index: int, t0: float, t1: float) -> float | None:
+        """The exact time in [t0, t1] at which the running (or held) chain starts command
+        `index` or a later one: the first instant `index_at` reports one of them (t0 when
+        it already does at t0); None when it does not by t1 or nothing runs. Found on the
+        chain position (where the command's first element starts), so a command that ends
+        where it began (a full circle) or a blend arc it owns count from their start. For
+        times the present run covers (e.g. the coming cycle, before the hardware runs)."""
+        r = self._run or self._held
+        if r is None or t1 < t0:
+            return None
+        if r.plan is None:
+            return max(r.t0, t0) if r.cmds[0].index >= index and r.t0 <= t1 else None
+        plan = r.plan
+        k = bisect.bisect_left(plan.chain.owners, index)  # owners follow the queue order
+        if k >= len(plan.chain.owners):
+            return None
+        s_b = float(plan.chain.cum[k])
+        if plan.s_at(t0) >= s_b:
+            return t0
+        if plan.s_at(t1) < s_b:
+            return None
+        lo, hi = t0, t1  # s(lo) < s_b <= s(hi); s(t) never decreases
+        while True:
+            mid = 0.5 * (lo + hi)
+            if not lo < mid < hi:
+                return hi
+            if plan.s_at(mid) >= s_b:
+                hi = mid
+            else:
+                lo = mid
 
     def _due(self, ctl: Controller) -> float:
         """When the cycle hook may next act (control/groups/groupdue.py)."""
