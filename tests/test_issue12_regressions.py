@@ -362,25 +362,40 @@ def test_14_overruns_are_counted_reported_and_no_cycle_is_skipped():
     ctl = free_axes(1)
     x = ctl["x"]
     slow = {"n": 15}
+    box: dict = {}
 
     def heavy(c, t):  # the first cycles take 4 periods each: the pacer falls behind
+        box.setdefault("t0", time.perf_counter())  # the first cycle's slot, about
         if slow["n"] > 0:
             slow["n"] -= 1
             time.sleep(4 * c.period)
 
+    def deficit() -> float:
+        """Slots passed since the first cycle minus the cycles run."""
+        return (time.perf_counter() - box["t0"]) / ctl.period + 1 - ctl.cycles
+
     ctl.add_cycle_hook(heavy)
     x.move_velocity(1000)
-    t0 = time.perf_counter()
     with ctl.start_realtime():
-        time.sleep(0.2)
-    slots = (time.perf_counter() - t0) / ctl.period
+        # wait until the slow cycles are over and the pacer is back on its schedule; a
+        # loaded machine may starve it for a while, hence the long timeout (no wall-clock
+        # figure is asserted)
+        end = time.perf_counter() + 60.0
+        behind = math.inf
+        while time.perf_counter() < end:
+            time.sleep(0.02)
+            if "t0" in box and slow["n"] == 0:
+                behind = deficit()
+                if behind <= 20:
+                    break
     st = ctl.cycle_stats()
     assert st.overruns >= 1 and st.late >= 10 and st.behind >= 3
     ev = ctl.events.events("overrun")
     assert ev and "catch-up" in ev[0].detail
-    # no slot skipped: the 45 slots the slow cycles overran were run in catch-up (they
-    # were dropped before: about 155 cycles in 200 slots)
-    assert ctl.cycles >= 0.9 * slots - 5
+    # no slot skipped: the 45 slots the slow cycles overran were run in catch-up, so the
+    # pacer comes back to its schedule (when they were dropped it stayed 45 slots behind
+    # for good: about 155 cycles in 200 slots)
+    assert behind <= 20, behind
 
 
 # -- 13: history records: no degenerate records, bounded memory ------------------------
