@@ -255,6 +255,13 @@ def test_a_second_tab_is_told_to_reload_and_sees_the_scope_history(page, browser
     other.wait_for_selector("#reload-banner[hidden]", state="attached")
     other.wait_for_function("() => window.openmotion.configVersion === "
                             "window.openmotion.status.config_version", timeout=30_000)
+    # the page shows the reloaded settings (the form is rebuilt when its interface read
+    # answers, after the version): the refused "9" is gone; a value typed before that
+    # would be overwritten by the rebuild
+    other.wait_for_function(
+        "() => { const e = document.querySelector("
+        "\"#if-pulse [data-name='pulse_width_us'] input\"); return e && e.value !== '9'; }",
+        timeout=30_000)
     field(other, "if-pulse", "pulse_width_us").fill("9")
     other.click("#if-save")
     other.wait_for_selector("#if-saved:has-text('applied'), #if-saved:has-text('saved to')",
