@@ -10,19 +10,6 @@
 
 #ifdef __clang__
 #pragma STDC FP_CONTRACT OFF
-/* _kernel_rt.c: real-time pacing of the compiled cycles (control/core/realtime.py) */
-int rt_before_cycle(long long k);  /* wait for cycle k's slot; 1: return at this boundary */
-void rt_after_cycle(long long k);  /* cycle k done: record its busy time */
-PyObject *rt_paced(PyObject *self, PyObject *args);
-PyObject *rt_wait(PyObject *self, PyObject *args);
-PyObject *rt_close(PyObject *self, PyObject *args);
-PyObject *rt_poll(PyObject *self, PyObject *args);
-PyObject *rt_now(PyObject *self, PyObject *args);
-PyObject *rt_slot(PyObject *self, PyObject *args);
-PyObject *rt_yield(PyObject *self, PyObject *args);
-extern const char rt_paced_doc[], rt_wait_doc[], rt_close_doc[], rt_poll_doc[], rt_now_doc[],
-    rt_slot_doc[], rt_yield_doc[];
-
 #endif
 
 typedef struct {
