@@ -35,171 +35,43 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
-from enum import Enum
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import MotionError, show
 from ..units import AxisUnits
-from . import canon
+from . import canon, runcompile, runqueue
 from .analogout import AnalogOut
-from .convert import ConvertOptions, Op, Scales, convert
+from .convert import Op, Scales
 from .css import FeedMode, SpindleMode
-from .interp import Interpreter, Session, compile_text
+from .interp import Session
 from .options import AXIS_LETTERS, GCodeOptions
 from .orient import Orient
-from .parser import parse_program
 from .probing import Probe, WaitInput
 from .rigidtap import RigidTap
-from .runfeed import ceiling_rps, follow_per_rev, planned_rps, x_reader
+from .runaxes import gcode_fields, machine_axes, travel_limits
+from .runcompile import RunPass
+from .runfeed import follow_per_rev
 from .runrequests import answer, begin_request, on_probe_edge
+from .runtypes import RunEvent, RunOptions, RunState
 from .runwait import InputWait, ProbeMove
-from .source import GCodeError, read_program
+from .source import read_program
 from .spindle import OrientMove, SpindleDrive, SyncMove
 from .splines import SplineFeed
 from .syncout import SyncedAnalog, SyncedOutputs
+
+__all__ = ["ProgramRunner", "RunEvent", "RunOptions", "RunState", "machine_axes",
+           "run_program", "travel_limits"]
 
 if TYPE_CHECKING:
     from ..control.core.controller import Controller
     from ..control.groups.group import Group
     from ..control.trigger.compare import CompareEngine
     from ..hw.interface import InputEdge
-
-
-class RunState(Enum):
-    READY = "ready"
-    RUNNING = "running"
-    PAUSED = "paused"
-    DONE = "done"
-    ABORTED = "aborted"
-    ERROR = "error"
-
-
-@dataclass(frozen=True)
-class RunEvent:
-    """Something that happened during the run: output, pause, message, fault, ..."""
-
-    t: float
-    kind: str
-    line: int
-    text: str
-    index: int | None = None
-    level: bool | None = None
-
-
-@dataclass(frozen=True)
-class RunOptions:
-    """Execution settings (see the module docstring and convert.py)."""
-
-    rapid_ratio: float = 1.0
-    feed_mode: str = "uniform"
-    chord_tol: float = 0.001        # machine units
-    acc_time: float = 0.05          # s from rest to the feed (path accel = feed / acc_time)
-    window: int = 1024              # commands queued in the group at most
-    repeat: int = 1
-    single_block: bool = False
-    optional_stop: bool = False
-    probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
-    spindle_axis: int | str | None = None  # the controller axis that is the spindle
-    spindle_acc_time: float = 0.5   # s of a spindle speed ramp
-
-    def __post_init__(self) -> None:
-        ConvertOptions(self.rapid_ratio, self.feed_mode, self.chord_tol)
-        a = self.acc_time
-        if isinstance(a, bool) or not isinstance(a, (int, float)) or not 0.0 < a < 1e3:
-            raise MotionError(f"acc_time must be a number in (0, 1000) s, got {a!r}")
-        for name, lo in (("window", 1), ("repeat", 1)):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-                raise MotionError(f"{name} must be an integer >= {lo}, got {v!r}")
-        for name in ("single_block", "optional_stop"):
-            if not isinstance(getattr(self, name), bool):
-                raise MotionError(f"{name} must be True or False")
-        sa = self.spindle_acc_time
-        if isinstance(sa, bool) or not isinstance(sa, (int, float)) or not 0.0 < sa < 1e3:
-            raise MotionError(f"spindle_acc_time must be a number in (0, 1000) s, got {sa!r}")
-        sp = self.spindle_axis
-        if sp is not None and (isinstance(sp, bool) or not isinstance(sp, (int, str))):
-            raise MotionError(f"spindle_axis must be an axis index or name, got {sp!r}")
-        pi = self.probe_input
-        if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
-                                   and pi[2:].isdigit()):
-            raise MotionError(f"probe_input must be a board input 'di<n>' or None, got {pi!r}")
-
-
-def machine_axes(ctl: Controller, axes: Mapping[str, int | str] | None = None) -> dict[str, int]:
-    """G-code letter -> controller axis index; default: axes named after letters (x, y, ...),
-    except that a degree axis named after a linear letter (the XYZU table's u) becomes the
-    first free rotary letter A, B or C (G-code U/V/W are linear and scaled by G20)."""
-    if axes is None:
-        out = {a.name.upper(): a.index for a in ctl.axes if a.name.upper() in AXIS_LETTERS
-               and len(a.name) == 1}
-        for letter, index in list(out.items()):
-            # a degree axis named u/v/w (G-code linear letters) becomes the next free A/B/C
-            if ctl.config.axes[index].unit == "degree" and letter not in "ABC":
-                free = [r for r in "ABC" if r not in out]
-                if free:
-                    del out[letter]
-                    out[free[0]] = index
-        if not out:
-            raise MotionError("axes: no controller axis is named after a G-code letter "
-                              f"({AXIS_LETTERS}); pass axes={{'X': 0, ...}}")
-        return out
-    if not isinstance(axes, Mapping) or not axes:
-        raise MotionError(f"axes must be a non-empty mapping letter -> axis, got {axes!r}")
-    out = {}
-    for letter, key in axes.items():
-        if not isinstance(letter, str) or letter.upper() not in AXIS_LETTERS:
-            raise MotionError(f"axes keys must be letters of {AXIS_LETTERS}, got {letter!r}")
-        out[letter.upper()] = ctl.axis(key).index
-    if len(set(out.values())) != len(out):
-        raise MotionError("axes must map letters to different controller axes")
-    return out
-
-
-def travel_limits(ctl: Controller, index: int) -> tuple[float, float] | None:
-    """Travel of a controller axis in its user units between its MEL and PEL switch edges
-    (None when it has neither); an open side is infinite."""
-    cfg = ctl.config.axes[index]
-    if cfg.mel is None and cfg.pel is None:
-        return None
-    u = AxisUnits.from_axis(cfg)
-    ends = [u.to_units(float(sw.position)) for sw in (cfg.mel, cfg.pel) if sw is not None]
-    lo = min(ends) if cfg.mel is not None else -math.inf
-    hi = max(ends) if cfg.pel is not None else math.inf
-    if cfg.mel is not None and cfg.pel is not None:
-        lo, hi = min(ends), max(ends)
-    return (lo, hi)
-
-
-@dataclass
-class _Pass:
-    ops: list[Op]
-    start: np.ndarray
-    pc: int = 0
-
-
-def _gcode_fields(gcode: object) -> dict[str, object]:
-    """The runner's `gcode` argument: GCodeOptions fields by name, minus those the
-    runner sets itself (their values are checked when the options are built)."""
-    if gcode is None:
-        return {}
-    if not isinstance(gcode, Mapping):
-        raise MotionError(f"gcode must be a mapping of GCodeOptions fields, got {show(gcode)}")
-    names = {f.name for f in dataclasses.fields(GCodeOptions)}
-    for key in gcode:
-        if key in ("axes", "n_axes", "start", "machine_units"):
-            raise MotionError(f"gcode must not set {key!r} (the runner sets it)")
-        if key not in names:
-            raise MotionError(f"gcode: {key!r} is not a GCodeOptions field "
-                              f"({', '.join(sorted(names))})")
-    return dict(gcode)
 
 
 class ProgramRunner:
@@ -232,7 +104,7 @@ class ProgramRunner:
                      if k not in "ABC" and u.unit in ("mm", "inch")}
         self.machine_units = "inch" if lin_units == {"inch"} else "mm"
         self.scales = Scales.build(units, self.letters, self.machine_units)
-        self._gextra = _gcode_fields(gcode)
+        self._gextra = gcode_fields(gcode)
         if not isinstance(file, (str, os.PathLike)):
             raise MotionError(f"file must be a file name (str or path) for messages, got "
                               f"{show(file)}")
@@ -331,47 +203,17 @@ class ProgramRunner:
         except MotionError as e:  # a gcode= field (or the soft limits made of the axes')
             raise MotionError(f"gcode options: {e}") from None
 
-    def _compile(self, start: np.ndarray) -> _Pass:
-        cmds = self._commands
-        if cmds is None:
-            assert self._text is not None
-            cmds = compile_text(self._text, self._goptions(start), self.file)
-        self.commands = cmds
-        ops = convert(cmds, self.scales, start, ConvertOptions(
-            self.options.rapid_ratio, self.options.feed_mode, self.options.chord_tol))
-        self._check_analog(cmds)
-        return _Pass(ops, start.copy())
+    def _compile(self, start: np.ndarray) -> RunPass:
+        return runcompile.compile_pass(self, start)
 
-    def _live_pass(self, start: np.ndarray) -> _Pass:
-        """Start interpreting the program against the machine: the ops up to the first
-        probe or input wait (the rest follows each answer, `_answer`)."""
-        assert self._text is not None
-        opts = self._goptions(start)
-        program = parse_program(self._text, self.file, opts.max_line_length)
-        self._session = Interpreter(program, opts).session()
-        chunk = self._session.advance()
-        self._rpm = 0.0
-        return _Pass(self._convert(chunk, start), start.copy())
+    def _live_pass(self, start: np.ndarray) -> RunPass:
+        return runcompile.live_pass(self, start)
 
     def _convert(self, chunk: list[canon.Command], start: np.ndarray) -> list[Op]:
-        ops = convert(chunk, self.scales, start, ConvertOptions(
-            self.options.rapid_ratio, self.options.feed_mode, self.options.chord_tol),
-            rpm=self._rpm)
-        for c in chunk:
-            if isinstance(c, canon.Spindle):
-                self._rpm = c.speed if c.on else 0.0
-        self._check_analog(chunk)
-        return ops
+        return runcompile.convert_chunk(self, chunk, start)
 
     def _check_analog(self, cmds: Sequence[object]) -> None:
-        """M67/M68 values against the board's range, before anything moves."""
-        for c in cmds:
-            if isinstance(c, AnalogOut):
-                try:
-                    self.analog.check(c.index, c.value)
-                except MotionError as exc:
-                    raise GCodeError(f"M{67 if c.synced else 68}: {exc}", line=c.line,
-                                     file=c.file) from None
+        runcompile.check_analog(self, cmds)
 
     @property
     def ops(self) -> list[Op]:
@@ -499,21 +341,13 @@ class ProgramRunner:
 
     def _set_output(self, op: Op, index: int, level: bool, kind: str,
                     t: float | None = None) -> None:
-        """Write output `index` now; the event at `t` (default now: an M62/M63 whose move
-        started earlier in the cycle carries that instant)."""
-        self._ctl.hardware.write_output(None, f"do{index}", level)
-        self.synced.levels[index] = level
-        self.events.append(RunEvent(self._ctl.time if t is None else t, kind, op.line,
-                                    f"do{index} = {int(level)}", index=index, level=level))
+        runqueue.set_output(self, op, index, level, kind, t)
 
     def _write_analog(self, op: Op) -> None:
-        assert isinstance(op.source, AnalogOut)
-        self.analog.set(op.source.index, op.source.value)
-        self._event("analog_output", op.line, op.text, index=op.index)
+        runqueue.write_analog(self, op)
 
     def _record_synced(self, t: float, op: Op, index: int, level: bool) -> None:
-        self.events.append(RunEvent(t, "sync_output", op.line, f"do{index} = {int(level)}",
-                                    index=index, level=level))
+        runqueue.record_synced(self, t, op, index, level)
 
     def _finish(self, state: RunState, text: str) -> None:
         if self._request is not None:  # disarm a probe / input wait in progress
@@ -553,11 +387,7 @@ class ProgramRunner:
             ctl.remove_cycle_hook(self._close_when_idle)
 
     def _idle(self) -> bool:
-        from ..control.groups.group import GroupState
-
-        g = self.group
-        assert g is not None
-        return g.state is GroupState.IDLE and g.queue_length == 0
+        return runqueue.idle(self)
 
     def _due(self, ctl: Controller) -> float:
         """When `_on_cycle` may next act beyond its trace (Controller.add_cycle_hook): now
@@ -579,21 +409,7 @@ class ProgramRunner:
         return -math.inf if self._feed_ready(g) else math.inf
 
     def _feed_ready(self, g: Group) -> bool:
-        """Whether `_feed` would change anything now (mirrors its tests)."""
-        p = self._pass
-        opts = self.options
-        if p.pc >= len(p.ops):
-            return self._idle() and not self.synced.armed and not self.synced_analog.armed
-        if g.queue_length >= opts.window:
-            return False
-        op = p.ops[p.pc]
-        if opts.single_block and self._step_line is not None and op.line != self._step_line:
-            return self._idle()
-        if op.kind in ("line", "arc", "delay", "output", "feedmode") or (
-                op.kind == "analog" and op.synced) or (
-                op.kind == "action" and not op.barrier):
-            return True
-        return self._idle()
+        return runqueue.feed_ready(self, g)
 
     def _on_jump(self, ctl: Controller, first: int, last: int,
                  positions: list[list[float]], actual: list[list[float]]) -> None:
@@ -650,97 +466,10 @@ class ProgramRunner:
             self._finish(RunState.ERROR, self.error)
 
     def _idle_past(self, index: int) -> bool:
-        # the command already ran (a short move started and ended within one cycle)
-        return self.group is not None and self._idle() and index < self._pushed
+        return runqueue.idle_past(self, index)
 
-    def _feed(self, g: Group) -> None:  # noqa: C901 - one dispatch over the op kinds
-        p = self._pass
-        opts = self.options
-        while p.pc < len(p.ops) and g.queue_length < opts.window:
-            op = p.ops[p.pc]
-            if opts.single_block and self._step_line is not None and op.line != self._step_line:
-                if not self._idle():
-                    return
-                self.state = RunState.PAUSED
-                self._step_line = None
-                self._event("single_block", self._last_line, "block done")
-                return
-            synced = isinstance(op.source, canon.SyncedFeed | RigidTap) \
-                and self.spindle is not None
-            if isinstance(op.source, Probe) or op.kind in ("wait", "orient") or synced:
-                if not self._idle():
-                    return
-                self._begin_request(g, op)
-                p.pc += 1
-                self._last_line = op.line
-                return
-            if op.kind in ("line", "arc", "delay"):
-                planned = planned_rps(self, op) if (
-                    self._per_rev and self.spindle is not None and op.kind != "delay") else 0.0
-                if planned > 0.0:  # G95: planned at the highest speed, the override scales
-                    ceiling = ceiling_rps(self, planned)
-                    op = replace(op, feed=op.feed * ceiling / planned)
-                idx = self._push(g, op)
-                if planned > 0.0:
-                    self._per_rev_ops[idx] = ceiling
-                self._line_of[idx] = op.line
-                self.op_of[idx] = op
-                if op.target is not None:
-                    self.starts_of[idx] = self._cursor
-                    self._cursor = op.target
-                if op.kind != "delay":
-                    self.synced.bind(idx, self.starts_of[idx])
-                    self.synced_analog.bind(idx)
-            elif op.kind == "feedmode":
-                self._per_rev = op.synced
-            elif op.kind == "analog":
-                if op.synced:
-                    self.synced_analog.pending.append(op)
-                else:  # M68: after the motion before it (LinuxCNC's task waits for it)
-                    if not self._idle():
-                        return
-                    self._write_analog(op)
-            elif op.kind == "output":
-                if op.synced:
-                    self.synced.pending.append(op)
-                else:
-                    self._set_output(op, op.index, op.level, "output")
-            elif op.kind == "action" and not op.barrier:
-                self._event("message", op.line, op.text)
-            else:  # barriers: blend, pause, end, spindle/coolant/tool
-                if not self._idle():
-                    return
-                if op.kind == "blend":
-                    if op.tolerance is None:
-                        g.disable_blend()
-                    else:
-                        g.enable_blend(op.tolerance)
-                elif op.kind == "action":
-                    if isinstance(op.source, canon.Spindle) and self.spindle is not None:
-                        self.spindle.apply(op.source)
-                    elif isinstance(op.source, SpindleMode) and self.spindle is not None:
-                        k = op.source.x_axis
-                        self.spindle.set_mode(op.source, x_reader(self, k))
-                    for index, level in op.outputs:
-                        self._set_output(op, index, level, "output")
-                    self._event("action", op.line, op.text)
-                elif op.kind == "pause" and (not op.optional or opts.optional_stop):
-                    p.pc += 1
-                    self._last_line = op.line
-                    self.state = RunState.PAUSED
-                    self._event("program_pause", op.line, "M1" if op.optional else "M0")
-                    return
-                elif op.kind == "end":
-                    p.pc = len(p.ops)
-                    self._last_line = op.line
-                    break
-            p.pc += 1
-            self._last_line = op.line
-            if opts.single_block:
-                self._step_line = op.line
-        if p.pc >= len(p.ops) and self._idle() and not self.synced.armed \
-                and not self.synced_analog.armed:
-            self._end_of_pass()
+    def _feed(self, g: Group) -> None:
+        runqueue.feed(self, g)
 
     def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
         on_probe_edge(self, ctl, e)
@@ -752,43 +481,10 @@ class ProgramRunner:
         return answer(self, g)
 
     def _push(self, g: Group, op: Op) -> int:
-        self._pushed += 1
-        if op.kind == "delay":
-            return g.delay(op.seconds)
-        g.set_feed(op.feed)
-        assert op.end is not None
-        if op.kind == "line":
-            return g.line(op.end)
-        assert op.centre is not None
-        return g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
-                     turns=op.turns)
+        return runqueue.push(self, g, op)
 
     def _end_of_pass(self) -> None:
-        self.synced.flush()
-        self.synced_analog.flush()
-        self.passes_done += 1
-        if self.passes_done >= self.options.repeat:
-            self._finish(RunState.DONE, f"{self.passes_done} pass(es) done")
-            return
-        self._event("repeat", self._last_line, f"pass {self.passes_done + 1}")
-        pos = self._positions()
-        self._cursor = pos
-        if self._live:
-            try:
-                self._pass = self._live_pass(pos)
-            except (GCodeError, MotionError) as err:
-                self.error = str(err)
-                self._event("fault", 0, str(err))
-                self._finish(RunState.ERROR, self.error)
-        elif np.array_equal(pos, self._pass.start):
-            self._pass.pc = 0
-        else:  # a program that does not return to its start: re-plan from here
-            try:
-                self._pass = self._compile(pos)
-            except (GCodeError, MotionError) as err:
-                self.error = str(err)
-                self._event("fault", 0, str(err))
-                self._finish(RunState.ERROR, self.error)
+        runqueue.end_of_pass(self)
 
 
 def run_program(ctl: Controller, program: str | os.PathLike[str] | Sequence[canon.Command], *,

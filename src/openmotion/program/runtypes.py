@@ -1,0 +1,70 @@
+"""The program runner's public records: its state, its events and its settings."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from ..errors import MotionError
+from .convert import ConvertOptions
+
+
+class RunState(Enum):
+    READY = "ready"
+    RUNNING = "running"
+    PAUSED = "paused"
+    DONE = "done"
+    ABORTED = "aborted"
+    ERROR = "error"
+
+
+@dataclass(frozen=True)
+class RunEvent:
+    """Something that happened during the run: output, pause, message, fault, ..."""
+
+    t: float
+    kind: str
+    line: int
+    text: str
+    index: int | None = None
+    level: bool | None = None
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Execution settings (see the module docstring and convert.py)."""
+
+    rapid_ratio: float = 1.0
+    feed_mode: str = "uniform"
+    chord_tol: float = 0.001        # machine units
+    acc_time: float = 0.05          # s from rest to the feed (path accel = feed / acc_time)
+    window: int = 1024              # commands queued in the group at most
+    repeat: int = 1
+    single_block: bool = False
+    optional_stop: bool = False
+    probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
+    spindle_axis: int | str | None = None  # the controller axis that is the spindle
+    spindle_acc_time: float = 0.5   # s of a spindle speed ramp
+
+    def __post_init__(self) -> None:
+        ConvertOptions(self.rapid_ratio, self.feed_mode, self.chord_tol)
+        a = self.acc_time
+        if isinstance(a, bool) or not isinstance(a, (int, float)) or not 0.0 < a < 1e3:
+            raise MotionError(f"acc_time must be a number in (0, 1000) s, got {a!r}")
+        for name, lo in (("window", 1), ("repeat", 1)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+                raise MotionError(f"{name} must be an integer >= {lo}, got {v!r}")
+        for name in ("single_block", "optional_stop"):
+            if not isinstance(getattr(self, name), bool):
+                raise MotionError(f"{name} must be True or False")
+        sa = self.spindle_acc_time
+        if isinstance(sa, bool) or not isinstance(sa, (int, float)) or not 0.0 < sa < 1e3:
+            raise MotionError(f"spindle_acc_time must be a number in (0, 1000) s, got {sa!r}")
+        sp = self.spindle_axis
+        if sp is not None and (isinstance(sp, bool) or not isinstance(sp, (int, str))):
+            raise MotionError(f"spindle_axis must be an axis index or name, got {sp!r}")
+        pi = self.probe_input
+        if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
+                                   and pi[2:].isdigit()):
+            raise MotionError(f"probe_input must be a board input 'di<n>' or None, got {pi!r}")
