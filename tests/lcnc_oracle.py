@@ -104,6 +104,8 @@ class _Canon:
         self.sync: float | None = None  # START_SPEED_FEED_SYNC pitch, mm per revolution
         self.per_rev = False  # SET_FEED_MODE(0, 1): G95, feeds per spindle revolution
         self.rpm = 0.0
+        self.css_max = 0.0  # SET_SPINDLE_MODE(0 D): G96 at most D rpm (0: G97)
+        self.css_mm = 0.0  # G96 surface speed, mm/min (S in m/min in G21, ft/min in G20)
 
     def mm(self, vals: list[float]) -> list[float]:
         return [v if k in ROTARY else v * self.scale for k, v in enumerate(vals)]
@@ -119,6 +121,9 @@ class _Canon:
     def feed_for(self, end: list[float]) -> float:
         """Feed of a move to `end` per minute (G95: per revolution x the commanded S)."""
         k = self.rpm if self.per_rev else 1.0
+        if self.per_rev and self.css_max > 0:  # G96: the rpm at the move's start X
+            r = abs(self.pos[0] - self.g5x[0] - self.g92[0] - self.tool[0])
+            k = self.css_max if r == 0 else min(self.css_max, self.css_mm / (2 * math.pi * r))
         return k * self._feed_for(end)
 
     def _feed_for(self, end: list[float]) -> float:
@@ -155,6 +160,9 @@ def parse_listing(listing: str) -> list[Motion]:
             c.per_rev = _nums(args)[1] == 1
         elif name == "SET_SPINDLE_SPEED":
             c.rpm = _nums(args)[1]
+            c.css_mm = c.rpm * (12 * 25.4 if c.scale != 1.0 else 1000.0)
+        elif name == "SET_SPINDLE_MODE":
+            c.css_max = _nums(args)[1]
         elif name == "START_SPEED_FEED_SYNC":
             c.sync = _nums(args)[0] * c.scale
         elif name == "STOP_SPEED_FEED_SYNCH":

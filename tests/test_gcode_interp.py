@@ -452,7 +452,6 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 
 
 @pytest.mark.parametrize("code, feature", [
-    ("G71 Q1", "roughing"),
     ("G87 Z-1 R1 I1 J1 K1", "back boring"),
     ("M101", "user M-code"), ("M60", "pallet")])
 def test_unsupported_features_are_named_before_any_motion(code, feature):

@@ -11,6 +11,7 @@ G_GROUP = {
     0: 1, 10: 1, 20: 1, 30: 1, 50: 1, 51: 1, 52: 1, 53: 1, 330: 1, 331: 1, 760: 1, 800: 1, 730: 1,
     740: 1, 810: 1, 820: 1,
     830: 1, 840: 1, 850: 1, 860: 1, 880: 1, 890: 1, 382: 1, 383: 1, 384: 1, 385: 1,
+    700: 1, 710: 1, 711: 1, 712: 1, 720: 1, 721: 1, 722: 1,  # lathe cycles (latheprofile.py)
     170: 2, 180: 2, 190: 2,
     900: 3, 910: 3,
     901: 4, 911: 4,
@@ -26,9 +27,6 @@ G_GROUP = {
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
 G_REFUSED = {
-    700: "lathe finishing cycle (G70) is not supported",
-    710: "lathe roughing cycle (G71) is not supported",
-    720: "lathe roughing cycle (G72) is not supported",
     **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
 }
 #: Why some well-known M-codes are refused.

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 from . import canon
 from .fastpath import compile_plain
+from .latheprofile import ProfileReader, pending_cycle
 from .loopguard import LoopGuard
 from .modal import Modal
 from .modalstate import on_return
@@ -164,6 +165,7 @@ class _Frame:
     repeat_left: int = 0
     start: int = 0
     loops: dict[int, list] = field(default_factory=dict)  # loop head -> LoopGuard record
+    profile: ProfileReader | None = None  # a G7x cycle reading its profile (this call)
 
 
 class Interpreter:
@@ -184,10 +186,13 @@ class Interpreter:
             label, i = next(iter(self.flow.missing.items()))
             self._load(label, self.blocks[i])
 
-    def _load(self, label: str, b: Block) -> None:
-        """Append subroutine file <label>.ngc (found on the search path) and re-analyse."""
+    def _load(self, label: str, b: Block, at: tuple[int, str] | None = None) -> None:
+        """Append subroutine file <label>.ngc (found on the search path) and re-analyse;
+        `at`: the caller's (position, word) when it is not an O-word or M98 (G70-G72)."""
         o = b.oword
         pos, word = (o.pos, f"O{label} call") if o is not None else (0, f"M98 P{label}")
+        if at is not None:
+            pos, word = at
         path = find_subroutine(label, self.search)
         if path is None:
             where = ", ".join(self.search) or "(no search path)"
@@ -235,6 +240,7 @@ class Interpreter:
         out: list[canon.Command] = []
         self._out = out
         frames: list[_Frame] = [_Frame("", -1)]
+        self._profile: ProfileReader | None = None
         steps = 0
         limit = self.opt.max_blocks
         guard = LoopGuard(modal, self.opt.max_loop_iterations)
@@ -259,6 +265,10 @@ class Interpreter:
                 continue
             o = b.oword
             modal.line = b.line
+            if o is None and self._profile is not None:  # a G70-G72 profile line
+                self._profile.line(modal, b)
+                pc += 1
+                continue
             if o is None:
                 try:
                     more = modal.execute(b, out)
@@ -282,6 +292,11 @@ class Interpreter:
                     pc += 1
                     continue
                 modal.flow_request = None
+                if req[0] == "G7x":
+                    pc = self._lathe_call(b, pc, frames)
+                    flow = self.flow  # a profile from a file extends the program
+                    n = len(blocks)
+                    continue
                 pc = self._fanuc(b, pc, req, frames)
                 flow = self.flow
                 n = len(blocks)
@@ -307,6 +322,9 @@ class Interpreter:
                 on_return(modal, self.params.depth, b, out)
                 self.params.pop_call()
                 pc = frame.return_to
+                if frame.profile is not None:  # the profile is read: cut it
+                    self._profile = None
+                    frame.profile.finish(modal, out)
             elif kw == "CALL":
                 if len(frames) > self.opt.max_call_depth:
                     raise b.error(f"subroutine calls nested deeper than "
@@ -393,6 +411,26 @@ class Interpreter:
             open_block_error(modal, blocks[min(pc, n) - 1], 0, "the end of the program")
         return out
 
+
+    def _lathe_call(self, b: Block, pc: int, frames: list[_Frame]) -> int:
+        """G70-G72: call the profile subroutine, its lines read by a ProfileReader."""
+        cycle = pending_cycle(self.modal)
+        label = cycle.label
+        if label not in self.flow.subs:
+            if label in self.flow.fanuc:
+                raise b.error(f"{cycle.word} Q{label}: O{label} is a Fanuc-style program "
+                              f"(M99); the profile must be O{label} sub ... endsub",
+                              cycle.gpos, cycle.word)
+            self._load(label, b, (cycle.gpos, f"{cycle.word} Q{label}"))
+        if len(frames) > self.opt.max_call_depth:
+            raise b.error(f"subroutine calls nested deeper than {self.opt.max_call_depth}",
+                          cycle.gpos, cycle.word)
+        reader = ProfileReader(self.modal, cycle)
+        self.params.set_named("_VALUE_RETURNED", 0.0)
+        self.params.push_call([])
+        frames.append(_Frame(label, pc + 1, profile=reader))
+        self._profile = reader
+        return self.flow.subs[label][0] + 1
 
     @staticmethod
     def _label(b: Block, v: float, pos: int) -> str:

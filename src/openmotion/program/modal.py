@@ -28,6 +28,7 @@ from .css import FeedMode, g96, nominal_rpm
 from .cuttercomp import CutterComp, comp_off, comp_on
 from .cycles import CYCLES, CycleState, canned_cycle
 from .expr import EvalError, Node
+from .latheprofile import LATHE_CYCLES, lathe_cycle
 from .messages import comment_commands
 from .modalstate import SavedState, state_word
 from .named import READ_ONLY, predefined
@@ -438,7 +439,7 @@ class Modal:
                 self.cycle.initial = None  # a series of cycles ends at any other motion
             if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")) or (
                     (1 in gs or self.polar_inc is not None) and self.motion in CYCLES) or (
-                    1 in gs and self.motion in (52, 53)):
+                    1 in gs and self.motion in (52, 53)) or self.motion in LATHE_CYCLES:
                 self._motion(b, gs, axes, words, used, out, machine=g0 is not None)
                 used.update(axes)
         if 11 in ms and ms[11][0] == 98:
@@ -619,6 +620,9 @@ class Modal:
                 raise b.error("canned cycles cannot be used with cutter compensation on",
                               gpos, gword)
             canned_cycle(self, b, mode, gpos, axes, words, used, out)
+            return
+        if mode in LATHE_CYCLES:
+            lathe_cycle(self, b, mode, gpos, axes, words, used, out)
             return
         if mode == 331:
             g33_1(self, b, gpos, axes, words, used, out)
