@@ -138,3 +138,12 @@ def test_spline_runs_on_the_machine_to_the_exact_end():
     moving = pos[:, 0] > 5.0 + 1e-6
     d = np.min(np.linalg.norm(pos[moving, None, :] - dense[None, :, :], axis=2), axis=1)
     assert d.max() < 0.02
+
+
+@pytest.mark.parametrize("gword", ["G5.2", "G[5.2]", "G#1", "g [ 5 + 0.2 ]"])
+def test_open_nurbs_block_at_the_end_is_refused_also_when_the_code_is_computed(gword):
+    """compile_text's fast path never sees the end of a program: a computed G5.2 must take
+    the general path too, which refuses the block left open."""
+    text = f"G21 F100\n#1=5.2\n{gword} X0 Y0 P1 L3\nX1 Y1 P1\nX2 Y0 P1\n"
+    with pytest.raises(GCodeError, match="not closed with G5.3"):
+        compile_text(text, GCodeOptions(axes={"X": 0, "Y": 1}))

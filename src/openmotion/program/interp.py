@@ -33,7 +33,10 @@ from .probing import Request, Result, apply_result, preview_result
 from .source import GCodeError, decode_program, read_program
 from .splines import open_block_error
 
-_NURBS = re.compile(r"G\s*0*5\s*\.\s*2", re.IGNORECASE)
+#: Programs the fast path must leave to the general one: a literal G5.2 or any computed G
+#: word (G[..], G#..), which might be a G5.2 whose open block only the general path's
+#: end-of-program check finds.
+_GENERAL_ONLY = re.compile(r"G\s*0*5\s*\.\s*2|G\s*[\[#]", re.IGNORECASE)
 _OPENERS = {"SUB": "ENDSUB", "IF": "ENDIF", "WHILE": "ENDWHILE", "DO": "WHILE",
             "REPEAT": "ENDREPEAT"}
 _LOOPS = ("WHILE", "DO", "REPEAT")
@@ -576,7 +579,7 @@ def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon
                          f"{options.max_bytes}", file=file)
     lines = text.splitlines()
     # a G5.2 block must be closed: only the general path checks the program's end
-    if len(lines) <= MAX_LINES and not _NURBS.search(text):  # fastpath.py: plain lines
+    if len(lines) <= MAX_LINES and not _GENERAL_ONLY.search(text):  # fastpath.py
         return compile_plain(lines, options, file, lambda: _compile_full(text, options, file))
     return _compile_full(text, options, file)
 
