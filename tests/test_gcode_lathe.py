@@ -151,3 +151,26 @@ M2
 """
     with pytest.raises(GCodeError, match="no progress"):
         compile_text(text, OPTS)
+
+
+def test_the_lathe_example_binds_to_the_xz_machine():
+    """examples/gcode/lathe_rough_finish.ngc on examples/lathe_xz.toml: compiled against
+    its travel (soft limits from the switches), roughing layers, the groove's pocket and
+    the finishing arcs all there (the run itself: test_examples_run with --long)."""
+    from pathlib import Path
+
+    from openmotion.config import load_machine
+    from openmotion.control import Controller
+    from openmotion.program.runner import ProgramRunner
+
+    root = Path(__file__).resolve().parent.parent / "examples"
+    ctl = Controller(load_machine(root / "lathe_xz.toml"))
+    run = ProgramRunner(ctl, root / "gcode" / "lathe_rough_finish.ngc",
+                        gcode={"parameters": {5221: 1.0, 5223: -60.0}})
+    kinds = [op.kind for op in run.ops]
+    assert kinds.count("arc") >= 10 and kinds.count("line") > 80
+    # the groove (a G2 R6 between Z-26 and Z-34 on the 18 mm diameter, 1.5 mm deep) is
+    # roughed as a pocket: cuts below radius 8.5 (machine = program + G54 X1 Z-60)
+    groove = [op.end[0] - 1.0 for op in run.ops if op.kind == "line"
+              and op.end is not None and -33.5 < op.end[1] + 60.0 < -26.5]
+    assert min(groove) < 8.5
