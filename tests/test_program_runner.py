@@ -166,10 +166,12 @@ def test_synced_output_fires_with_next_motion_and_immediate_at_once():
     run = run_program(ctl, prog, timeout=60)
     ev = {(e.index, e.level): e for e in run.events if e.index is not None}
     assert set(ev) == {(1, True), (2, True), (2, False)}
-    # M64 is set while the first move still runs; M62 when the X10 move starts
-    assert ev[(1, True)].t < 0.4
-    t_start_2 = ev[(2, True)].t
+    # M64 once the first move has ended (LinuxCNC waits for it); M62 when X10 starts
     t, idx, p = run.trace()
+    k1 = int(np.searchsorted(t, ev[(1, True)].t))
+    assert p[k1, 0] == pytest.approx(5.0, abs=1e-9)  # the X5 move is over
+    assert ev[(1, True)].t <= ev[(2, True)].t
+    t_start_2 = ev[(2, True)].t
     k = int(np.searchsorted(t, t_start_2))
     assert p[k, 0] == pytest.approx(5.0, abs=0.02)
 

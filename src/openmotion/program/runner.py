@@ -24,8 +24,8 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
   end (the group applies blending when a chain starts).
 - G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
   until resume(). M2/M30: end of one pass; `repeat` passes in all.
-- M64/M65: output set when the runner reaches the command (immediately, not waiting for the
-  motion queued before it). M62/M63: set at the exact instant the group starts the next
+- M64/M65: output set once the motion queued before it has ended (LinuxCNC's task waits
+  for it, as for M68). M62/M63: set at the exact instant the group starts the next
   motion command (syncout.py: Group.start_time, through a compare-engine job).
   M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs. M6: logged,
   ignored. (MSG)/(DEBUG): logged.

@@ -75,8 +75,8 @@ def feed_ready(run: ProgramRunner, g: Group) -> bool:
     op = p.ops[p.pc]
     if opts.single_block and run._step_line is not None and op.line != run._step_line:
         return run._idle()
-    if op.kind in ("line", "arc", "delay", "output", "feedmode") or (
-            op.kind == "analog" and op.synced) or (
+    if op.kind in ("line", "arc", "delay", "feedmode") or (
+            op.kind in ("analog", "output") and op.synced) or (
             op.kind == "action" and not op.barrier):
         return True
     return run._idle()
@@ -132,7 +132,9 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
         elif op.kind == "output":
             if op.synced:
                 run.synced.pending.append(op)
-            else:
+            else:  # M64/M65: after the motion before it (LinuxCNC's task waits for it)
+                if not run._idle():
+                    return
                 run._set_output(op, op.index, op.level, "output")
         elif op.kind == "action" and not op.barrier:
             run._event("message", op.line, op.text)
