@@ -222,7 +222,8 @@ def inch_tool_table(path: Path = TOOLS) -> str:
 
 
 def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None,
-              extra_files: dict[str, str] | None = None) -> Rs274Result:
+              extra_files: dict[str, str] | None = None, timeout: float = 60.0
+              ) -> Rs274Result:
     """Run rs274 on program text (in a scratch folder, with `extra_files` next to it)."""
     tool_table = inch_tool_table() if tool_table is None else tool_table
     exe = rs274 or rs274_path()
@@ -238,7 +239,7 @@ def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None
         for _ in range(2):  # rs274 was seen dying by a signal (SIGBUS) under load: retry
             proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", "-g",
                                    "test.ngc"], cwd=d, capture_output=True, text=True,
-                                  timeout=60, env={**os.environ, "TMPDIR": tmp})
+                                  timeout=timeout, env={**os.environ, "TMPDIR": tmp})
             if proc.returncode >= 0:
                 break
     listing = proc.stdout
