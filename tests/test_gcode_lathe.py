@@ -112,6 +112,9 @@ def test_the_profile_sub_may_come_from_a_file(tmp_path):
 
     cmds = compile_file(main, OPTS)
     assert sum(isinstance(c, Feed) for c in cmds) > 5
+    from openmotion.program.stream import stream_file
+
+    assert list(stream_file(main, OPTS)) == cmds  # the streaming compile hands it over
 
 
 @pytest.mark.parametrize("body, line, column, word, text", [
