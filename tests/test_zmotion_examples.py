@@ -88,11 +88,19 @@ def test_hw_timer_edits_and_soft_close(run):
     assert r["ignored"] == 2
 
 
-def test_article_main_program_runs_the_selected_subroutines(run, tmp_path):
+def test_article_main_program_runs_the_selected_subroutines(tmp_path):
+    # the two shortest subroutines, one after the other on one controller (Clean_Pos
+    # between them): each gives what its example gives on a fresh controller
     sys.path.insert(0, str(EXAMPLES))
     try:
-        r = importlib.import_module("article").main(tmp_path, cmds=(1, 35))
+        r = importlib.import_module("article").main(tmp_path, cmds=(36, 35))
+        with pytest.raises(ValueError, match="g_cmd 4"):
+            importlib.import_module("article").main(tmp_path, cmds=(4,))
     finally:
         sys.path.remove(str(EXAMPLES))
-    np.testing.assert_allclose(r[1]["widths"], [0.5] * 3, atol=1e-9)
-    np.testing.assert_allclose(r[35]["widths"], [0.05] * 6, atol=1e-9)
+    pts = np.array([20, 40, 70, 100, 140, 180], float)
+    entry = (pts - 0.1) * math.sqrt(3) / SPEED  # as test_mode35_36_one_50ms_pulse_per_point
+    for cmd in (35, 36):
+        assert r[cmd]["index"].tolist() == list(range(6))
+        np.testing.assert_allclose(r[cmd]["widths"], [0.05] * 6, atol=1e-9)
+        np.testing.assert_allclose(np.diff(r[cmd]["times"]), np.diff(entry), atol=1e-9)
