@@ -31,15 +31,45 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "long: a heavy run, reduced unless --long is given")
 
 
+# The normal run draws a quarter of each property test's `max_examples` (at least
+# PROPERTY_FLOOR, never more than the test asks): every property is still checked on every
+# run, on fewer drawn cases; `--long` draws the full count. Tests that need a small count
+# already ask for it and are left alone by the floor.
+PROPERTY_SHARE = 4
+PROPERTY_FLOOR = 20
+
+
+def reduced_examples(n: int) -> int:
+    """The normal run's example count for a property test that asks for `n`."""
+    return min(n, max(PROPERTY_FLOOR, n // PROPERTY_SHARE))
+
+
+def _reduce_properties(items: list[pytest.Item]) -> None:
+    done: set[int] = set()
+    for item in items:
+        test = getattr(item, "obj", None)
+        test = getattr(test, "__func__", test)  # (a method's function holds the settings)
+        current = getattr(test, "_hypothesis_internal_use_settings", None)
+        if current is None or not hasattr(test, "hypothesis") or id(test) in done:
+            continue
+        done.add(id(test))  # (parametrized items share the function)
+        n = reduced_examples(current.max_examples)
+        if n < current.max_examples:  # hypothesis reads this attribute when the test runs
+            test._hypothesis_internal_use_settings = settings(current, max_examples=n)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Browser tests first (a stable sort: module order kept). They are the longest and
-    run one after another on a module's server, so under xdist (`--dist worksteal`, set in
-    pyproject.toml) they start at once and the short tests fill the other worker around
-    them, instead of the browser modules running alone at the end."""
+    """Property tests reduced unless --long (see PROPERTY_SHARE). Browser tests first (a
+    stable sort: module order kept). They are the longest and run one after another on a
+    module's server, so under xdist (`--dist worksteal`, set in pyproject.toml) they start
+    at once and the short tests fill the other worker around them, instead of the browser
+    modules running alone at the end."""
     def browser_first(item: pytest.Item) -> int:
         names = getattr(item, "fixturenames", ())
         return 0 if "page" in names or "browser" in names else 1
 
+    if not config.getoption("--long"):
+        _reduce_properties(items)
     items.sort(key=browser_first)
 
 

@@ -30,6 +30,14 @@ def line_to(c, end_units, **kw):
         assert c.wait_motion_done(timeout=30)
 
 
+def quick(v: float = 20_000.0, k: float = 4.0) -> dict[str, float]:
+    """start_line's limits for a line at speed v (pulses/s; default the helper's), time-scaled
+    by k: v, a and j times k, k^2, k^3 trace the same path in 1/k of the time (and cycles).
+    Where a timer train must end before the next point, the legs still last long enough
+    (the tests check the widths and overruns)."""
+    return {"v": v * k, "a": 2e5 * k**2, "j": 2e7 * k**3}
+
+
 SEED_2D = (0, 0, 50, 50, 100, 100, 50, 150, 0, 200, -50, 150, -100, 100, -50, 50)
 SEED_3D = (20, 20, 20, 40, 40, 40, 70, 70, 70, 100, 100, 100, 140, 140, 140, 180, 180, 180)
 
@@ -61,8 +69,8 @@ def test_mode3_vector_table_and_mode2_clears():
     z.table(0, 100, 150, 250, 300, 400, 450)
     z.set_vector_moved(0)
     jid = z.hw_pswitch2(3, 0, 1, 0, 5)  # seed Test_Mode3: MOVEABS(300,200) MOVEABS(400,0)
-    line_to(c, (300, 200))
-    line_to(c, (400, 0))
+    line_to(c, (300, 200), **quick())
+    line_to(c, (400, 0), **quick())
     l1, l2 = math.hypot(300, 200), math.hypot(100, 200)
     assert z.vector_moved() == pytest.approx(l1 + l2, abs=1e-9)
     log = eng.log.for_job(jid)
@@ -113,7 +121,7 @@ def test_mode25_seed_2d_table_fires_inside_window_in_order():
     jid = z.hw_pswitch2(25, 0, 1, 10, 8, 0)  # seed: OUT0, first ON, maxerr 10, 8 points
     pts = np.array(SEED_2D, float).reshape(8, 2)
     for p in [*pts[1:], pts[0]]:
-        line_to(c, p)
+        line_to(c, p, **quick())
     log = eng.log.for_job(jid)
     assert log["index"].tolist() == list(range(8))
     assert log["state"].tolist() == [1, 0, 1, 0, 1, 0, 1, 0]
@@ -145,7 +153,7 @@ def test_mode26_timer_pulses_per_point():
     jid = z.hw_pswitch2(26, 0, 1, 10, 8, 0)
     pts = np.array(SEED_2D, float).reshape(8, 2)
     for p in [*pts[1:], pts[0]]:
-        line_to(c, p, v=10_000)  # legs last > 0.2 s, so no train overlaps the next point
+        line_to(c, p, **quick(10_000, 3))  # legs > 0.2 s: no train overlaps the next point
     c.advance(0.3)
     assert eng.log.for_job(jid)["time"].size == 8
     w = eng.output(0).pulse_widths()
@@ -159,15 +167,15 @@ def test_mode35_36_seed_3d_table():
     jid = z.hw_pswitch2(35, 0, 1, 10, 6, 0)
     pts = np.array(SEED_3D, float).reshape(6, 3)
     for p in pts:
-        line_to(c, p)
+        line_to(c, p, **quick())
     log = eng.log.for_job(jid)
     assert log["index"].tolist() == list(range(6))
     assert np.all(np.abs(log["positions"] - pts * UNITS) <= 10 + 1e-9)
     # mode 36 with the pulse parameters given inline (ophwtimeus, ophwtimes, hwcyctimeus)
     jid36 = z.hw_pswitch2(36, 1, 1, 10, 6, 0, 50000, 1, 100000)
-    line_to(c, (0, 0, 0))
+    line_to(c, (0, 0, 0), **quick())
     for p in pts:
-        line_to(c, p)
+        line_to(c, p, **quick())
     c.advance(0.2)
     assert eng.log.for_job(jid36)["time"].size == 6
     np.testing.assert_allclose(eng.output(1).pulse_widths(), [0.05] * 6, atol=1e-9)
@@ -250,7 +258,7 @@ def test_mode26_36_accept_hw_pswitch2_before_hw_timer():
     z.hw_timer(2, 100000, 50000, 2, 0, 0)
     pts = np.array(SEED_2D, float).reshape(8, 2)
     for p in [*pts[1:], pts[0]]:
-        line_to(c, p, v=10_000)
+        line_to(c, p, **quick(10_000, 3))
     c.advance(0.3)
     assert eng.log.for_job(jid)["time"].size == 8
     np.testing.assert_allclose(eng.output(0).pulse_widths(), [0.05] * 16, atol=1e-9)
@@ -259,7 +267,7 @@ def test_mode26_36_accept_hw_pswitch2_before_hw_timer():
     jid3 = z3.hw_pswitch2(36, 0, 1, 10, 6, 0)
     z3.hw_timer(2, 100000, 50000, 1, 0, 0)
     for p in np.array(SEED_3D, float).reshape(6, 3):
-        line_to(c3, p, v=10_000)
+        line_to(c3, p, **quick(10_000))
     c3.advance(0.2)
     assert eng3.log.for_job(jid3)["time"].size == 6
     np.testing.assert_allclose(eng3.output(0).pulse_widths(), [0.05] * 6, atol=1e-9)
@@ -291,7 +299,7 @@ def test_mode35_with_hw_timer_pulses_instead_of_inverting():
     jid = z.hw_pswitch2(35, 0, 1, 10, 6, 0)
     z.hw_timer(2, 100000, 50000, 1, 0, 0)
     for p in np.array(SEED_3D, float).reshape(6, 3):
-        line_to(c, p, v=10_000)
+        line_to(c, p, **quick(10_000))
     c.advance(0.2)
     log = eng.log.for_job(jid)
     assert log["state"].tolist() == [1] * 6  # every point drives the pulse level
@@ -301,8 +309,8 @@ def test_mode35_with_hw_timer_pulses_instead_of_inverting():
     np.testing.assert_allclose(starts, log["time"], atol=1e-12)
     # without a timer on the output, mode 35 inverts at each point
     z.hw_timer(0, 10000, 6000, 1, 0, 0)
-    line_to(c, (0, 0, 0))
+    line_to(c, (0, 0, 0), **quick())
     jid2 = z.hw_pswitch2(35, 0, 1, 10, 6, 0)
     for p in np.array(SEED_3D, float).reshape(6, 3):
-        line_to(c, p, v=10_000)
+        line_to(c, p, **quick(10_000))
     assert eng.log.for_job(jid2)["state"].tolist() == [1, 0, 1, 0, 1, 0]

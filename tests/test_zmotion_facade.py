@@ -15,25 +15,30 @@ from openmotion.compat.zmotion_params import (
 )
 from openmotion.errors import MotionError
 
+# Ten times the article's SPEED and ACCEL (100 units/s, 1000 units/s^2): the same ramps
+# (SPEED/ACCEL = 0.1 s) and relations in a tenth of the machine time (and of the cycles).
+SPEED = 1000.0
+ACCEL = 10_000.0
 
-def ctl(**kw) -> ZController:
+
+def ctl(speed: float = SPEED, accel: float = ACCEL, **kw) -> ZController:
     c = ZController(**kw)
     c.BASE(0, 1, 2)
     c.UNITS = 100, 100, 100
-    c.SPEED = 100, 100, 100
-    c.ACCEL = 1000, 1000, 1000
-    c.DECEL = 1000, 1000, 1000
+    c.SPEED = speed, speed, speed
+    c.ACCEL = accel, accel, accel
+    c.DECEL = accel, accel, accel
     return c
 
 
 def test_axis_parameters_index_call_and_base_assignment():
     c = ctl()
-    assert c.UNITS[1] == 100 and c.UNITS(2) == 100 and list(c.SPEED) == [100, 100, 100]
+    assert c.UNITS[1] == 100 and c.UNITS(2) == 100 and list(c.SPEED) == [SPEED] * 3
     c.UNITS[1] = 250
     assert c.UNITS[1] == 250
     c.BASE(1)
     c.SPEED = 10, 20            # BASE(1): axes 1 and 2 (the list extends)
-    assert [c.SPEED[a] for a in range(3)] == [100, 10, 20]
+    assert [c.SPEED[a] for a in range(3)] == [SPEED, 10, 20]
     c.MERGE = ON
     assert c.MERGE[1] == 1 and c.MERGE[0] == 0
     c.SRAMP[0] = 50
@@ -54,9 +59,9 @@ def test_table_call_index_and_slices():
 def test_move_runs_at_speed_and_dpos_mpos_follow():
     c = ctl()
     c.BASE(0, 1)
-    c.MOVE(300, 400)                     # 500 units at 100 units/s, accel 1000
+    c.MOVE(300, 400)                     # 500 units at SPEED, ramps of SPEED / ACCEL
     t = c.WAIT_IDLE(0)
-    assert t == pytest.approx(5.0 + 0.1, abs=2 * c.ctl.period)
+    assert t == pytest.approx(500 / SPEED + SPEED / ACCEL, abs=2 * c.ctl.period)
     assert (c.DPOS[0], c.DPOS[1]) == (300, 400) and c.MPOS[1] == pytest.approx(400)
     c.MOVEABS(0, 100)
     c.WAIT_IDLE(0)
@@ -73,13 +78,13 @@ def test_single_axis_move_with_sramp():
     t0 = c.ctl.time
     c.MOVE(200)
     t = c.WAIT_IDLE(2) - t0
-    # ramp to 100 units/s at 1000 units/s^2 smoothed over 50 ms: v/A + Ts = 0.15 s
-    assert t == pytest.approx(200 / 100 + 0.15, abs=2 * c.ctl.period)
+    # ramp to SPEED at ACCEL smoothed over 50 ms: v/A + Ts = 0.15 s
+    assert t == pytest.approx(200 / SPEED + SPEED / ACCEL + 0.05, abs=2 * c.ctl.period)
     assert c.DPOS[2] == 200 and c.ctl.axes[2].position == 20000  # ends on the pulse
 
 
 def test_merge_blends_within_one_pulse_of_the_corner():
-    c = ctl()
+    c = ctl(speed=100.0, accel=1000.0)  # the article's: the 1 ms scope sample bound below
     c.BASE(0, 1)
     c.MERGE = ON, ON
     c.TRIGGER()
@@ -104,14 +109,15 @@ def test_rapidstop_2_stops_on_the_path_3_at_once():
     c.BASE(0, 1)
     c.MOVE(300, 400)
     c.MOVE(100, 0)
-    c.run(1.0)
+    c.run(0.2)                            # 150 units along the first line
     c.RAPIDSTOP(2)
     c.WAIT_IDLE(0)
     x, y = c.DPOS[0], c.DPOS[1]
     assert 0 < x < 300 and y == pytest.approx(x * 4 / 3, abs=0.02)  # on the line
     assert c.IDLE(0) and c.IDLE(1)
-    c.MOVE(10, 10)
+    c.MOVE(100, 100)
     c.run(0.05)
+    assert c.ctl.axes[0].is_moving
     c.RAPIDSTOP(3)
     assert c.IDLE(0) and not c.ctl.axes[0].is_moving
 
@@ -259,14 +265,14 @@ def test_unsupported_and_state_refusals_have_their_codes():
 def test_decel_different_from_accel():
     c = ctl()
     c.BASE(0, 1)
-    c.DECEL = 500, 500
+    c.DECEL = ACCEL / 2, ACCEL / 2
     c.MOVE(10, 10)
     g = c._group((0, 1), "MOVE")
     assert g.dec_time == pytest.approx(2 * g.acc_time)   # DECEL half of ACCEL: twice the time
     c.WAIT_IDLE(0)
     assert c.DPOS[0] == 10
     c.BASE(2)                             # a single axis has its own deceleration
-    c.DECEL[2] = 500
+    c.DECEL[2] = ACCEL / 2
     c.MOVE(10)
     c.WAIT_IDLE(2)
     assert c.DPOS[2] == 10

@@ -9,7 +9,7 @@ it fires at once.
   (0,200)-(-50,150), (-100,100)-(-50,50): 8 firings, 4 ON stretches.
 - mode 26, HW_PSWITCH2 first, then HW_TIMER(2, 100000, 50000, 2, OFF, 0): each point gives
   2 pulses of 50 ms, 100 ms apart: 8 firings, 16 pulses.
-Run: python examples/zmotion/mode25_26_2d.py [outdir]
+Run: python examples/zmotion/mode25_26_2d.py [outdir]  (main(modes=...) runs one of them)
 """
 
 import sys
@@ -54,9 +54,11 @@ def test_mode26(c):
     return job
 
 
-def main(outdir=OUT):
+def main(outdir=OUT, modes=("mode25", "mode26")):
     results = {}
-    for name, sub in (("mode25", test_mode25), ("mode26", test_mode26)):
+    subs = {"mode25": test_mode25, "mode26": test_mode26}
+    for name in modes:
+        sub = subs[name]
         c = controller()
         clean_pos(c)
         job = sub(c)

@@ -276,6 +276,14 @@ class CompareEngine:
         """Start accumulating `source`'s path length (from 0) if not already."""
         self._vectors.setdefault(source, 0.0)
 
+    def untrack_vector(self, source: VectorSource) -> None:
+        """Stop accumulating `source`'s path length (every tracked source costs a path
+        integral each moving cycle), unless a job or a speed PWM still reads it."""
+        if any(getattr(j, "source", None) == source for j in self._jobs.values()) or \
+                any(p.source == source for p in self._pwms):
+            return
+        self._vectors.pop(source, None)
+
     def vector_moved(self, source: VectorSource) -> float:
         """Path length accumulated so far (ZMotion VECTOR_MOVED)."""
         self.track_vector(source)

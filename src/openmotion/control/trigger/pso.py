@@ -224,8 +224,14 @@ class ZPso:
         self.eng.track_vector(self._vector())  # VECTOR_MOVED accumulates from now on
 
     def set_units(self, axis: int, units: float) -> None:
-        self._units[_int("axis", axis, 0, len(self._units) - 1)] = check_positive("units", units)
-        self.eng.track_vector(self._vector())
+        a = _int("axis", axis, 0, len(self._units) - 1)
+        u = check_positive("units", units)
+        old = self._vector()
+        self._units[a] = u
+        new = self._vector()
+        if new != old:  # UNITS=100,100,100 sets one axis after the other: the half-set
+            self.eng.untrack_vector(old)  # scales would be integrated every cycle for nothing
+        self.eng.track_vector(new)
 
     def source(self, axis: int, kind: str) -> None:
         if not isinstance(kind, str) or kind not in ("dpos", "mpos"):
