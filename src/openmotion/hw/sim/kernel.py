@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from openmotion.hw.interface import AXIS_INPUTS
+from openmotion.hw.interface import AXIS_INPUTS, InputEdge
 
 from .cubic import Cubic
 from .plant import StepperPlant
@@ -46,7 +46,7 @@ _NO_TRACE = np.zeros(0, dtype=np.int64)
 _BIT = {sig: i for i, sig in enumerate(AXIS_INPUTS)}
 
 # field indices, kept in step with _kernel.c (checked against its constants below)
-_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 26, 8, 4, 3, 12
+_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 26, 8, 4, 4, 12
 (D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
  D_UPP) = range(_ND)
 (I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
@@ -131,7 +131,7 @@ class KernelState:
     landing of a virtual-time jump costs no per-axis packing or copying."""
 
     __slots__ = ("ad", "ai", "sd", "si", "names", "recording", "_wake", "_wake_key",
-                 "_readback")
+                 "_readback", "_edges")
 
     def __init__(self, axes: list[SimAxis]) -> None:
         n = len(axes)
@@ -162,7 +162,7 @@ class KernelState:
                 bits = _switch_bits(name, sws)
                 if sw.active:
                     base ^= bits
-                si[x, s] = (sw.active, 0, bits)
+                si[x, s] = (sw.active, 0, bits, _BIT[name])
             ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
                         dec.count, dec.period, len(sws), dec.turn[1], dec.turn[-1],
                         *fwd, *bwd, 0, 0, 0, g.record is not None, base])
@@ -174,6 +174,11 @@ class KernelState:
         self._wake_key: object = ()  # no wake set computed yet
         self._wake = np.zeros((n, _MAXSW), dtype=np.int64)
         self._readback: tuple[list[int], list[int], list[int]] | None = None
+        self._edges = _edge_room(64, n)
+
+    def grow_edges(self) -> None:
+        """Room for twice as many edges in one cycle (the kernel asked for more)."""
+        self._edges = _edge_room(2 * len(self._edges[0]), len(self.ad))
 
     def set_wake(self, axes: list[SimAxis], wake: Collection[str] | None) -> None:
         """Mark the switches whose edges end a kernel run (computed once per wake set)."""
@@ -185,6 +190,12 @@ class KernelState:
                     self._wake[x, s] = _wakes(name, sws, key)
             self._wake_key = key
         self.si[:, :, 1] = self._wake
+
+    def set_command(self, x: int, p0: float, v0: float, a0: float, j: float, tc: float,
+                    te: float) -> None:
+        """Axis x's generator follows the cubic (p0, v0, a0, j) over [tc, te] from now
+        (SimAxis.set_command without a pulse record)."""
+        self.ad[x, D_P0:D_TE + 1] = (p0, v0, a0, j, tc, te)
 
     def readback(self, x: int) -> tuple[int, int, int]:
         """(pulse count, decoded count, input level bits) of axis x now."""
@@ -220,19 +231,49 @@ class KernelState:
             ax.run_start = (tr.z, (dec.q, dec.last_dir, dec.count))
 
 
+def _edge_room(cap: int, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return (np.zeros(cap), np.zeros((cap, 4), dtype=np.int64),
+            np.zeros((cap, n), dtype=np.int64))
+
+
 def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin: float,
               period: float, start: int, stop: int, now: float, limit: float,
-              wake: Collection[str] | None, trace: bool = False
-              ) -> tuple[int, float, np.ndarray | None]:
+              wake: Collection[str] | None, trace: bool = False, report: bool = False,
+              paced: bool = True
+              ) -> tuple[int, float, np.ndarray | None, list[InputEdge]]:
     """Run cycles start+1 .. at most stop in the kernel on the arrays of `ks`; returns
-    (cycle reached, time, trace): with `trace`, an int64 array [cycles run, axis, 3] of the
-    pulse count, decoded count and input levels (`level_bits`) at the end of each cycle.
+    (cycle reached, time, trace, edges): with `trace`, an int64 array [cycles run, axis, 3]
+    of the pulse count, decoded count and input levels (`level_bits`) at the end of each
+    cycle; `edges`, the input edges of the last cycle run when it crossed a switch on a
+    `wake` signal (then it is the last cycle run), every axis's decoded count at each.
+    `report`: every cycle reports its edges (the first cycle with any ends the run).
 
-    Stops before the first cycle ending at or after `limit` or with an edge on a `wake`
-    signal. The pieces started leave their queues; the axis state stays in `ks` (with
-    pulse recording on, it and the record are written back into the axes at once)."""
+    Stops before the first cycle ending at or after `limit` or one the kernel cannot run
+    exactly (a count beyond its integer range: the caller runs it). The pieces started
+    leave their queues; the axis state stays in `ks` (with pulse recording on, it and the
+    record are written back into the axes at once)."""
+    parts: list[np.ndarray] = []
+    while True:
+        k, now, tr, edges, full = _run(ks, axes, queues, origin, period, start, stop, now,
+                                       limit, wake, trace, report, paced)
+        if tr is not None:
+            parts.append(tr)
+        if not full:
+            break
+        ks.grow_edges()
+        start = k
+    if trace and len(parts) > 1:
+        return k, now, np.concatenate(parts), edges
+    return k, now, parts[0] if trace else None, edges
+
+
+def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin: float,
+         period: float, start: int, stop: int, now: float, limit: float,
+         wake: Collection[str] | None, trace: bool, report: bool, paced: bool
+         ) -> tuple[int, float, np.ndarray | None, list[InputEdge], bool]:
     n = len(axes)
-    ks.set_wake(axes, wake)
+    if not report:  # in report mode every crossing is an edge anyway
+        ks.set_wake(axes, wake)
     ai = ks.ai
     ai[:, I_PBEGIN:I_CURSOR + 1] = 0
     blocks: list[np.ndarray] = []
@@ -261,10 +302,12 @@ def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], or
     cap = (stop - start) * n * 8 + 16 if recording else 0
     rows = np.zeros((cap, _NREC)) if cap else _NONE
     tr = np.zeros((stop - start, n, 3), dtype=np.int64) if trace else _NO_TRACE
-    k, t, nrows = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, float(origin),
-                         float(period), int(start), int(stop), float(now), float(limit))
+    et, ei, enc = ks._edges
+    k, t, nrows, nedges, full = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, et,
+                                       ei, enc, float(origin), float(period), int(start),
+                                       int(stop), float(now), float(limit), report, paced)
     if k == start:
-        return k, now, tr[:0] if trace else None
+        return k, now, tr[:0] if trace else None, [], bool(full)
     ks._readback = None
     if used:
         cursor = ai[used, I_CURSOR].tolist()
@@ -276,7 +319,14 @@ def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], or
     if recording:
         ks.write_back(axes)
         _record_stretches(axes, rows[:nrows])
-    return k, t, tr[:k - start] if trace else None
+    edges: list[InputEdge] = []
+    if nedges:
+        names = AXIS_INPUTS
+        for tm, (axis, bit, level, _), counts in zip(et[:nedges].tolist(),
+                                                     ei[:nedges].tolist(),
+                                                     enc[:nedges].tolist(), strict=True):
+            edges.append(InputEdge(tm, axis, names[bit], level == 1, tuple(counts)))
+    return k, t, tr[:k - start] if trace else None, edges, bool(full)
 
 
 def _record_commands(axes: list[SimAxis], used: list[int], begin: list[int],

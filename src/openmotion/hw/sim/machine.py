@@ -136,13 +136,20 @@ class SimMachine(SimAnalogOutputs):
         the command at the current time is a whole pulse or more away from the pulses
         emitted, the difference is emitted at once (a jump; a real stepper loses it).
         """
-        ax = self._axis(axis)
+        i = self._index(axis)
         if not isinstance(cmd, AxisCommand):
             raise MotionError(f"cmd must be an AxisCommand, got {type(cmd).__name__}")
         for f in ("t0", "p0", "v0", "a0", "j"):
             check_finite(f"cmd.{f}", getattr(cmd, f))
         check_nonnegative("cmd.dt", cmd.dt)
-        self._set_command(ax, cmd)
+        ks = self._ks
+        if ks is not None and not ks.recording:  # into the kernel's arrays (stepping)
+            t0 = float(cmd.t0)
+            ks.set_command(i, float(cmd.p0), float(cmd.v0), float(cmd.a0), float(cmd.j), t0,
+                           t0 + float(cmd.dt))
+            self._stale = True
+            return
+        self._set_command(self._axes[i], cmd)
 
     def _set_command(self, ax: SimAxis, cmd: AxisCommand) -> None:
         t0 = float(cmd.t0)
@@ -203,14 +210,14 @@ class SimMachine(SimAnalogOutputs):
                 and not self._pending else None
             if ks is not None:
                 k0 = k
-                k, self._t, tr = kernel.run_quiet(ks, self._ax, queues, origin, period, k,
-                                                  stop, self._t, self._next_action(), wake,
-                                                  trace)
+                k, self._t, tr, edges = kernel.run_quiet(ks, self._ax, queues, origin, period,
+                                                         k, stop, self._t, self._next_action(),
+                                                         wake, trace)
                 if k > k0 and not ks.recording:
                     self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
-                if k >= stop or (paced and kernel.interrupted()):
+                if edges or k >= stop or (paced and kernel.interrupted()):
                     break
             if paced:
                 kernel.wait_slot(k + 1)
@@ -293,6 +300,17 @@ class SimMachine(SimAnalogOutputs):
         if t < self._t:
             raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
         queues = self._queues
+        ks = self._kernel_state() if self.native and not self._pending \
+            and not self._edge_filters else None
+        if ks is not None:  # one cycle [now, t] in the kernel, every edge reported
+            k, t1, _, edges = kernel.run_quiet(ks, self._ax, queues, t, 1.0, -1, 0, self._t,
+                                               self._next_action(), None, report=True,
+                                               paced=False)
+            if k == 0:  # else an action is due in it or a count left the exact range
+                self._t = t1
+                if not ks.recording:
+                    self._stale = True
+                return edges
         if not any(len(q) for q in queues):
             return self._advance(t)
         edges: list[InputEdge] = []
@@ -471,6 +489,9 @@ class SimMachine(SimAnalogOutputs):
 
     def stop_time(self, axis: int) -> float | None:
         """When an armed stop cut the pulses of `axis` in the last advance, else None."""
+        if self._stale:  # the kernel ran last: it models no armed stop
+            self._index(axis)
+            return None
         return self._view(axis).stop_time
 
     # -- extras for tests and tools ---------------------------------------------------------
