@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...errors import MotionError
 from ...hw.interface import AXIS_INPUTS, PieceBlock, QueuedHardware
 from . import motion as _motion
 from .counters import Counters
@@ -240,6 +241,29 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     if not m:
         return
     axes = ctl.axes
+    kern = _motion._kernel
+    if kern is not None:  # the rows straight into the recorder's ring, in C
+        origin, period = ctl._t_origin, ctl.period
+        cnt = [ax.counters for ax in axes]
+        args = (origin, period, n, np.ascontiguousarray(trace, dtype=np.int64),
+                np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
+                np.array([ax.index for ax in movers], dtype=np.int64),
+                tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
+                np.array([ax.counters._cmd_off for ax in movers], dtype=float),
+                np.array([c._fb_internal for c in cnt], dtype=np.int64),
+                np.array([c._fb_off for c in cnt], dtype=np.int64), _nc_words(ctl),
+                _io_table(), bool(ctl._estop),
+                np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int32))
+
+        def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
+            try:
+                kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
+            except ValueError as exc:
+                raise MotionError(f"record_block: {exc}") from None
+
+        t_first = origin + (n + 1) * period
+        if ctl.recorder.record_into(m, t_first, origin + (n + m) * period, fill):
+            return
     t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
     pos = np.empty((m, len(axes)))
     vel = np.empty((m, len(axes)))
