@@ -82,3 +82,47 @@ def test_a_bad_row_is_refused_and_nothing_stored():
     assert r.total == 1
     with pytest.raises(MotionError, match="non-decreasing"):
         r.record_into(1, -1.0, -1.0, fill)
+
+
+def stepped(compiled: bool, jumping: bool, monkeypatch) -> dict:
+    from openmotion.control.core import controller as ctlmod
+
+    with monkeypatch.context() as mp:
+        if not compiled:
+            mp.setattr(ctlmod, "record_now", lambda *a: False)
+        x = default_machine().axes[0]
+        axes = (replace(x, name="x", org=SwitchConfig(position=2_000.0, width=300.0),
+                        logic={"org": "nc", "alm": "nc"}),
+                replace(x, name="s", drive=replace(x.drive, type="servo")),
+                replace(x, name="z"))
+        c = Controller(MachineConfig(name="rec", axes=axes))
+        c.virtual_jumps = jumping
+        c.enable_all()
+        c.start_recording(capacity=3000)
+        c.axes[2].counters.set_feedback_source("internal")
+        c.axes[0].move_relative(6_000, max_vel=60_000, tacc=0.02)
+        c.axes[1].move_relative(3_000, max_vel=40_000, tacc=0.02)
+        c.advance(0.03)
+
+        def toggle(ctl, t):  # read in this cycle, then change RDY: the row shows the read
+            if ctl.cycles in (40, 41):
+                _ = ctl.axes[0].counters.feedback, ctl.axes[1].counters.feedback
+                _ = ctl.input_active(1, "rdy")
+                ctl.hardware.write_output(1, "svon", ctl.cycles == 41)
+
+        c.add_cycle_hook(toggle)
+        c.advance(0.02)
+        c.remove_cycle_hook(toggle)
+        c.hardware.scenario.trip_alarm(2, at=c.time + 0.0042)
+        c.axes[2].move_velocity(-20_000, tacc=0.02)
+        c.advance(0.1)
+        return c.recorder.arrays()
+
+
+@pytest.mark.parametrize("jumping", [False, True])
+def test_the_compiled_landing_row_is_the_python_row(jumping, monkeypatch):
+    got = stepped(True, jumping, monkeypatch)
+    want = stepped(False, jumping, monkeypatch)
+    for k in want:
+        assert got[k].tobytes() == want[k].tobytes(), k
+    assert len(want["t"]) > 100

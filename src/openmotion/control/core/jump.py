@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import MotionError
-from ...hw.interface import AXIS_INPUTS, PieceBlock, QueuedHardware
+from ...hw.interface import AXIS_INPUTS, BulkReadback, PieceBlock, QueuedHardware
 from . import motion as _motion
 from .counters import Counters
 
@@ -282,6 +282,54 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     state = np.broadcast_to(np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int64),
                             (m, len(axes)))
     ctl.recorder.record_block(t, cmd_pos=pos, fb_pos=fb, cmd_vel=vel, state=state, io=io)
+
+
+_BULK: dict[type, bool] = {}
+_NO_MOVERS = np.zeros(0, dtype=np.int64)
+_NO_OFFSETS = np.zeros(0)
+
+
+def record_now(ctl: Controller, n: int) -> bool:
+    """Record the row of cycle n (its end, now) as `Controller._record` does, in one
+    compiled call: the back end's readback of every axis in one call (BulkReadback), the
+    cached one of an axis already read in this cycle (what its counters and inputs show).
+    False (nothing done) without the compiled kernel or a bulk readback."""
+    from .controller import STATE_CODES  # the controller imports this module
+
+    kern = _motion._kernel
+    hw = ctl.hardware
+    t = type(hw)
+    bulk = _BULK.get(t)
+    if bulk is None:
+        bulk = _BULK[t] = isinstance(hw, BulkReadback)
+    if kern is None or not bulk:
+        return False
+    axes = ctl.axes
+    rows = np.array(hw.read_axes(), dtype=np.int64)
+    for i, c in enumerate(ctl._rb_cycle):
+        if c == ctl._n:  # read in this cycle: the values the controller holds
+            cnt = axes[i].counters
+            inputs = ctl._inputs[i]
+            rows[i] = (cnt._raw_out, cnt._raw_enc,
+                       sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if inputs.get(sig)))
+    cnt_all = [ax.counters for ax in axes]
+    origin, period = ctl._t_origin, ctl.period
+    args = (origin, period, n - 1, rows.reshape(1, -1, 3),
+            np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
+            _NO_MOVERS, (), _NO_OFFSETS,
+            np.array([c._fb_internal for c in cnt_all], dtype=np.int64),
+            np.array([c._fb_off for c in cnt_all], dtype=np.int64), _nc_words(ctl),
+            _io_table(), bool(ctl._estop),
+            np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int32))
+
+    def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
+        try:
+            kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
+        except ValueError as exc:
+            raise MotionError(f"record: {exc}") from None
+
+    t1 = origin + n * period
+    return ctl.recorder.record_into(1, t1, t1, fill)
 
 
 _IO_TABLE: list[np.ndarray] = []

@@ -207,6 +207,15 @@ class KernelState:
                                    (ai[:, I_LEVELS] ^ flips).tolist())
         return rb[0][x], rb[1][x], rb[2][x]
 
+    def readback_rows(self) -> np.ndarray:
+        """int64 [n, 3]: (pulse count, decoded count, input level bits) of every axis now."""
+        ai, si = self.ai, self.si
+        out = np.empty((len(ai), 3), dtype=np.int64)
+        out[:, 0] = ai[:, I_COUNT]
+        out[:, 1] = ai[:, I_DCOUNT]
+        out[:, 2] = ai[:, I_LEVELS] ^ np.bitwise_xor.reduce(si[:, :, 0] * si[:, :, 2], axis=1)
+        return out
+
     def at_rest(self, t: float) -> bool:
         """Every generator holds its command's end at time t (te <= t)."""
         return bool((self.ad[:, D_TE] <= t).all())

@@ -362,6 +362,15 @@ class SimMachine(SimAnalogOutputs):
         return AxisReadback(ax.gen.count, ax.decoder.count,
                             dict(zip(AXIS_INPUTS, ax.levels(), strict=True)))
 
+    def read_axes(self) -> np.ndarray:
+        """int64 [n_axes, 3]: pulses out, decoded count and input level bits of every axis
+        (hw.interface.BulkReadback; `read_axis` of each in one call)."""
+        ks = self._ks
+        if ks is not None:
+            return ks.readback_rows()
+        return np.array([(ax.gen.count, ax.decoder.count, kernel.level_bits(ax))
+                         for ax in self._objects()], dtype=np.int64).reshape(-1, 3)
+
     def write_output(self, axis: int | None, signal: str, level: bool) -> None:
         if not isinstance(level, bool):
             raise MotionError(f"level must be a bool, got {level!r}")
