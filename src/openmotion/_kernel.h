@@ -37,6 +37,8 @@ static inline void release(Buf *bufs, int n)
 /* _kernel_stepper.c: the simulator's stepper pipeline over a chunk of cycles */
 PyObject *kernel_run(PyObject *self, PyObject *args);
 extern const char kernel_run_doc[];
+PyObject *kernel_readback(PyObject *self, PyObject *args);
+extern const char kernel_readback_doc[];
 /* field counts of its arrays, exported as module constants */
 int kernel_layout(PyObject *module);
 

@@ -709,3 +709,41 @@ int kernel_layout(PyObject *m)
             || PyModule_AddIntConstant(m, "NSI", NSI) < 0
             || PyModule_AddIntConstant(m, "NREC", NREC) < 0) ? -1 : 0;
 }
+
+const char kernel_readback_doc[] =
+"readback(ai, si, out) -> None\n\n"
+"out int64[n, 3] = (pulse count, decoded count, input level bits) of every axis of the\n"
+"kernel's arrays ai[n, NI], si[n, 8, NSI] (the level base word with the bits of every\n"
+"active switch flipped), as a trace row.";
+
+PyObject *kernel_readback(PyObject *self, PyObject *args)
+{
+    PyObject *o[3];
+    if (!PyArg_ParseTuple(args, "OOO", &o[0], &o[1], &o[2])) return NULL;
+    Buf bufs[3];
+    memset(bufs, 0, sizeof bufs);
+    static const char *names[3] = {"ai", "si", "out"};
+    for (int k = 0; k < 3; k++)
+        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, 3); return NULL; }
+    Py_ssize_t n = bufs[0].b.len / (8 * NI);
+    if (bufs[0].b.len != n * 8 * NI || bufs[1].b.len != n * 8 * MAXSW * NSI
+            || bufs[2].b.len != n * 8 * 3) {
+        release(bufs, 3);
+        PyErr_SetString(PyExc_ValueError, "readback: arrays disagree in size");
+        return NULL;
+    }
+    const int64_t *AI = bufs[0].b.buf, *SI = bufs[1].b.buf;
+    int64_t *out = bufs[2].b.buf;
+    for (Py_ssize_t x = 0; x < n; x++) {
+        const int64_t *ai = AI + x * NI, *si = SI + x * MAXSW * NSI;
+        int64_t levels = ai[I_LEVELS];
+        int nsw = ai[I_NSW] < 0 ? 0 : (ai[I_NSW] > MAXSW ? MAXSW : (int)ai[I_NSW]);
+        for (int sw = 0; sw < nsw; sw++)
+            if (si[sw * NSI + S_ACTIVE]) levels ^= si[sw * NSI + S_LEVELBITS];
+        out[x * 3] = ai[I_COUNT];
+        out[x * 3 + 1] = ai[I_DCOUNT];
+        out[x * 3 + 2] = levels;
+    }
+    release(bufs, 3);
+    Py_RETURN_NONE;
+}

@@ -289,6 +289,20 @@ _NO_MOVERS = np.zeros(0, dtype=np.int64)
 _NO_OFFSETS = np.zeros(0)
 
 
+_WORDS: dict[tuple, int] = {}
+
+
+def _level_word(inputs: dict[str, bool]) -> int:
+    """The input-level bits (bit k = AXIS_INPUTS[k]) of a readback's inputs dict."""
+    key = tuple(inputs.items())
+    w = _WORDS.get(key)
+    if w is None:
+        w = sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if inputs.get(sig))
+        if len(_WORDS) < 4096:
+            _WORDS[key] = w
+    return w
+
+
 def record_now(ctl: Controller, n: int) -> bool:
     """Record the row of cycle n (its end, now) as `Controller._record` does, in one
     compiled call: the back end's readback of every axis in one call (BulkReadback), the
@@ -309,9 +323,7 @@ def record_now(ctl: Controller, n: int) -> bool:
     for i, c in enumerate(ctl._rb_cycle):
         if c == ctl._n:  # read in this cycle: the values the controller holds
             cnt = axes[i].counters
-            inputs = ctl._inputs[i]
-            rows[i] = (cnt._raw_out, cnt._raw_enc,
-                       sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if inputs.get(sig)))
+            rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
     cnt_all = [ax.counters for ax in axes]
     origin, period = ctl._t_origin, ctl.period
     args = (origin, period, n - 1, rows.reshape(1, -1, 3),

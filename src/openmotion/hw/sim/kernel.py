@@ -173,7 +173,7 @@ class KernelState:
         self.recording = any(ax.gen.record is not None for ax in axes)  # pulse records
         self._wake_key: object = ()  # no wake set computed yet
         self._wake = np.zeros((n, _MAXSW), dtype=np.int64)
-        self._readback: tuple[list[int], list[int], list[int]] | None = None
+        self._readback: list[list[int]] | None = None
         self._edges = _edge_room(64, n)
 
     def grow_edges(self) -> None:
@@ -201,19 +201,13 @@ class KernelState:
         """(pulse count, decoded count, input level bits) of axis x now."""
         rb = self._readback
         if rb is None:
-            ai, si = self.ai, self.si
-            flips = np.bitwise_xor.reduce(si[:, :, 0] * si[:, :, 2], axis=1)
-            rb = self._readback = (ai[:, I_COUNT].tolist(), ai[:, I_DCOUNT].tolist(),
-                                   (ai[:, I_LEVELS] ^ flips).tolist())
-        return rb[0][x], rb[1][x], rb[2][x]
+            rb = self._readback = self.readback_rows().tolist()
+        return tuple(rb[x])  # type: ignore[return-value]
 
     def readback_rows(self) -> np.ndarray:
         """int64 [n, 3]: (pulse count, decoded count, input level bits) of every axis now."""
-        ai, si = self.ai, self.si
-        out = np.empty((len(ai), 3), dtype=np.int64)
-        out[:, 0] = ai[:, I_COUNT]
-        out[:, 1] = ai[:, I_DCOUNT]
-        out[:, 2] = ai[:, I_LEVELS] ^ np.bitwise_xor.reduce(si[:, :, 0] * si[:, :, 2], axis=1)
+        out = np.empty((len(self.ai), 3), dtype=np.int64)
+        _k.readback(self.ai, self.si, out)
         return out
 
     def at_rest(self, t: float) -> bool:

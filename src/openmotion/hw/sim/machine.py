@@ -366,7 +366,7 @@ class SimMachine(SimAnalogOutputs):
         """int64 [n_axes, 3]: pulses out, decoded count and input level bits of every axis
         (hw.interface.BulkReadback; `read_axis` of each in one call)."""
         ks = self._ks
-        if ks is not None:
+        if ks is not None:  # the kernel's arrays are current (objects maybe not)
             return ks.readback_rows()
         return np.array([(ax.gen.count, ax.decoder.count, kernel.level_bits(ax))
                          for ax in self._objects()], dtype=np.int64).reshape(-1, 3)
