@@ -9,9 +9,10 @@
  * crossing of every switch becomes an edge with its exact time (the threshold solved on the
  * stretch's cubic), the level and the own decoded count at that instant, and every other
  * axis's decoded count at that instant (from the cycle's per-axis piece records); the chunk
- * ends after that cycle. Every formula repeats the operation order of the reference
- * pipeline (tests/simref, the oracle) exactly (compiled with -ffp-contract=off), so the
- * floats are bit-identical.
+ * ends after that cycle. Every formula repeats the operation order of the Python pipeline
+ * (hw/sim/simaxis.py, pulses.py, plant.py, encoder.py, switches.py, cubic.py: the oracle of
+ * tests/test_kernel_*.py) exactly (compiled with -ffp-contract=off), so the floats are
+ * bit-identical.
  */
 #include "_kernel.h"
 

@@ -1,12 +1,15 @@
-"""The compiled stepper pipeline (`openmotion._kernel.run`, C) behind `SimMachine.run_cycles`.
+"""The compiled stepper pipeline (`openmotion._kernel.run`, C) behind `SimMachine.run_cycles`
+and `SimMachine.advance`.
 
 `run_quiet` hands the kernel a chunk of cycles as flat arrays over all axes: each axis's
 command, pulse count, losses, load position, decoder state and switches, and its queued
-pieces. The kernel runs the cycles in C with the GIL released and stops before the first
-cycle that has an edge to report, a scenario action or timed output due, or anything else
-it does not model; `SimMachine` runs that cycle through the Python path (simaxis.py), which
-finds the edge's exact time and counts. The state comes back into the `SimAxis` objects,
-so both paths always share one state.
+pieces. The kernel runs the cycles in C with the GIL released. The first cycle with a
+crossing on a `wake` signal is run again in report mode and ends the run: every crossing of
+that cycle comes back as an `InputEdge` with its exact time and every axis's decoded count
+at that instant. It stops before a scenario action or timed output (the Python path runs
+that cycle) and before anything it cannot run exactly. The state stays in the kernel's
+arrays (`KernelState`) between runs and goes back into the `SimAxis` objects when Python
+needs them.
 
 The kernel takes a machine whose axes are all steppers (ideal or stalling) without an
 armed edge stop or a pitch-error table; for any other machine `usable` is False and every
