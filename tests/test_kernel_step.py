@@ -110,3 +110,44 @@ def test_a_controller_stepped_in_the_kernel_is_the_python_path():
     events = runs[0][0]
     assert {e[1] for e in events} >= {"limit", "estop"}, events
     assert runs[0] == runs[1]
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_board_outputs_at_a_time_run_through_the_kernel_as_in_python(seed):
+    """Board outputs at a time touch no axis: the kernel runs through their cycles (no
+    Python cycle) and they are emitted at their exact times, in their order."""
+    rng = np.random.default_rng(seed)
+    cfg, _ = machine(rng, 2)
+    cfg = replace(cfg, digital_outputs=3)
+    period = 0.001
+    cycles = int(rng.integers(10, 60))
+    plans = [random_pieces(rng, cycles, period, 0.0) for _ in range(2)]
+    times = np.sort(rng.uniform(0.0, cycles * period, size=int(rng.integers(1, 40))))
+    times[rng.random(len(times)) < 0.2] = times[0]  # equal times keep their order
+    lines = [f"do{int(k)}" for k in rng.integers(0, 3, size=len(times))]
+    levels = [bool(b) for b in rng.random(len(times)) < 0.5]
+    step = bool(rng.random() < 0.5)
+    runs = []
+    for native in (False, True):
+        hw = SimMachine(cfg)
+        hw.native = native
+        for i, rows in enumerate(plans):
+            hw.queue_pieces(i, PieceBlock(rows))
+        for t, line, lv in zip(times.tolist(), lines, levels, strict=True):
+            hw.write_output_at(t, None, line, lv)
+        seen = []
+        k = 0
+        while k < cycles:
+            if step:
+                k += 1
+                seen.append(edges_of(hw.advance(k * period)))
+            else:
+                r = hw.run_cycles(0.0, period, k, cycles, frozenset({"pel", "mel"}))
+                k = r.cycle
+                seen.append((k, edges_of(r.edges)))
+            seen.append([hw.read_output(None, f"do{d}") for d in range(3)])
+        seen.append([hw.output_record.edges(f"do{d}") for d in range(3)])
+        seen.append(state(hw))
+        runs.append(seen)
+    assert runs[0] == runs[1]

@@ -14,6 +14,7 @@
 
 static inline int64_t wrap28(int64_t x)
 {
+    if (x >= -HALF28 && x < HALF28) return x; /* the usual case: no division */
     int64_t r = (x + HALF28) % FULL28;
     if (r < 0) r += FULL28;
     return r - HALF28;
@@ -127,8 +128,8 @@ PyObject *record_rows(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "recorded positions/velocities must be finite");
         return NULL;
     }
-    for (Py_ssize_t r = m - keep; r < m; r++) {
-        Py_ssize_t row = (Py_ssize_t)((head + r) % R);
+    Py_ssize_t row = (Py_ssize_t)((head + (m - keep)) % R);
+    for (Py_ssize_t r = m - keep; r < m; r++, row = row + 1 == R ? 0 : row + 1) {
         rt[row] = origin + (double)(n0 + 1 + r) * period;
         double *f = rf + row * F * n;
         const int64_t *trr = tr + r * n * 3;

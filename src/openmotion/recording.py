@@ -60,6 +60,10 @@ class Recorder:
         self._t = np.zeros(rows)
         self._f = np.zeros((rows, len(self._fchans), n_axes))
         self._i = {c: np.zeros((rows, n_axes), dtype=_INT_DTYPES[c]) for c in self._ichans}
+        # touched now, so no cycle pays the page faults of its first write (np.zeros maps
+        # the pages lazily)
+        for a in (self._t, self._f, *self._i.values()):
+            a.fill(0)
         self._fslot = {c: k for k, c in enumerate(self._fchans)}
         self._slots: np.ndarray | None = None  # record_into's float slots
         self._head = 0   # next row to write

@@ -213,8 +213,10 @@ class SimMachine(SimAnalogOutputs):
                 k, self._t, tr, edges = kernel.run_quiet(ks, self._ax, queues, origin, period,
                                                          k, stop, self._t, self._next_action(),
                                                          wake, trace)
-                if k > k0 and not ks.recording:
-                    self._stale = True
+                if k > k0:
+                    self._timed_done()
+                    if not ks.recording:
+                        self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
                 if edges or k >= stop or (paced and kernel.interrupted()):
@@ -252,15 +254,20 @@ class SimMachine(SimAnalogOutputs):
 
     def _trace_row(self) -> np.ndarray:
         """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""
-        return np.array([[(ax.gen.count, ax.decoder.count, kernel.level_bits(ax))
-                          for ax in self._axes]], dtype=np.int64).reshape(1, -1, 3)
+        return self.read_axes().reshape(1, -1, 3)
 
     def _next_action(self) -> float:
-        """Time of the next scenario action or timed output (inf: none): the kernel
-        stops before the cycle it falls in."""
-        t = self.scenario._heap[0][0] if self.scenario._heap else math.inf
-        timed = self._timed._heap
-        return min(t, timed[0][0]) if timed else t
+        """Time of the next scenario action (inf: none; an axis output at a time is one):
+        the kernel stops before the cycle it falls in. Board outputs at a time
+        (`write_output_at(t, None, ...)`) touch no axis: the kernel runs through them and
+        `_timed_done` emits them after its run, in their (time, order) sequence."""
+        return self.scenario._heap[0][0] if self.scenario._heap else math.inf
+
+    def _timed_done(self) -> None:
+        """The board outputs due by now (after a kernel run), at their exact times."""
+        if self._timed._heap:
+            for tk, _, sig, lv in self._timed.pop_due(self._t):
+                self._set_do(tk, sig, lv)
 
     def _holding(self) -> bool:
         """Nothing moves by itself: steppers only, each holding its command's end."""
@@ -289,8 +296,8 @@ class SimMachine(SimAnalogOutputs):
             while origin + (n + 1) * period < ta:
                 n += 1
             last = min(stop, n)
-        if last > k:
-            return last, self._advance(origin + last * period)
+        if last > k:  # one stretch (in the kernel when it models the machine)
+            return last, self.advance(origin + last * period)
         return k, []
 
     def advance(self, t: float) -> list[InputEdge]:
@@ -308,6 +315,7 @@ class SimMachine(SimAnalogOutputs):
                                                paced=False)
             if k == 0:  # else an action is due in it or a count left the exact range
                 self._t = t1
+                self._timed_done()
                 if not ks.recording:
                     self._stale = True
                 return edges
