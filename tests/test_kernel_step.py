@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -150,4 +151,30 @@ def test_board_outputs_at_a_time_run_through_the_kernel_as_in_python(seed):
         seen.append([hw.output_record.edges(f"do{d}") for d in range(3)])
         seen.append(state(hw))
         runs.append(seen)
+    assert runs[0] == runs[1]
+
+
+@pytest.mark.parametrize("mode,jumping", [(0, False), (0, True), (1, True), (2, False)])
+def test_homing_with_armed_stops_in_the_kernel_is_the_python_path(mode, jumping):
+    """Homing arms edge stops (ORG, EZ, EL): the dry scan, the cut at the armed edge's
+    exact time and the run on are the kernel's now; the Python pipeline is the oracle."""
+    from openmotion.control.home.homing import HomeConfig, home_search
+
+    runs = []
+    for native in (False, True):
+        c = Controller()
+        c.virtual_jumps = jumping
+        c.hardware.native = native
+        c.enable_all()
+        c.axes[0].move_relative(60_000, max_vel=100_000, tacc=0.05)
+        c.wait_motion_done()
+        h = home_search(c, 0, HomeConfig(mode=mode, str_vel=2_000.0, max_vel=20_000.0,
+                                         tacc=0.05))
+        c.run_until(lambda h=h: not h.running, 60.0, event_driven=True)
+        ax = c.axes[0]
+        runs.append((h.status, c.time, ax.counters.command, ax.counters.feedback,
+                     ax.position, [(e.time, e.kind, e.detail)
+                                   for e in c.events.events()],
+                     [bits(r) for r in c.history.rows(0, 0.0, c.time)], state(c.hardware)))
+    assert runs[0][0].state == "done", runs[0][0]
     assert runs[0] == runs[1]

@@ -22,26 +22,28 @@
 
 /* per-axis double fields */
 enum { D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
-       D_UPP, ND };
+       D_UPP, D_STOP, ND };
 /* per-axis int64 fields */
 enum { I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
        I_TURNF, I_TURNB, I_FWD, I_BWD = I_FWD + 5, I_PBEGIN = I_BWD + 5, I_PEND, I_CURSOR,
-       I_RECORD, I_LEVELS, NI };
+       I_RECORD, I_LEVELS, I_ARMED, NI };
 #define MAXSW 8
 /* per-switch double fields: kind (0 span, 1 index), lo|period, hi|width, hysteresis */
 enum { S_KIND, S_A, S_B, S_H, NSD };
 /* per-switch int64 fields: active, reported, the input-level bits it flips when active,
  * the bit of its own signal (AXIS_INPUTS index) */
-enum { S_ACTIVE, S_WAKE, S_LEVELBITS, S_BIT, NSI };
+enum { S_ACTIVE, S_WAKE, S_LEVELBITS, S_BIT, S_ARM, S_ARMLEVEL, S_ARMDIR, NSI };
+/* S_ARM: 0 not armed, else 1 + the switch's rank in the order the stops were armed (ties
+ * at one instant go to the first armed, as SimAxis._first_armed) */
 #define LTC_BIT 4 /* AXIS_INPUTS.index("ltc"): SD shares its pin while no LTC is placed */
 #define TIME_TOL 1e-13
 /* edge row (int64): axis, signal bit, level, own decoded count */
 #define NEI 4
-#define MAXPREC 16 /* motor pieces per axis and stretch of a cycle (<= 12) */
+#define MAXPREC 32 /* motor pieces per axis and stretch of a cycle (<= 2 x 12: armed) */
 /* record row: axis, kind (0 jump, 1 cubic), t0, t1, tc, p0, v0, a0, j, d, c0, c1 */
 #define NREC 12
 
-enum { OK = 0, BAIL = 1, WAKE = 2, FULL = 3 };
+enum { OK = 0, BAIL = 1, WAKE = 2, FULL = 3, HIT = 4 };
 
 /* a motor piece scanned in report mode (simref's StepPiece / JumpPiece with the load and
  * decoder state at its start), for the own count at an edge and encoder_at */
@@ -53,6 +55,9 @@ typedef struct {
 
 typedef struct {
     int on;
+    int dry;          /* the dry scan for an armed stop: no edges, no wake, no records */
+    double hit_t;     /* its result: the first armed edge's time and switch */
+    int hit_s, hit_rank;
     double *et;       /* edge times */
     int64_t *ei;      /* edge rows [cap, NEI] */
     int64_t *enc;     /* every axis's decoded count at each edge [cap, n] */
@@ -353,7 +358,7 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
     double *ad = a->d;
     int64_t *ai = a->i;
     double z0 = ad[D_Z], z1;
-    if (r->on) { /* the record SimAxis.scan keeps for encoder_at */
+    if (r->on && !r->dry) { /* the record SimAxis.scan keeps for encoder_at */
         if (r->rcnt[r->axis] >= MAXPREC) return BAIL;
         p->z0 = z0; p->q = ai[I_Q]; p->lastdir = ai[I_LASTDIR]; p->count = ai[I_DCOUNT];
         r->pr[r->rbeg[r->axis] + r->rcnt[r->axis]++] = *p;
@@ -365,7 +370,8 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
         z1 = mb < z0 ? mb : z0;
     }
     double y1 = z1, y = ad[D_Y];
-    if (y1 != y) {
+    r->hit_s = -1;
+    if (y1 != y || r->dry) {
         int nsw = (int)ai[I_NSW];
         for (int s = 0; s < nsw; s++) {
             double *sw = a->sd + s * NSD;
@@ -373,13 +379,29 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
             double thr;
             if (!next_threshold(sw, (int)si[S_ACTIVE], y, d, &thr)) continue;
             if (d > 0 ? y1 < thr : y1 >= thr) continue;
-            if (si[S_WAKE] && !r->on) return WAKE; /* run the cycle again, reporting */
+            if (si[S_WAKE] && !r->on && !r->dry) return WAKE; /* again, reporting */
             double yy = y;
             for (int k = 0; k < MAX_TOGGLES; k++) {
                 if (!next_threshold(sw, (int)si[S_ACTIVE], yy, d, &thr)) break;
                 if (d > 0 ? y1 < thr : y1 >= thr) break;
                 double et = 0.0;
                 int64_t em = 0;
+                if (r->dry) { /* SimAxis._first_armed */
+                    si[S_ACTIVE] = !si[S_ACTIVE];
+                    int64_t lv = ((ai[I_LEVELS] >> si[S_BIT]) & 1) ^ si[S_ACTIVE];
+                    if (si[S_ARM] && lv == si[S_ARMLEVEL]
+                            && (si[S_ARMDIR] == 0 || si[S_ARMDIR] == d)) {
+                        double level = d > 0 ? thr : thr - ad[D_BACKLASH];
+                        if (piece_time_at(p, level, &et, &em)) return BAIL;
+                        if (r->hit_s < 0 || et < r->hit_t
+                                || (et == r->hit_t && si[S_ARM] < r->hit_rank)) {
+                            r->hit_t = et; r->hit_s = s; r->hit_rank = (int)si[S_ARM];
+                        }
+                        break;
+                    }
+                    yy = thr;
+                    continue;
+                }
                 if (r->on) {
                     double level = d > 0 ? thr : thr - ad[D_BACKLASH];
                     if (piece_time_at(p, level, &et, &em)) return BAIL;
@@ -400,6 +422,7 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
             }
         }
     }
+    if (r->dry && r->hit_s >= 0) return HIT;
     ad[D_Z] = z1;
     ad[D_Y] = y1;
     return decoder_advance(a, y1, d);
@@ -445,7 +468,7 @@ static int run_axis(Axis *a, double ta, double tb, Rec *rec, Report *r)
         int dir = c1 > c0 ? 1 : -1;
         if (rec_on && record(rec, 0, ta, ta, ta, ad, dir, c0, c1)) return BAIL;
         if (enabled && ideal) {
-            if (r->on) { /* JumpPiece(ta, c0 - lost, c1 - lost) */
+            if (r->on || r->dry) { /* JumpPiece(ta, c0 - lost, c1 - lost) */
                 pr.kind = 0; pr.dir = dir; pr.t0 = pr.t1 = pr.tc = ta;
                 pr.m1 = c1 - ai[I_LOST];
             }
@@ -491,7 +514,7 @@ static int run_axis(Axis *a, double ta, double tb, Rec *rec, Report *r)
             continue;
         }
         if (c1 == c0) continue;
-        if (r->on) { /* StepPiece(cubic, tc, t0, t1, c0, c1, lost, d, half) */
+        if (r->on || r->dry) { /* StepPiece(cubic, tc, t0, t1, c0, c1, lost, d, half) */
             pr.kind = 1; pr.dir = d; pr.t0 = t0; pr.t1 = t1; pr.tc = tc;
             pr.p0 = ad[D_P0]; pr.v0 = ad[D_V0]; pr.a0 = ad[D_A0]; pr.j = ad[D_J];
             pr.half = half; pr.c0 = c0; pr.lost = ai[I_LOST]; pr.m1 = c1 - ai[I_LOST];
@@ -500,6 +523,57 @@ static int run_axis(Axis *a, double ta, double tb, Rec *rec, Report *r)
         if (st) return st;
     }
     return OK;
+}
+
+/* SimAxis.run over [ta, tb]: with an armed stop (and the command not over by ta) the dry
+ * scan finds the first armed edge; then the axis runs up to its time, the edge is made if
+ * rounding left it a hair short, the pulse output stops (the command holds the count
+ * emitted, SimAxis.cut_pulses) and the axis runs on to tb. Outside report mode a hit
+ * returns WAKE (the cycle is run again reporting). */
+static int run_axis_armed(Axis *a, double ta, double tb, Rec *rec, Report *r)
+{
+    double *ad = a->d;
+    int64_t *ai = a->i, *si = a->si;
+    if (!ai[I_ARMED] || !(ad[D_TE] > ta)) return run_axis(a, ta, tb, rec, r);
+    double sd_[ND];
+    int64_t si_[MAXSW * NSI], ai_[NI];
+    memcpy(sd_, ad, sizeof sd_);
+    memcpy(ai_, ai, sizeof ai_);
+    memcpy(si_, si, sizeof si_);
+    Py_ssize_t rows0 = rec->n;
+    int on = r->on;
+    r->dry = 1;
+    r->on = 0;
+    int st = run_axis(a, ta, tb, rec, r);
+    r->dry = 0;
+    r->on = on;
+    double ts = r->hit_t;
+    int hs = r->hit_s;
+    memcpy(ad, sd_, sizeof sd_); /* the dry scan leaves no trace */
+    memcpy(ai, ai_, sizeof ai_);
+    memcpy(si, si_, sizeof si_);
+    rec->n = rows0;
+    if (st == OK) return run_axis(a, ta, tb, rec, r);
+    if (st != HIT) return st;
+    if (!r->on) return WAKE;
+    if (ai[I_RECORD]) return BAIL; /* the cut command goes into the pulse record: Python */
+    Py_ssize_t e0 = r->ne;
+    st = run_axis(a, ta, ts, rec, r);
+    if (st) return st;
+    int64_t *sw = si + hs * NSI, bit = sw[S_BIT];
+    int seen = 0;
+    for (Py_ssize_t k = e0; k < r->ne; k++)
+        if (r->ei[k * NEI] == r->axis && r->ei[k * NEI + 1] == bit) seen = 1;
+    if (!seen) { /* rounding left the motor a hair short of the switch: the edge is at ts */
+        sw[S_ACTIVE] = !sw[S_ACTIVE];
+        st = add_edge(r, ts, bit, ((ai[I_LEVELS] >> bit) & 1) ^ sw[S_ACTIVE], ai[I_DCOUNT]);
+        if (st) return st;
+    }
+    ad[D_P0] = (double)ai[I_COUNT];
+    ad[D_V0] = ad[D_A0] = ad[D_J] = 0.0;
+    ad[D_TC] = ad[D_TE] = ts;
+    ad[D_STOP] = ts;
+    return run_axis(a, ts, tb, rec, r);
 }
 
 const char kernel_run_doc[] =
@@ -609,7 +683,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
         PyMem_Free(rstart); release(bufs, 11);
         return PyErr_NoMemory();
     }
-    Report rep = {0, bufs[8].b.buf, bufs[9].b.buf, bufs[10].b.buf, 0, ecap, n, prec, 0,
+    Report rep = {0, 0, 0.0, -1, 0, bufs[8].b.buf, bufs[9].b.buf, bufs[10].b.buf, 0, ecap, n, prec, 0,
                   rix, rix + n, rstart, 0};
     for (Py_ssize_t x = 0; x < n; x++) rix[x] = x * MAXPREC;
     long long k = start;
@@ -654,7 +728,8 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
                 Axis a = {AD + x * ND, AI + x * NI, SD + x * MAXSW * NSD, SI + x * MAXSW * NSI};
                 rec.axis = (int)x;
                 rep.axis = (int)x;
-                status = run_axis(&a, now, tn, &rec, &rep);
+                AD[x * ND + D_STOP] = NAN; /* SimMachine._advance: stop_time = None */
+                status = run_axis_armed(&a, now, tn, &rec, &rep);
             }
             if (status == OK && rep.on && rep.ne > e0)
                 status = finish_edges(&rep, e0, AD, AI, SD, SI);

@@ -12,8 +12,8 @@ emitted by SimMachine after the run. The state stays in the kernel's
 arrays (`KernelState`) between runs and goes back into the `SimAxis` objects when Python
 needs them.
 
-The kernel takes a machine whose axes are all steppers (ideal or stalling) without an
-armed edge stop or a pitch-error table; for any other machine `usable` is False and every
+The kernel takes a machine whose axes are all steppers (ideal or stalling, armed edge stops
+included) without a pitch-error table; for any other machine `usable` is False and every
 cycle runs in Python. It is built by the package's own build (setup.py); when the module is
 missing (a source tree that was never built) `AVAILABLE` is False and the Python path runs.
 Set `SimMachine.native = False` to force the Python path (the equivalence tests do).
@@ -21,6 +21,7 @@ Set `SimMachine.native = False` to force the Python path (the equivalence tests 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Collection
 from typing import TYPE_CHECKING
 
@@ -50,12 +51,13 @@ _NO_TRACE = np.zeros(0, dtype=np.int64)
 _BIT = {sig: i for i, sig in enumerate(AXIS_INPUTS)}
 
 # field indices, kept in step with _kernel.c (checked against its constants below)
-_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 26, 8, 4, 4, 12
+_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 14, 27, 8, 4, 7, 12
 (D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
- D_UPP) = range(_ND)
+ D_UPP, D_STOP) = range(_ND)
 (I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
  I_TURNF, I_TURNB) = range(11)
-I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD, I_LEVELS = 11, 16, 21, 22, 23, 24, 25
+I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD, I_LEVELS, I_ARMED = (11, 16, 21, 22,
+                                                                       23, 24, 25, 26)
 if _k is not None:
     assert (_k.ND, _k.NI, _k.MAXSW, _k.NSD, _k.NSI, _k.NREC) == (
         _ND, _NI, _MAXSW, _NSD, _NSI, _NREC), "_kernel.c layout differs from kernel.py"
@@ -68,7 +70,7 @@ def usable(axes: list[SimAxis]) -> bool:
     if _k is None:
         return False
     for ax in axes:
-        if (type(ax.plant) is not StepperPlant or ax.armed or ax.trans.pitch.e
+        if (type(ax.plant) is not StepperPlant or ax.trans.pitch.e
                 or len(ax.switches) > _MAXSW or not _BIT.keys() >= ax.switches.keys()):
             return False
     return True
@@ -150,7 +152,8 @@ class KernelState:
             g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
             c = g.cubic
             adl.append((c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
-                        tr.backlash, tr.z, ax.y, dec.upp))
+                        tr.backlash, tr.z, ax.y, dec.upp,
+                        math.nan if ax.stop_time is None else ax.stop_time))
             fwd = [*dec.fwd_pre, 0, 0, 0, 0][:5]
             bwd = [*dec.bwd_pre, 0, 0, 0, 0][:5]
             sws = ax.switches
@@ -166,10 +169,14 @@ class KernelState:
                 bits = _switch_bits(name, sws)
                 if sw.active:
                     base ^= bits
-                si[x, s] = (sw.active, 0, bits, _BIT[name])
+                arm = ax.armed.get(name) if name != "ez" else None
+                rank = list(ax.armed).index(name) + 1 if arm is not None else 0
+                si[x, s] = (sw.active, 0, bits, _BIT[name], rank,
+                            arm[0] if arm else 0, arm[1] if arm else 0)
             ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
                         dec.count, dec.period, len(sws), dec.turn[1], dec.turn[-1],
-                        *fwd, *bwd, 0, 0, 0, g.record is not None, base])
+                        *fwd, *bwd, 0, 0, 0, g.record is not None, base,
+                        any(name in sws and name != "ez" for name in ax.armed)])
         if n:
             ad[:] = adl
             ai[:] = ail
@@ -214,6 +221,15 @@ class KernelState:
         _k.readback(self.ai, self.si, out)
         return out
 
+    def stop_time(self, x: int) -> float | None:
+        """When an armed stop cut axis x's pulses in the last stretch run, else None."""
+        t = float(self.ad[x, D_STOP])
+        return None if math.isnan(t) else t
+
+    def stopped(self) -> bool:
+        """An armed stop cut some axis's pulses in the last stretch run."""
+        return not bool(np.isnan(self.ad[:, D_STOP]).all())
+
     def at_rest(self, t: float) -> bool:
         """Every generator holds its command's end at time t (te <= t)."""
         return bool((self.ad[:, D_TE] <= t).all())
@@ -233,7 +249,7 @@ class KernelState:
             dec.q, dec.last_dir, dec.count = i[I_Q], i[I_LASTDIR], i[I_DCOUNT]
             for s, name in enumerate(self.names[x]):
                 ax.switches[name].active = bool(sil[x][s][0])
-            ax.stop_time = None
+            ax.stop_time = None if math.isnan(d[D_STOP]) else d[D_STOP]
             ax.record = []
             ax.run_start = (tr.z, (dec.q, dec.last_dir, dec.count))
 

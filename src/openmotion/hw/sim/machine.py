@@ -219,6 +219,10 @@ class SimMachine(SimAnalogOutputs):
                         self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
+                if edges and not (wake is None or any(e.signal in wake for e in edges)
+                                  or ks.stopped()):
+                    edges = []  # a cycle with edges on other signals only: run on
+                    continue
                 if edges or k >= stop or (paced and kernel.interrupted()):
                     break
             if paced:
@@ -506,9 +510,9 @@ class SimMachine(SimAnalogOutputs):
 
     def stop_time(self, axis: int) -> float | None:
         """When an armed stop cut the pulses of `axis` in the last advance, else None."""
-        if self._stale:  # the kernel ran last: it models no armed stop
-            self._index(axis)
-            return None
+        if self._stale:  # the kernel ran last: its arrays hold the stop times
+            assert self._ks is not None
+            return self._ks.stop_time(self._index(axis))
         return self._view(axis).stop_time
 
     # -- extras for tests and tools ---------------------------------------------------------
