@@ -4,8 +4,9 @@ Random scenarios on ideal steppers, stalling steppers with backlash and servo dr
 (moves, velocity moves, speed changes, stops, end limits, E-stop, alarms,
 step losses, soft limits, digital inputs, group lines/arcs/delays, homing in three modes,
 G-code with arcs and dwells, compare tables with pulses and windows) run twice on
-the same machine: once cycle by cycle (`virtual_jumps = False`, the reference) and once
-jumping. After every operation the two controllers must agree on everything observable:
+the same machine: once cycle by cycle (`virtual_jumps = False`) through the Python
+pipeline (`SimMachine.native = False`: the reference) and once jumping with the compiled
+kernel. After every operation the two controllers must agree on everything observable:
 time and cycle count, every axis's state, fault, position, velocity, motion_done and
 counters, the event log with exact times, the safety stop records, the motion history,
 every output edge, every pulse the generators emitted (exact times), in part of the
@@ -265,6 +266,9 @@ def run_both(seed: int) -> tuple[list, list, int]:
     for jumping in (False, True):
         ctl = Controller(cfg)
         ctl.virtual_jumps = jumping
+        # the reference steps every cycle through the Python pipeline (the oracle); the
+        # fast run jumps with the compiled kernel
+        ctl.hardware.native = jumping
         ctl.enable_all()
         if capacity:
             ctl.start_recording(capacity=capacity)

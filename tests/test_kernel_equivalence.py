@@ -171,6 +171,10 @@ def test_run_cycles_in_the_kernel_is_the_python_path(seed):
         s for s in sigs if rng.random() < 0.3)
     plans = [random_pieces(rng, cycles, period, 0.0) for _ in range(n_axes)]
     record = bool(rng.random() < 0.7)
+    arms = [(int(rng.integers(n_axes)), str(rng.choice(["pel", "mel", "org", "sd", "ltc",
+                                                         "ez", "alm"])),
+             bool(rng.random() < 0.5), int(rng.integers(-1, 2)))
+            for _ in range(int(rng.integers(0, 4)) if rng.random() < 0.5 else 0)]
     runs = []
     for native in (False, True):
         hw = SimMachine(cfg)
@@ -179,6 +183,8 @@ def test_run_cycles_in_the_kernel_is_the_python_path(seed):
             hw.set_half_pulse(False)
         if record:
             hw.record_pulses()
+        for axis, sig, level, direction in arms:  # armed edge stops (homing, latches)
+            hw.arm_stop(axis, sig, level, direction)
         for i, rows in enumerate(plans):
             hw.queue_pieces(i, PieceBlock(rows))
         trace = []
@@ -186,7 +192,8 @@ def test_run_cycles_in_the_kernel_is_the_python_path(seed):
         while k < cycles:
             r = hw.run_cycles(0.0, period, k, cycles, wake)
             trace.append((r.cycle, [(bits([e.time]), e.axis, e.signal, e.level, e.encoders)
-                                    for e in r.edges], r.drained, state(hw)))
+                                    for e in r.edges], r.drained,
+                          [hw.stop_time(i) for i in range(n_axes)], state(hw)))
             k = r.cycle
         runs.append((trace, pulses(hw) if record else None))
     assert simkernel.usable(SimMachine(cfg)._axes)
@@ -272,8 +279,8 @@ def test_machines_the_kernel_does_not_model_run_in_python():
         assert not simkernel.usable(hw._axes)
     hw = SimMachine(MachineConfig(name="m", axes=(x,)))
     assert simkernel.usable(hw._axes)
-    hw.arm_stop(0, "org", True)
-    assert not simkernel.usable(hw._axes)
+    hw.arm_stop(0, "org", True)  # armed edge stops run in the kernel
+    assert simkernel.usable(hw._axes)
 
 
 @pytest.mark.parametrize("rows,match", [

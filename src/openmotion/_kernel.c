@@ -142,7 +142,9 @@ static PyObject *check_rows(PyObject *self, PyObject *args)
 static PyMethodDef methods[] = {
     {"check_rows", check_rows, METH_VARARGS, check_rows_doc},
     {"run", kernel_run, METH_VARARGS, kernel_run_doc},
+    {"readback", kernel_readback, METH_VARARGS, kernel_readback_doc},
     {"pieces", pieces, METH_VARARGS, pieces_doc},
+    {"record_rows", record_rows, METH_VARARGS, record_rows_doc},
     {"rt_paced", rt_paced, METH_VARARGS, rt_paced_doc},
     {"rt_wait", rt_wait, METH_VARARGS, rt_wait_doc},
     {"rt_close", rt_close, METH_VARARGS, rt_close_doc},

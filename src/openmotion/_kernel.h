@@ -37,8 +37,14 @@ static inline void release(Buf *bufs, int n)
 /* _kernel_stepper.c: the simulator's stepper pipeline over a chunk of cycles */
 PyObject *kernel_run(PyObject *self, PyObject *args);
 extern const char kernel_run_doc[];
+PyObject *kernel_readback(PyObject *self, PyObject *args);
+extern const char kernel_readback_doc[];
 /* field counts of its arrays, exported as module constants */
 int kernel_layout(PyObject *module);
+
+/* _kernel_record.c: a jump's crossed cycles into the recorder's ring arrays */
+PyObject *record_rows(PyObject *self, PyObject *args);
+extern const char record_rows_doc[];
 
 /* _kernel_rt.c: real-time pacing of the compiled cycles (control/core/realtime.py) */
 int rt_before_cycle(long long k);  /* wait for cycle k's slot; 1: return at this boundary */

@@ -4,11 +4,15 @@
  * start queued pieces at their t0, cut the command into monotone stretches (velocity
  * zeros, pull-out cuts), count pulses by the half-pulse rule, apply the stepper plant
  * (stalls lose pulses), the backlash, the switches and the quadrature decoder. Crossings
- * of switches nobody listens to (`wake` 0) only toggle the switch, as the Python path does
- * before it drops those edges; a crossing that must be reported (`wake` 1) ends the chunk
- * *before* that cycle (its state is rolled back), and the Python path runs that cycle and
- * computes the edge's exact time and counts. Every formula repeats the Python operation
- * order exactly (compiled with -ffp-contract=off), so the floats are bit-identical.
+ * of switches nobody listens to (`wake` 0) only toggle the switch; a crossing that must be
+ * reported (`wake` 1) rolls that cycle back and runs it again in report mode, where every
+ * crossing of every switch becomes an edge with its exact time (the threshold solved on the
+ * stretch's cubic), the level and the own decoded count at that instant, and every other
+ * axis's decoded count at that instant (from the cycle's per-axis piece records); the chunk
+ * ends after that cycle. Every formula repeats the operation order of the Python pipeline
+ * (hw/sim/simaxis.py, pulses.py, plant.py, encoder.py, switches.py, cubic.py: the oracle of
+ * tests/test_kernel_*.py) exactly (compiled with -ffp-contract=off), so the floats are
+ * bit-identical.
  */
 #include "_kernel.h"
 
@@ -18,20 +22,51 @@
 
 /* per-axis double fields */
 enum { D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
-       D_UPP, ND };
+       D_UPP, D_STOP, ND };
 /* per-axis int64 fields */
 enum { I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
        I_TURNF, I_TURNB, I_FWD, I_BWD = I_FWD + 5, I_PBEGIN = I_BWD + 5, I_PEND, I_CURSOR,
-       I_RECORD, I_LEVELS, NI };
+       I_RECORD, I_LEVELS, I_ARMED, NI };
 #define MAXSW 8
 /* per-switch double fields: kind (0 span, 1 index), lo|period, hi|width, hysteresis */
 enum { S_KIND, S_A, S_B, S_H, NSD };
-/* per-switch int64 fields: active, reported, the input-level bits it flips when active */
-enum { S_ACTIVE, S_WAKE, S_LEVELBITS, NSI };
+/* per-switch int64 fields: active, reported, the input-level bits it flips when active,
+ * the bit of its own signal (AXIS_INPUTS index) */
+enum { S_ACTIVE, S_WAKE, S_LEVELBITS, S_BIT, S_ARM, S_ARMLEVEL, S_ARMDIR, NSI };
+/* S_ARM: 0 not armed, else 1 + the switch's rank in the order the stops were armed (ties
+ * at one instant go to the first armed, as SimAxis._first_armed) */
+#define LTC_BIT 4 /* AXIS_INPUTS.index("ltc"): SD shares its pin while no LTC is placed */
+#define TIME_TOL 1e-13
+/* edge row (int64): axis, signal bit, level, own decoded count */
+#define NEI 4
+#define MAXPREC 32 /* motor pieces per axis and stretch of a cycle (<= 2 x 12: armed) */
 /* record row: axis, kind (0 jump, 1 cubic), t0, t1, tc, p0, v0, a0, j, d, c0, c1 */
 #define NREC 12
 
-enum { OK = 0, BAIL = 1 };
+enum { OK = 0, BAIL = 1, WAKE = 2, FULL = 3, HIT = 4 };
+
+/* a motor piece scanned in report mode (simref's StepPiece / JumpPiece with the load and
+ * decoder state at its start), for the own count at an edge and encoder_at */
+typedef struct {
+    int kind, dir; /* kind 0 jump, 1 step */
+    double t0, t1, tc, p0, v0, a0, j, half, z0;
+    int64_t c0, lost, m1, q, lastdir, count;
+} PRec;
+
+typedef struct {
+    int on;
+    int dry;          /* the dry scan for an armed stop: no edges, no wake, no records */
+    double hit_t;     /* its result: the first armed edge's time and switch */
+    int hit_s, hit_rank;
+    double *et;       /* edge times */
+    int64_t *ei;      /* edge rows [cap, NEI] */
+    int64_t *enc;     /* every axis's decoded count at each edge [cap, n] */
+    Py_ssize_t ne, cap, n;
+    PRec *pr;         /* the current stretch's piece records, per axis contiguous */
+    Py_ssize_t np, *rbeg, *rcnt;
+    int64_t *start;   /* per axis: decoded count at the stretch's start */
+    int axis;
+} Report;
 
 typedef struct {
     double *d;
@@ -177,11 +212,157 @@ static inline int decoder_advance(Axis *a, double y, int d)
     return OK;
 }
 
-/* simaxis.SimAxis.scan for one motor piece ending at m1 in direction d */
-static int scan(Axis *a, double m1, int d)
+/* Python's min/max of two floats (the first argument wins ties: signed zeros stay) */
+static inline double pmax(double a, double b) { return b > a ? b : a; }
+static inline double pmin(double a, double b) { return b < a ? b : a; }
+
+/* cubic.solve_monotone with f = the cubic's position, df = its velocity */
+static double solve_monotone(const double *c, double lo, double hi, double target)
+{
+    double flo = cpos(c, lo) - target, fhi = cpos(c, hi) - target;
+    if (flo == 0.0) return lo;
+    if (fhi == 0.0) return hi;
+    if ((flo > 0.0) == (fhi > 0.0)) return fabs(flo) <= fabs(fhi) ? lo : hi;
+    double lo_neg, hi_pos;
+    if (flo > 0.0) { lo_neg = hi; hi_pos = lo; }
+    else { lo_neg = lo; hi_pos = hi; }
+    double s = lo - flo * (hi - lo) / (fhi - flo);
+    for (int it = 0; it < 100; it++) {
+        double fs = cpos(c, s) - target;
+        if (fs == 0.0) return s;
+        if (fs < 0.0) lo_neg = s;
+        else hi_pos = s;
+        double width = fabs(hi_pos - lo_neg);
+        if (width <= TIME_TOL * pmax(1.0, fabs(s))) return 0.5 * (lo_neg + hi_pos);
+        double d = cvel(c, s);
+        int step_ok = 0;
+        if (d != 0.0) {
+            double s_new = s - fs / d;
+            if (pmin(lo_neg, hi_pos) < s_new && s_new < pmax(lo_neg, hi_pos)
+                    && fabs(s_new - s) < 0.5 * width) {
+                s = s_new;
+                step_ok = 1;
+            }
+        }
+        if (!step_ok) s = 0.5 * (lo_neg + hi_pos);
+    }
+    return s;
+}
+
+/* cubic.cubic_time_at */
+static double cubic_time_at(const double *c, double level, double lo, double hi)
+{
+    if (c[D_J] == 0.0 && c[D_A0] == 0.0 && c[D_V0] != 0.0) {
+        double s = (level - c[D_P0]) / c[D_V0];
+        return pmin(pmax(s, lo), hi);
+    }
+    return solve_monotone(c, lo, hi, level);
+}
+
+/* Piece.time_at: the time the motor first reaches `level` on the piece, and m there */
+static int piece_time_at(const PRec *p, double level, double *t, int64_t *m)
+{
+    if (p->kind == 0) { *t = p->t0; *m = p->m1; return OK; }
+    double kk = ceil(level + (double)p->lost);
+    if (!(fabs(kk) < BIG)) return BAIL;
+    int64_t k = (int64_t)kk - (p->dir > 0 ? 0 : 1);
+    double u = p->dir > 0 ? (double)k - p->half : (double)k + p->half;
+    double c[4] = {p->p0, p->v0, p->a0, p->j};
+    double s = cubic_time_at(c, u, p->t0 - p->tc, p->t1 - p->tc);
+    *t = pmin(pmax(p->tc + s, p->t0), p->t1);
+    *m = k - p->lost;
+    return OK;
+}
+
+/* encoder.Decoder.index_after */
+static inline int index_after(const Axis *a, double y, int64_t q, int d, int64_t *out)
+{
+    double x = y * a->d[D_UPP];
+    *out = q;
+    if (d > 0) {
+        double k = floor(x + EPS_PULSE);
+        if (!(fabs(k) < BIG)) return BAIL;
+        if ((int64_t)k > q) *out = (int64_t)k;
+    } else if (d < 0) {
+        double k = ceil(x - EPS_PULSE);
+        if (!(fabs(k) < BIG)) return BAIL;
+        if ((int64_t)k < q) *out = (int64_t)k;
+    }
+    return OK;
+}
+
+/* encoder.Decoder.increment */
+static inline int64_t increment(const Axis *a, int64_t q0, int64_t q1, int64_t last_dir)
+{
+    const int64_t *ai = a->i;
+    if (q1 == q0) return 0;
+    int dd = q1 > q0 ? 1 : -1;
+    int64_t inc = dd != last_dir ? (dd > 0 ? ai[I_TURNF] : ai[I_TURNB]) : 0;
+    int64_t n = q1 > q0 ? q1 - q0 : q0 - q1;
+    int64_t p = ai[I_DPERIOD];
+    if (dd > 0) return inc + run_sum(ai + I_FWD, p, q0, n);
+    return inc + run_sum(ai + I_BWD, p, q0 - n + 1, n);
+}
+
+/* simaxis.SimAxis._peek: the decoded count with the motor at m on piece p */
+static inline int peek(const Axis *a, const PRec *p, double m, int64_t *out)
+{
+    double z;
+    if (p->dir > 0) z = m > p->z0 ? m : p->z0;
+    else if (p->dir < 0) { double mb = m + a->d[D_BACKLASH]; z = mb < p->z0 ? mb : p->z0; }
+    else z = p->z0;
+    int64_t q1;
+    if (index_after(a, z, p->q, p->dir, &q1)) return BAIL;
+    *out = p->count + increment(a, p->q, q1, p->lastdir);
+    return OK;
+}
+
+/* StepPiece.m_at / JumpPiece.m_at */
+static inline int piece_m_at(const PRec *p, double t, int64_t *m)
+{
+    if (p->kind == 0 || t >= p->t1) { *m = p->m1; return OK; }
+    double c[4] = {p->p0, p->v0, p->a0, p->j};
+    int bad = 0;
+    int64_t cnt = count_after(cpos(c, t - p->tc), p->c0, p->dir, p->half, &bad);
+    if (bad) return BAIL;
+    *m = cnt - p->lost;
+    return OK;
+}
+
+/* SimAxis.encoder_at: axis x's decoded count at time t within the current stretch */
+static int encoder_at(const Axis *a, const Report *r, Py_ssize_t x, double t, int64_t *out)
+{
+    const PRec *rec = r->pr + r->rbeg[x];
+    Py_ssize_t k = r->rcnt[x] - 1;
+    while (k >= 0 && rec[k].t0 > t) k--;
+    if (k < 0) { *out = r->rcnt[x] ? rec[0].count : r->start[x]; return OK; }
+    int64_t m;
+    if (piece_m_at(rec + k, t, &m)) return BAIL;
+    return peek(a, rec + k, (double)m, out);
+}
+
+static inline int add_edge(Report *r, double t, int64_t bit, int64_t level, int64_t own)
+{
+    if (r->ne >= r->cap) return FULL;
+    int64_t *e = r->ei + r->ne * NEI;
+    r->et[r->ne] = t;
+    e[0] = r->axis; e[1] = bit; e[2] = level; e[3] = own;
+    r->ne++;
+    return OK;
+}
+
+/* simaxis.SimAxis.scan for one motor piece ending at m1 in direction d; in report mode
+ * (r->on) `p` describes the piece and every crossing is an edge (SimAxis._scan_switch) */
+static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
 {
     double *ad = a->d;
+    int64_t *ai = a->i;
     double z0 = ad[D_Z], z1;
+    if (r->on && !r->dry) { /* the record SimAxis.scan keeps for encoder_at */
+        if (r->rcnt[r->axis] >= MAXPREC) return BAIL;
+        p->z0 = z0; p->q = ai[I_Q]; p->lastdir = ai[I_LASTDIR]; p->count = ai[I_DCOUNT];
+        r->pr[r->rbeg[r->axis] + r->rcnt[r->axis]++] = *p;
+    }
     if (d > 0) {
         z1 = m1 > z0 ? m1 : z0;
     } else {
@@ -189,24 +370,59 @@ static int scan(Axis *a, double m1, int d)
         z1 = mb < z0 ? mb : z0;
     }
     double y1 = z1, y = ad[D_Y];
-    if (y1 != y) {
-        int nsw = (int)a->i[I_NSW];
+    r->hit_s = -1;
+    if (y1 != y || r->dry) {
+        int nsw = (int)ai[I_NSW];
         for (int s = 0; s < nsw; s++) {
             double *sw = a->sd + s * NSD;
             int64_t *si = a->si + s * NSI;
             double thr;
             if (!next_threshold(sw, (int)si[S_ACTIVE], y, d, &thr)) continue;
             if (d > 0 ? y1 < thr : y1 >= thr) continue;
-            if (si[S_WAKE]) return BAIL; /* an edge to report: the Python path runs it */
+            if (si[S_WAKE] && !r->on && !r->dry) return WAKE; /* again, reporting */
             double yy = y;
             for (int k = 0; k < MAX_TOGGLES; k++) {
                 if (!next_threshold(sw, (int)si[S_ACTIVE], yy, d, &thr)) break;
                 if (d > 0 ? y1 < thr : y1 >= thr) break;
+                double et = 0.0;
+                int64_t em = 0;
+                if (r->dry) { /* SimAxis._first_armed */
+                    si[S_ACTIVE] = !si[S_ACTIVE];
+                    int64_t lv = ((ai[I_LEVELS] >> si[S_BIT]) & 1) ^ si[S_ACTIVE];
+                    if (si[S_ARM] && lv == si[S_ARMLEVEL]
+                            && (si[S_ARMDIR] == 0 || si[S_ARMDIR] == d)) {
+                        double level = d > 0 ? thr : thr - ad[D_BACKLASH];
+                        if (piece_time_at(p, level, &et, &em)) return BAIL;
+                        if (r->hit_s < 0 || et < r->hit_t
+                                || (et == r->hit_t && si[S_ARM] < r->hit_rank)) {
+                            r->hit_t = et; r->hit_s = s; r->hit_rank = (int)si[S_ARM];
+                        }
+                        break;
+                    }
+                    yy = thr;
+                    continue;
+                }
+                if (r->on) {
+                    double level = d > 0 ? thr : thr - ad[D_BACKLASH];
+                    if (piece_time_at(p, level, &et, &em)) return BAIL;
+                }
                 si[S_ACTIVE] = !si[S_ACTIVE];
+                if (r->on) {
+                    int64_t own, bit = si[S_BIT], act = si[S_ACTIVE];
+                    if (peek(a, p, (double)em, &own)) return BAIL;
+                    int st = add_edge(r, et, bit, ((ai[I_LEVELS] >> bit) & 1) ^ act, own);
+                    if (st) return st;
+                    if (si[S_LEVELBITS] != ((int64_t)1 << bit)) { /* SD is also LTC */
+                        st = add_edge(r, et, LTC_BIT, ((ai[I_LEVELS] >> LTC_BIT) & 1) ^ act,
+                                      own);
+                        if (st) return st;
+                    }
+                }
                 yy = thr;
             }
         }
     }
+    if (r->dry && r->hit_s >= 0) return HIT;
     ad[D_Z] = z1;
     ad[D_Y] = y1;
     return decoder_advance(a, y1, d);
@@ -226,8 +442,9 @@ static inline int record(Rec *rec, int kind, double t0, double t1, double tc, co
 }
 
 /* StepperPlant.pieces (with PulseGenerator.stretches) + scan over [ta, tb] */
-static int run_axis(Axis *a, double ta, double tb, Rec *rec)
+static int run_axis(Axis *a, double ta, double tb, Rec *rec, Report *r)
 {
+    PRec pr;
     double *ad = a->d;
     int64_t *ai = a->i;
     double tc = ad[D_TC], te = ad[D_TE], half = ad[D_HALF];
@@ -251,7 +468,12 @@ static int run_axis(Axis *a, double ta, double tb, Rec *rec)
         int dir = c1 > c0 ? 1 : -1;
         if (rec_on && record(rec, 0, ta, ta, ta, ad, dir, c0, c1)) return BAIL;
         if (enabled && ideal) {
-            if (scan(a, (double)(c1 - ai[I_LOST]), dir)) return BAIL;
+            if (r->on || r->dry) { /* JumpPiece(ta, c0 - lost, c1 - lost) */
+                pr.kind = 0; pr.dir = dir; pr.t0 = pr.t1 = pr.tc = ta;
+                pr.m1 = c1 - ai[I_LOST];
+            }
+            int st = scan(a, (double)(c1 - ai[I_LOST]), dir, r, &pr);
+            if (st) return st;
         } else {
             ai[I_LOST] += c1 - c0;
         }
@@ -291,40 +513,138 @@ static int run_axis(Axis *a, double ta, double tb, Rec *rec)
             ai[I_LOST] += c1 - c0;
             continue;
         }
-        if (c1 != c0 && scan(a, (double)(c1 - ai[I_LOST]), d)) return BAIL;
+        if (c1 == c0) continue;
+        if (r->on || r->dry) { /* StepPiece(cubic, tc, t0, t1, c0, c1, lost, d, half) */
+            pr.kind = 1; pr.dir = d; pr.t0 = t0; pr.t1 = t1; pr.tc = tc;
+            pr.p0 = ad[D_P0]; pr.v0 = ad[D_V0]; pr.a0 = ad[D_A0]; pr.j = ad[D_J];
+            pr.half = half; pr.c0 = c0; pr.lost = ai[I_LOST]; pr.m1 = c1 - ai[I_LOST];
+        }
+        int st = scan(a, (double)(c1 - ai[I_LOST]), d, r, &pr);
+        if (st) return st;
     }
     return OK;
 }
 
+/* SimAxis.run over [ta, tb]: with an armed stop (and the command not over by ta) the dry
+ * scan finds the first armed edge; then the axis runs up to its time, the edge is made if
+ * rounding left it a hair short, the pulse output stops (the command holds the count
+ * emitted, SimAxis.cut_pulses) and the axis runs on to tb. Outside report mode a hit
+ * returns WAKE (the cycle is run again reporting). */
+static int run_axis_armed(Axis *a, double ta, double tb, Rec *rec, Report *r)
+{
+    double *ad = a->d;
+    int64_t *ai = a->i, *si = a->si;
+    if (!ai[I_ARMED] || !(ad[D_TE] > ta)) return run_axis(a, ta, tb, rec, r);
+    double sd_[ND];
+    int64_t si_[MAXSW * NSI], ai_[NI];
+    memcpy(sd_, ad, sizeof sd_);
+    memcpy(ai_, ai, sizeof ai_);
+    memcpy(si_, si, sizeof si_);
+    Py_ssize_t rows0 = rec->n;
+    int on = r->on;
+    r->dry = 1;
+    r->on = 0;
+    int st = run_axis(a, ta, tb, rec, r);
+    r->dry = 0;
+    r->on = on;
+    double ts = r->hit_t;
+    int hs = r->hit_s;
+    memcpy(ad, sd_, sizeof sd_); /* the dry scan leaves no trace */
+    memcpy(ai, ai_, sizeof ai_);
+    memcpy(si, si_, sizeof si_);
+    rec->n = rows0;
+    if (st == OK) return run_axis(a, ta, tb, rec, r);
+    if (st != HIT) return st;
+    if (!r->on) return WAKE;
+    if (ai[I_RECORD]) return BAIL; /* the cut command goes into the pulse record: Python */
+    Py_ssize_t e0 = r->ne;
+    st = run_axis(a, ta, ts, rec, r);
+    if (st) return st;
+    int64_t *sw = si + hs * NSI, bit = sw[S_BIT];
+    int seen = 0;
+    for (Py_ssize_t k = e0; k < r->ne; k++)
+        if (r->ei[k * NEI] == r->axis && r->ei[k * NEI + 1] == bit) seen = 1;
+    if (!seen) { /* rounding left the motor a hair short of the switch: the edge is at ts */
+        sw[S_ACTIVE] = !sw[S_ACTIVE];
+        st = add_edge(r, ts, bit, ((ai[I_LEVELS] >> bit) & 1) ^ sw[S_ACTIVE], ai[I_DCOUNT]);
+        if (st) return st;
+    }
+    ad[D_P0] = (double)ai[I_COUNT];
+    ad[D_V0] = ad[D_A0] = ad[D_J] = 0.0;
+    ad[D_TC] = ad[D_TE] = ts;
+    ad[D_STOP] = ts;
+    return run_axis(a, ts, tb, rec, r);
+}
+
 const char kernel_run_doc[] =
-"run(ad, ai, sd, si, pieces, popt, rows, trace, origin, period, start, stop, now, limit)\n"
-"-> (cycle reached, hardware time, record rows used)\n\n"
-"Run cycles start+1..stop over float64 ad[n, ND], int64 ai[n, NI], float64 sd[n, 8, 4],\n"
-"int64 si[n, 8, 2], float64 pieces[P, 6] (t0, dt, p0, v0, a0, j) with each axis's range\n"
+"run(ad, ai, sd, si, pieces, popt, rows, trace, et, ei, enc, origin, period, start, stop,\n"
+"    now, limit, report, paced)\n"
+"-> (cycle reached, hardware time, record rows used, edges, edge room short)\n\n"
+"Run cycles start+1..stop over float64 ad[n, ND], int64 ai[n, NI], float64 sd[n, 8, NSD],\n"
+"int64 si[n, 8, NSI], float64 pieces[P, 6] (t0, dt, p0, v0, a0, j) with each axis's range\n"
 "and cursor in ai, popt[P] (the time each piece started; empty: not wanted), rows[R, 12]\n"
-"(pulse record),\n"
-"int64 trace[stop - start, n, 3] (per cycle: pulse count, decoded count, input levels;\n"
-"an empty array: no trace).\n"
-"Stops before the first cycle ending at or after `limit`, or with an edge to report.";
+"(pulse record), int64 trace[stop - start, n, 3] (per cycle: pulse count, decoded count,\n"
+"input levels; an empty array: no trace), the edges of the last cycle run: float64 et[E]\n"
+"(times), int64 ei[E, 4] (axis, signal bit, level, own count), int64 enc[E, n] (every\n"
+"axis's decoded count at the edge). `report` 1: every cycle reports its edges (advance);\n"
+"0: a cycle reports only when a switch with `wake` set is crossed. `paced` 0: no\n"
+"real-time slot waits. Stops before the first cycle ending at or after `limit` or one the\n"
+"kernel cannot run exactly (the caller runs it), or after the first cycle with edges; with\n"
+"`edge room short` the edge arrays were too small for that cycle (not run: call again\n"
+"with larger ones).";
+
+/* the edges of one stretch [now, tn] in time order (stable, as SimMachine._advance sorts
+ * them) with every axis's decoded count at each edge's instant */
+static int finish_edges(Report *r, Py_ssize_t e0, double *AD, int64_t *AI, double *SD,
+                        int64_t *SI)
+{
+    for (Py_ssize_t k = e0 + 1; k < r->ne; k++) { /* insertion sort: stable */
+        double t = r->et[k];
+        int64_t row[NEI];
+        memcpy(row, r->ei + k * NEI, sizeof row);
+        Py_ssize_t m = k - 1;
+        while (m >= e0 && r->et[m] > t) {
+            r->et[m + 1] = r->et[m];
+            memcpy(r->ei + (m + 1) * NEI, r->ei + m * NEI, sizeof row);
+            m--;
+        }
+        r->et[m + 1] = t;
+        memcpy(r->ei + (m + 1) * NEI, row, sizeof row);
+    }
+    for (Py_ssize_t k = e0; k < r->ne; k++) {
+        int64_t *enc = r->enc + k * r->n, axis = r->ei[k * NEI];
+        for (Py_ssize_t x = 0; x < r->n; x++) {
+            if (x == axis) { enc[x] = r->ei[k * NEI + 3]; continue; }
+            Axis a = {AD + x * ND, AI + x * NI, SD + x * MAXSW * NSD, SI + x * MAXSW * NSI};
+            if (encoder_at(&a, r, x, r->et[k], enc + x)) return BAIL;
+        }
+    }
+    return OK;
+}
 
 PyObject *kernel_run(PyObject *self, PyObject *args)
 {
-    PyObject *o[8];
+    PyObject *o[11];
     double origin, period, now, limit;
     long long start, stop;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOddLLdd", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &o[7], &origin, &period, &start, &stop, &now, &limit))
+    int report_all, paced;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOddLLddpp", &o[0], &o[1], &o[2], &o[3], &o[4],
+                          &o[5], &o[6], &o[7], &o[8], &o[9], &o[10], &origin, &period, &start,
+                          &stop, &now, &limit, &report_all, &paced))
         return NULL;
-    Buf bufs[8];
+    Buf bufs[11];
     memset(bufs, 0, sizeof bufs);
-    static const char *names[8] = {"ad", "ai", "sd", "si", "pieces", "popt", "rows", "trace"};
-    for (int k = 0; k < 8; k++)
-        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, 8); return NULL; }
+    static const char *names[11] = {"ad", "ai", "sd", "si", "pieces", "popt", "rows", "trace",
+                                    "et", "ei", "enc"};
+    for (int k = 0; k < 11; k++)
+        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, 11); return NULL; }
     Py_ssize_t n = bufs[0].b.len / (8 * ND);
+    Py_ssize_t ecap = bufs[8].b.len / 8;
     if (bufs[1].b.len != n * 8 * NI || bufs[2].b.len != n * 8 * MAXSW * NSD
-            || bufs[3].b.len != n * 8 * MAXSW * NSI) {
-        release(bufs, 8);
-        PyErr_SetString(PyExc_ValueError, "run: axis arrays disagree in size");
+            || bufs[3].b.len != n * 8 * MAXSW * NSI || bufs[9].b.len != ecap * 8 * NEI
+            || bufs[10].b.len != ecap * 8 * n) {
+        release(bufs, 11);
+        PyErr_SetString(PyExc_ValueError, "run: axis or edge arrays disagree in size");
         return NULL;
     }
     double *AD = bufs[0].b.buf, *SD = bufs[2].b.buf, *PC = bufs[4].b.buf;
@@ -333,38 +653,56 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
     /* piece start times only when the caller passes room for them (pulse recording) */
     double *PT = bufs[5].b.len >= npieces * 8 ? bufs[5].b.buf : NULL;
     for (Py_ssize_t x = 0; x < n; x++) {
-        int64_t *ai = AI + x * NI;
+        int64_t *ai = AI + x * NI, *si = SI + x * MAXSW * NSI;
         if (ai[I_PBEGIN] < 0 || ai[I_PEND] > npieces || ai[I_CURSOR] < ai[I_PBEGIN]
                 || ai[I_CURSOR] > ai[I_PEND] || ai[I_NSW] < 0 || ai[I_NSW] > MAXSW
                 || ai[I_DPERIOD] < 1 || ai[I_DPERIOD] > 4) {
-            release(bufs, 8);
+            release(bufs, 11);
             PyErr_SetString(PyExc_ValueError, "run: bad axis layout");
             return NULL;
         }
+        for (int sw = 0; sw < ai[I_NSW]; sw++)
+            if (si[sw * NSI + S_BIT] < 0 || si[sw * NSI + S_BIT] > 62) {
+                release(bufs, 11);
+                PyErr_SetString(PyExc_ValueError, "run: bad switch bit");
+                return NULL;
+            }
     }
     Rec rec = {bufs[6].b.buf, 0, bufs[6].b.len / (8 * NREC), 0};
     /* trace[cycle - start - 1, axis] = (pulse count, decoded count, input levels: I_LEVELS
      * with the S_LEVELBITS of every active switch flipped) when the
      * caller asks for it (a buffer large enough for every cycle), else none */
     int64_t *TR = bufs[7].b.len >= (stop - start) * n * 3 * 8 ? bufs[7].b.buf : NULL;
-    double *save_d = PyMem_Malloc(sizeof(double) * (n * ND + n * MAXSW * NSD + 1));
+    double *save_d = PyMem_Malloc(sizeof(double) * (n * ND + 1));
     int64_t *save_i = PyMem_Malloc(sizeof(int64_t) * (n * NI + n * MAXSW * NSI + 1));
-    if (!save_d || !save_i) {
-        PyMem_Free(save_d); PyMem_Free(save_i); release(bufs, 8);
+    PRec *prec = PyMem_Malloc(sizeof(PRec) * (n * MAXPREC + 1));
+    Py_ssize_t *rix = PyMem_Malloc(sizeof(Py_ssize_t) * (2 * n + 1));
+    int64_t *rstart = PyMem_Malloc(sizeof(int64_t) * (n + 1));
+    if (!save_d || !save_i || !prec || !rix || !rstart) {
+        PyMem_Free(save_d); PyMem_Free(save_i); PyMem_Free(prec); PyMem_Free(rix);
+        PyMem_Free(rstart); release(bufs, 11);
         return PyErr_NoMemory();
     }
+    Report rep = {0, 0, 0.0, -1, 0, bufs[8].b.buf, bufs[9].b.buf, bufs[10].b.buf, 0, ecap, n, prec, 0,
+                  rix, rix + n, rstart, 0};
+    for (Py_ssize_t x = 0; x < n; x++) rix[x] = x * MAXPREC;
     long long k = start;
+    int full = 0;
     Py_BEGIN_ALLOW_THREADS
     while (k < stop) {
         double t = origin + (double)(k + 1) * period;
-        if (rt_before_cycle(k + 1)) break; /* real time: its slot (_kernel_rt.c) */
+        if (paced && rt_before_cycle(k + 1)) break; /* real time: its slot (_kernel_rt.c) */
         if (t >= limit) break;
+        int report = report_all;
+    redo:
         memcpy(save_d, AD, sizeof(double) * n * ND);
         memcpy(save_i, AI, sizeof(int64_t) * n * NI);
         memcpy(save_i + n * NI, SI, sizeof(int64_t) * n * MAXSW * NSI);
         Py_ssize_t rows0 = rec.n;
         double now0 = now;
         int status = OK;
+        rep.on = report;
+        rep.ne = 0;
         for (;;) { /* SimMachine.advance: start due pieces, run to the next start or t */
             double tn = t;
             for (Py_ssize_t x = 0; x < n; x++) {
@@ -380,22 +718,38 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
                 if (ai[I_CURSOR] < ai[I_PEND] && PC[ai[I_CURSOR] * 6] < tn)
                     tn = PC[ai[I_CURSOR] * 6];
             }
+            Py_ssize_t e0 = rep.ne;
+            if (rep.on)
+                for (Py_ssize_t x = 0; x < n; x++) {
+                    rix[n + x] = 0;
+                    rstart[x] = AI[x * NI + I_DCOUNT];
+                }
             for (Py_ssize_t x = 0; x < n && status == OK; x++) {
                 Axis a = {AD + x * ND, AI + x * NI, SD + x * MAXSW * NSD, SI + x * MAXSW * NSI};
                 rec.axis = (int)x;
-                status = run_axis(&a, now, tn, &rec);
+                rep.axis = (int)x;
+                AD[x * ND + D_STOP] = NAN; /* SimMachine._advance: stop_time = None */
+                status = run_axis_armed(&a, now, tn, &rec, &rep);
             }
+            if (status == OK && rep.on && rep.ne > e0)
+                status = finish_edges(&rep, e0, AD, AI, SD, SI);
             if (status != OK) break;
             now = tn;
             if (tn >= t) break;
         }
-        if (status != OK) { /* roll the cycle back: the Python path runs it */
+        if (status != OK) { /* roll the cycle back */
             memcpy(AD, save_d, sizeof(double) * n * ND);
             memcpy(AI, save_i, sizeof(int64_t) * n * NI);
             memcpy(SI, save_i + n * NI, sizeof(int64_t) * n * MAXSW * NSI);
             rec.n = rows0;
             now = now0;
-            break;
+            rep.ne = 0;
+            if (status == WAKE && !report) { /* the same cycle again, reporting */
+                report = 1;
+                goto redo;
+            }
+            full = status == FULL;
+            break; /* BAIL: the caller runs this cycle; FULL: again with more room */
         }
         if (TR != NULL) {
             int64_t *tr = TR + (k - start) * n * 3;
@@ -409,14 +763,18 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
                 tr[x * 3 + 2] = levels;
             }
         }
-        rt_after_cycle(k + 1);
+        if (paced) rt_after_cycle(k + 1);
         k++;
+        if (rep.ne) break; /* edges: the caller's hooks see them at this cycle's end */
     }
     Py_END_ALLOW_THREADS
     PyMem_Free(save_d);
     PyMem_Free(save_i);
-    release(bufs, 8);
-    return Py_BuildValue("LdN", k, now, PyLong_FromSsize_t(rec.n));
+    PyMem_Free(prec);
+    PyMem_Free(rix);
+    PyMem_Free(rstart);
+    release(bufs, 11);
+    return Py_BuildValue("LdNni", k, now, PyLong_FromSsize_t(rec.n), rep.ne, full);
 }
 
 int kernel_layout(PyObject *m)
@@ -426,4 +784,42 @@ int kernel_layout(PyObject *m)
             || PyModule_AddIntConstant(m, "NSD", NSD) < 0
             || PyModule_AddIntConstant(m, "NSI", NSI) < 0
             || PyModule_AddIntConstant(m, "NREC", NREC) < 0) ? -1 : 0;
+}
+
+const char kernel_readback_doc[] =
+"readback(ai, si, out) -> None\n\n"
+"out int64[n, 3] = (pulse count, decoded count, input level bits) of every axis of the\n"
+"kernel's arrays ai[n, NI], si[n, 8, NSI] (the level base word with the bits of every\n"
+"active switch flipped), as a trace row.";
+
+PyObject *kernel_readback(PyObject *self, PyObject *args)
+{
+    PyObject *o[3];
+    if (!PyArg_ParseTuple(args, "OOO", &o[0], &o[1], &o[2])) return NULL;
+    Buf bufs[3];
+    memset(bufs, 0, sizeof bufs);
+    static const char *names[3] = {"ai", "si", "out"};
+    for (int k = 0; k < 3; k++)
+        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, 3); return NULL; }
+    Py_ssize_t n = bufs[0].b.len / (8 * NI);
+    if (bufs[0].b.len != n * 8 * NI || bufs[1].b.len != n * 8 * MAXSW * NSI
+            || bufs[2].b.len != n * 8 * 3) {
+        release(bufs, 3);
+        PyErr_SetString(PyExc_ValueError, "readback: arrays disagree in size");
+        return NULL;
+    }
+    const int64_t *AI = bufs[0].b.buf, *SI = bufs[1].b.buf;
+    int64_t *out = bufs[2].b.buf;
+    for (Py_ssize_t x = 0; x < n; x++) {
+        const int64_t *ai = AI + x * NI, *si = SI + x * MAXSW * NSI;
+        int64_t levels = ai[I_LEVELS];
+        int nsw = ai[I_NSW] < 0 ? 0 : (ai[I_NSW] > MAXSW ? MAXSW : (int)ai[I_NSW]);
+        for (int sw = 0; sw < nsw; sw++)
+            if (si[sw * NSI + S_ACTIVE]) levels ^= si[sw * NSI + S_LEVELBITS];
+        out[x * 3] = ai[I_COUNT];
+        out[x * 3 + 1] = ai[I_DCOUNT];
+        out[x * 3 + 2] = levels;
+    }
+    release(bufs, 3);
+    Py_RETURN_NONE;
 }

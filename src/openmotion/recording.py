@@ -18,7 +18,7 @@ Channels, per axis:
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +31,8 @@ FLOAT_CHANNELS = ("cmd_pos", "fb_pos", "cmd_vel")
 INT_CHANNELS = ("state", "io")
 CHANNELS = FLOAT_CHANNELS + INT_CHANNELS
 _INT_DTYPES = {"state": np.int32, "io": np.int64}
+_NO_STATE = np.zeros(0, dtype=np.int32)
+_NO_IO = np.zeros(0, dtype=np.int64)
 
 
 class Recorder:
@@ -58,7 +60,12 @@ class Recorder:
         self._t = np.zeros(rows)
         self._f = np.zeros((rows, len(self._fchans), n_axes))
         self._i = {c: np.zeros((rows, n_axes), dtype=_INT_DTYPES[c]) for c in self._ichans}
+        # touched now, so no cycle pays the page faults of its first write (np.zeros maps
+        # the pages lazily)
+        for a in (self._t, self._f, *self._i.values()):
+            a.fill(0)
         self._fslot = {c: k for k, c in enumerate(self._fchans)}
+        self._slots: np.ndarray | None = None  # record_into's float slots
         self._head = 0   # next row to write
         self._count = 0  # live rows (<= capacity)
         self.total = 0   # rows ever recorded since the last clear
@@ -158,6 +165,35 @@ class Recorder:
         self._count = min(self.capacity, self._count + m)
         self._head = (self._head + m) % rows
         self.total += m
+
+    def record_into(self, m: int, t_first: float, t_last: float,
+                    fill: Callable[..., None]) -> bool:
+        """Store m rows that `fill(t, f, state, io, head, slots)` writes straight into the
+        ring (the compiled recorder of a jump's crossed cycles, control/core/jump.py):
+        `t`, `f` (rows, float channels, n_axes), int32 `state` and int64 `io` (rows,
+        n_axes; empty arrays when the channel is off) are the ring arrays, `head` the row
+        the first of the m goes to (mod rows: only the last min(m, capacity) are kept),
+        `slots` the float slot of cmd_pos, fb_pos, cmd_vel (-1: off). Returns False and
+        stores nothing when the rows must go through `record_block` (a spilling recorder).
+        `fill` raises MotionError before writing anything if a value is bad."""
+        if self._spill is not None:
+            return False
+        if not (math.isfinite(t_first) and t_first >= self._last_t and t_last >= t_first):
+            raise MotionError(f"t must be finite and non-decreasing from the previous time "
+                              f"{self._last_t!r}")
+        if not m:
+            return True
+        slots = self._slots
+        if slots is None:
+            slots = self._slots = np.array([self._fslot.get(c, -1) for c in FLOAT_CHANNELS],
+                                           dtype=np.int64)
+        fill(self._t, self._f, self._i.get("state", _NO_STATE), self._i.get("io", _NO_IO),
+             self._head, slots)
+        self._last_t = float(t_last)
+        self._count = min(self.capacity, self._count + m)
+        self._head = (self._head + m) % (self.capacity + 1)
+        self.total += m
+        return True
 
     # ------------------------------------------------------------------ reading
     def __len__(self) -> int:

@@ -206,6 +206,17 @@ class QueueRun:
 
 
 @runtime_checkable
+class BulkReadback(Protocol):
+    """Optional extension: every axis's readback in one call, encoded as a QueueRun.trace
+    row (the recorder reads it at each recorded cycle instead of one `read_axis` per axis).
+    """
+
+    def read_axes(self) -> Any:
+        """int64 array [n_axes, 3]: pulses_out, encoder and the electrical input levels as
+        bits (bit i = AXIS_INPUTS[i]) of every axis now, what `read_axis` gives."""
+
+
+@runtime_checkable
 class QueuedHardware(Protocol):
     """Optional extension: a queue of timed cubic pieces per axis, executed by the back end.
 

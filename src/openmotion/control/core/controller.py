@@ -34,7 +34,7 @@ from ...units import MAX_PULSE_RATE
 from .axis import Axis
 from .clock import CycleStats, RealtimePacer, check_period
 from .events import EventLog
-from .jump import jump, plan_jump
+from .jump import jump, plan_jump, record_now
 from .motion import ActiveMotion
 from .realtime import AVAILABLE as _COMPILED_RT
 from .realtime import HandoverLock, RealtimeExecutor
@@ -707,6 +707,8 @@ class Controller:
         return rec
 
     def _record(self, t: float) -> None:
+        if record_now(self, self._n):  # compiled, with a bulk readback (jump.py)
+            return
         axes = self.axes
         io = [_io_word(self, ax.index) for ax in axes] if "io" in self.recorder.channels \
             else None

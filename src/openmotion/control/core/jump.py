@@ -40,7 +40,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...hw.interface import AXIS_INPUTS, PieceBlock, QueuedHardware
+from ...errors import MotionError
+from ...hw.interface import AXIS_INPUTS, BulkReadback, PieceBlock, QueuedHardware
 from . import motion as _motion
 from .counters import Counters
 
@@ -240,6 +241,29 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     if not m:
         return
     axes = ctl.axes
+    kern = _motion._kernel
+    if kern is not None:  # the rows straight into the recorder's ring, in C
+        origin, period = ctl._t_origin, ctl.period
+        cnt = [ax.counters for ax in axes]
+        args = (origin, period, n, np.ascontiguousarray(trace, dtype=np.int64),
+                np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
+                np.array([ax.index for ax in movers], dtype=np.int64),
+                tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
+                np.array([ax.counters._cmd_off for ax in movers], dtype=float),
+                np.array([c._fb_internal for c in cnt], dtype=np.int64),
+                np.array([c._fb_off for c in cnt], dtype=np.int64), _nc_words(ctl),
+                _io_table(), bool(ctl._estop),
+                np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int32))
+
+        def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
+            try:
+                kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
+            except ValueError as exc:
+                raise MotionError(f"record_block: {exc}") from None
+
+        t_first = origin + (n + 1) * period
+        if ctl.recorder.record_into(m, t_first, origin + (n + m) * period, fill):
+            return
     t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
     pos = np.empty((m, len(axes)))
     vel = np.empty((m, len(axes)))
@@ -258,6 +282,66 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     state = np.broadcast_to(np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int64),
                             (m, len(axes)))
     ctl.recorder.record_block(t, cmd_pos=pos, fb_pos=fb, cmd_vel=vel, state=state, io=io)
+
+
+_BULK: dict[type, bool] = {}
+_NO_MOVERS = np.zeros(0, dtype=np.int64)
+_NO_OFFSETS = np.zeros(0)
+
+
+_WORDS: dict[tuple, int] = {}
+
+
+def _level_word(inputs: dict[str, bool]) -> int:
+    """The input-level bits (bit k = AXIS_INPUTS[k]) of a readback's inputs dict."""
+    key = tuple(inputs.items())
+    w = _WORDS.get(key)
+    if w is None:
+        w = sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if inputs.get(sig))
+        if len(_WORDS) < 4096:
+            _WORDS[key] = w
+    return w
+
+
+def record_now(ctl: Controller, n: int) -> bool:
+    """Record the row of cycle n (its end, now) as `Controller._record` does, in one
+    compiled call: the back end's readback of every axis in one call (BulkReadback), the
+    cached one of an axis already read in this cycle (what its counters and inputs show).
+    False (nothing done) without the compiled kernel or a bulk readback."""
+    from .controller import STATE_CODES  # the controller imports this module
+
+    kern = _motion._kernel
+    hw = ctl.hardware
+    t = type(hw)
+    bulk = _BULK.get(t)
+    if bulk is None:
+        bulk = _BULK[t] = isinstance(hw, BulkReadback)
+    if kern is None or not bulk:
+        return False
+    axes = ctl.axes
+    rows = np.array(hw.read_axes(), dtype=np.int64)
+    for i, c in enumerate(ctl._rb_cycle):
+        if c == ctl._n:  # read in this cycle: the values the controller holds
+            cnt = axes[i].counters
+            rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
+    cnt_all = [ax.counters for ax in axes]
+    origin, period = ctl._t_origin, ctl.period
+    args = (origin, period, n - 1, rows.reshape(1, -1, 3),
+            np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
+            _NO_MOVERS, (), _NO_OFFSETS,
+            np.array([c._fb_internal for c in cnt_all], dtype=np.int64),
+            np.array([c._fb_off for c in cnt_all], dtype=np.int64), _nc_words(ctl),
+            _io_table(), bool(ctl._estop),
+            np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int32))
+
+    def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
+        try:
+            kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
+        except ValueError as exc:
+            raise MotionError(f"record: {exc}") from None
+
+    t1 = origin + n * period
+    return ctl.recorder.record_into(1, t1, t1, fill)
 
 
 _IO_TABLE: list[np.ndarray] = []

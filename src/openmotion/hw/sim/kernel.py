@@ -1,15 +1,19 @@
-"""The compiled stepper pipeline (`openmotion._kernel.run`, C) behind `SimMachine.run_cycles`.
+"""The compiled stepper pipeline (`openmotion._kernel.run`, C) behind `SimMachine.run_cycles`
+and `SimMachine.advance`.
 
 `run_quiet` hands the kernel a chunk of cycles as flat arrays over all axes: each axis's
 command, pulse count, losses, load position, decoder state and switches, and its queued
-pieces. The kernel runs the cycles in C with the GIL released and stops before the first
-cycle that has an edge to report, a scenario action or timed output due, or anything else
-it does not model; `SimMachine` runs that cycle through the Python path (simaxis.py), which
-finds the edge's exact time and counts. The state comes back into the `SimAxis` objects,
-so both paths always share one state.
+pieces. The kernel runs the cycles in C with the GIL released. The first cycle with a
+crossing on a `wake` signal is run again in report mode and ends the run: every crossing of
+that cycle comes back as an `InputEdge` with its exact time and every axis's decoded count
+at that instant. It stops before a scenario action (the Python path runs that cycle) and
+before anything it cannot run exactly; board outputs at a time touch no axis and are
+emitted by SimMachine after the run. The state stays in the kernel's
+arrays (`KernelState`) between runs and goes back into the `SimAxis` objects when Python
+needs them.
 
-The kernel takes a machine whose axes are all steppers (ideal or stalling) without an
-armed edge stop or a pitch-error table; for any other machine `usable` is False and every
+The kernel takes a machine whose axes are all steppers (ideal or stalling, armed edge stops
+included) without a pitch-error table; for any other machine `usable` is False and every
 cycle runs in Python. It is built by the package's own build (setup.py); when the module is
 missing (a source tree that was never built) `AVAILABLE` is False and the Python path runs.
 Set `SimMachine.native = False` to force the Python path (the equivalence tests do).
@@ -17,12 +21,13 @@ Set `SimMachine.native = False` to force the Python path (the equivalence tests 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Collection
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from openmotion.hw.interface import AXIS_INPUTS
+from openmotion.hw.interface import AXIS_INPUTS, InputEdge
 
 from .cubic import Cubic
 from .plant import StepperPlant
@@ -46,12 +51,13 @@ _NO_TRACE = np.zeros(0, dtype=np.int64)
 _BIT = {sig: i for i, sig in enumerate(AXIS_INPUTS)}
 
 # field indices, kept in step with _kernel.c (checked against its constants below)
-_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 13, 26, 8, 4, 3, 12
+_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 14, 27, 8, 4, 7, 12
 (D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
- D_UPP) = range(_ND)
+ D_UPP, D_STOP) = range(_ND)
 (I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
  I_TURNF, I_TURNB) = range(11)
-I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD, I_LEVELS = 11, 16, 21, 22, 23, 24, 25
+I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD, I_LEVELS, I_ARMED = (11, 16, 21, 22,
+                                                                       23, 24, 25, 26)
 if _k is not None:
     assert (_k.ND, _k.NI, _k.MAXSW, _k.NSD, _k.NSI, _k.NREC) == (
         _ND, _NI, _MAXSW, _NSD, _NSI, _NREC), "_kernel.c layout differs from kernel.py"
@@ -64,7 +70,7 @@ def usable(axes: list[SimAxis]) -> bool:
     if _k is None:
         return False
     for ax in axes:
-        if (type(ax.plant) is not StepperPlant or ax.armed or ax.trans.pitch.e
+        if (type(ax.plant) is not StepperPlant or ax.trans.pitch.e
                 or len(ax.switches) > _MAXSW or not _BIT.keys() >= ax.switches.keys()):
             return False
     return True
@@ -131,7 +137,7 @@ class KernelState:
     landing of a virtual-time jump costs no per-axis packing or copying."""
 
     __slots__ = ("ad", "ai", "sd", "si", "names", "recording", "_wake", "_wake_key",
-                 "_readback")
+                 "_readback", "_edges")
 
     def __init__(self, axes: list[SimAxis]) -> None:
         n = len(axes)
@@ -146,7 +152,8 @@ class KernelState:
             g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
             c = g.cubic
             adl.append((c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
-                        tr.backlash, tr.z, ax.y, dec.upp))
+                        tr.backlash, tr.z, ax.y, dec.upp,
+                        math.nan if ax.stop_time is None else ax.stop_time))
             fwd = [*dec.fwd_pre, 0, 0, 0, 0][:5]
             bwd = [*dec.bwd_pre, 0, 0, 0, 0][:5]
             sws = ax.switches
@@ -162,10 +169,14 @@ class KernelState:
                 bits = _switch_bits(name, sws)
                 if sw.active:
                     base ^= bits
-                si[x, s] = (sw.active, 0, bits)
+                arm = ax.armed.get(name) if name != "ez" else None
+                rank = list(ax.armed).index(name) + 1 if arm is not None else 0
+                si[x, s] = (sw.active, 0, bits, _BIT[name], rank,
+                            arm[0] if arm else 0, arm[1] if arm else 0)
             ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
                         dec.count, dec.period, len(sws), dec.turn[1], dec.turn[-1],
-                        *fwd, *bwd, 0, 0, 0, g.record is not None, base])
+                        *fwd, *bwd, 0, 0, 0, g.record is not None, base,
+                        any(name in sws and name != "ez" for name in ax.armed)])
         if n:
             ad[:] = adl
             ai[:] = ail
@@ -173,7 +184,12 @@ class KernelState:
         self.recording = any(ax.gen.record is not None for ax in axes)  # pulse records
         self._wake_key: object = ()  # no wake set computed yet
         self._wake = np.zeros((n, _MAXSW), dtype=np.int64)
-        self._readback: tuple[list[int], list[int], list[int]] | None = None
+        self._readback: list[list[int]] | None = None
+        self._edges = _edge_room(64, n)
+
+    def grow_edges(self) -> None:
+        """Room for twice as many edges in one cycle (the kernel asked for more)."""
+        self._edges = _edge_room(2 * len(self._edges[0]), len(self.ad))
 
     def set_wake(self, axes: list[SimAxis], wake: Collection[str] | None) -> None:
         """Mark the switches whose edges end a kernel run (computed once per wake set)."""
@@ -186,15 +202,33 @@ class KernelState:
             self._wake_key = key
         self.si[:, :, 1] = self._wake
 
+    def set_command(self, x: int, p0: float, v0: float, a0: float, j: float, tc: float,
+                    te: float) -> None:
+        """Axis x's generator follows the cubic (p0, v0, a0, j) over [tc, te] from now
+        (SimAxis.set_command without a pulse record)."""
+        self.ad[x, D_P0:D_TE + 1] = (p0, v0, a0, j, tc, te)
+
     def readback(self, x: int) -> tuple[int, int, int]:
         """(pulse count, decoded count, input level bits) of axis x now."""
         rb = self._readback
         if rb is None:
-            ai, si = self.ai, self.si
-            flips = np.bitwise_xor.reduce(si[:, :, 0] * si[:, :, 2], axis=1)
-            rb = self._readback = (ai[:, I_COUNT].tolist(), ai[:, I_DCOUNT].tolist(),
-                                   (ai[:, I_LEVELS] ^ flips).tolist())
-        return rb[0][x], rb[1][x], rb[2][x]
+            rb = self._readback = self.readback_rows().tolist()
+        return tuple(rb[x])  # type: ignore[return-value]
+
+    def readback_rows(self) -> np.ndarray:
+        """int64 [n, 3]: (pulse count, decoded count, input level bits) of every axis now."""
+        out = np.empty((len(self.ai), 3), dtype=np.int64)
+        _k.readback(self.ai, self.si, out)
+        return out
+
+    def stop_time(self, x: int) -> float | None:
+        """When an armed stop cut axis x's pulses in the last stretch run, else None."""
+        t = float(self.ad[x, D_STOP])
+        return None if math.isnan(t) else t
+
+    def stopped(self) -> bool:
+        """An armed stop cut some axis's pulses in the last stretch run."""
+        return not bool(np.isnan(self.ad[:, D_STOP]).all())
 
     def at_rest(self, t: float) -> bool:
         """Every generator holds its command's end at time t (te <= t)."""
@@ -215,24 +249,54 @@ class KernelState:
             dec.q, dec.last_dir, dec.count = i[I_Q], i[I_LASTDIR], i[I_DCOUNT]
             for s, name in enumerate(self.names[x]):
                 ax.switches[name].active = bool(sil[x][s][0])
-            ax.stop_time = None
+            ax.stop_time = None if math.isnan(d[D_STOP]) else d[D_STOP]
             ax.record = []
             ax.run_start = (tr.z, (dec.q, dec.last_dir, dec.count))
 
 
+def _edge_room(cap: int, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return (np.zeros(cap), np.zeros((cap, 4), dtype=np.int64),
+            np.zeros((cap, n), dtype=np.int64))
+
+
 def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin: float,
               period: float, start: int, stop: int, now: float, limit: float,
-              wake: Collection[str] | None, trace: bool = False
-              ) -> tuple[int, float, np.ndarray | None]:
+              wake: Collection[str] | None, trace: bool = False, report: bool = False,
+              paced: bool = True
+              ) -> tuple[int, float, np.ndarray | None, list[InputEdge]]:
     """Run cycles start+1 .. at most stop in the kernel on the arrays of `ks`; returns
-    (cycle reached, time, trace): with `trace`, an int64 array [cycles run, axis, 3] of the
-    pulse count, decoded count and input levels (`level_bits`) at the end of each cycle.
+    (cycle reached, time, trace, edges): with `trace`, an int64 array [cycles run, axis, 3]
+    of the pulse count, decoded count and input levels (`level_bits`) at the end of each
+    cycle; `edges`, the input edges of the last cycle run when it crossed a switch on a
+    `wake` signal (then it is the last cycle run), every axis's decoded count at each.
+    `report`: every cycle reports its edges (the first cycle with any ends the run).
 
-    Stops before the first cycle ending at or after `limit` or with an edge on a `wake`
-    signal. The pieces started leave their queues; the axis state stays in `ks` (with
-    pulse recording on, it and the record are written back into the axes at once)."""
+    Stops before the first cycle ending at or after `limit` or one the kernel cannot run
+    exactly (a count beyond its integer range: the caller runs it). The pieces started
+    leave their queues; the axis state stays in `ks` (with pulse recording on, it and the
+    record are written back into the axes at once)."""
+    parts: list[np.ndarray] = []
+    while True:
+        k, now, tr, edges, full = _run(ks, axes, queues, origin, period, start, stop, now,
+                                       limit, wake, trace, report, paced)
+        if tr is not None:
+            parts.append(tr)
+        if not full:
+            break
+        ks.grow_edges()
+        start = k
+    if trace and len(parts) > 1:
+        return k, now, np.concatenate(parts), edges
+    return k, now, parts[0] if trace else None, edges
+
+
+def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin: float,
+         period: float, start: int, stop: int, now: float, limit: float,
+         wake: Collection[str] | None, trace: bool, report: bool, paced: bool
+         ) -> tuple[int, float, np.ndarray | None, list[InputEdge], bool]:
     n = len(axes)
-    ks.set_wake(axes, wake)
+    if not report:  # in report mode every crossing is an edge anyway
+        ks.set_wake(axes, wake)
     ai = ks.ai
     ai[:, I_PBEGIN:I_CURSOR + 1] = 0
     blocks: list[np.ndarray] = []
@@ -261,10 +325,12 @@ def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], or
     cap = (stop - start) * n * 8 + 16 if recording else 0
     rows = np.zeros((cap, _NREC)) if cap else _NONE
     tr = np.zeros((stop - start, n, 3), dtype=np.int64) if trace else _NO_TRACE
-    k, t, nrows = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, float(origin),
-                         float(period), int(start), int(stop), float(now), float(limit))
+    et, ei, enc = ks._edges
+    k, t, nrows, nedges, full = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, et,
+                                       ei, enc, float(origin), float(period), int(start),
+                                       int(stop), float(now), float(limit), report, paced)
     if k == start:
-        return k, now, tr[:0] if trace else None
+        return k, now, tr[:0] if trace else None, [], bool(full)
     ks._readback = None
     if used:
         cursor = ai[used, I_CURSOR].tolist()
@@ -276,7 +342,14 @@ def run_quiet(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], or
     if recording:
         ks.write_back(axes)
         _record_stretches(axes, rows[:nrows])
-    return k, t, tr[:k - start] if trace else None
+    edges: list[InputEdge] = []
+    if nedges:
+        names = AXIS_INPUTS
+        for tm, (axis, bit, level, _), counts in zip(et[:nedges].tolist(),
+                                                     ei[:nedges].tolist(),
+                                                     enc[:nedges].tolist(), strict=True):
+            edges.append(InputEdge(tm, axis, names[bit], level == 1, tuple(counts)))
+    return k, t, tr[:k - start] if trace else None, edges, bool(full)
 
 
 def _record_commands(axes: list[SimAxis], used: list[int], begin: list[int],

@@ -136,13 +136,20 @@ class SimMachine(SimAnalogOutputs):
         the command at the current time is a whole pulse or more away from the pulses
         emitted, the difference is emitted at once (a jump; a real stepper loses it).
         """
-        ax = self._axis(axis)
+        i = self._index(axis)
         if not isinstance(cmd, AxisCommand):
             raise MotionError(f"cmd must be an AxisCommand, got {type(cmd).__name__}")
         for f in ("t0", "p0", "v0", "a0", "j"):
             check_finite(f"cmd.{f}", getattr(cmd, f))
         check_nonnegative("cmd.dt", cmd.dt)
-        self._set_command(ax, cmd)
+        ks = self._ks
+        if ks is not None and not ks.recording:  # into the kernel's arrays (stepping)
+            t0 = float(cmd.t0)
+            ks.set_command(i, float(cmd.p0), float(cmd.v0), float(cmd.a0), float(cmd.j), t0,
+                           t0 + float(cmd.dt))
+            self._stale = True
+            return
+        self._set_command(self._axes[i], cmd)
 
     def _set_command(self, ax: SimAxis, cmd: AxisCommand) -> None:
         t0 = float(cmd.t0)
@@ -203,14 +210,20 @@ class SimMachine(SimAnalogOutputs):
                 and not self._pending else None
             if ks is not None:
                 k0 = k
-                k, self._t, tr = kernel.run_quiet(ks, self._ax, queues, origin, period, k,
-                                                  stop, self._t, self._next_action(), wake,
-                                                  trace)
-                if k > k0 and not ks.recording:
-                    self._stale = True
+                k, self._t, tr, edges = kernel.run_quiet(ks, self._ax, queues, origin, period,
+                                                         k, stop, self._t, self._next_action(),
+                                                         wake, trace)
+                if k > k0:
+                    self._timed_done()
+                    if not ks.recording:
+                        self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
-                if k >= stop or (paced and kernel.interrupted()):
+                if edges and not (wake is None or any(e.signal in wake for e in edges)
+                                  or ks.stopped()):
+                    edges = []  # a cycle with edges on other signals only: run on
+                    continue
+                if edges or k >= stop or (paced and kernel.interrupted()):
                     break
             if paced:
                 kernel.wait_slot(k + 1)
@@ -245,15 +258,20 @@ class SimMachine(SimAnalogOutputs):
 
     def _trace_row(self) -> np.ndarray:
         """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""
-        return np.array([[(ax.gen.count, ax.decoder.count, kernel.level_bits(ax))
-                          for ax in self._axes]], dtype=np.int64).reshape(1, -1, 3)
+        return self.read_axes().reshape(1, -1, 3)
 
     def _next_action(self) -> float:
-        """Time of the next scenario action or timed output (inf: none): the kernel
-        stops before the cycle it falls in."""
-        t = self.scenario._heap[0][0] if self.scenario._heap else math.inf
-        timed = self._timed._heap
-        return min(t, timed[0][0]) if timed else t
+        """Time of the next scenario action (inf: none; an axis output at a time is one):
+        the kernel stops before the cycle it falls in. Board outputs at a time
+        (`write_output_at(t, None, ...)`) touch no axis: the kernel runs through them and
+        `_timed_done` emits them after its run, in their (time, order) sequence."""
+        return self.scenario._heap[0][0] if self.scenario._heap else math.inf
+
+    def _timed_done(self) -> None:
+        """The board outputs due by now (after a kernel run), at their exact times."""
+        if self._timed._heap:
+            for tk, _, sig, lv in self._timed.pop_due(self._t):
+                self._set_do(tk, sig, lv)
 
     def _holding(self) -> bool:
         """Nothing moves by itself: steppers only, each holding its command's end."""
@@ -282,8 +300,8 @@ class SimMachine(SimAnalogOutputs):
             while origin + (n + 1) * period < ta:
                 n += 1
             last = min(stop, n)
-        if last > k:
-            return last, self._advance(origin + last * period)
+        if last > k:  # one stretch (in the kernel when it models the machine)
+            return last, self.advance(origin + last * period)
         return k, []
 
     def advance(self, t: float) -> list[InputEdge]:
@@ -293,6 +311,18 @@ class SimMachine(SimAnalogOutputs):
         if t < self._t:
             raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
         queues = self._queues
+        ks = self._kernel_state() if self.native and not self._pending \
+            and not self._edge_filters else None
+        if ks is not None:  # one cycle [now, t] in the kernel, every edge reported
+            k, t1, _, edges = kernel.run_quiet(ks, self._ax, queues, t, 1.0, -1, 0, self._t,
+                                               self._next_action(), None, report=True,
+                                               paced=False)
+            if k == 0:  # else an action is due in it or a count left the exact range
+                self._t = t1
+                self._timed_done()
+                if not ks.recording:
+                    self._stale = True
+                return edges
         if not any(len(q) for q in queues):
             return self._advance(t)
         edges: list[InputEdge] = []
@@ -343,6 +373,15 @@ class SimMachine(SimAnalogOutputs):
         ax = self._objects()[self._index(axis)]
         return AxisReadback(ax.gen.count, ax.decoder.count,
                             dict(zip(AXIS_INPUTS, ax.levels(), strict=True)))
+
+    def read_axes(self) -> np.ndarray:
+        """int64 [n_axes, 3]: pulses out, decoded count and input level bits of every axis
+        (hw.interface.BulkReadback; `read_axis` of each in one call)."""
+        ks = self._ks
+        if ks is not None:  # the kernel's arrays are current (objects maybe not)
+            return ks.readback_rows()
+        return np.array([(ax.gen.count, ax.decoder.count, kernel.level_bits(ax))
+                         for ax in self._objects()], dtype=np.int64).reshape(-1, 3)
 
     def write_output(self, axis: int | None, signal: str, level: bool) -> None:
         if not isinstance(level, bool):
@@ -471,6 +510,9 @@ class SimMachine(SimAnalogOutputs):
 
     def stop_time(self, axis: int) -> float | None:
         """When an armed stop cut the pulses of `axis` in the last advance, else None."""
+        if self._stale:  # the kernel ran last: its arrays hold the stop times
+            assert self._ks is not None
+            return self._ks.stop_time(self._index(axis))
         return self._view(axis).stop_time
 
     # -- extras for tests and tools ---------------------------------------------------------

@@ -1,0 +1,156 @@
+/* The recorder's rows of the cycles a virtual-time jump crossed (openmotion._kernel.
+ * record_rows, called by control/core/jump.record_trace), written straight into the
+ * Recorder's ring arrays: per cycle the time on the grid, per axis the command position
+ * and velocity (a mover's piece end state plus its command offset, else the axis's value
+ * at the jump's start), the feedback counter (Counters.feedback_of: the output pulses or the
+ * encoder, plus the offset, wrapped to 28 bits), the state code and the io word (the table
+ * lookup of the logical input levels, + the E-stop bit). The same operations as the numpy
+ * expressions they replace, so the rows are identical.
+ */
+#include "_kernel.h"
+
+#define HALF28 ((int64_t)1 << 27)
+#define FULL28 ((int64_t)1 << 28)
+
+static inline int64_t wrap28(int64_t x)
+{
+    if (x >= -HALF28 && x < HALF28) return x; /* the usual case: no division */
+    int64_t r = (x + HALF28) % FULL28;
+    if (r < 0) r += FULL28;
+    return r - HALF28;
+}
+
+const char record_rows_doc[] =
+"record_rows(rt, rf, rstate, rio, head, slots, origin, period, n0, trace, pos, vel, idx,\n"
+"            ends, cmd_off, internal, fb_off, nc, table, estop, state) -> None\n\n"
+"Write the rows of cycles n0+1 .. n0+m (m = len(trace)) into the ring rt[R], rf[R, F, n],\n"
+"int32 rstate[R, n], int64 rio[R, n] (empty: channel off) from row `head` on (mod R; only\n"
+"the last min(m, R - 1) rows). slots: int64[3], the float slot of cmd_pos, fb_pos, cmd_vel\n"
+"(-1: off). trace int64[m, n, 3]; pos, vel float64[n]; idx int64[k] the movers; ends a\n"
+"tuple of k float64[>= m, 2]; cmd_off float64[k]; internal, fb_off, nc int64[n]; table\n"
+"int64[T] (io word of each logical level word); state int32[n].";
+
+PyObject *record_rows(PyObject *self, PyObject *args)
+{
+    PyObject *o[4], *oslots, *otr, *opos, *ovel, *oidx, *ends, *ooff, *oint, *ofb, *onc, *otab,
+        *ost;
+    long long head, n0;
+    double origin, period;
+    int estop;
+    if (!PyArg_ParseTuple(args, "OOOOLOddLOOOOO!OOOOOpO", &o[0], &o[1], &o[2], &o[3], &head,
+                          &oslots, &origin, &period, &n0, &otr, &opos, &ovel, &oidx,
+                          &PyTuple_Type, &ends, &ooff, &oint, &ofb, &onc, &otab, &estop, &ost))
+        return NULL;
+    PyObject *objs[17] = {o[0], o[1], o[2], o[3], oslots, otr, opos, ovel, oidx, ooff, oint,
+                          ofb, onc, otab, ost, NULL, NULL};
+    static const Py_ssize_t sizes[15] = {8, 8, 4, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 4};
+    static const char *names[15] = {"rt", "rf", "rstate", "rio", "slots", "trace", "pos", "vel",
+                                    "idx", "cmd_off", "internal", "fb_off", "nc", "table",
+                                    "state"};
+    Buf bufs[15];
+    memset(bufs, 0, sizeof bufs);
+    for (int k = 0; k < 15; k++)
+        if (get_buf(objs[k], &bufs[k], sizes[k], names[k]) < 0) { release(bufs, 15); return NULL; }
+    Py_ssize_t R = bufs[0].b.len / 8, n = bufs[6].b.len / 8, nk = bufs[8].b.len / 8;
+    Py_ssize_t m = n ? bufs[5].b.len / (8 * 3 * n) : 0;
+    Py_ssize_t F = (R && n) ? bufs[1].b.len / (8 * R * n) : 0;
+    const int64_t *slots = bufs[4].b.buf, *idx = bufs[8].b.buf, *table = bufs[13].b.buf;
+    Py_ssize_t T = bufs[13].b.len / 8;
+    const char *bad = NULL;
+    if (R < 2 || n < 1 || bufs[4].b.len != 3 * 8 || bufs[7].b.len != n * 8
+            || bufs[5].b.len != m * n * 3 * 8 || bufs[1].b.len != R * F * n * 8
+            || bufs[9].b.len != nk * 8 || bufs[10].b.len != n * 8 || bufs[11].b.len != n * 8
+            || bufs[12].b.len != n * 8 || bufs[14].b.len != n * 4
+            || (bufs[2].b.len && bufs[2].b.len != R * n * 4)
+            || (bufs[3].b.len && bufs[3].b.len != R * n * 8)
+            || PyTuple_GET_SIZE(ends) != nk || head < 0 || head >= R)
+        bad = "record_rows: arrays disagree in size";
+    for (int s = 0; s < 3 && !bad; s++)
+        if (slots[s] < -1 || slots[s] >= F) bad = "record_rows: bad slot";
+    for (Py_ssize_t k = 0; k < nk && !bad; k++)
+        if (idx[k] < 0 || idx[k] >= n) bad = "record_rows: bad mover index";
+    if (bad) {
+        release(bufs, 15);
+        PyErr_SetString(PyExc_ValueError, bad);
+        return NULL;
+    }
+    Buf *eb = PyMem_Calloc(nk + 1, sizeof(Buf));
+    if (eb == NULL) { release(bufs, 15); return PyErr_NoMemory(); }
+    int fail = 0;
+    for (Py_ssize_t k = 0; k < nk && !fail; k++) {
+        if (PyObject_GetBuffer(PyTuple_GET_ITEM(ends, k), &eb[k].b, PyBUF_C_CONTIGUOUS) < 0) {
+            fail = 1;
+            break;
+        }
+        eb[k].held = 1;
+        if (eb[k].b.itemsize != 8 || eb[k].b.len < m * 2 * 8) {
+            PyErr_SetString(PyExc_ValueError, "record_rows: ends too short");
+            fail = 1;
+        }
+    }
+    if (fail) {
+        release(eb, (int)nk);
+        PyMem_Free(eb);
+        release(bufs, 15);
+        return NULL;
+    }
+    double *rt = bufs[0].b.buf, *rf = bufs[1].b.buf;
+    int32_t *rstate = bufs[2].b.len ? bufs[2].b.buf : NULL;
+    int64_t *rio = bufs[3].b.len ? bufs[3].b.buf : NULL;
+    const int64_t *tr = bufs[5].b.buf, *internal = bufs[10].b.buf, *fboff = bufs[11].b.buf,
+                  *nc = bufs[12].b.buf;
+    const double *pos = bufs[6].b.buf, *vel = bufs[7].b.buf, *off = bufs[9].b.buf;
+    const int32_t *state = bufs[14].b.buf;
+    int64_t *mover = PyMem_Malloc(sizeof(int64_t) * (n + 1));
+    if (mover == NULL) {
+        release(eb, (int)nk);
+        PyMem_Free(eb);
+        release(bufs, 15);
+        return PyErr_NoMemory();
+    }
+    for (Py_ssize_t x = 0; x < n; x++) mover[x] = -1;
+    for (Py_ssize_t k = 0; k < nk; k++) mover[idx[k]] = k;
+    Py_ssize_t keep = m < R - 1 ? m : R - 1;
+    int64_t sp = slots[0], sf = slots[1], sv = slots[2];
+    int finite = 1; /* Recorder.record_block's check, before any row is written */
+    for (Py_ssize_t x = 0; x < n; x++)
+        if (mover[x] < 0 && !(isfinite(pos[x]) && isfinite(vel[x]))) finite = 0;
+    for (Py_ssize_t k = 0; k < nk && finite; k++) {
+        const double *e = eb[k].b.buf;
+        for (Py_ssize_t r = m - keep; r < m; r++)
+            if (!(isfinite(e[r * 2] + off[k]) && isfinite(e[r * 2 + 1]))) { finite = 0; break; }
+    }
+    if (!finite) {
+        PyMem_Free(mover);
+        release(eb, (int)nk);
+        PyMem_Free(eb);
+        release(bufs, 15);
+        PyErr_SetString(PyExc_ValueError, "recorded positions/velocities must be finite");
+        return NULL;
+    }
+    Py_ssize_t row = (Py_ssize_t)((head + (m - keep)) % R);
+    for (Py_ssize_t r = m - keep; r < m; r++, row = row + 1 == R ? 0 : row + 1) {
+        rt[row] = origin + (double)(n0 + 1 + r) * period;
+        double *f = rf + row * F * n;
+        const int64_t *trr = tr + r * n * 3;
+        for (Py_ssize_t x = 0; x < n; x++) {
+            int64_t k = mover[x];
+            const double *e = k >= 0 ? (const double *)eb[k].b.buf + r * 2 : NULL;
+            if (sp >= 0) f[sp * n + x] = e ? e[0] + off[k] : pos[x];
+            if (sv >= 0) f[sv * n + x] = e ? e[1] : vel[x];
+            if (sf >= 0) f[sf * n + x] = (double)wrap28((internal[x] ? trr[x * 3]
+                                                                    : trr[x * 3 + 1]) + fboff[x]);
+            if (rstate) rstate[row * n + x] = state[x];
+            if (rio) {
+                int64_t w = trr[x * 3 + 2] ^ nc[x];
+                int64_t v = (w >= 0 && w < T) ? table[w] : 0;
+                rio[row * n + x] = estop ? v | (1 << 6) : v;
+            }
+        }
+    }
+    PyMem_Free(mover);
+    release(eb, (int)nk);
+    PyMem_Free(eb);
+    release(bufs, 15);
+    Py_RETURN_NONE;
+}
