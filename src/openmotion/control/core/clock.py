@@ -74,23 +74,15 @@ class CycleStats:
     own_overruns: int = 0
 
 
-class RealtimePacer:
-    """Runs `cycle()` every `period` seconds of wall clock on a daemon thread."""
+class PacedThread:
+    """The life cycle both real-time executors share (`RealtimePacer` here, the compiled
+    `realtime.RealtimeExecutor`): one daemon thread named "openmotion-rt" runs `_run`
+    until `stop()`; `error` keeps what ended it (surfaced by the caller, never dropped).
+    `_begin` runs before the thread starts, `_end` after it has ended."""
 
-    def __init__(self, cycle: Callable[[], None], period: float,
-                 on_overrun: Callable[[int, int], None] | None = None) -> None:
-        self._cycle = cycle
-        self._period = period
-        self._on_overrun = on_overrun
-        self._late_cycles = 0
-        self._behind = 0
-        self._errors = 0
+    def __init__(self) -> None:
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
-        self._busy = np.zeros(_STATS_WINDOW)
-        self._late = np.zeros(_STATS_WINDOW)
-        self._n = 0
-        self._overruns = 0
         self.error: BaseException | None = None
 
     @property
@@ -102,14 +94,47 @@ class RealtimePacer:
             raise MotionError("real-time mode is already running")
         self._stop.clear()
         self.error = None
+        self._begin()
         self._thread = threading.Thread(target=self._run, name="openmotion-rt", daemon=True)
         self._thread.start()
 
     def stop(self) -> None:
         self._stop.set()
+        self._wake()
         if self._thread is not None:
             self._thread.join()
             self._thread = None
+            self._end()
+
+    def _begin(self) -> None:
+        """Reset the statistics and settings of a new run (before the thread starts)."""
+
+    def _wake(self) -> None:
+        """Make a thread waiting for its next slot see the stop request at once."""
+
+    def _end(self) -> None:
+        """Undo what `_begin` set (the thread has ended)."""
+
+    def _run(self) -> None:  # pragma: no cover - each executor has its own
+        raise NotImplementedError
+
+
+class RealtimePacer(PacedThread):
+    """Runs `cycle()` every `period` seconds of wall clock on a daemon thread."""
+
+    def __init__(self, cycle: Callable[[], None], period: float,
+                 on_overrun: Callable[[int, int], None] | None = None) -> None:
+        super().__init__()
+        self._cycle = cycle
+        self._period = period
+        self._on_overrun = on_overrun
+        self._late_cycles = 0
+        self._behind = 0
+        self._errors = 0
+        self._busy = np.zeros(_STATS_WINDOW)
+        self._late = np.zeros(_STATS_WINDOW)
+        self._n = 0
+        self._overruns = 0
 
     def _run(self) -> None:
         clock = _time.perf_counter

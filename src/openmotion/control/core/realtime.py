@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import MotionError
-from .clock import CycleStats
+from .clock import CycleStats, PacedThread
 from .jump import jump, plan_jump
 
 try:  # the compiled inner loops (setup.py builds them)
@@ -107,7 +107,7 @@ class HandoverLock:
         self._lock.release()
 
 
-class RealtimeExecutor:
+class RealtimeExecutor(PacedThread):
     """Real time for one controller: compiled cycles paced in C where virtual time would
     jump, `Controller.step` at its slot otherwise (see the module docstring)."""
 
@@ -116,6 +116,7 @@ class RealtimeExecutor:
         if not AVAILABLE:
             raise MotionError("the compiled real-time executor is not built "
                               "(python setup.py build_ext --inplace)")
+        super().__init__()
         self._ctl = ctl
         self._period = ctl.period
         self._on_overrun = on_overrun
@@ -123,43 +124,29 @@ class RealtimeExecutor:
         self._busy = np.zeros(_WINDOW)
         self._late = np.zeros(_WINDOW)
         self._work = np.zeros(_WINDOW)
-        self._thread: threading.Thread | None = None
-        self._stop = threading.Event()
         self._errors = 0
         self.python_cycles = 0
         self.compiled_runs = 0
-        self.error: BaseException | None = None
+        self._switch = sys.getswitchinterval()
 
-    @property
-    def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
-
-    def start(self) -> None:
-        if self.running:
-            raise MotionError("real-time mode is already running")
+    def _begin(self) -> None:
         st = self.st
         waiting = st[RT_WAITERS]
         st[:] = 0.0
         st[RT_WAITERS] = waiting
         st[RT_PENDING] = -1.0
         st[RT_PERIOD] = self._period
-        self._stop.clear()
-        self.error = None
         self._errors = 0
         self.python_cycles = 0
         self.compiled_runs = 0
         self._switch = sys.getswitchinterval()
         sys.setswitchinterval(min(self._switch, SWITCH_INTERVAL_S))
-        self._thread = threading.Thread(target=self._run, name="openmotion-rt", daemon=True)
-        self._thread.start()
 
-    def stop(self) -> None:
-        self._stop.set()
-        self.st[RT_STOPPING] = 1.0
-        if self._thread is not None:
-            self._thread.join()
-            self._thread = None
-            sys.setswitchinterval(self._switch)
+    def _wake(self) -> None:
+        self.st[RT_STOPPING] = 1.0  # the C wait returns within 1 ms
+
+    def _end(self) -> None:
+        sys.setswitchinterval(self._switch)
 
     def _compiled(self) -> bool:
         paced = getattr(self._ctl.hardware, "paced_cycles", None)
