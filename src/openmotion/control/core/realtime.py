@@ -35,6 +35,7 @@ values (that ends the run at the next cycle boundary).
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
 import sys
 import threading
@@ -42,6 +43,10 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+# numpy imports numpy.ma lazily on the first np.unique (a path plan): 50-90 ms inside the
+# first landing that plans a path. Imported here, before real time starts.
+import numpy.ma  # noqa: F401
 
 from ...errors import MotionError
 from .clock import CycleStats, PacedThread
@@ -64,7 +69,7 @@ _WINDOW = 65536
 # st fields, as in _kernel_rt.c (the C side checks the array's length)
 (RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START, RT_LASTEND,
  RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST, RT_INTERRUPTED, RT_LASTK,
- RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_NFIELDS) = range(19)
+ RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_CPU0, RT_NFIELDS) = range(20)
 
 AVAILABLE = _kernel is not None and hasattr(_kernel, "rt_paced")
 
@@ -124,6 +129,7 @@ class RealtimeExecutor(PacedThread):
         self._busy = np.zeros(_WINDOW)
         self._late = np.zeros(_WINDOW)
         self._work = np.zeros(_WINDOW)
+        self._cpu = np.zeros(_WINDOW)
         self._errors = 0
         self.python_cycles = 0
         self.compiled_runs = 0
@@ -141,12 +147,17 @@ class RealtimeExecutor(PacedThread):
         self.compiled_runs = 0
         self._switch = sys.getswitchinterval()
         sys.setswitchinterval(min(self._switch, SWITCH_INTERVAL_S))
+        # the objects alive now (the program, plans, the machine) are never scanned again
+        # by a garbage collection, which otherwise runs inside some landing
+        gc.collect()
+        gc.freeze()
 
     def _wake(self) -> None:
         self.st[RT_STOPPING] = 1.0  # the C wait returns within 1 ms
 
     def _end(self) -> None:
         sys.setswitchinterval(self._switch)
+        gc.unfreeze()
 
     def _compiled(self) -> bool:
         paced = getattr(self._ctl.hardware, "paced_cycles", None)
@@ -156,7 +167,7 @@ class RealtimeExecutor(PacedThread):
         ctl = self._ctl
         k = _kernel
         assert k is not None
-        ctx = (self.st, self._busy, self._late, self._work)
+        ctx = (self.st, self._busy, self._late, self._work, self._cpu)
         st = self.st
         horizon = max(2, math.ceil(HORIZON_S / self._period - 1e-9))
         # cycle n + 1 is due now; cycle j's slot starts at wall0 + j * period
@@ -208,7 +219,7 @@ class RealtimeExecutor(PacedThread):
             return CycleStats(0, self._period, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0,
                               0, 0, self._errors,
                               executor="compiled")
-        busy, late, work = self._busy[:n], self._late[:n], self._work[:n]
+        busy, late, work, cpu = self._busy[:n], self._late[:n], self._work[:n], self._cpu[:n]
         return CycleStats(
             cycles=count,
             period=self._period,
@@ -228,16 +239,19 @@ class RealtimeExecutor(PacedThread):
             python_cycles=self.python_cycles,
             executor="compiled",
             own_overruns=_own_overruns(self.samples(), self._period),
+            p99_cpu=float(np.percentile(cpu, 99)),
+            max_cpu=float(cpu.max()),
+            own_cpu_overruns=int(np.count_nonzero(cpu > self._period)),
         )
 
     def samples(self) -> dict[str, np.ndarray]:
-        """The per-cycle rings in cycle order (seconds): busy, late, work (the last
-        65536 cycles at most)."""
+        """The per-cycle rings in cycle order (seconds): busy, late, work, cpu (the
+        last 65536 cycles at most)."""
         count = int(self.st[RT_COUNT])
         n = min(count, _WINDOW)
         order = np.arange(count - n, count) % _WINDOW
         return {"busy": self._busy[order].copy(), "late": self._late[order].copy(),
-                "work": self._work[order].copy()}
+                "work": self._work[order].copy(), "cpu": self._cpu[order].copy()}
 
 
 def _own_overruns(rings: dict[str, np.ndarray], period: float) -> int:
