@@ -61,14 +61,15 @@ def show(name: str, mode: str, s: CycleStats, busy: np.ndarray | None = None,
         work += f"compiled runs {runs}; "
     print(f"{name:11s} {mode:8s} cycles {s.cycles:6d}: busy p50 {p50:6.1f} p99 "
           f"{s.p99_busy * 1e6:7.1f} max {s.max_busy * 1e6:7.0f} us; jitter p99 "
-          f"{s.p99_jitter * 1e6:6.0f} us; {work}overruns {s.overruns} (own {s.own_overruns}); "
-          f"py cycles {s.python_cycles}")
+          f"{s.p99_jitter * 1e6:6.0f} us; {work}cpu p99 {s.p99_cpu * 1e6:6.1f} max "
+          f"{s.max_cpu * 1e6:6.0f} us; overruns {s.overruns} (own {s.own_overruns}, own by "
+          f"cpu {s.own_cpu_overruns}); py cycles {s.python_cycles}")
 
 
 def compiled_noop(seconds: float) -> CycleStats:
     """The compiled executor's wait (rt_wait/rt_close) around no work at all."""
     st = np.zeros(realtime.RT_NFIELDS)
-    rings = [np.zeros(65536) for _ in range(3)]
+    rings = [np.zeros(65536) for _ in range(4)]
     st[realtime.RT_PENDING] = -1.0
     st[realtime.RT_PERIOD] = 0.001
     st[realtime.RT_WALL0] = _kernel.rt_now() - 0.001
@@ -76,10 +77,12 @@ def compiled_noop(seconds: float) -> CycleStats:
     for k in range(1, n + 1):
         _kernel.rt_wait(st, *rings, k)
         _kernel.rt_close(st, *rings)
-    busy, late = rings[0][:n], rings[1][:n]
+    busy, late, cpu = rings[0][:n], rings[1][:n], rings[3][:n]
     return CycleStats(n, 0.001, float(busy.mean()), float(np.percentile(busy, 99)),
                       float(busy.max()), float(late.mean()), float(np.percentile(late, 99)),
-                      float(late.max()), int(st[realtime.RT_OVERRUNS]), executor="compiled")
+                      float(late.max()), int(st[realtime.RT_OVERRUNS]), executor="compiled",
+                      p99_cpu=float(np.percentile(cpu, 99)), max_cpu=float(cpu.max()),
+                      own_cpu_overruns=int(np.count_nonzero(cpu > 0.001)))
 
 
 def timed_run(ctl: Controller, compiled: bool, body, limit: float = 120.0) -> None:  # noqa: ANN001

@@ -111,8 +111,11 @@ def test_stats_count_every_cycle_once():
     assert 0 <= s.overruns <= s.cycles and s.errors == 0
     assert 0 <= s.own_overruns <= s.cycles
     samples = ctl.cycle_samples()
-    assert len(samples["busy"]) == s.cycles
+    assert len(samples["busy"]) == len(samples["cpu"]) == s.cycles
     assert np.all(samples["late"] >= 0.0) and np.all(samples["busy"] >= 0.0)
+    # the thread's CPU time per cycle (and the work after it): measured, never negative
+    assert np.all(samples["cpu"] >= 0.0) and samples["cpu"].sum() > 0.0
+    assert s.p99_cpu <= s.max_cpu and 0 <= s.own_cpu_overruns <= s.cycles
 
 
 def test_a_per_cycle_hook_falls_back_to_python_steps():
@@ -201,7 +204,9 @@ def test_the_python_pacer_is_still_there_on_request():
     _realtime_run(ctl, 100)
     s = ctl.cycle_stats()
     assert s.executor == "python" and s.python_cycles == s.cycles == ctl.cycles
-    assert len(ctl.cycle_samples()["busy"]) == s.cycles
+    rings = ctl.cycle_samples()
+    assert len(rings["busy"]) == len(rings["cpu"]) == s.cycles and rings["cpu"].sum() > 0.0
+    assert 0 <= s.own_cpu_overruns <= s.cycles
 
 
 def test_a_failure_inside_a_compiled_run_faults_and_real_time_goes_on():

@@ -15,9 +15,11 @@
  * (CLOCK_MONOTONIC seconds); a late cycle is never skipped (catch-up, as RealtimePacer).
  *
  * The context lives in float64 numpy arrays owned by the executor: st[RT_NFIELDS], the
- * rings busy/late/work (same length): per cycle the busy time, the start lateness, and the
+ * rings busy/late/work/cpu (same length): per cycle the busy time, the start lateness, the
  * Python work done between the previous cycle's end and the wait for this one (landing
- * and feeding the piece queue ahead).
+ * and feeding the piece queue ahead), and the executor thread's CPU time from the cycle's
+ * start to the wait for the next one (the cycle and the work after it, without the time
+ * the thread was preempted: the controller's own cost on a loaded machine).
  */
 #include "_kernel.h"
 #include <time.h>
@@ -25,10 +27,10 @@
 
 enum { RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START,
        RT_LASTEND, RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST,
-       RT_INTERRUPTED, RT_LASTK, RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_NFIELDS };
+       RT_INTERRUPTED, RT_LASTK, RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_CPU0, RT_NFIELDS };
 
 typedef struct {
-    double *st, *busy, *late, *work;
+    double *st, *busy, *late, *work, *cpu;
     Py_ssize_t cap;
 } RtCtx;
 
@@ -38,6 +40,14 @@ static double now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* this thread's CPU time (s) */
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
@@ -126,6 +136,9 @@ static int begin(RtCtx *c, long long k, int interruptible)
     double t = now_s();
     close_pending(c, t);
     double work = st[RT_LASTEND] > 0.0 ? t - st[RT_LASTEND] : 0.0;
+    if (st[RT_COUNT] >= 1.0 && st[RT_CPU0] > 0.0)  /* the last cycle and the work after it */
+        c->cpu[(Py_ssize_t)((long long)(st[RT_COUNT] - 1.0) % (long long)c->cap)] =
+            cpu_s() - st[RT_CPU0];
     if (wait_until(c, st[RT_WALL0] + (double)k * st[RT_PERIOD], interruptible)) {
         /* no cycle begins: the landing work that follows still belongs to the last
          * cycle, the time spent here (planning, the wait) does not */
@@ -134,9 +147,12 @@ static int begin(RtCtx *c, long long k, int interruptible)
         return 1;
     }
     st[RT_EXTEND] = 0.0;
-    c->work[(Py_ssize_t)((long long)st[RT_COUNT] % (long long)c->cap)] = work;
+    Py_ssize_t i = (Py_ssize_t)((long long)st[RT_COUNT] % (long long)c->cap);
+    c->work[i] = work;
+    c->cpu[i] = 0.0;
     st[RT_PENDING] = (double)k;
     st[RT_START] = now_s();
+    st[RT_CPU0] = cpu_s();
     return 0;
 }
 
@@ -155,11 +171,12 @@ void rt_after_cycle(long long k)
 
 static int get_ctx(PyObject *const *o, Buf *bufs, RtCtx *c)
 {
-    static const char *names[4] = {"st", "busy", "late", "work"};
-    for (int k = 0; k < 4; k++)
+    static const char *names[5] = {"st", "busy", "late", "work", "cpu"};
+    for (int k = 0; k < 5; k++)
         if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) return -1;
     if (bufs[0].b.len != 8 * RT_NFIELDS || bufs[1].b.len == 0
-            || bufs[2].b.len != bufs[1].b.len || bufs[3].b.len != bufs[1].b.len) {
+            || bufs[2].b.len != bufs[1].b.len || bufs[3].b.len != bufs[1].b.len
+            || bufs[4].b.len != bufs[1].b.len) {
         PyErr_SetString(PyExc_ValueError, "rt: context arrays have the wrong sizes");
         return -1;
     }
@@ -167,71 +184,73 @@ static int get_ctx(PyObject *const *o, Buf *bufs, RtCtx *c)
     c->busy = bufs[1].b.buf;
     c->late = bufs[2].b.buf;
     c->work = bufs[3].b.buf;
+    c->cpu = bufs[4].b.buf;
     c->cap = bufs[1].b.len / 8;
     return 0;
 }
 
 const char rt_paced_doc[] =
-"rt_paced(st, busy, late, work, fn, args) -> fn(*args)\n\n"
+"rt_paced(st, busy, late, work, cpu, fn, args) -> fn(*args)\n\n"
 "Call fn(*args) with the pacing context bound to this thread: every compiled cycle run\n"
 "inside waits for its slot on the wall clock and records its busy time.";
 
 PyObject *rt_paced(PyObject *self, PyObject *args)
 {
-    PyObject *o[4], *fn, *fargs;
-    if (!PyArg_ParseTuple(args, "OOOOOO!", &o[0], &o[1], &o[2], &o[3], &fn, &PyTuple_Type,
-                          &fargs))
+    PyObject *o[5], *fn, *fargs;
+    if (!PyArg_ParseTuple(args, "OOOOOOO!", &o[0], &o[1], &o[2], &o[3], &o[4], &fn,
+                          &PyTuple_Type, &fargs))
         return NULL;
-    Buf bufs[4];
+    Buf bufs[5];
     memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
     RtCtx *outer = rt_cur;
     rt_cur = &c;
     PyObject *res = PyObject_Call(fn, fargs, NULL);
     rt_cur = outer;
-    release(bufs, 4);
+    release(bufs, 5);
     return res;
 }
 
 const char rt_wait_doc[] =
-"rt_wait(st, busy, late, work, k) -> True when interrupted instead\n\n"
+"rt_wait(st, busy, late, work, cpu, k) -> True when interrupted instead\n\n"
 "End the pending cycle, then sleep (GIL released) until cycle k's slot and make k the\n"
 "pending cycle (a cycle the Python path runs; `rt_close` ends it). Returns True without\n"
 "beginning k when the executor stops or another thread waits for the lock.";
 
 PyObject *rt_wait(PyObject *self, PyObject *args)
 {
-    PyObject *o[4];
+    PyObject *o[5];
     long long k;
-    if (!PyArg_ParseTuple(args, "OOOOL", &o[0], &o[1], &o[2], &o[3], &k)) return NULL;
-    Buf bufs[4];
+    if (!PyArg_ParseTuple(args, "OOOOOL", &o[0], &o[1], &o[2], &o[3], &o[4], &k))
+        return NULL;
+    Buf bufs[5];
     memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
     int stopped;
     Py_BEGIN_ALLOW_THREADS
     stopped = begin(&c, k, 1);
     Py_END_ALLOW_THREADS
-    release(bufs, 4);
+    release(bufs, 5);
     return PyBool_FromLong(stopped);
 }
 
 const char rt_close_doc[] =
-"rt_close(st, busy, late, work)\n\nEnd the pending cycle now, or, with none pending,\n"
+"rt_close(st, busy, late, work, cpu)\n\nEnd the pending cycle now, or, with none pending,\n"
 "extend the last ended cycle's busy time to now (the Python work that landed it).";
 
 PyObject *rt_close(PyObject *self, PyObject *args)
 {
-    PyObject *o[4];
-    if (!PyArg_ParseTuple(args, "OOOO", &o[0], &o[1], &o[2], &o[3])) return NULL;
-    Buf bufs[4];
+    PyObject *o[5];
+    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) return NULL;
+    Buf bufs[5];
     memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
     if (c.st[RT_PENDING] >= 0.0) close_pending(&c, now_s());
     else extend_last(&c, now_s());
-    release(bufs, 4);
+    release(bufs, 5);
     Py_RETURN_NONE;
 }
 
@@ -272,17 +291,17 @@ PyObject *rt_slot(PyObject *self, PyObject *args)
 }
 
 const char rt_yield_doc[] =
-"rt_yield(st, busy, late, work)\n\nSleep (GIL released) while another thread waits for\n"
+"rt_yield(st, busy, late, work, cpu)\n\nSleep (GIL released) while another thread waits for\n"
 "the controller's lock (st[RT_WAITERS] > 0), so it gets the lock; at most 20 ms.";
 
 PyObject *rt_yield(PyObject *self, PyObject *args)
 {
-    PyObject *o[4];
-    if (!PyArg_ParseTuple(args, "OOOO", &o[0], &o[1], &o[2], &o[3])) return NULL;
-    Buf bufs[4];
+    PyObject *o[5];
+    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) return NULL;
+    Buf bufs[5];
     memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 4); return NULL; }
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
     Py_BEGIN_ALLOW_THREADS
     double end = now_s() + 0.02;
     while (vread(&c.st[RT_WAITERS]) > 0.0 && vread(&c.st[RT_STOPPING]) == 0.0
@@ -291,6 +310,6 @@ PyObject *rt_yield(PyObject *self, PyObject *args)
         nanosleep(&ts, NULL);
     }
     Py_END_ALLOW_THREADS
-    release(bufs, 4);
+    release(bufs, 5);
     Py_RETURN_NONE;
 }

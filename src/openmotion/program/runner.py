@@ -63,6 +63,7 @@ from .source import read_program
 from .spindle import OrientMove, SpindleDrive, SyncMove
 from .splines import SplineFeed
 from .syncout import SyncedAnalog, SyncedOutputs
+from .trace import CycleTrace
 
 __all__ = ["ProgramRunner", "RunEvent", "RunOptions", "RunState", "machine_axes",
            "run_program", "travel_limits"]
@@ -185,10 +186,7 @@ class ProgramRunner:
         self._last_line = 0
         self._step_line: int | None = None
         self.t_start = self.t_end = 0.0
-        self._trace_t: list[float] = []
-        self._trace_i: list[int] = []
-        self._trace_p: list[list[float]] = []
-        self._trace_a: list[list[float]] = []  # actual (feedback) positions, pulses
+        self._trace = CycleTrace(self.axis_indices)  # per cycle (program/trace.py)
 
     # ------------------------------------------------------------------ compile
     def _positions(self) -> np.ndarray:
@@ -312,16 +310,13 @@ class ProgramRunner:
     def trace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per cycle of the run: times (s), command index executing (-1: none), and the
         group axes' positions in machine units (rows = cycles)."""
-        t = np.array(self._trace_t, dtype=float)
-        idx = np.array(self._trace_i, dtype=int)
-        p = np.array(self._trace_p, dtype=float).reshape(len(t), len(self.letters))
+        t, idx, p, _ = self._trace.arrays()
         return t, idx, p / self.scales.ppu
 
     def actual_trace(self) -> np.ndarray:
         """Per cycle of the run (the rows of `trace`): the group axes' actual (feedback)
         positions in machine units; trace()[2] minus this is the following error."""
-        a = np.array(self._trace_a, dtype=float).reshape(len(self._trace_t), len(self.letters))
-        return a / self.scales.ppu
+        return self._trace.arrays()[3] / self.scales.ppu
 
     def line_of(self, index: int) -> int:
         """Source line of a group command index (0 if unknown)."""
@@ -412,18 +407,10 @@ class ProgramRunner:
         return runqueue.feed_ready(self, g)
 
     def _on_jump(self, ctl: Controller, first: int, last: int,
-                 positions: list[list[float]], actual: list[list[float]]) -> None:
+                 positions: np.ndarray, actual: np.ndarray) -> None:
         """A jump crossed cycles first..last: their trace rows, as `_on_cycle` records."""
-        g = self.group
-        assert g is not None
-        idx = [ax.index for ax in g.axes]
-        origin, period = ctl._t_origin, ctl.period
-        for k, row, act in zip(range(first, last + 1), positions, actual, strict=True):
-            t = origin + k * period
-            self._trace_t.append(t)
-            self._trace_i.append(g.index_at(t))
-            self._trace_p.append([row[i] for i in idx])
-            self._trace_a.append([act[i] for i in idx])
+        assert self.group is not None
+        self._trace.add_span(ctl, self.group, first, last, positions, actual)
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         from ..control.groups.group import GroupError, GroupState
@@ -445,10 +432,8 @@ class ProgramRunner:
             self.spindle.sample(t)
             if self._request is None:
                 follow_per_rev(self, g)
-        self._trace_t.append(t)
-        self._trace_i.append(g.current_index)
-        self._trace_p.append([ax.position for ax in g.axes])
-        self._trace_a.append([ax.counters.actual() for ax in g.axes])
+        self._trace.add(t, g.current_index, [ax.position for ax in g.axes],
+                        [ax.counters.actual() for ax in g.axes])
         self.synced.fire(g.current_index, self._idle_past)
         self.synced_analog.fire(g.current_index, self._idle_past)
         if self.state is not RunState.RUNNING:

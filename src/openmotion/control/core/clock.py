@@ -51,7 +51,11 @@ class CycleStats:
     Python work between cycles (landing, feeding the pieces ahead), python_cycles = cycles
     stepped in Python because nothing could be jumped (the fallback). own_overruns = cycles
     whose own busy time plus the Python work before the next one exceeded the period: the
-    overruns the controller causes by itself, with the OS's wake-up lateness left out.
+    overruns the controller causes by itself, with the OS's wake-up lateness left out (wall
+    time: a thread preempted inside counts). cpu = the real-time thread's CPU time for a
+    cycle and the work after it, up to the wait for the next one (what the controller
+    itself costs, preemption left out); own_cpu_overruns = cycles where that exceeded the
+    period: the overruns the controller would cause on a machine of its own.
     """
 
     cycles: int
@@ -72,25 +76,20 @@ class CycleStats:
     python_cycles: int = 0
     executor: str = "python"
     own_overruns: int = 0
+    p99_cpu: float = 0.0
+    max_cpu: float = 0.0
+    own_cpu_overruns: int = 0
 
 
-class RealtimePacer:
-    """Runs `cycle()` every `period` seconds of wall clock on a daemon thread."""
+class PacedThread:
+    """The life cycle both real-time executors share (`RealtimePacer` here, the compiled
+    `realtime.RealtimeExecutor`): one daemon thread named "openmotion-rt" runs `_run`
+    until `stop()`; `error` keeps what ended it (surfaced by the caller, never dropped).
+    `_begin` runs before the thread starts, `_end` after it has ended."""
 
-    def __init__(self, cycle: Callable[[], None], period: float,
-                 on_overrun: Callable[[int, int], None] | None = None) -> None:
-        self._cycle = cycle
-        self._period = period
-        self._on_overrun = on_overrun
-        self._late_cycles = 0
-        self._behind = 0
-        self._errors = 0
+    def __init__(self) -> None:
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
-        self._busy = np.zeros(_STATS_WINDOW)
-        self._late = np.zeros(_STATS_WINDOW)
-        self._n = 0
-        self._overruns = 0
         self.error: BaseException | None = None
 
     @property
@@ -102,17 +101,51 @@ class RealtimePacer:
             raise MotionError("real-time mode is already running")
         self._stop.clear()
         self.error = None
+        self._begin()
         self._thread = threading.Thread(target=self._run, name="openmotion-rt", daemon=True)
         self._thread.start()
 
     def stop(self) -> None:
         self._stop.set()
+        self._wake()
         if self._thread is not None:
             self._thread.join()
             self._thread = None
+            self._end()
+
+    def _begin(self) -> None:
+        """Reset the statistics and settings of a new run (before the thread starts)."""
+
+    def _wake(self) -> None:
+        """Make a thread waiting for its next slot see the stop request at once."""
+
+    def _end(self) -> None:
+        """Undo what `_begin` set (the thread has ended)."""
+
+    def _run(self) -> None:  # pragma: no cover - each executor has its own
+        raise NotImplementedError
+
+
+class RealtimePacer(PacedThread):
+    """Runs `cycle()` every `period` seconds of wall clock on a daemon thread."""
+
+    def __init__(self, cycle: Callable[[], None], period: float,
+                 on_overrun: Callable[[int, int], None] | None = None) -> None:
+        super().__init__()
+        self._cycle = cycle
+        self._period = period
+        self._on_overrun = on_overrun
+        self._late_cycles = 0
+        self._behind = 0
+        self._errors = 0
+        self._busy = np.zeros(_STATS_WINDOW)
+        self._late = np.zeros(_STATS_WINDOW)
+        self._cpu = np.zeros(_STATS_WINDOW)
+        self._n = 0
+        self._overruns = 0
 
     def _run(self) -> None:
-        clock = _time.perf_counter
+        clock, cpu = _time.perf_counter, _time.thread_time
         period = self._period
         t_next = clock()
         in_burst = False
@@ -124,7 +157,7 @@ class RealtimePacer:
                     # threads that issue commands. Linux wakes within ~0.1 ms.
                     _time.sleep(t_next - now)
                     now = clock()
-                start = now
+                start, cpu0 = now, cpu()
                 if start - t_next >= period:  # this cycle's slot passed: catch-up
                     self._late_cycles += 1
                 try:
@@ -134,6 +167,7 @@ class RealtimePacer:
                     self._errors += 1
                 end = clock()
                 i = self._n % _STATS_WINDOW
+                self._cpu[i] = cpu() - cpu0
                 self._late[i] = start - t_next
                 self._busy[i] = end - start
                 self._n += 1
@@ -151,8 +185,10 @@ class RealtimePacer:
             self.error = exc
 
     def samples(self) -> dict[str, np.ndarray]:
-        """The per-cycle rings in cycle order (s): busy and late (start lateness)."""
-        return {"busy": _ring(self._busy, self._n), "late": _ring(self._late, self._n)}
+        """The per-cycle rings in cycle order (s): busy, late (start lateness) and cpu
+        (the thread's CPU time in the cycle)."""
+        return {"busy": _ring(self._busy, self._n), "late": _ring(self._late, self._n),
+                "cpu": _ring(self._cpu, self._n)}
 
     def stats(self) -> CycleStats:
         n = min(self._n, _STATS_WINDOW)
@@ -161,6 +197,7 @@ class RealtimePacer:
                               0, 0, self._errors)
         busy = self._busy[:n]
         late = self._late[:n]
+        cpu = self._cpu[:n]
         return CycleStats(
             cycles=self._n,
             period=self._period,
@@ -176,6 +213,9 @@ class RealtimePacer:
             errors=self._errors,
             python_cycles=self._n,
             own_overruns=int(np.count_nonzero(busy > self._period)),
+            p99_cpu=float(np.percentile(cpu, 99)),
+            max_cpu=float(cpu.max()),
+            own_cpu_overruns=int(np.count_nonzero(cpu > self._period)),
         )
 
 

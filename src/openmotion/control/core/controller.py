@@ -23,7 +23,7 @@ import contextlib
 import dataclasses
 import math
 from collections.abc import Callable, Collection, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ...config import ENCODER_MULTIPLIER, MachineConfig, default_machine
 from ...errors import MotionError, check_int, check_nonnegative
@@ -39,6 +39,9 @@ from .motion import ActiveMotion
 from .realtime import AVAILABLE as _COMPILED_RT
 from .realtime import HandoverLock, RealtimeExecutor
 from .states import AxisState
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: Recorder state channel numbering (the order of AxisState).
 STATE_CODES = {st: i for i, st in enumerate(AxisState)}
@@ -93,7 +96,7 @@ DECODER_FIELDS = ("encoder_mode", "swap_ab", "invert_a", "invert_b", "invert_z")
 RECONFIGURABLE = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed", "logic",
                   "pulse_mode", "pulse_width_us", "encoder_lines_per_rev", "move_ratio",
                   *DECODER_FIELDS)
-JumpObserver = Callable[["Controller", int, int, list[list[float]], list[list[float]]], None]
+JumpObserver = Callable[["Controller", int, int, "np.ndarray", "np.ndarray"], None]
 
 
 class Controller:
@@ -322,9 +325,10 @@ class Controller:
     def add_jump_observer(self, observer: JumpObserver) -> None:
         """Call `observer(controller, first, last, positions, actual)` when a jump
         (control/core/jump.py) crosses cycles first..last without running their hooks:
-        `positions[i]` holds every axis's command position (pulses) at the end of cycle
-        first + i, exactly as those cycles would have left it, and `actual[i]` every axis's
-        `counters.actual()` (the feedback position in the command frame) there. A hook
+        `positions[i, a]` (float arrays, one row per crossed cycle, one column per axis)
+        is axis a's command position (pulses) at the end of cycle first + i, exactly as
+        those cycles would have left it, and `actual[i, a]` its `counters.actual()` (the
+        feedback position in the command frame) there; valid during the call only. A hook
         that records something every cycle (a trace) fills the crossed cycles from it and
         can declare a `due`."""
         if not callable(observer):

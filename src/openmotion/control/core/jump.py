@@ -374,17 +374,18 @@ def _nc_words(ctl: Controller) -> np.ndarray:
 def _observe(ctl: Controller, n: int, last: int, movers: list,
              ends: list[np.ndarray], trace: np.ndarray) -> None:
     """Hand the jump observers the command and actual (feedback, `Counters.actual_from`
-    of the back end's readback `trace`) positions of the crossed cycles n+1..last."""
+    of the back end's readback `trace`) positions of the crossed cycles n+1..last, as
+    arrays (rows = cycles, columns = axes)."""
     if last <= n:
         return
-    rows = [[ax.position] * (last - n) for ax in ctl.axes]
+    m = last - n
+    positions = np.empty((m, len(ctl.axes)))
+    positions[:] = [ax.position for ax in ctl.axes]
     for ax, p1v1 in zip(movers, ends, strict=True):
-        off = ax.counters._cmd_off  # Axis.position = raw position + this offset
-        rows[ax.index] = (p1v1[:last - n, 0] + off).tolist()
-    positions = [list(r) for r in zip(*rows, strict=True)]
-    tr = trace[:last - n]
-    act = np.stack([np.asarray(ax.counters.actual_from(tr[:, ax.index, 0], tr[:, ax.index, 1]),
-                               dtype=float) for ax in ctl.axes], axis=1)
-    actual = act.tolist()
+        # Axis.position = raw position + this offset
+        positions[:, ax.index] = p1v1[:m, 0] + ax.counters._cmd_off
+    tr = trace[:m]
+    actual = np.stack([np.asarray(ax.counters.actual_from(tr[:, ax.index, 0], tr[:, ax.index, 1]),
+                                  dtype=float) for ax in ctl.axes], axis=1)
     for obs in tuple(ctl._jump_observers):
         obs(ctl, n + 1, last, positions, actual)

@@ -35,6 +35,7 @@ values (that ends the run at the next cycle boundary).
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
 import sys
 import threading
@@ -43,8 +44,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+# numpy imports numpy.ma lazily on the first np.unique (a path plan): 50-90 ms inside the
+# first landing that plans a path. Imported here, before real time starts.
+import numpy.ma  # noqa: F401
+
 from ...errors import MotionError
-from .clock import CycleStats
+from .clock import CycleStats, PacedThread
 from .jump import jump, plan_jump
 
 try:  # the compiled inner loops (setup.py builds them)
@@ -64,7 +69,7 @@ _WINDOW = 65536
 # st fields, as in _kernel_rt.c (the C side checks the array's length)
 (RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START, RT_LASTEND,
  RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST, RT_INTERRUPTED, RT_LASTK,
- RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_NFIELDS) = range(19)
+ RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_CPU0, RT_NFIELDS) = range(20)
 
 AVAILABLE = _kernel is not None and hasattr(_kernel, "rt_paced")
 
@@ -107,7 +112,7 @@ class HandoverLock:
         self._lock.release()
 
 
-class RealtimeExecutor:
+class RealtimeExecutor(PacedThread):
     """Real time for one controller: compiled cycles paced in C where virtual time would
     jump, `Controller.step` at its slot otherwise (see the module docstring)."""
 
@@ -116,6 +121,7 @@ class RealtimeExecutor:
         if not AVAILABLE:
             raise MotionError("the compiled real-time executor is not built "
                               "(python setup.py build_ext --inplace)")
+        super().__init__()
         self._ctl = ctl
         self._period = ctl.period
         self._on_overrun = on_overrun
@@ -123,43 +129,35 @@ class RealtimeExecutor:
         self._busy = np.zeros(_WINDOW)
         self._late = np.zeros(_WINDOW)
         self._work = np.zeros(_WINDOW)
-        self._thread: threading.Thread | None = None
-        self._stop = threading.Event()
+        self._cpu = np.zeros(_WINDOW)
         self._errors = 0
         self.python_cycles = 0
         self.compiled_runs = 0
-        self.error: BaseException | None = None
+        self._switch = sys.getswitchinterval()
 
-    @property
-    def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
-
-    def start(self) -> None:
-        if self.running:
-            raise MotionError("real-time mode is already running")
+    def _begin(self) -> None:
         st = self.st
         waiting = st[RT_WAITERS]
         st[:] = 0.0
         st[RT_WAITERS] = waiting
         st[RT_PENDING] = -1.0
         st[RT_PERIOD] = self._period
-        self._stop.clear()
-        self.error = None
         self._errors = 0
         self.python_cycles = 0
         self.compiled_runs = 0
         self._switch = sys.getswitchinterval()
         sys.setswitchinterval(min(self._switch, SWITCH_INTERVAL_S))
-        self._thread = threading.Thread(target=self._run, name="openmotion-rt", daemon=True)
-        self._thread.start()
+        # the objects alive now (the program, plans, the machine) are never scanned again
+        # by a garbage collection, which otherwise runs inside some landing
+        gc.collect()
+        gc.freeze()
 
-    def stop(self) -> None:
-        self._stop.set()
-        self.st[RT_STOPPING] = 1.0
-        if self._thread is not None:
-            self._thread.join()
-            self._thread = None
-            sys.setswitchinterval(self._switch)
+    def _wake(self) -> None:
+        self.st[RT_STOPPING] = 1.0  # the C wait returns within 1 ms
+
+    def _end(self) -> None:
+        sys.setswitchinterval(self._switch)
+        gc.unfreeze()
 
     def _compiled(self) -> bool:
         paced = getattr(self._ctl.hardware, "paced_cycles", None)
@@ -169,7 +167,7 @@ class RealtimeExecutor:
         ctl = self._ctl
         k = _kernel
         assert k is not None
-        ctx = (self.st, self._busy, self._late, self._work)
+        ctx = (self.st, self._busy, self._late, self._work, self._cpu)
         st = self.st
         horizon = max(2, math.ceil(HORIZON_S / self._period - 1e-9))
         # cycle n + 1 is due now; cycle j's slot starts at wall0 + j * period
@@ -221,7 +219,7 @@ class RealtimeExecutor:
             return CycleStats(0, self._period, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0,
                               0, 0, self._errors,
                               executor="compiled")
-        busy, late, work = self._busy[:n], self._late[:n], self._work[:n]
+        busy, late, work, cpu = self._busy[:n], self._late[:n], self._work[:n], self._cpu[:n]
         return CycleStats(
             cycles=count,
             period=self._period,
@@ -241,16 +239,19 @@ class RealtimeExecutor:
             python_cycles=self.python_cycles,
             executor="compiled",
             own_overruns=_own_overruns(self.samples(), self._period),
+            p99_cpu=float(np.percentile(cpu, 99)),
+            max_cpu=float(cpu.max()),
+            own_cpu_overruns=int(np.count_nonzero(cpu > self._period)),
         )
 
     def samples(self) -> dict[str, np.ndarray]:
-        """The per-cycle rings in cycle order (seconds): busy, late, work (the last
-        65536 cycles at most)."""
+        """The per-cycle rings in cycle order (seconds): busy, late, work, cpu (the
+        last 65536 cycles at most)."""
         count = int(self.st[RT_COUNT])
         n = min(count, _WINDOW)
         order = np.arange(count - n, count) % _WINDOW
         return {"busy": self._busy[order].copy(), "late": self._late[order].copy(),
-                "work": self._work[order].copy()}
+                "work": self._work[order].copy(), "cpu": self._cpu[order].copy()}
 
 
 def _own_overruns(rings: dict[str, np.ndarray], period: float) -> int:

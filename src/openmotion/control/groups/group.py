@@ -154,6 +154,7 @@ class Group(GroupSettings):
         self._queue: deque[_Cmd] = deque()
         self._pre: dict[int, tuple[Any, ...]] = {}  # corners blended ahead (groupexec)
         self._index_memo: tuple[Any, ...] | None = None  # (t, run, plan, index): index_at
+        self._owners_memo: tuple[Any, np.ndarray] | None = None  # (chain, owners): indices_at
         self._pre_tail: tuple[int, Any] | None = None
         self._queue_size = queue_size
         self._next_index = 0
@@ -258,6 +259,27 @@ class Group(GroupSettings):
             idx = r.cmds[0].index
         self._index_memo = (t, r, r.plan, idx)
         return idx
+
+    def indices_at(self, ts: np.ndarray) -> np.ndarray:
+        """`index_at` at each of the times `ts` (float64 array) in one vectorised pass,
+        the same values (the same arithmetic as `Profile.state_at`, `Chain.locate`): the
+        trace of the cycles a jump crossed (program/trace.py)."""
+        r = self._run or self._held
+        if r is None:
+            return np.full(len(ts), -1, dtype=np.int64)
+        plan = r.plan
+        if plan is None:
+            return np.full(len(ts), r.cmds[0].index, dtype=np.int64)
+        sprof, chain = plan.sprof, plan.chain
+        if not sprof.n_segments:  # (Profile.sample needs segments; state_at: the end)
+            return np.array([self.index_at(float(t)) for t in ts], dtype=np.int64)
+        u = np.minimum(np.maximum(ts - plan.t0, 0.0), sprof.duration)
+        k = np.searchsorted(chain.cum, sprof.sample(u).p, side="right") - 1
+        np.clip(k, 0, len(chain.elements) - 1, out=k)
+        owners = self._owners_memo
+        if owners is None or owners[0] is not chain:  # chains never change once made
+            owners = self._owners_memo = (chain, np.asarray(chain.owners, dtype=np.int64))
+        return owners[1][k]
 
     def start_time(self, index: int, t0: float, t1: float) -> float | None:
         """The exact time in [t0, t1] at which the running (or held) chain starts command

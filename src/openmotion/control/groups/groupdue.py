@@ -12,8 +12,9 @@ to do, a group axis in ErrorStop or standing on a limit switch (the limit check 
 the velocity's sign cycle by cycle).
 
 The join instant is found on the very cycle grid the hook sees, by evaluating the plan's
-`remaining(t)` at the cycle ends ahead (cached while the plan and the queue head stay the
-same), so the cycle found is the one the cycle-by-cycle run joins in.
+`remaining(t)` at the cycle ends ahead (vectorised, blocks of JOIN_BLOCK cycles, the same
+arithmetic as `Profile.state_at`; cached while the plan and the queue head stay the same),
+so the cycle found is the one the cycle-by-cycle run joins in.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ import itertools
 import math
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from ..core.states import AxisState
 
 if TYPE_CHECKING:
@@ -29,6 +32,8 @@ if TYPE_CHECKING:
 
 #: How many cycle ends ahead one due call looks for the join cycle (then it asks again).
 JOIN_HORIZON = 4096
+#: Cycle ends evaluated per vectorised pass of that search.
+JOIN_BLOCK = 256
 
 
 def group_due(g: Any, ctl: Controller) -> float:
@@ -134,11 +139,20 @@ def _join_due(g: Any, ctl: Controller) -> float:
     if cache is not None and cache[0] is plan and cache[1] == key:
         k = max(k, cache[2])  # the cycles before it were checked: no join there
     last = n + JOIN_HORIZON
-    while k <= last:
-        t = origin + k * period
-        if t >= plan.t0 and plan.remaining(t) < reach:
+    raw = plan.raw
+    while k <= last:  # the cycle ends ahead in blocks, each in one vectorised pass
+        ks = np.arange(k, min(k + JOIN_BLOCK, last + 1))
+        t = origin + ks * period
+        if raw.n_segments:  # plan.remaining(t), as Profile.state_at computes it
+            u = np.minimum(np.maximum(t - plan.raw_t0, 0.0), raw.duration)
+            rem = plan.chain.length - raw.sample(u).p
+        else:
+            rem = np.array([plan.remaining(float(x)) for x in t])
+        hit = np.flatnonzero((t >= plan.t0) & (rem < reach))
+        if len(hit):
+            k = int(ks[hit[0]])
             g._join_due_cache = (plan, key, k)
-            return t
-        k += 1
+            return float(t[hit[0]])
+        k = int(ks[-1]) + 1
     g._join_due_cache = (plan, key, k)
     return origin + last * period

@@ -7,9 +7,11 @@ takes the commands off the queue and starts a worker thread that builds the join
 re-plans the running plan from t_j (`pathrun.replan` is a pure function of the immutable
 plan) and builds the axis profiles from the group position the running profiles reach at
 t_j. At the hook of cycle t_j, `_poll_join` installs the result exactly as `_launch` does
-when the running plan is still the same object, the settings are unchanged and the worker
-has finished; otherwise (late, failed, or the plan changed by a hold, an override, a
-continue) the commands go back to the queue front; abort and faults drop them
+when the running plan is still the same object and the settings are unchanged, waiting
+for the worker if it has not finished yet (at most JOIN_WAIT_S: the cycle would otherwise
+do the same re-plan itself, and which joins the worker carries must not depend on the
+thread schedule); otherwise (failed, later than that, or the plan changed by a hold, an
+override, a continue) the commands go back to the queue front; abort and faults drop them
 (`_drop_join`). After `MAX_MISSES` misses in a row the next join is synchronous.
 
 The worker reads only immutable values or copies taken before it starts: the plan, the
@@ -39,6 +41,11 @@ if TYPE_CHECKING:
 JOIN_LEAD = 0.025
 #: Misses in a row (late, failed, or the plan changed) before a join is done in the cycle.
 MAX_MISSES = 2
+#: How long (wall clock, s) the install cycle waits for a worker that has not finished.
+#: The cycle would otherwise do the same re-plan itself (a wait never costs more than
+#: that), and waiting keeps which joins the worker carries independent of the thread
+#: schedule, so this only guards against a worker that never ends (then: a miss).
+JOIN_WAIT_S = 10.0
 
 
 def lead_cycles(period: float) -> int:
@@ -83,17 +90,16 @@ class AsyncJoin:
     def _use_worker(self, plan: pathrun.PathPlan) -> bool:
         """Whether a due join goes to the worker (real-time mode) or is done in the cycle:
         virtual time, dry run, after MAX_MISSES misses in a row, a chain that ends before
-        the worker's cycle, or the worker still busy with a late job (waiting for it
-        would let the chain brake for its end)."""
+        the worker's cycle. Only the controller's state decides (not whether the worker is
+        still busy: jobs queue up, and the install waits for its job), so the same cycles
+        give the same joins on the worker."""
         ctl = self._ctl  # type: ignore[attr-defined]
         if not ctl.realtime or self._dry:  # type: ignore[attr-defined]
             return False
         if self._join_misses >= MAX_MISSES:
             self._join_misses = 0
             return False
-        if plan.t_end <= ctl.time + (self._lead_cycles() + 1) * ctl.period:
-            return False
-        return self._last_job is None or self._last_job.done.is_set()
+        return plan.t_end > ctl.time + (self._lead_cycles() + 1) * ctl.period
 
     def _join_async(self, r: Any, new: list[Any]) -> None:
         """Start the worker on a join of `new` to the running chain at t + K cycles."""
@@ -150,6 +156,8 @@ class AsyncJoin:
         if same and t < job.t_j - 0.5 * self._ctl.period:  # type: ignore[attr-defined]
             return True
         self._job = None
+        if same and not job.done.is_set() and t < job.t_j + 0.5 * self._ctl.period:  # type: ignore[attr-defined]
+            job.done.wait(JOIN_WAIT_S)  # the cycle would do the same re-plan: wait for it
         if same and job.done.is_set() and job.result is not None \
                 and t < job.t_j + 0.5 * self._ctl.period:  # type: ignore[attr-defined]
             p2, profiles = job.result
