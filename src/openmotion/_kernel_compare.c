@@ -368,6 +368,90 @@ static int stream_fill(Stream *S)
     return 0;
 }
 
+/* Rejecting a candidate without refining it. A root of a monotone piece that refine()
+ * would return for the bracket (u, w) is enclosed first by a few cheap Newton steps: when
+ * F (the float polynomial refine evaluates) is beyond +-m at both ends of [A, B], with m
+ * twice the rounding noise of F plus the largest step refine's stopping rule allows,
+ * refine's answer lies in [A - tol, B + tol] (it stops with F > 0 at or just before it and
+ * F <= 0 at or just after it, or on a Newton step shorter than tol, which needs |F| <=
+ * tol |F'|). If some axis is then farther than its window over that whole time span (its
+ * position's change bounded by its speed, plus the evaluation noise), the candidate
+ * cannot be inside and is dropped unrefined: the first time inside is the same. */
+static int check_rejects = 0;           /* tests: refine rejected candidates and verify */
+static long long n_refined = 0, n_rejected = 0;
+
+static inline double poly_f(double c, double v, double a2, double j, double x)
+{
+    return c + x * (v + x * (a2 + x * j / 6.0));
+}
+
+/* [*ta, *tb] (absolute times) holding tk + refine(c, v, a, j, u, w, su, tk); 0 if no
+ * enclosure was found (then the candidate is refined) */
+static int root_enclosure(const Pend *e, double *ta, double *tb)
+{
+    double c = e->c, v = e->v, a = e->a, j = e->j, u = e->u, w = e->w, tk = e->tk;
+    double a2 = a / 2.0;
+    int up = e->su > 0;
+    double lo = u, hi = w, x = 0.5 * (u + w);
+    for (int it = 0; it < 12; it++) {  /* safeguarded Newton, no exactness needed */
+        double f = poly_f(c, v, a2, j, x);
+        if (f == 0.0) break;
+        if (up ? (f > 0.0) : (f < 0.0)) lo = x; else hi = x;
+        double d = v + x * (a + x * j / 2.0);
+        double xn = d != 0.0 ? x - f / d : NAN;
+        if (lo < xn && xn < hi) {
+            int done = fabs(xn - x) <= 4.0 * EPS * fabs(x);
+            x = xn;
+            if (done) break;
+        } else {
+            x = 0.5 * (lo + hi);
+        }
+    }
+    double sc = fabs(c) + fabs(w * v) + fabs(w * w * a / 2.0) + fabs(w * w * w * j / 6.0);
+    double vm = pymax(fabs(v + u * (a + u * j / 2.0)), fabs(v + w * (a + w * j / 2.0)));
+    if (j != 0.0) {
+        double xv = -a / j;
+        if (u < xv && xv < w) vm = pymax(vm, fabs(v + xv * (a + xv * j / 2.0)));
+    }
+    vm = vm * (1.0 + 1e-6) + 1e-300;
+    double tol = 2.0 * EPS * (fabs(tk) + fabs(w)) * (1.0 + 1e-6);
+    double m = 2.0 * (64.0 * EPS * sc) + 2.0 * tol * vm + 1e-300;
+    double s = fabs(v + x * (a + x * j / 2.0));
+    if (!(s > 0.0) || !isfinite(s)) return 0;
+    double delta = 4.0 * m / s + 4.0 * tol + 4.0 * EPS * fabs(x);
+    double A = x - delta, B = x + delta;
+    if (!(u <= A && B <= w)) return 0;
+    double fa = poly_f(c, v, a2, j, A), fb = poly_f(c, v, a2, j, B);
+    if (up ? !(fa > m && fb < -m) : !(fa < -m && fb > m)) return 0;
+    double lo_t = tk + (A - tol), hi_t = tk + (B + tol);
+    *ta = lo_t - 4.0 * EPS * fabs(lo_t);
+    *tb = hi_t + 4.0 * EPS * fabs(hi_t);
+    return 1;
+}
+
+/* is track T farther than lim from c at every time in [ta, tb] (as position() reads it)? */
+static int outside_over(const Trk *T, double c, double lim, double ta, double tb)
+{
+    Py_ssize_t lo = 0, hi = T->n;  /* position()'s record at ta */
+    while (lo < hi) {
+        Py_ssize_t mid = (lo + hi) / 2;
+        if (ta < T->ts[mid]) hi = mid; else lo = mid + 1;
+    }
+    Py_ssize_t k = lo - 1 > 0 ? lo - 1 : 0;
+    if (k + 1 < T->n && T->ts[k + 1] <= tb) return 0;  /* a record starts inside */
+    if (k > 0 && ta < T->ts[k]) return 0;
+    double p = T->p0[k], v = T->v0[k], a = T->a0[k], j = T->j[k];
+    double da = ta - T->ts[k], db = tb - T->ts[k], W = tb - ta;
+    if (!(W >= 0.0)) return 0;
+    double x = p + da * (v + da * (a / 2.0 + da * j / 6.0));
+    double dm = pymax(fabs(da), fabs(db));
+    double vmax = fabs(v + da * (a + da * j / 2.0)) + (fabs(a + da * j) + fabs(j) * W) * W;
+    double noise = 64.0 * EPS * (fabs(p) + fabs(dm * v) + fabs(dm * dm * a / 2.0)
+                                 + fabs(dm * dm * dm * j / 6.0) + fabs(c));
+    double gap = fabs(x - c) - (vmax * W * (1.0 + 1e-6) + 2.0 * noise);
+    return gap > lim * (1.0 + 1e-12);
+}
+
 /* compare_math.first_inside: the first time in [t, t1] every track is within +-maxerr of
  * its centre. Returns 1 and *x, 0 for none, -1 on error. lo/hi: each track's range.
  * The candidates (t, and every crossing of c - maxerr and c + maxerr) are tested in time
@@ -381,6 +465,7 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
     (void)sc;
     double lim[MAX_AXES];
     Stream st[2 * MAX_AXES];
+    int axis_of[2 * MAX_AXES];
     int ns = 0;
     for (int i = 0; i < na; i++) {
         double c = centre[i];
@@ -391,6 +476,7 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
         for (int q = 0; q < 2; q++) {
             if (!(lo[i] - slack <= lv[q] && lv[q] <= hi[i] + slack)) continue;
             stream_init(&st[ns], &T[i], lv[q], t, t1);
+            axis_of[ns] = i;
             if (stream_fill(&st[ns])) ns++;
         }
     }
@@ -410,6 +496,29 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
         }
         Pend *e = &st[best].pend[st[best].head];
         if (!e->exact) {
+            double ta, tb;
+            int out = 0;
+            int enc = root_enclosure(e, &ta, &tb);
+            if (enc)
+                for (int i = 0; i < na && !out; i++)
+                    out = i != axis_of[best] && outside_over(&T[i], centre[i], lim[i], ta, tb);
+            if (out && check_rejects) {  /* tests: the dropped root really is outside */
+                double r = e->tk + refine(e->c, e->v, e->a, e->j, e->u, e->w, e->su, e->tk);
+                int in = 1;
+                for (int i = 0; i < na && in; i++)
+                    in = fabs(position(&T[i], r) - centre[i]) <= lim[i];
+                if (in || r < ta || r > tb) {
+                    PyErr_Format(PyExc_AssertionError, "rejected root %.17g inside (%d) or "
+                                 "outside [%.17g, %.17g]", r, in, ta, tb);
+                    return -1;
+                }
+            }
+            if (out) {
+                n_rejected++;
+                if (++st[best].head >= st[best].npend && !stream_fill(&st[best])) live--;
+                continue;
+            }
+            n_refined++;
             e->time = e->tk + refine(e->c, e->v, e->a, e->j, e->u, e->w, e->su, e->tk);
             e->exact = 1;
             continue;  /* it may no longer be the smallest */
@@ -1091,6 +1200,22 @@ done:
     return res;
 }
 
+PyDoc_STRVAR(solver_checks_doc,
+"solver_checks(on) -> (refined, rejected)\n\n"
+"Tests: with on, every window candidate dropped unrefined is refined anyway and\n"
+"verified to be outside its window (AssertionError otherwise). Returns the counts of\n"
+"refined and dropped candidates since the last call, and resets them.");
+
+static PyObject *solver_checks(PyObject *self, PyObject *args)
+{
+    int on;
+    if (!PyArg_ParseTuple(args, "p", &on)) return NULL;
+    check_rejects = on;
+    PyObject *r = Py_BuildValue("(LL)", n_refined, n_rejected);
+    n_refined = n_rejected = 0;
+    return r;
+}
+
 /* ------------------------------------------------------------------ module */
 static PyMethodDef methods[] = {
     {"level_events", level_events_py, METH_VARARGS, level_events_doc},
@@ -1106,6 +1231,7 @@ static PyMethodDef methods[] = {
     {"time_of", time_of_py, METH_VARARGS, time_of_doc},
     {"vector_scan", vector_scan, METH_VARARGS, vector_scan_doc},
     {"line_set", line_set, METH_VARARGS, line_set_doc},
+    {"solver_checks", solver_checks, METH_VARARGS, solver_checks_doc},
     {NULL, NULL, 0, NULL},
 };
 
