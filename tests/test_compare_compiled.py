@@ -227,3 +227,17 @@ def test_engine_runs_are_identical_on_the_oracle(seed, monkeypatch, fuzz_long):
     assert got == want
     if seed < 8:  # (the normal run's seeds: a few long-run seeds happen to fire nothing)
         assert got["log"]["time"], "the scenario fired nothing: it tests nothing"
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_scan_driver_is_the_python_job_loop(seed, monkeypatch):
+    """The compiled scan driver (bank_scan: every axis/window job with a built-in action
+    in one call) gives what the engine's per-job Python loop gives on the same solvers."""
+    from openmotion.control.trigger import compare as engine
+
+    got = _scenario(seed)
+    with monkeypatch.context() as m:
+        m.setattr(engine, "_ACTIONS", {})  # no job is native: all run in the Python loop
+        want = _scenario(seed)
+    assert got == want
+    assert got["log"]["time"]
