@@ -316,3 +316,79 @@ def line_set(t_list: list[float], lv_list: list[bool], initial: bool, times, lev
                 if lv_list[i] == prev:
                     del t_list[i]
                     del lv_list[i]
+
+
+# ---------------------------------------------------------------------------- scan driver
+def solver_checks(on: bool) -> tuple[int, int]:  # noqa: ARG001
+    """(The compiled module's test switch; the oracle refines every candidate.)"""
+    return (0, 0)
+
+
+def bank_new(specs):  # noqa: ANN001, ANN201
+    """The jobs of a scan group, as given (see bank_scan)."""
+    return [tuple(s) for s in specs]
+
+
+def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # noqa: ANN001, ANN201
+    """CompareEngine's job loop for LevelJob (axis) / WindowJob with Toggle, SetLevel or
+    Pulse, as it was in Python: each job's scan, its action on its line, its row."""
+    ranges: dict[int, tuple[float, float]] = {}
+    f: list[tuple[float, float]] = []
+    k: list[tuple[int, int, int, int]] = []
+    done: list[int] = []
+    for i, (spec, job) in enumerate(zip(bank, jobs, strict=True)):
+        (code, slots, direction, repeat, vals, n, after, maxerr, t_armed, jid, act, flag,
+         width, ln, output) = spec
+        rng = [ranges.setdefault(s, track_range(tracks[s], ta, t1)) for s in slots]
+        a = max(ta, t_armed)
+        hits: list[tuple[float, float, int]] = []
+        if code == 0:
+            size = n + (after is not None)
+            if a < t1:
+                if repeat:
+                    lvl = _level(vals, n, after, 0)
+                    slack = 1e-9 * (abs(lvl) + 1.0)
+                    if rng[0][0] - slack <= lvl <= rng[0][1] + slack:
+                        hits = [(tf, lvl, 0) for tf in
+                                level_events(tracks[slots[0]], lvl, a, t1, direction, False)]
+                elif job.index < size:
+                    found = level_scan(tracks[slots[0]], rng[0], vals, n, after, job.index, a,
+                                       t1, direction)
+                    hits = [(tf, v, job.index + q) for q, (tf, v) in enumerate(found)]
+                    job.index += len(found)
+            finished = not repeat and job.index >= size
+        else:
+            if a <= t1 and job.index < n:
+                found = window_scan([tracks[s] for s in slots], rng, vals, maxerr, job.index,
+                                    a, t1)
+                hits = [(tf, float(job.index + q), job.index + q) for q, tf in enumerate(found)]
+                job.index += len(found)
+            finished = job.index >= n
+        if hits:
+            line = lines[ln]
+            sent = line._sent_until if line.timed else -math.inf
+            times, levels, states = [], [], []
+            for q, (tf, _, _) in enumerate(hits):
+                st = (bool(flag) if (job.hits + q) % 2 == 0 else not flag) if act == 0 \
+                    else bool(flag)
+                states.append(st)
+                times.append(tf)
+                levels.append(st)
+                if act == 2:
+                    times.append(tf + width)
+                    levels.append(not st)
+            line_set(line._t, line._lv, bool(line.initial), times, levels, sent, line._late)
+            job.hits += len(hits)
+            f.extend((tf, v) for tf, v, _ in hits)
+            k.extend((jid, idx, output, int(st)) for (_, _, idx), st in zip(hits, states,
+                                                                           strict=True))
+        if finished:
+            done.append(i)
+    if not f and not done:
+        return None
+    import numpy as np
+
+    pos = np.empty((len(f), len(pos_tracks)))
+    positions(pos_tracks, [x[0] for x in f], pos)
+    return (np.array(f, dtype=np.float64).reshape(-1, 2).tobytes(),
+            np.array(k, dtype=np.int64).reshape(-1, 4).tobytes(), pos.tobytes(), done)

@@ -368,6 +368,90 @@ static int stream_fill(Stream *S)
     return 0;
 }
 
+/* Rejecting a candidate without refining it. A root of a monotone piece that refine()
+ * would return for the bracket (u, w) is enclosed first by a few cheap Newton steps: when
+ * F (the float polynomial refine evaluates) is beyond +-m at both ends of [A, B], with m
+ * twice the rounding noise of F plus the largest step refine's stopping rule allows,
+ * refine's answer lies in [A - tol, B + tol] (it stops with F > 0 at or just before it and
+ * F <= 0 at or just after it, or on a Newton step shorter than tol, which needs |F| <=
+ * tol |F'|). If some axis is then farther than its window over that whole time span (its
+ * position's change bounded by its speed, plus the evaluation noise), the candidate
+ * cannot be inside and is dropped unrefined: the first time inside is the same. */
+static int check_rejects = 0;           /* tests: refine rejected candidates and verify */
+static long long n_refined = 0, n_rejected = 0;
+
+static inline double poly_f(double c, double v, double a2, double j, double x)
+{
+    return c + x * (v + x * (a2 + x * j / 6.0));
+}
+
+/* [*ta, *tb] (absolute times) holding tk + refine(c, v, a, j, u, w, su, tk); 0 if no
+ * enclosure was found (then the candidate is refined) */
+static int root_enclosure(const Pend *e, double *ta, double *tb)
+{
+    double c = e->c, v = e->v, a = e->a, j = e->j, u = e->u, w = e->w, tk = e->tk;
+    double a2 = a / 2.0;
+    int up = e->su > 0;
+    double lo = u, hi = w, x = 0.5 * (u + w);
+    for (int it = 0; it < 12; it++) {  /* safeguarded Newton, no exactness needed */
+        double f = poly_f(c, v, a2, j, x);
+        if (f == 0.0) break;
+        if (up ? (f > 0.0) : (f < 0.0)) lo = x; else hi = x;
+        double d = v + x * (a + x * j / 2.0);
+        double xn = d != 0.0 ? x - f / d : NAN;
+        if (lo < xn && xn < hi) {
+            int done = fabs(xn - x) <= 4.0 * EPS * fabs(x);
+            x = xn;
+            if (done) break;
+        } else {
+            x = 0.5 * (lo + hi);
+        }
+    }
+    double sc = fabs(c) + fabs(w * v) + fabs(w * w * a / 2.0) + fabs(w * w * w * j / 6.0);
+    double vm = pymax(fabs(v + u * (a + u * j / 2.0)), fabs(v + w * (a + w * j / 2.0)));
+    if (j != 0.0) {
+        double xv = -a / j;
+        if (u < xv && xv < w) vm = pymax(vm, fabs(v + xv * (a + xv * j / 2.0)));
+    }
+    vm = vm * (1.0 + 1e-6) + 1e-300;
+    double tol = 2.0 * EPS * (fabs(tk) + fabs(w)) * (1.0 + 1e-6);
+    double m = 2.0 * (64.0 * EPS * sc) + 2.0 * tol * vm + 1e-300;
+    double s = fabs(v + x * (a + x * j / 2.0));
+    if (!(s > 0.0) || !isfinite(s)) return 0;
+    double delta = 4.0 * m / s + 4.0 * tol + 4.0 * EPS * fabs(x);
+    double A = x - delta, B = x + delta;
+    if (!(u <= A && B <= w)) return 0;
+    double fa = poly_f(c, v, a2, j, A), fb = poly_f(c, v, a2, j, B);
+    if (up ? !(fa > m && fb < -m) : !(fa < -m && fb > m)) return 0;
+    double lo_t = tk + (A - tol), hi_t = tk + (B + tol);
+    *ta = lo_t - 4.0 * EPS * fabs(lo_t);
+    *tb = hi_t + 4.0 * EPS * fabs(hi_t);
+    return 1;
+}
+
+/* is track T farther than lim from c at every time in [ta, tb] (as position() reads it)? */
+static int outside_over(const Trk *T, double c, double lim, double ta, double tb)
+{
+    Py_ssize_t lo = 0, hi = T->n;  /* position()'s record at ta */
+    while (lo < hi) {
+        Py_ssize_t mid = (lo + hi) / 2;
+        if (ta < T->ts[mid]) hi = mid; else lo = mid + 1;
+    }
+    Py_ssize_t k = lo - 1 > 0 ? lo - 1 : 0;
+    if (k + 1 < T->n && T->ts[k + 1] <= tb) return 0;  /* a record starts inside */
+    if (k > 0 && ta < T->ts[k]) return 0;
+    double p = T->p0[k], v = T->v0[k], a = T->a0[k], j = T->j[k];
+    double da = ta - T->ts[k], db = tb - T->ts[k], W = tb - ta;
+    if (!(W >= 0.0)) return 0;
+    double x = p + da * (v + da * (a / 2.0 + da * j / 6.0));
+    double dm = pymax(fabs(da), fabs(db));
+    double vmax = fabs(v + da * (a + da * j / 2.0)) + (fabs(a + da * j) + fabs(j) * W) * W;
+    double noise = 64.0 * EPS * (fabs(p) + fabs(dm * v) + fabs(dm * dm * a / 2.0)
+                                 + fabs(dm * dm * dm * j / 6.0) + fabs(c));
+    double gap = fabs(x - c) - (vmax * W * (1.0 + 1e-6) + 2.0 * noise);
+    return gap > lim * (1.0 + 1e-12);
+}
+
 /* compare_math.first_inside: the first time in [t, t1] every track is within +-maxerr of
  * its centre. Returns 1 and *x, 0 for none, -1 on error. lo/hi: each track's range.
  * The candidates (t, and every crossing of c - maxerr and c + maxerr) are tested in time
@@ -381,6 +465,7 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
     (void)sc;
     double lim[MAX_AXES];
     Stream st[2 * MAX_AXES];
+    int axis_of[2 * MAX_AXES];
     int ns = 0;
     for (int i = 0; i < na; i++) {
         double c = centre[i];
@@ -391,6 +476,7 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
         for (int q = 0; q < 2; q++) {
             if (!(lo[i] - slack <= lv[q] && lv[q] <= hi[i] + slack)) continue;
             stream_init(&st[ns], &T[i], lv[q], t, t1);
+            axis_of[ns] = i;
             if (stream_fill(&st[ns])) ns++;
         }
     }
@@ -410,6 +496,29 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
         }
         Pend *e = &st[best].pend[st[best].head];
         if (!e->exact) {
+            double ta, tb;
+            int out = 0;
+            int enc = root_enclosure(e, &ta, &tb);
+            if (enc)
+                for (int i = 0; i < na && !out; i++)
+                    out = i != axis_of[best] && outside_over(&T[i], centre[i], lim[i], ta, tb);
+            if (out && check_rejects) {  /* tests: the dropped root really is outside */
+                double r = e->tk + refine(e->c, e->v, e->a, e->j, e->u, e->w, e->su, e->tk);
+                int in = 1;
+                for (int i = 0; i < na && in; i++)
+                    in = fabs(position(&T[i], r) - centre[i]) <= lim[i];
+                if (in || r < ta || r > tb) {
+                    PyErr_Format(PyExc_AssertionError, "rejected root %.17g inside (%d) or "
+                                 "outside [%.17g, %.17g]", r, in, ta, tb);
+                    return -1;
+                }
+            }
+            if (out) {
+                n_rejected++;
+                if (++st[best].head >= st[best].npend && !stream_fill(&st[best])) live--;
+                continue;
+            }
+            n_refined++;
             e->time = e->tk + refine(e->c, e->v, e->a, e->j, e->u, e->w, e->su, e->tk);
             e->exact = 1;
             continue;  /* it may no longer be the smallest */
@@ -1091,6 +1200,432 @@ done:
     return res;
 }
 
+
+/* ------------------------------------------------------------------ the scan driver */
+/* One call per cycle runs every "native" job of a group (LevelJob on an axis, WindowJob;
+ * actions Toggle / SetLevel / Pulse): CompareEngine._scan's loop, LevelJob.scan /
+ * WindowJob.scan, the actions' apply_many on the OutputLine edge lists (line_set_one) and
+ * every axis's position at each firing, without a Python call per job. A job's fixed
+ * description (kind, track slots, values or points, action) is parsed once into a Bank
+ * (a capsule, rebuilt when the engine's job set changes); its running state (`index`,
+ * `hits`) stays on the job object, read and written here. */
+enum { K_LEVEL = 0, K_WINDOW = 1 };
+enum { A_TOGGLE = 0, A_SET = 1, A_PULSE = 2 };
+
+typedef struct {
+    int kind, na, slot[MAX_AXES], direction, repeat, act, flag, line, output;
+    Levels L;
+    Py_buffer vb;
+    int held;
+    const double *pts;
+    Py_ssize_t npts;
+    double maxerr, t_armed, width;
+    long long jid;
+} Spec;
+
+typedef struct {
+    Py_ssize_t n;
+    Spec *s;
+} Bank;
+
+static void bank_free(PyObject *cap)
+{
+    Bank *B = PyCapsule_GetPointer(cap, "openmotion._compare.Bank");
+    if (B == NULL) return;
+    for (Py_ssize_t i = 0; i < B->n; i++)
+        if (B->s[i].held) PyBuffer_Release(&B->s[i].vb);
+    free(B->s);
+    free(B);
+}
+
+PyDoc_STRVAR(bank_new_doc,
+"bank_new(specs) -> bank\n\n"
+"Parse the jobs of one scan group once. Each spec: (kind, slots, direction, repeat,\n"
+"values, n, after_final, maxerr, t_armed, job_id, action, flag, width, line, output):\n"
+"kind 0 a "
+"LevelJob on track slots[0] (values: float64 array or (start, step), n of them, then\n"
+"after_final or None), 1 a WindowJob on slots (values: float64[n, len(slots)]); action\n"
+"0 Toggle (flag = first), 1 SetLevel (flag = level), 2 Pulse (flag = active, width);\n"
+"line: the index of its OutputLine in bank_scan's `lines`, output: its number (logged).");
+
+static PyObject *bank_new(PyObject *self, PyObject *args)
+{
+    PyObject *specs_o;
+    if (!PyArg_ParseTuple(args, "O", &specs_o)) return NULL;
+    PyObject *seq = PySequence_Fast(specs_o, "specs must be a sequence");
+    if (seq == NULL) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    Bank *B = calloc(1, sizeof *B);
+    if (B) B->s = calloc((size_t)(n > 0 ? n : 1), sizeof(Spec));
+    if (B == NULL || B->s == NULL) {
+        free(B);
+        Py_DECREF(seq);
+        return PyErr_NoMemory();
+    }
+    PyObject *cap = PyCapsule_New(B, "openmotion._compare.Bank", bank_free);
+    if (cap == NULL) { free(B->s); free(B); Py_DECREF(seq); return NULL; }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        Spec *S = &B->s[i];
+        PyObject *slots, *vals, *after;
+        long long nv;
+        int repeat;
+        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(seq, i), "iOipOLOddLiidii", &S->kind,
+                              &slots, &S->direction, &repeat, &vals, &nv, &after, &S->maxerr,
+                              &S->t_armed, &S->jid, &S->act, &S->flag, &S->width, &S->line,
+                              &S->output))
+            goto fail;
+        S->repeat = repeat;
+        B->n = i + 1;  /* (bank_free releases what is held so far) */
+        PyObject *sl = PySequence_Fast(slots, "slots must be a sequence");
+        if (sl == NULL) goto fail;
+        S->na = (int)PySequence_Fast_GET_SIZE(sl);
+        if (S->na < 1 || S->na > MAX_AXES) {
+            Py_DECREF(sl);
+            PyErr_Format(PyExc_ValueError, "slots: 1..%d, got %d", MAX_AXES, S->na);
+            goto fail;
+        }
+        for (int q = 0; q < S->na; q++) {
+            S->slot[q] = (int)PyLong_AsLong(PySequence_Fast_GET_ITEM(sl, q));
+            if (S->slot[q] < 0) {
+                Py_DECREF(sl);
+                if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "slots must be >= 0");
+                goto fail;
+            }
+        }
+        Py_DECREF(sl);
+        if (S->act < 0 || S->act > 2) {
+            PyErr_SetString(PyExc_ValueError, "action must be 0, 1 or 2");
+            goto fail;
+        }
+        if (S->kind == K_LEVEL) {
+            if (get_levels(vals, nv, after, &S->L, &S->vb, &S->held) < 0) goto fail;
+        } else if (S->kind == K_WINDOW) {
+            if (get_vec(vals, &S->vb, "points") < 0) goto fail;
+            S->held = 1;
+            S->pts = S->vb.buf;
+            S->npts = S->vb.len / 8 / S->na;
+            if (S->npts * S->na * 8 != S->vb.len) {
+                PyErr_SetString(PyExc_ValueError, "points must be float64[n, len(slots)]");
+                goto fail;
+            }
+        } else {
+            PyErr_SetString(PyExc_ValueError, "kind must be 0 (level) or 1 (window)");
+            goto fail;
+        }
+    }
+    Py_DECREF(seq);
+    return cap;
+fail:
+    Py_DECREF(seq);
+    Py_DECREF(cap);
+    return NULL;
+}
+
+/* growing row buffers of one bank_scan call */
+typedef struct {
+    double *f;       /* time, value */
+    long long *k;    /* job, index, output, state */
+    Py_ssize_t m, cap;
+} Rows;
+
+static int rows_add(Rows *R, double t, double val, long long jid, long long idx, long long out,
+                    long long st)
+{
+    if (R->m == R->cap) {
+        Py_ssize_t cap = R->cap ? 2 * R->cap : 64;
+        double *f = realloc(R->f, (size_t)cap * 2 * sizeof(double));
+        if (f == NULL) { PyErr_NoMemory(); return -1; }
+        R->f = f;
+        long long *k = realloc(R->k, (size_t)cap * 4 * sizeof(long long));
+        if (k == NULL) { PyErr_NoMemory(); return -1; }
+        R->k = k;
+        R->cap = cap;
+    }
+    R->f[2 * R->m] = t; R->f[2 * R->m + 1] = val;
+    long long *kk = R->k + 4 * R->m;
+    kk[0] = jid; kk[1] = idx; kk[2] = out; kk[3] = st;
+    R->m++;
+    return 0;
+}
+
+/* an OutputLine's edit state, read once per job that fired */
+typedef struct {
+    PyObject *tl, *ll, *late;
+    int initial;
+    double sent;
+} LineRef;
+
+static int line_ref(PyObject *line, LineRef *L)
+{
+    L->tl = L->ll = L->late = NULL;
+    PyObject *o = PyObject_GetAttrString(line, "_t");
+    if (o == NULL) return -1;
+    L->tl = o; Py_DECREF(o);  /* borrowed: the line holds them during the call */
+    if ((o = PyObject_GetAttrString(line, "_lv")) == NULL) return -1;
+    L->ll = o; Py_DECREF(o);
+    if ((o = PyObject_GetAttrString(line, "_late")) == NULL) return -1;
+    L->late = o; Py_DECREF(o);
+    if (!PyList_Check(L->tl) || !PyList_Check(L->ll) || !PyList_Check(L->late)) {
+        PyErr_SetString(PyExc_TypeError, "OutputLine edge lists must be lists");
+        return -1;
+    }
+    if ((o = PyObject_GetAttrString(line, "initial")) == NULL) return -1;
+    L->initial = PyObject_IsTrue(o);
+    Py_DECREF(o);
+    if ((o = PyObject_GetAttrString(line, "timed")) == NULL) return -1;
+    int timed = PyObject_IsTrue(o);
+    Py_DECREF(o);
+    L->sent = -INFINITY;
+    if (timed) {
+        if ((o = PyObject_GetAttrString(line, "_sent_until")) == NULL) return -1;
+        L->sent = PyFloat_AsDouble(o);
+        Py_DECREF(o);
+        if (L->sent == -1.0 && PyErr_Occurred()) return -1;
+    }
+    return L->initial < 0 || timed < 0 ? -1 : 0;
+}
+
+static int get_ll_attr(PyObject *o, const char *name, long long *out)
+{
+    PyObject *v = PyObject_GetAttrString(o, name);
+    if (v == NULL) return -1;
+    *out = PyLong_AsLongLong(v);
+    Py_DECREF(v);
+    return *out == -1 && PyErr_Occurred() ? -1 : 0;
+}
+
+static int set_ll_attr(PyObject *o, const char *name, long long v)
+{
+    PyObject *x = PyLong_FromLongLong(v);
+    if (x == NULL) return -1;
+    int r = PyObject_SetAttrString(o, name, x);
+    Py_DECREF(x);
+    return r;
+}
+
+/* one job's scan of (ta, t1]: appends (time, value, index) to hits; returns the count or -1 */
+static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const double *hi,
+                           long long *index, double ta, double t1, double **hb,
+                           Py_ssize_t *hcap, double *ev, Py_ssize_t evcap)
+{
+    Py_ssize_t m = 0;
+#define PUSH(tt, vv, ii) do { \
+        if (3 * (m + 1) > *hcap) { \
+            Py_ssize_t c_ = *hcap ? 2 * *hcap : 96; \
+            double *b_ = realloc(*hb, (size_t)c_ * sizeof(double)); \
+            if (b_ == NULL) { PyErr_NoMemory(); return -1; } \
+            *hb = b_; *hcap = c_; \
+        } \
+        (*hb)[3 * m] = (tt); (*hb)[3 * m + 1] = (vv); (*hb)[3 * m + 2] = (double)(ii); m++; \
+    } while (0)
+    ta = pymax(ta, S->t_armed);
+    if (S->kind == K_LEVEL) {
+        if (ta >= t1) return 0;
+        int sl = S->slot[0];
+        const Trk *tr = &T[sl];
+        if (S->repeat) {
+            double lvl = level_at(&S->L, 0);
+            double slack = 1e-9 * (fabs(lvl) + 1.0);
+            if (!(lo[sl] - slack <= lvl && lvl <= hi[sl] + slack)) return 0;
+            if (max_events(tr->n) > evcap) {
+                PyErr_SetString(PyExc_RuntimeError, "bank_scan: event buffer too small");
+                return -1;
+            }
+            Py_ssize_t ne = level_events(tr, lvl, ta, t1, S->direction, 0, ev);
+            for (Py_ssize_t q = 0; q < ne; q++) PUSH(ev[q], lvl, 0);
+            return m;
+        }
+        long long size = S->L.n + S->L.has_after, k = *index;
+        double t = ta;
+        while (k < size) {
+            double lvl = level_at(&S->L, k);
+            double slack = 1e-9 * (fabs(lvl) + 1.0);
+            if (!(lo[sl] - slack <= lvl && lvl <= hi[sl] + slack)) break;
+            if (level_events(tr, lvl, t, t1, S->direction, 1, ev) == 0) break;
+            PUSH(ev[0], lvl, k);
+            k++;
+            t = ev[0];
+        }
+        *index = k;
+        return m;
+    }
+    if (ta > t1 || *index >= S->npts) return 0;
+    Trk W[MAX_AXES];
+    double wlo[MAX_AXES], whi[MAX_AXES];
+    for (int q = 0; q < S->na; q++) {
+        W[q] = T[S->slot[q]];
+        wlo[q] = lo[S->slot[q]];
+        whi[q] = hi[S->slot[q]];
+    }
+    long long k = *index;
+    double t = ta;
+    while (k < S->npts) {
+        double x;
+        int r = first_inside(W, S->na, S->pts + k * S->na, S->maxerr, t, t1, wlo, whi, NULL,
+                             &x);
+        if (r < 0) return -1;
+        if (r == 0) break;
+        PUSH(x, (double)k, k);
+        k++;
+        t = x;
+    }
+    *index = k;
+    return m;
+#undef PUSH
+}
+
+PyDoc_STRVAR(bank_scan_doc,
+"bank_scan(bank, jobs, tracks, lines, pos_tracks, ta, t1) -> (f, k, pos, done) or None\n\n"
+"Run the bank's jobs over (ta, t1] in order (CompareEngine._scan for them): each job's\n"
+"hits (LevelJob.scan / WindowJob.scan from its `index`), its action on lines[line]\n"
+"(apply_many from its `hits`), `index` and `hits` written back. tracks: one per slot;\n"
+"jobs: the job objects, in the bank's order. Returns the firings as f (float64[m, 2]:\n"
+"time, value), k (int64[m, 4]: job id, point index, output, state), pos (float64[m,\n"
+"len(pos_tracks)]: every pos_track at each time) and done (bank positions of the jobs\n"
+"that finished), or None when nothing fired or finished.");
+
+static PyObject *bank_scan(PyObject *self, PyObject *args)
+{
+    PyObject *cap, *jobs_o, *tr_o, *lines_o, *pt_o;
+    double ta, t1;
+    if (!PyArg_ParseTuple(args, "OOOOOdd", &cap, &jobs_o, &tr_o, &lines_o, &pt_o, &ta, &t1))
+        return NULL;
+    Bank *B = PyCapsule_GetPointer(cap, "openmotion._compare.Bank");
+    if (B == NULL) return NULL;
+    if (!PyList_Check(jobs_o) || PyList_GET_SIZE(jobs_o) != B->n || !PyList_Check(tr_o)
+            || !PyList_Check(lines_o) || !PyList_Check(pt_o)) {
+        PyErr_SetString(PyExc_TypeError, "bank_scan: jobs (one per spec), tracks, lines and "
+                        "pos_tracks must be lists");
+        return NULL;
+    }
+    Py_ssize_t nt = PyList_GET_SIZE(tr_o), npt = PyList_GET_SIZE(pt_o);
+    Py_ssize_t nl = PyList_GET_SIZE(lines_o);
+    Trk *T = calloc((size_t)(nt + npt + 1), sizeof(Trk));
+    TrkBuf *tb = calloc((size_t)(nt + npt + 1), sizeof(TrkBuf));
+    double *lo = malloc((size_t)(nt + 1) * sizeof(double));
+    double *hi = malloc((size_t)(nt + 1) * sizeof(double));
+    char *have_rng = calloc((size_t)(nt + 1), 1);
+    PyObject *res = NULL, *done = NULL;
+    Rows R = {NULL, NULL, 0, 0};
+    double *hb = NULL, *ev = NULL;
+    Py_ssize_t hcap = 0, got = 0, evcap = 0;
+    if (!T || !tb || !lo || !hi || !have_rng) { PyErr_NoMemory(); goto out; }
+    for (Py_ssize_t i = 0; i < nt + npt; i++) {
+        PyObject *o = i < nt ? PyList_GET_ITEM(tr_o, i) : PyList_GET_ITEM(pt_o, i - nt);
+        if (get_track(o, &T[i], &tb[i]) < 0) goto out;
+        got = i + 1;
+        if (max_events(T[i].n) > evcap) evcap = max_events(T[i].n);
+    }
+    ev = malloc((size_t)(evcap > 0 ? evcap : 1) * sizeof(double));
+    done = PyList_New(0);
+    if (ev == NULL || done == NULL) { if (!ev) PyErr_NoMemory(); goto out; }
+    for (Py_ssize_t i = 0; i < B->n; i++) {
+        const Spec *S = &B->s[i];
+        for (int q = 0; q < S->na; q++) {
+            int sl = S->slot[q];
+            if (sl >= nt) { PyErr_SetString(PyExc_IndexError, "bank_scan: track slot"); goto out; }
+            if (!have_rng[sl]) {
+                track_range(&T[sl], ta, t1, &lo[sl], &hi[sl]);
+                have_rng[sl] = 1;
+            }
+        }
+    }
+    for (Py_ssize_t i = 0; i < B->n; i++) {
+        const Spec *S = &B->s[i];
+        PyObject *job = PyList_GET_ITEM(jobs_o, i);
+        long long index, hits;
+        if (get_ll_attr(job, "index", &index) < 0) goto out;
+        long long index0 = index;
+        Py_ssize_t m = job_scan(S, T, lo, hi, &index, ta, t1, &hb, &hcap, ev, evcap);
+        if (m < 0) goto out;
+        if (index != index0 && set_ll_attr(job, "index", index) < 0) goto out;
+        if (m > 0) {
+            if (get_ll_attr(job, "hits", &hits) < 0) goto out;
+            if (S->line < 0 || S->line >= nl) {
+                PyErr_SetString(PyExc_IndexError, "bank_scan: line index");
+                goto out;
+            }
+            LineRef L;
+            if (line_ref(PyList_GET_ITEM(lines_o, S->line), &L) < 0) goto out;
+            Py_ssize_t nlist = PyList_GET_SIZE(L.tl);
+            if (PyList_GET_SIZE(L.ll) != nlist) {
+                PyErr_SetString(PyExc_ValueError, "OutputLine: t and lv differ in length");
+                goto out;
+            }
+            for (Py_ssize_t q = 0; q < m; q++) {
+                double tf = hb[3 * q];
+                int st;
+                if (S->act == A_TOGGLE) {
+                    st = (hits + q) % 2 == 0 ? (S->flag != 0) : (S->flag == 0);
+                    if (line_set_one(L.tl, L.ll, L.initial, tf, st, L.sent, L.late) < 0) goto out;
+                } else if (S->act == A_SET) {
+                    st = S->flag != 0;
+                    if (line_set_one(L.tl, L.ll, L.initial, tf, st, L.sent, L.late) < 0) goto out;
+                } else {
+                    st = S->flag != 0;
+                    if (line_set_one(L.tl, L.ll, L.initial, tf, st, L.sent, L.late) < 0
+                            || line_set_one(L.tl, L.ll, L.initial, tf + S->width, !st, L.sent,
+                                            L.late) < 0)
+                        goto out;
+                }
+                if (rows_add(&R, tf, hb[3 * q + 1], S->jid, (long long)hb[3 * q + 2],
+                             S->output, st) < 0)
+                    goto out;
+            }
+            if (set_ll_attr(job, "hits", hits + m) < 0) goto out;
+        }
+        int finished = S->kind == K_LEVEL ? (!S->repeat && index >= S->L.n + S->L.has_after)
+                                          : index >= S->npts;
+        if (finished) {
+            PyObject *x = PyLong_FromSsize_t(i);
+            if (x == NULL || PyList_Append(done, x) < 0) { Py_XDECREF(x); goto out; }
+            Py_DECREF(x);
+        }
+    }
+    if (R.m == 0 && PyList_GET_SIZE(done) == 0) { res = Py_NewRef(Py_None); goto out; }
+    res = Py_BuildValue("(y#y#y#O)", (const char *)R.f, (Py_ssize_t)(R.m * 2 * sizeof(double)),
+                        (const char *)R.k, (Py_ssize_t)(R.m * 4 * sizeof(long long)),
+                        "", (Py_ssize_t)0, done);
+    if (res == NULL) goto out;
+    {
+        /* positions: every pos_track at each firing time */
+        double *P = malloc((size_t)(R.m * npt > 0 ? R.m * npt : 1) * sizeof(double));
+        if (P == NULL) { Py_CLEAR(res); PyErr_NoMemory(); goto out; }
+        for (Py_ssize_t q = 0; q < R.m; q++)
+            for (Py_ssize_t a = 0; a < npt; a++)
+                P[q * npt + a] = position(&T[nt + a], R.f[2 * q]);
+        PyObject *pb = PyBytes_FromStringAndSize((const char *)P,
+                                                 (Py_ssize_t)(R.m * npt * sizeof(double)));
+        free(P);
+        if (pb == NULL) { Py_CLEAR(res); goto out; }
+        PyObject *old = PyTuple_GET_ITEM(res, 2);
+        PyTuple_SET_ITEM(res, 2, pb);
+        Py_DECREF(old);
+    }
+out:
+    for (Py_ssize_t i = 0; i < got; i++) release_track(&tb[i]);
+    free(T); free(tb); free(lo); free(hi); free(have_rng); free(hb); free(ev);
+    free(R.f); free(R.k);
+    Py_XDECREF(done);
+    return res;
+}
+
+PyDoc_STRVAR(solver_checks_doc,
+"solver_checks(on) -> (refined, rejected)\n\n"
+"Tests: with on, every window candidate dropped unrefined is refined anyway and\n"
+"verified to be outside its window (AssertionError otherwise). Returns the counts of\n"
+"refined and dropped candidates since the last call, and resets them.");
+
+static PyObject *solver_checks(PyObject *self, PyObject *args)
+{
+    int on;
+    if (!PyArg_ParseTuple(args, "p", &on)) return NULL;
+    check_rejects = on;
+    PyObject *r = Py_BuildValue("(LL)", n_refined, n_rejected);
+    n_refined = n_rejected = 0;
+    return r;
+}
+
 /* ------------------------------------------------------------------ module */
 static PyMethodDef methods[] = {
     {"level_events", level_events_py, METH_VARARGS, level_events_doc},
@@ -1106,6 +1641,9 @@ static PyMethodDef methods[] = {
     {"time_of", time_of_py, METH_VARARGS, time_of_doc},
     {"vector_scan", vector_scan, METH_VARARGS, vector_scan_doc},
     {"line_set", line_set, METH_VARARGS, line_set_doc},
+    {"solver_checks", solver_checks, METH_VARARGS, solver_checks_doc},
+    {"bank_new", bank_new, METH_VARARGS, bank_new_doc},
+    {"bank_scan", bank_scan, METH_VARARGS, bank_scan_doc},
     {NULL, NULL, 0, NULL},
 };
 

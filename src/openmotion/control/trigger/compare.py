@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 from ...errors import MotionError, check_finite, check_int, check_positive
 from . import compare_math as _cm
 from .compare_due import engine_due
-from .compare_io import EventLog, OutputLine
+from .compare_io import EventLog, OutputLine, send_lines
 from .compare_jobs import (
     SOURCE_KINDS,
     Action,
@@ -151,13 +151,14 @@ class CompareEngine:
         #: DPOS/vector jobs run before the hardware advances; edges go out at exact times
         self.timed = isinstance(controller.hardware, TimedOutputHardware)
         self._t_pre = self._t_last
-        self._pre_rows: list[tuple[float, int, int, float, int, int]] = []
-        self._pre_pos: list[Array] = []
+        self._pre_rows: list[_Block] = []  # the pre-advance scan's firings
         self._plan: list[tuple[float, ...]] | None = None  # records planned (rollback)
         self._plan_key: tuple[int, int, int] | None = None  # what _plan_axes was made for
         self._plan_axes: list[int] = []
         self._timers: dict[int, Any] = {}
         self._prune_due = False  # a job finished: drop unused MPOS error models
+        self._jobs_ver = 0  # bumped whenever the job set or its order changes
+        self._banks: dict[bool | None, _Group] = {}
         controller.add_cycle_hook(self._on_cycle, due=self._due)
         if self.timed:
             controller.add_pre_advance_hook(self._pre_advance, due=self._due)
@@ -182,6 +183,7 @@ class CompareEngine:
             line = OutputLine(number, False)
             line.attach(self.ctl.hardware)
             self._lines[number] = line
+            self._jobs_ver += 1  # (scan groups use the lines that exist)
         return line
 
     # ------------------------------------------------------------------ jobs
@@ -236,12 +238,14 @@ class CompareEngine:
         job.t_armed = self.ctl.time
         job.arm(self)
         self._jobs[job.id] = job
+        self._jobs_ver += 1
         return job.id
 
     def remove(self, job_id: int) -> None:
         """Stop a job and drop its unfired points (HW_PSWITCH2(2) for one job)."""
         with self.ctl.lock:
             job = self._jobs.pop(job_id, None)
+            self._jobs_ver += 1
             if job is not None:
                 job.active = False
                 self._prune_mpos()
@@ -392,12 +396,66 @@ class CompareEngine:
         self._windows: dict[tuple[tuple[int, ...], str],
                             tuple[list[Track], list[tuple[float, float]]]] = {}
 
-    def _scan(self, pre: bool | None, ta: float, t1: float
-              ) -> list[tuple[float, int, int, float, int, int]]:
-        """Run the jobs (pre True: command-position ones, False: MPOS ones, None: all)."""
+    def _group(self, pre: bool | None) -> _Group:
+        """The jobs of a scan group (pre True: command-position ones, False: MPOS ones,
+        None: all), split into those the compiled driver runs and the rest; rebuilt only
+        when the job set changes."""
+        g = self._banks.get(pre)
+        if g is not None and g.ver == self._jobs_ver:
+            return g
+        jobs = [j for j in self._jobs.values()
+                if j.active and (pre is None or _on_command(j) == pre)]
+        order = {j.id: k for k, j in enumerate(jobs)}
+        # (a job whose line does not exist yet runs in Python until its first firing
+        # creates it, which rebuilds the group: lines are created at the first firing)
+        native = [j for j in jobs if _native(j) and j.action.output in self._lines]
+        others = [j for j in jobs if j not in native]
+        shared = {j.action.output for j in others} | {p.output for p in self._pwms}
+        if any(j.action.output in shared for j in native):
+            native, others = [], jobs  # one line edited by both: keep the job order
+        slots: dict[AxisSource, int] = {}
+        lines: dict[int, int] = {}
+        specs = []
+        for j in native:
+            act = j.action
+            ln = lines.setdefault(act.output, len(lines))
+            kind, flag, width = _ACTIONS[type(act)](act)
+            if isinstance(j, WindowJob):
+                srcs = [AxisSource(a, j.kind) for a in j.axes]
+                vals, n, after, direction, repeat, code = j.points, j.size, None, 0, False, 1
+            else:
+                srcs = [j.source]
+                vals, n, after = j._values()
+                direction, repeat, code = j.direction, j.repeat, 0
+            sl = tuple(slots.setdefault(x, len(slots)) for x in srcs)
+            specs.append((code, sl, direction, repeat, vals, n, after,
+                          float(getattr(j, "maxerr", 0.0)), float(j.t_armed), j.id, kind,
+                          flag, width, ln, act.output))
+        g = _Group(self._jobs_ver, _cm._solvers().bank_new(specs) if specs else None, native,
+                   list(slots), [self._lines[o] for o in lines], others, order)
+        self._banks[pre] = g
+        return g
+
+    def _scan(self, pre: bool | None, ta: float, t1: float) -> list[_Block]:
+        """Run the jobs of a group (see _group) over (ta, t1]: blocks of firings."""
+        g = self._group(pre)
+        blocks: list[_Block] = []
+        if g.bank is not None:
+            res = _cm._solvers().bank_scan(
+                g.bank, g.native, [self.track(x) for x in g.slots], g.lines,
+                [self.track(AxisSource(a)) for a in range(len(self.ctl.axes))], ta, t1)
+            if res is not None:
+                fb, kb, pb, done = res
+                f = np.frombuffer(fb, dtype=np.float64).reshape(-1, 2)
+                if f.shape[0]:
+                    k = np.frombuffer(kb, dtype=np.int64).reshape(-1, 4)
+                    blocks.append((f, k, np.frombuffer(pb, dtype=np.float64).reshape(
+                        f.shape[0], -1), g.order))
+                for i in done:
+                    self._finished(g.native[i])
         rows: list[tuple[float, int, int, float, int, int]] = []
-        for job in list(self._jobs.values()):
-            if not job.active or (pre is not None and _on_command(job) != pre):
+        for job in g.others:
+            if not job.active:
                 continue
             hits = job.scan(self, ta, t1)
             if hits:
@@ -415,10 +473,18 @@ class CompareEngine:
                 rows.extend([(tf, jid, idx, val, out, int(st))
                              for (tf, idx, val), st in zip(hits, states, strict=True)])
             if job.done:
-                self._jobs.pop(job.id, None)
-                job.active = False
-                self._prune_due = True  # (after this cycle's error model update)
-        return rows
+                self._finished(job)
+        if rows:
+            f = np.array([(r[0], r[3]) for r in rows], dtype=np.float64)
+            k = np.array([(r[1], r[2], r[4], r[5]) for r in rows], dtype=np.int64)
+            blocks.append((f, k, self._positions(rows), g.order))
+        return blocks
+
+    def _finished(self, job: CompareJob) -> None:
+        self._jobs.pop(job.id, None)
+        self._jobs_ver += 1
+        job.active = False
+        self._prune_due = True  # (after this cycle's error model update)
 
     def _positions(self, rows: list[tuple[float, int, int, float, int, int]]) -> Array:
         """Every axis's command position at each row's time: (len(rows), n_axes)."""
@@ -493,6 +559,7 @@ class CompareEngine:
                 j.index, j.hits, j.active = idx, hits, active
                 if active:
                     self._jobs[k] = j
+        self._jobs_ver += 1
         for k, (busy, over, ign) in tstate.items():
             timers[k].busy_until, timers[k].overruns, timers[k].ignored = busy, over, ign
         for n_, snap in lines.items():
@@ -500,7 +567,7 @@ class CompareEngine:
         self._vectors.update(vectors)
         for p, n_ in zip(self._pwms, duties, strict=False):
             del p.duties[n_:]
-        self._pre_rows, self._pre_pos = [], []
+        self._pre_rows = []
 
     def _due(self, ctl: Controller) -> float:
         """When a hook of the engine may next act (control/trigger/compare_due.py)."""
@@ -514,14 +581,9 @@ class CompareEngine:
             return
         self._begin(ta, t1)
         self._snapshot(ta, t1)
-        rows = self._scan(True, ta, t1)
-        if rows:
-            self._pre_rows.extend(rows)
-            self._pre_pos.append(self._positions(rows))
+        self._pre_rows.extend(self._scan(True, ta, t1))
         self._vectors_end(ta, t1)
-        hw = ctl.hardware
-        for line in self._lines.values():
-            line.send(hw, ta, t1)
+        send_lines(list(self._lines.values()), ctl.hardware, ta, t1)
 
     def _on_cycle(self, ctl: Controller, t1: float) -> None:
         # after a jump the window starts at the previous cycle end, as cycle by cycle
@@ -534,36 +596,83 @@ class CompareEngine:
         self._begin(ta, t1)
         if replan:  # redo the command-position jobs on the motion as executed
             self._rollback(ta)
-            rows = self._scan(True, ta, t1)
+            pre = self._scan(True, ta, t1)
             self._vectors_end(ta, t1)
         else:
-            rows = []
+            pre = self._pre_rows
+        self._pre_rows = []
         self._mpos_e1 = {a: self._mpos_error(a) for a in self._mpos_err}
-        rows += self._scan(False if self.timed else None, ta, t1)
+        post = self._scan(False if self.timed else None, ta, t1)
         if not self.timed:
             self._vectors_end(ta, t1)
         self._mpos_err.update(self._mpos_e1)
         if self._prune_due:
             self._prune_due = False
             self._prune_mpos()
-        pos = [self._positions(rows)] if rows else []
-        if self._pre_rows:
-            rows = self._pre_rows + rows
-            pos = self._pre_pos + pos
-            self._pre_rows, self._pre_pos = [], []
-        if rows:  # in time order (a stable sort: equal times keep job order)
-            p = pos[0] if len(pos) == 1 else np.concatenate(pos)
-            times = [r[0] for r in rows]
-            if all(a <= b for a, b in zip(times, times[1:], strict=False)):
-                self.log.add(rows, p)
-            else:
-                order = np.argsort(np.array(times), kind="stable")
-                self.log.add([rows[k] for k in order.tolist()], p[order])
+        if pre or post:
+            _log_blocks(self.log, pre, post)
         hw = ctl.hardware
         keep = t1 - ctl.history.window_s  # waveforms are kept as long as the motion history
         for line in self._lines.values():
             line.flush(hw, ta, t1)
             line.forget_before(keep)
+
+
+def _log_blocks(log: EventLog, pre: list[_Block], post: list[_Block]) -> None:
+    """Add a cycle's firings to the log in time order; equal times keep the order of the
+    scans: pre-advance before after-cycle, then job order, then hit order (a stable sort)."""
+    blocks = pre + post
+    if len(blocks) == 1:  # one block is in job order: a stable sort by time alone
+        f, k, p, _ = blocks[0]
+        if f.shape[0] < 2 or bool(np.all(f[1:, 0] >= f[:-1, 0])):
+            log.add_arrays(f, k, p)
+        else:
+            order = np.argsort(f[:, 0], kind="stable")
+            log.add_arrays(f[order], k[order], p[order])
+        return
+    f = np.concatenate([b[0] for b in blocks])
+    k = np.concatenate([b[1] for b in blocks])
+    p = np.concatenate([b[2] for b in blocks])
+    group = np.concatenate([np.full(b[0].shape[0], int(i >= len(pre)))
+                            for i, b in enumerate(blocks)])
+    pos = np.concatenate([np.fromiter((b[3].get(j, -1) for j in b[1][:, 0].tolist()),
+                                      dtype=np.int64, count=b[1].shape[0]) for b in blocks])
+    order = np.lexsort((pos, group, f[:, 0]))
+    if bool(np.all(order[1:] > order[:-1])):
+        log.add_arrays(f, k, p)
+    else:
+        log.add_arrays(f[order], k[order], p[order])
+
+
+_Block = tuple[Array, NDArray[np.int64], Array, dict[int, int]]  # f, k, positions, job order
+
+
+class _Group:
+    """A scan group's jobs: the compiled driver's bank (and its jobs, track sources and
+    lines, in its order) and the jobs run in Python; job id -> position in the group."""
+
+    def __init__(self, ver: int, bank: Any, native: list[CompareJob], slots: list[AxisSource],
+                 lines: list[OutputLine], others: list[CompareJob], order: dict[int, int]
+                 ) -> None:
+        self.ver, self.bank, self.native, self.slots = ver, bank, native, slots
+        self.lines, self.others, self.order = lines, others, order
+
+
+_ACTIONS = {  # the actions the driver applies itself: (code, flag, width)
+    Toggle: lambda a: (0, int(bool(a.first)), 0.0),
+    SetLevel: lambda a: (1, int(bool(a.level)), 0.0),
+    Pulse: lambda a: (2, int(bool(a.active)), float(a.width)),
+}
+
+
+def _native(job: CompareJob) -> bool:
+    """Does the compiled driver run this job (an axis LevelJob or a WindowJob with a
+    built-in action)?"""
+    if type(job.action) not in _ACTIONS:
+        return False
+    if type(job) is WindowJob:
+        return True
+    return type(job) is LevelJob and isinstance(job.source, AxisSource)  # type: ignore[attr-defined]
 
 
 def _timer_of(action: Action) -> Any:

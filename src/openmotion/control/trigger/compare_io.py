@@ -149,6 +149,23 @@ class OutputLine:
         self._late.clear()
         self._hold = False
 
+    def _plain_send(self, t0: float, t1: float) -> tuple[list[float], list[bool]] | None:
+        """`send`'s bookkeeping when nothing late or stretched is pending (the physical
+        line shows the level at t0): the cycle's edges to hand over, or None (use send)."""
+        t = self._t
+        a = bisect.bisect_right(t, t0)
+        lvl0 = self._lv[a - 1] if a else self.initial
+        if lvl0 != self._written:
+            return None
+        b = bisect.bisect_right(t, t1, a)
+        times, levels = t[a:b], self._lv[a:b]
+        self._sent = list(zip(times, levels, strict=True))
+        self._written = self._lv[b - 1] if b else self.initial
+        self._sent_until = t1
+        self._late.clear()
+        self._hold = False
+        return times, levels
+
     def flush(self, hw: Hardware, t0: float, t1: float) -> None:
         """Write the physical line for the cycle (t0, t1] (see module docstring)."""
         if self.timed:
@@ -179,46 +196,90 @@ class OutputLine:
         return b > a
 
 
+def send_lines(lines: Sequence[OutputLine], hw: Hardware, t0: float, t1: float) -> None:
+    """`line.send(hw, t0, t1)` for every line, with the edges of all of them handed to the
+    hardware in one `write_outputs_many` call when it has one (the simulator does)."""
+    bulk = getattr(hw, "write_outputs_many", None)
+    if bulk is None:
+        for line in lines:
+            line.send(hw, t0, t1)
+        return
+    writes = []
+    for line in lines:
+        w = line._plain_send(t0, t1)
+        if w is None:  # (the writes so far first: the hardware sees the lines in order)
+            if writes:
+                bulk(writes)
+                writes = []
+            line.send(hw, t0, t1)
+        elif w[0]:
+            writes.append((w[0], line.signal, w[1]))
+    if writes:
+        bulk(writes)
+
+
 class EventLog:
-    """Every firing of every compare job (see module docstring)."""
+    """Every firing of every compare job (see module docstring). Kept as blocks of arrays
+    as the engine adds them (a cycle's firings at once), joined when read."""
 
     FIELDS = ("time", "job", "index", "value", "output", "state")
 
     def __init__(self, n_axes: int) -> None:
         self.n_axes = n_axes
-        self._rows: list[tuple[float, int, int, float, int, int]] = []
-        self._pos: list[Array] = []  # blocks of rows (k x n_axes), as added
+        self._n = 0
+        self._f: list[Array] = []  # (k x 2): time, value
+        self._k: list[NDArray[np.int64]] = []  # (k x 4): job, index, output, state
+        self._pos: list[Array] = []  # (k x n_axes)
 
     def __len__(self) -> int:
-        return len(self._rows)
+        return self._n
 
-    def add(self, rows: list[tuple[float, int, int, float, int, int]], pos: Array) -> None:
+    def add(self, rows: Sequence[tuple[float, int, int, float, int, int]], pos: Array) -> None:
         """Append firings (rows as FIELDS) with their positions (len(rows) x n_axes)."""
-        p = np.asarray(pos, dtype=np.float64).reshape(len(rows), self.n_axes)
-        self._rows.extend(rows)
-        self._pos.append(p)
+        if not rows:
+            return
+        f = np.array([(r[0], r[3]) for r in rows], dtype=np.float64)
+        k = np.array([(r[1], r[2], r[4], r[5]) for r in rows], dtype=np.int64)
+        self.add_arrays(f, k, pos)
+
+    def add_arrays(self, f: Array, k: NDArray[np.int64], pos: Array) -> None:
+        """Append firings as columns: f (m x 2: time, value), k (m x 4: job, index, output,
+        state), pos (m x n_axes)."""
+        m = f.shape[0]
+        if not m:
+            return
+        self._f.append(f)
+        self._k.append(k)
+        self._pos.append(np.asarray(pos, dtype=np.float64).reshape(m, self.n_axes))
+        self._n += m
 
     def clear(self) -> None:
-        self._rows.clear()
+        self._f.clear()
+        self._k.clear()
         self._pos.clear()
+        self._n = 0
 
-    def _positions(self) -> Array:
-        if len(self._pos) > 1:  # join the blocks once
+    def _joined(self) -> tuple[Array, NDArray[np.int64], Array]:
+        if len(self._f) > 1:  # join the blocks once
+            self._f[:] = [np.concatenate(self._f)]
+            self._k[:] = [np.concatenate(self._k)]
             self._pos[:] = [np.concatenate(self._pos)]
-        return self._pos[0] if self._pos else np.empty((0, self.n_axes))
+        if not self._f:
+            return (np.empty((0, 2)), np.empty((0, 4), dtype=np.int64),
+                    np.empty((0, self.n_axes)))
+        return self._f[0], self._k[0], self._pos[0]
 
     def arrays(self) -> dict[str, NDArray]:
         """Columns: time, job, index, value, output, state (-1 none), positions (n x axes)."""
-        n = len(self._rows)
-        cols = list(zip(*self._rows, strict=True)) if n else [[]] * 6
+        f, k, pos = self._joined()
         return {
-            "time": np.array(cols[0], dtype=np.float64),
-            "job": np.array(cols[1], dtype=np.int64),
-            "index": np.array(cols[2], dtype=np.int64),
-            "value": np.array(cols[3], dtype=np.float64),
-            "output": np.array(cols[4], dtype=np.int64),
-            "state": np.array(cols[5], dtype=np.int64),
-            "positions": self._positions().copy(),
+            "time": f[:, 0].copy(),
+            "job": k[:, 0].copy(),
+            "index": k[:, 1].copy(),
+            "value": f[:, 1].copy(),
+            "output": k[:, 2].copy(),
+            "state": k[:, 3].copy(),
+            "positions": pos.copy(),
         }
 
     def for_job(self, job: int) -> dict[str, NDArray]:
@@ -240,12 +301,13 @@ class EventLog:
         if p.suffix != ".csv":
             raise MotionError(f"path must end with .csv, got {str(path)!r}")
         p.parent.mkdir(parents=True, exist_ok=True)
+        f, k, pos = self._joined()
         with p.open("w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow([*self.FIELDS, *(f"pos{i}" for i in range(self.n_axes))])
-            for row, pos in zip(self._rows, self._positions(), strict=True):
-                t, job, idx, val, out, st = row
-                w.writerow([repr(t), job, idx, repr(val), out, st, *(repr(float(x)) for x in pos)])
+            for (t, val), (job, idx, out, st), ps in zip(f.tolist(), k.tolist(), pos.tolist(),
+                                                          strict=True):
+                w.writerow([repr(t), job, idx, repr(val), out, st, *(repr(x) for x in ps)])
         return p
 
 

@@ -462,13 +462,45 @@ class SimMachine(SimAnalogOutputs):
         for t, lv in zip(times, levels, strict=True):
             self.write_output_at(t, axis, signal, lv)
 
+    def write_outputs_many(self, writes: Sequence[tuple[Sequence[float], str, Sequence[bool]]]
+                           ) -> None:
+        """`write_outputs_at(times, None, signal, levels)` for each (times, signal, levels)
+        in order, in one call (the compare engine's lines of a cycle). Everything is
+        checked first: on refusal nothing is scheduled."""
+        now = self._t
+        items: list[tuple[float, str, bool]] = []
+        at_now = False
+        for times, signal, levels in writes:
+            if len(times) != len(levels):
+                raise MotionError(f"times and levels must have one entry each, got "
+                                  f"{len(times)} times and {len(levels)} levels")
+            if not all(map(math.isfinite, times)):
+                raise MotionError(f"times must be finite, got {list(times)!r}")
+            first = min(times) if times else math.inf
+            if first < now:
+                raise MotionError(f"t must be >= the current time {now!r}, got {first!r}")
+            at_now = at_now or first == now
+            if not set(map(type, levels)) <= {bool}:
+                raise MotionError(f"levels must be bools, got {list(levels)!r}")
+            self._board_index(signal, "do", len(self._do))
+        if at_now:  # (a write at the present instant goes out at once)
+            for times, signal, levels in writes:
+                self.write_outputs_at(times, None, signal, levels)
+            return
+        for times, signal, levels in writes:
+            items.extend(zip(times, [signal] * len(times), levels, strict=True))
+        self._timed.push_rows(items)
+
     def _timed_axis_output(self, axis: int, signal: str, level: bool, raw: list) -> None:
         self.write_output(axis, signal, level)
         raw.extend(self._pending)  # RDY/INP edges it caused belong to this advance
         self._pending.clear()
 
     def _set_do(self, t: float, signal: str, level: bool) -> None:
-        k = self._board_index(signal, "do", len(self._do))
+        slots = self.__dict__.setdefault("_do_slots", {})  # signal -> index, parsed once
+        k = slots.get(signal)
+        if k is None:
+            k = slots[signal] = self._board_index(signal, "do", len(self._do))
         if self._do[k] != level:
             self._do[k] = level
             self.output_record.add(t, None, signal, level)

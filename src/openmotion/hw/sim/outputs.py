@@ -39,6 +39,12 @@ class TimedOutputs:
             for it in items:
                 heapq.heappush(self._heap, it)
 
+    def push_rows(self, rows: list[tuple[float, str, bool]]) -> None:
+        """`push(t, None, signal, level)` for every (t, signal, level) row, in order."""
+        seq = self._seq
+        self._heap.extend([(t, next(seq), None, sig, lv) for t, sig, lv in rows])
+        heapq.heapify(self._heap)
+
     def next_time(self) -> float | None:
         return self._heap[0][0] if self._heap else None
 
