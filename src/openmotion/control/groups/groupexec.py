@@ -188,8 +188,16 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         return np.asarray(coords, dtype=float) * self._k
 
     def _caps(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per-axis speed and acceleration caps in logical units (from the pulse caps)."""
-        return self._vmax / self._ppu, self._amax / self._ppu
+        """Per-axis speed and acceleration caps in logical units (from the pulse caps);
+        kept while the three arrays are the same objects (settings replace them, never
+        write into them), as every corner and element asks."""
+        memo = self.__dict__.get("_caps_memo")
+        vm, am, ppu = self._vmax, self._amax, self._ppu
+        if memo is not None and memo[0] is vm and memo[1] is am and memo[2] is ppu:
+            return memo[3]
+        out = (vm / ppu, am / ppu)
+        self._caps_memo = (vm, am, ppu, out)
+        return out
 
     def _pulse_profiles(self, profiles: list[Profile]) -> list[Profile]:
         """Axis profiles planned in logical units -> command pulses."""

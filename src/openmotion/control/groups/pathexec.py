@@ -245,19 +245,29 @@ class Chain:
         else:  # one side follows its accelerations
             dec = _cat(self.accels if self.decels is None else self.decels,
                        accels if decels is None else decels)
-        return Chain(head + tuple(elements), self.owners + tuple(owners),
-                     _cat(self.feeds, feeds), _cat(self.accels, accels), dec,
-                     cum=np.concatenate([cum, tail]))
+        out = Chain(head + tuple(elements), self.owners + tuple(owners),
+                    _cat(self.feeds, feeds), _cat(self.accels, accels), dec,
+                    cum=np.concatenate([cum, tail]))
+        if self._table is not None and (elements or replace_last is not None):
+            # the kept rows of this chain's table and a table of the new elements only
+            kept = self._table.sliced(0, len(self.elements) - 1) \
+                if replace_last is not None else self._table
+            fresh = ([replace_last] if replace_last is not None else []) + list(elements)
+            out._table = kept.concat(ElementTable(fresh))
+        return out
 
     def dropped(self, k: int) -> tuple[Chain, float]:
         """The chain without its first k elements, s rebased to start at 0, and the offset
         subtracted (the same subtraction applied to a profile keeps both consistent)."""
         off = float(self.cum[k])
-        return Chain(self.elements[k:], self.owners[k:],
-                     None if self.feeds is None else self.feeds[k:],
-                     None if self.accels is None else self.accels[k:],
-                     None if self.decels is None else self.decels[k:],
-                     cum=self.cum[k:] - off), off
+        chain = Chain(self.elements[k:], self.owners[k:],
+                      None if self.feeds is None else self.feeds[k:],
+                      None if self.accels is None else self.accels[k:],
+                      None if self.decels is None else self.decels[k:],
+                      cum=self.cum[k:] - off)
+        if self._table is not None:
+            chain._table = self._table.sliced(k)
+        return chain, off
 
     def tail_elements(self, s0: float) -> tuple[list[PathElement], int]:
         """Elements from s0 on (the first trimmed) and the index of the first."""
