@@ -40,7 +40,7 @@ from ...path import ElementSpeeds, Line, plan_speeds
 from ...path.contour import contour_error  # noqa: F401 - re-exported (was defined here)
 from ...path.geometry import PathElement
 from ...path.lookahead import speed_caps, tangential_accels
-from ...profile.segments import Profile, ProfileBuilder
+from ...profile.segments import Profile, State
 from .pathpoints import ElementTable
 
 #: plan_speeds' default tangential share of an arc's acceleration budget (lookahead step 1)
@@ -158,9 +158,28 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
     v = np.sqrt(v2)
     ds = np.diff(knots)
     dv2 = np.diff(v2)
-    b = ProfileBuilder(float(knots[0]), float(v[0]), v_before=0.0 if curve.jump else None)
+    # ProfileBuilder's segments written out (direction +1, jerk 0): the same float
+    # operations in the same order, without a method call per piece (a chain of
+    # hundreds of elements is one such loop per re-plan)
+    p, vcur, acur, t = float(knots[0]), float(v[0]), 0.0, 0.0
+    start = State(p, 0.0 if curve.jump else vcur, 0.0)
+    rows: list[tuple[float, float, float, float, float]] = []
+    dts: list[float] = []
+    labels: list[str] = []
+
+    def piece(dt: float, label: str) -> None:
+        nonlocal p, vcur, acur, t
+        rows.append((t, p, vcur, acur, 0.0))
+        dts.append(dt)
+        labels.append(label or f"segment {len(labels)}")
+        p = p + dt * (vcur + dt * (acur / 2.0 + dt * 0.0 / 6.0))
+        vcur = vcur + dt * (acur + dt * 0.0 / 2.0)
+        acur = acur + dt * 0.0
+        t += dt
+
     if lead > 0.0:
-        b.segment(lead, 0.0, accel=0.0, label="dwell")
+        acur = 0.0
+        piece(lead, "dwell")
     last = len(ds) - 1
     # a stall is a piece crawling at a speed rounding left (> 1e6 s at under 1e-6 of the
     # curve's peak); a long piece at a real speed is a long path (2^45 pulses at a low feed)
@@ -178,12 +197,25 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
                 continue
             raise InfeasibleError("path speed curve stalls at rest before its end")
         dt = 2.0 * d / vm  # exact for constant acceleration, also when a = 0
-        b.set_velocity(vl[k])
-        b.segment(dt, 0.0, accel=a)
+        vcur = vl[k]
+        acur = a
+        if dt > 0.0:
+            rows.append((t, p, vcur, acur, 0.0))
+            dts.append(dt)
+            labels.append(f"segment {len(labels)}")
+            p = p + dt * (vcur + dt * (acur / 2.0 + dt * 0.0 / 6.0))
+            vcur = vcur + dt * (acur + dt * 0.0 / 2.0)
+            acur = acur + dt * 0.0
+            t += dt
         if dwell > 0.0 and vl[k + 1] == 0.0 and k < last:
-            b.set_velocity(0.0)
-            b.segment(dwell, 0.0, accel=0.0, label="dwell")
-    return b.build(end_p=float(s_end))
+            vcur = 0.0
+            acur = 0.0
+            piece(dwell, "dwell")
+    arr = np.array(rows, dtype=np.float64).reshape(-1, 5)
+    return Profile(t0=arr[:, 0].copy(), p0=arr[:, 1].copy(), v0=arr[:, 2].copy(),
+                   a0=arr[:, 3].copy(), j=arr[:, 4].copy(), duration=t, start=start,
+                   end=State(float(s_end), 0.0, 0.0), labels=tuple(labels),
+                   dt=np.array(dts, dtype=np.float64))
 
 
 # -------------------------------------------------------------------------- chains
