@@ -21,6 +21,13 @@ a fresh process so the RSS figures do not mix. The last lines give the per-comma
 the largest N over the smallest: flat streaming keeps it near 1.
 
     python bench/bench_stream.py [N ...]          (default 1000 10000 50000)
+    python bench/bench_stream.py --against SRC [N] [ROUNDS]
+
+`--against SRC` (another checkout's `src` directory, e.g. the commit before a planner
+change) measures the join cost of the group feeder (N commands, default 1000) with that
+code and with this one, in ROUNDS (default 5) alternating fresh processes, and prints
+both series, their least values and the ratio: before and after in one run, each figure
+CPU time (the least of the rounds is the one least disturbed by other load).
 """
 
 from __future__ import annotations
@@ -183,7 +190,30 @@ def _figures(kind: str, n: int, wall: float, machine: float, probe: Probe, err: 
             "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
 
 
+def against(src: str, n: int, rounds: int) -> None:
+    """Join us/command of the group feeder: `src`'s code against this checkout's."""
+    import os
+    from pathlib import Path
+
+    here = str(Path(__file__).resolve().parents[1] / "src")
+    series: dict[str, list[float]] = {"before": [], "after": []}
+    for _ in range(rounds):
+        for name, path in (("before", src), ("after", here)):
+            env = dict(os.environ, PYTHONPATH=path)
+            out = subprocess.run([sys.executable, __file__, "--case", "group", str(n)],
+                                 check=True, capture_output=True, text=True, env=env).stdout
+            series[name].append(json.loads(out.strip().splitlines()[-1])["join_us_per_cmd"])
+    for name, xs in series.items():
+        print(f"join us/cmd {name:6} ({'SRC' if name == 'before' else 'this checkout'}): "
+              + " ".join(f"{x:.0f}" for x in xs) + f"   least {min(xs):.0f}")
+    print(f"after / before (least of {rounds}): {min(series['after']) / min(series['before']):.2f}")
+
+
 def main() -> None:
+    if len(sys.argv) >= 3 and sys.argv[1] == "--against":
+        n = int(sys.argv[3]) if len(sys.argv) > 3 else 1000
+        against(sys.argv[2], n, int(sys.argv[4]) if len(sys.argv) > 4 else 5)
+        return
     if len(sys.argv) == 4 and sys.argv[1] == "--case":
         fn = case_group if sys.argv[2] == "group" else case_runner
         print(json.dumps(fn(int(sys.argv[3]))))

@@ -69,3 +69,29 @@ def test_table_equals_each_elements_own_methods(fractions, seed):
     straight = [i for i, el in enumerate(els) if el.max_curvature == 0.0]
     assert np.array_equal(table.line_tangents(np.array(straight)),
                           np.array([els[i].tangent(0.0) for i in straight]))
+
+
+def test_joined_and_dropped_chains_carry_the_same_table_as_built_anew():
+    """A streaming join builds its chain's table from the old rows and the new elements
+    only (Chain.joined / Chain.dropped): every array equals a table built from scratch."""
+    from openmotion.control.groups.pathexec import Chain
+    from openmotion.control.groups.pathpoints import _FIELDS
+
+    pts = [np.array([10.0 * k, 3.0 * (k % 2), 0.5 * k]) for k in range(8)]
+    lines = [Line(a, b) for a, b in zip(pts, pts[1:], strict=False)]
+    arc = Arc3D(lines[-1].end, lines[-1].end + [1.0, 1.0, 0.0], lines[-1].end + [2.0, 0.0, 0.0])
+    chain = Chain(lines[:4], [0, 1, 2, 3])
+    _ = chain.table
+    trimmed_last = Trimmed(lines[3], 0.0, lines[3].length * 0.5)
+    cases = [chain.joined(lines[4:], [4, 5, 6], None, None),
+             chain.joined([arc], [7], None, None, replace_last=trimmed_last),
+             chain.dropped(2)[0],
+             chain.joined(lines[4:], [4, 5, 6], None, None).dropped(3)[0]]
+    for c in cases:
+        assert c._table is not None
+        fresh = ElementTable(c.elements)
+        assert tuple(c.table.elements) == tuple(fresh.elements)
+        for name in _FIELDS:
+            a, b = getattr(c.table, name), getattr(fresh, name)
+            assert a.dtype == b.dtype and a.shape == b.shape, name
+            assert np.array_equal(a, b), name

@@ -126,3 +126,19 @@ def test_sync_is_axis_by_axis(axes):
             assert np.array_equal(getattr(p, f), getattr(q, f)), f
         assert p.duration == t_sync
         assert p.end == q.end and p.labels == q.labels
+
+
+def test_peak_speed_bounds_every_sampled_speed():
+    """groupexec._peak_speed bounds |v| everywhere (the join check skips evaluating s(t)
+    while the length ahead minus peak x elapsed time still holds the reach)."""
+    from openmotion.control.groups.groupexec import _peak_speed
+
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        b = ProfileBuilder(0.0, float(rng.uniform(0, 5)))
+        for _ in range(int(rng.integers(1, 8))):
+            b.segment(float(rng.uniform(0.01, 0.5)), float(rng.uniform(-50, 50)),
+                      accel=float(rng.uniform(-10, 10)))
+        p = b.build()
+        v = p.sample(np.linspace(0.0, p.duration, 2001)).v
+        assert np.max(np.abs(v)) <= _peak_speed(p) * (1 + 1e-12)

@@ -7,8 +7,13 @@ every cycle. Two checkouts that print the same digests move every axis identical
 for bit, cycle by cycle; a faster planner (issue 14) is checked this way against the one
 it replaces:
 
-    PYTHONPATH=<old>/src python tools/motion_hash.py [N]
-    PYTHONPATH=<new>/src python tools/motion_hash.py [N]
+    PYTHONPATH=<old>/src python tools/motion_hash.py [N] [--save old.npz]
+    PYTHONPATH=<new>/src python tools/motion_hash.py [N] [--compare old.npz]
+
+A change allowed to move the result by rounding only (issue 14: "bit for bit or within
+1e-9") is checked with `--save` on the old checkout and `--compare` on the new one: it
+prints the largest difference of any axis position in any cycle (pulses), and of the
+command index, between the two runs (a different cycle count is reported as such).
 """
 
 from __future__ import annotations
@@ -29,8 +34,9 @@ from openmotion.program.runjob import work_origin  # noqa: E402
 from openmotion.program.runner import ProgramRunner, RunState  # noqa: E402
 
 
-def stream_digest(n: int) -> tuple[int, str]:
-    """(cycles, digest) of the group feeder streaming n segments."""
+def stream_digest(n: int, rows: list | None = None) -> tuple[int, str]:
+    """(cycles, digest) of the group feeder streaming n segments (each cycle's positions
+    and command index appended to `rows` when given)."""
     h = hashlib.sha256()
     ctl = bs.controller()
     g = Group(ctl, ["x", "y"], units=True, feed=bs.FEED, acc_time=bs.ACC_TIME)
@@ -54,13 +60,15 @@ def stream_digest(n: int) -> tuple[int, str]:
     while not (done[0] and g.state is GroupState.IDLE and g.queue_length == 0):
         ctl.step()
         cycles += 1
-        h.update(np.array([a.position for a in g.axes] + [g.current_index],
-                          dtype=float).tobytes())
+        row = np.array([a.position for a in g.axes] + [g.current_index], dtype=float)
+        h.update(row.tobytes())
+        if rows is not None:
+            rows.append(row)
     return cycles, h.hexdigest()
 
 
-def program_digest(path: Path) -> tuple[int, str]:
-    """(cycles, digest) of a G-code program run on the default table."""
+def program_digest(path: Path, rows: list | None = None) -> tuple[int, str]:
+    """(cycles, digest) of a G-code program run on the default table (rows as above)."""
     h = hashlib.sha256()
     ctl = Controller()
     ctl.enable_all()
@@ -70,18 +78,49 @@ def program_digest(path: Path) -> tuple[int, str]:
     while run.state is RunState.RUNNING:
         ctl.step()
         cycles += 1
-        h.update(np.array([a.position for a in ctl.axes], dtype=float).tobytes())
+        row = np.array([a.position for a in ctl.axes], dtype=float)
+        h.update(row.tobytes())
+        if rows is not None:
+            rows.append(row)
     if run.state is not RunState.DONE:
         raise SystemExit(f"{path.name}: {run.state} {run.error}")
     return cycles, h.hexdigest()
 
 
+def _compare(name: str, new: np.ndarray, old: np.ndarray) -> None:
+    if new.shape != old.shape:
+        print(f"  {name}: {len(new)} cycles against {len(old)} saved: DIFFERENT")
+        return
+    diff = np.abs(new - old)
+    pos = float(diff[:, :-1].max(initial=0.0)) if name == "stream" else float(diff.max())
+    idx = float(diff[:, -1].max(initial=0.0)) if name == "stream" else 0.0
+    print(f"  {name}: largest position difference {pos:.3g} pulses, command index "
+          f"difference {idx:g}")
+
+
 def main() -> None:
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
-    cycles, digest = stream_digest(n)
+    args = sys.argv[1:]
+    save = compare = None
+    if "--save" in args:
+        save = args.pop(args.index("--save") + 1)
+        args.remove("--save")
+    if "--compare" in args:
+        compare = args.pop(args.index("--compare") + 1)
+        args.remove("--compare")
+    n = int(args[0]) if args else 1000
+    s_rows: list = []
+    p_rows: list = []
+    cycles, digest = stream_digest(n, s_rows)
     print(f"stream {n} segments: {cycles} cycles, {digest}")
-    cycles, digest = program_digest(ROOT / "examples" / "programs" / "cam_rose.ngc")
+    cycles, digest = program_digest(ROOT / "examples" / "programs" / "cam_rose.ngc", p_rows)
     print(f"cam_rose.ngc: {cycles} cycles, {digest}")
+    runs = {"stream": np.array(s_rows), "cam_rose": np.array(p_rows)}
+    if save:
+        np.savez_compressed(save, **runs)
+    if compare:
+        old = np.load(compare)
+        for name, new in runs.items():
+            _compare(name, new, old[name])
 
 
 if __name__ == "__main__":

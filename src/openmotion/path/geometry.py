@@ -188,13 +188,17 @@ class Line:
 
     @property
     def max_abs_tangent(self) -> Array:
-        """Per axis, the largest |tangent component| along the element."""
-        return frozen(np.abs(self.direction))
+        """Per axis, the largest |tangent component| along the element (computed once: the
+        queue checks and the look-ahead ask for it on every line)."""
+        out = self.__dict__.get("_abs_dir")
+        if out is None:
+            out = self.__dict__["_abs_dir"] = frozen(np.abs(self.direction))
+        return out
 
     @property
     def axis_accel_weight(self) -> Array:
         """Per axis, max of sqrt(t_i**2 + n_i**2) (n: unit normal); bounds axis accelerations."""
-        return frozen(np.abs(self.direction))
+        return self.max_abs_tangent
 
     def point(self, s: ArrayLike) -> Array:
         """Point at path position s; shape s.shape + (N,)."""

@@ -520,7 +520,12 @@ class Group(GroupSettings):
         """Linear interpolation to `target` (all logical axes) at the feed."""
         start = self._start_point()
         p = self._point("target", target, start if relative else None)
-        el = Line(start, p)
+        if p.size >= 2:  # both points checked (finite, in range, one per axis): not again
+            a, b = np.array(start, dtype=float), np.array(p, dtype=float)
+            a.flags.writeable = b.flags.writeable = False
+            el = Line.between(a, b)  # the same line as Line(start, p), bit for bit
+        else:
+            el = Line(start, p)
         if el.length == 0.0:
             raise GroupError(ERR_ARGUMENT, "target must differ from the start (zero-length move)")
         return self._push_path(el, p)

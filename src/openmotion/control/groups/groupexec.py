@@ -188,8 +188,16 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
         return np.asarray(coords, dtype=float) * self._k
 
     def _caps(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per-axis speed and acceleration caps in logical units (from the pulse caps)."""
-        return self._vmax / self._ppu, self._amax / self._ppu
+        """Per-axis speed and acceleration caps in logical units (from the pulse caps);
+        kept while the three arrays are the same objects (settings replace them, never
+        write into them), as every corner and element asks."""
+        memo = self.__dict__.get("_caps_memo")
+        vm, am, ppu = self._vmax, self._amax, self._ppu
+        if memo is not None and memo[0] is vm and memo[1] is am and memo[2] is ppu:
+            return memo[3]
+        out = (vm / ppu, am / ppu)
+        self._caps_memo = (vm, am, ppu, out)
+        return out
 
     def _pulse_profiles(self, profiles: list[Profile]) -> list[Profile]:
         """Axis profiles planned in logical units -> command pulses."""
@@ -430,9 +438,19 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             return  # a command run alone, or a time-overlap blend: no chain to join
         if t < plan.t0 or not self._joins(plan.tj, self._queue[0], plan.limits.str_vel):
             return  # (a plan starting later in this cycle joins from the next one)
+        reach = max(self._reach(self._queue[0], plan.tj), self._reach(r.cmds[-1], plan.tj))
+        memo = self.__dict__.get("_have_memo")
+        if memo is not None and memo[0] is plan and t >= memo[1]:
+            # a lower bound of the length ahead from the last evaluation and the plan's
+            # peak raw speed: no join while it holds the reach (what the evaluation would
+            # say), without evaluating s(t) every cycle
+            dt = t - memo[1]
+            low = memo[2] - memo[3] * dt * (1.0 + 1e-9) - 1e-9 * max(1.0, plan.chain.length)
+            if low >= reach:
+                return
         have = plan.remaining(t)
-        if have >= self._reach(self._queue[0], plan.tj) and have >= self._reach(
-                r.cmds[-1], plan.tj):
+        self._have_memo = (plan, t, have, _peak_speed(plan.raw))
+        if have >= reach:
             return
         new = self._take(plan.tj, have, [r.cmds[-1]])
         if not new:
@@ -815,6 +833,17 @@ class GroupEngine(AsyncJoin, LookaheadSettings):
             for a in self.axes:
                 if a.state is not AxisState.ERROR_STOP:
                     a.stop_immediately()
+
+
+def _peak_speed(p: Profile) -> float:
+    """The largest |speed| a profile reaches (at a segment's ends: its pieces have constant
+    jerk at most, so also at a zero of the acceleration inside one, bounded here by
+    |v0| + |a0|*dt + |j|*dt**2/2), and its end speed."""
+    if not p.n_segments:
+        return abs(p.end.v)
+    dts = p.dt if p.dt is not None else np.diff(np.append(p.t0, p.duration))
+    top = np.abs(p.v0) + np.abs(p.a0) * dts + 0.5 * np.abs(p.j) * dts * dts
+    return max(float(np.max(top)), abs(p.end.v), abs(p.start.v))
 
 
 def _section(sp: Profile, u: float, w: float) -> Profile:

@@ -40,7 +40,7 @@ from ...path import ElementSpeeds, Line, plan_speeds
 from ...path.contour import contour_error  # noqa: F401 - re-exported (was defined here)
 from ...path.geometry import PathElement
 from ...path.lookahead import speed_caps, tangential_accels
-from ...profile.segments import Profile, ProfileBuilder
+from ...profile.segments import Profile, State
 from .pathpoints import ElementTable
 
 #: plan_speeds' default tangential share of an arc's acceleration budget (lookahead step 1)
@@ -158,9 +158,28 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
     v = np.sqrt(v2)
     ds = np.diff(knots)
     dv2 = np.diff(v2)
-    b = ProfileBuilder(float(knots[0]), float(v[0]), v_before=0.0 if curve.jump else None)
+    # ProfileBuilder's segments written out (direction +1, jerk 0): the same float
+    # operations in the same order, without a method call per piece (a chain of
+    # hundreds of elements is one such loop per re-plan)
+    p, vcur, acur, t = float(knots[0]), float(v[0]), 0.0, 0.0
+    start = State(p, 0.0 if curve.jump else vcur, 0.0)
+    rows: list[tuple[float, float, float, float, float]] = []
+    dts: list[float] = []
+    labels: list[str] = []
+
+    def piece(dt: float, label: str) -> None:
+        nonlocal p, vcur, acur, t
+        rows.append((t, p, vcur, acur, 0.0))
+        dts.append(dt)
+        labels.append(label or f"segment {len(labels)}")
+        p = p + dt * (vcur + dt * (acur / 2.0 + dt * 0.0 / 6.0))
+        vcur = vcur + dt * (acur + dt * 0.0 / 2.0)
+        acur = acur + dt * 0.0
+        t += dt
+
     if lead > 0.0:
-        b.segment(lead, 0.0, accel=0.0, label="dwell")
+        acur = 0.0
+        piece(lead, "dwell")
     last = len(ds) - 1
     # a stall is a piece crawling at a speed rounding left (> 1e6 s at under 1e-6 of the
     # curve's peak); a long piece at a real speed is a long path (2^45 pulses at a low feed)
@@ -178,12 +197,25 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
                 continue
             raise InfeasibleError("path speed curve stalls at rest before its end")
         dt = 2.0 * d / vm  # exact for constant acceleration, also when a = 0
-        b.set_velocity(vl[k])
-        b.segment(dt, 0.0, accel=a)
+        vcur = vl[k]
+        acur = a
+        if dt > 0.0:
+            rows.append((t, p, vcur, acur, 0.0))
+            dts.append(dt)
+            labels.append(f"segment {len(labels)}")
+            p = p + dt * (vcur + dt * (acur / 2.0 + dt * 0.0 / 6.0))
+            vcur = vcur + dt * (acur + dt * 0.0 / 2.0)
+            acur = acur + dt * 0.0
+            t += dt
         if dwell > 0.0 and vl[k + 1] == 0.0 and k < last:
-            b.set_velocity(0.0)
-            b.segment(dwell, 0.0, accel=0.0, label="dwell")
-    return b.build(end_p=float(s_end))
+            vcur = 0.0
+            acur = 0.0
+            piece(dwell, "dwell")
+    arr = np.array(rows, dtype=np.float64).reshape(-1, 5)
+    return Profile(t0=arr[:, 0].copy(), p0=arr[:, 1].copy(), v0=arr[:, 2].copy(),
+                   a0=arr[:, 3].copy(), j=arr[:, 4].copy(), duration=t, start=start,
+                   end=State(float(s_end), 0.0, 0.0), labels=tuple(labels),
+                   dt=np.array(dts, dtype=np.float64))
 
 
 # -------------------------------------------------------------------------- chains
@@ -245,19 +277,29 @@ class Chain:
         else:  # one side follows its accelerations
             dec = _cat(self.accels if self.decels is None else self.decels,
                        accels if decels is None else decels)
-        return Chain(head + tuple(elements), self.owners + tuple(owners),
-                     _cat(self.feeds, feeds), _cat(self.accels, accels), dec,
-                     cum=np.concatenate([cum, tail]))
+        out = Chain(head + tuple(elements), self.owners + tuple(owners),
+                    _cat(self.feeds, feeds), _cat(self.accels, accels), dec,
+                    cum=np.concatenate([cum, tail]))
+        if self._table is not None and (elements or replace_last is not None):
+            # the kept rows of this chain's table and a table of the new elements only
+            kept = self._table.sliced(0, len(self.elements) - 1) \
+                if replace_last is not None else self._table
+            fresh = ([replace_last] if replace_last is not None else []) + list(elements)
+            out._table = kept.concat(ElementTable(fresh))
+        return out
 
     def dropped(self, k: int) -> tuple[Chain, float]:
         """The chain without its first k elements, s rebased to start at 0, and the offset
         subtracted (the same subtraction applied to a profile keeps both consistent)."""
         off = float(self.cum[k])
-        return Chain(self.elements[k:], self.owners[k:],
-                     None if self.feeds is None else self.feeds[k:],
-                     None if self.accels is None else self.accels[k:],
-                     None if self.decels is None else self.decels[k:],
-                     cum=self.cum[k:] - off), off
+        chain = Chain(self.elements[k:], self.owners[k:],
+                      None if self.feeds is None else self.feeds[k:],
+                      None if self.accels is None else self.accels[k:],
+                      None if self.decels is None else self.decels[k:],
+                      cum=self.cum[k:] - off)
+        if self._table is not None:
+            chain._table = self._table.sliced(k)
+        return chain, off
 
     def tail_elements(self, s0: float) -> tuple[list[PathElement], int]:
         """Elements from s0 on (the first trimmed) and the index of the first."""

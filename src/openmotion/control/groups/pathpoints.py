@@ -22,8 +22,18 @@ from ...path.geometry import Array, Line, PathElement
 _GENERIC, _LINE, _ARC = 0, 1, 2
 
 
+#: The per-element arrays of an `ElementTable` (sliced and concatenated row by row).
+_FIELDS = ("kind", "trimmed", "offset", "stop", "blen", "start", "end", "dirn", "centre",
+           "e1", "e2", "lin", "helix", "radius", "k", "rs", "lengths", "curvature")
+
+
 class ElementTable:
-    """Line/arc parameters of `elements`, row i for element i (see the module doc)."""
+    """Line/arc parameters of `elements`, row i for element i (see the module doc).
+
+    A streaming chain is re-planned at every join as the old chain (its travelled part
+    dropped, its last element perhaps trimmed by a blend) plus the new elements:
+    `sliced` and `concat` build that chain's table from the old table's rows and a table
+    of the new elements only, the same arrays value for value as building it anew."""
 
     def __init__(self, elements: Sequence[PathElement]) -> None:
         from .pathexec import Trimmed
@@ -31,48 +41,79 @@ class ElementTable:
         n = len(elements)
         dim = elements[0].dim
         self.elements = elements
-        self.kind = np.zeros(n, dtype=np.int8)
-        self.trimmed = np.zeros(n, dtype=bool)
-        self.offset = np.zeros(n)
-        self.stop = np.zeros(n)            # a Trimmed's end on its base
-        self.blen = np.zeros(n)            # length of the evaluated (base) element
-        self.start = np.zeros((n, dim))
-        self.end = np.zeros((n, dim))
-        self.dirn = np.zeros((n, dim))     # lines: unit direction
-        self.centre = np.zeros((n, dim))   # arcs: the circle frame
-        self.e1 = np.zeros((n, dim))
-        self.e2 = np.zeros((n, dim))
-        self.lin = np.zeros((n, dim))
-        self.helix = np.zeros((n, dim))
-        self.radius = np.zeros(n)
-        self.k = np.zeros(n)               # sweep / length
-        self.rs = np.zeros(n)              # radius * sweep
-        self.lengths = np.array([el.length for el in elements], dtype=float)
-        self.curvature = np.array([el.max_curvature for el in elements], dtype=float)
+        zero = np.zeros(dim)
+        kind = [_GENERIC] * n
+        trimmed = [False] * n
+        offset = [0.0] * n
+        stop = [0.0] * n                 # a Trimmed's end on its base
+        blen = [0.0] * n                 # length of the evaluated (base) element
+        start: list = [zero] * n
+        end: list = [zero] * n
+        dirn: list = [zero] * n          # lines: unit direction
+        centre: list = [zero] * n        # arcs: the circle frame
+        e1: list = [zero] * n
+        e2: list = [zero] * n
+        lin: list = [zero] * n
+        helix: list = [zero] * n
+        radius = [0.0] * n
+        k = [0.0] * n                    # sweep / length
+        rs = [0.0] * n                   # radius * sweep
         for i, el in enumerate(elements):
             base = el
+            tr = False
             if type(el) is Trimmed and type(el.base) is not Trimmed:
                 base = el.base
-                self.trimmed[i] = True
-                self.offset[i] = el.offset
-                self.stop[i] = el._stop
+                tr = True
             if type(base) is Line:
-                self.kind[i] = _LINE
-                self.dirn[i] = base.direction
+                kind[i] = _LINE
+                dirn[i] = base.direction
             elif isinstance(base, _ArcQueries):
                 f = base._frame
-                self.kind[i] = _ARC
-                self.centre[i], self.e1[i], self.e2[i] = f.centre, f.e1, f.e2
-                self.lin[i], self.helix[i] = f.lin, f.helix
-                self.radius[i] = f.radius
-                self.k[i] = f.sweep / f.length
-                self.rs[i] = f.radius * f.sweep
+                kind[i] = _ARC
+                centre[i], e1[i], e2[i] = f.centre, f.e1, f.e2
+                lin[i], helix[i] = f.lin, f.helix
+                radius[i] = f.radius
+                k[i] = f.sweep / f.length
+                rs[i] = f.radius * f.sweep
                 base = f
             else:
-                self.trimmed[i] = False
                 continue
-            self.blen[i] = base.length
-            self.start[i], self.end[i] = base.start, base.end
+            if tr:
+                trimmed[i] = True
+                offset[i] = el.offset
+                stop[i] = el._stop
+            blen[i] = base.length
+            start[i], end[i] = base.start, base.end
+        self.kind = np.array(kind, dtype=np.int8)
+        self.trimmed = np.array(trimmed, dtype=bool)
+        self.offset = np.array(offset, dtype=float)
+        self.stop = np.array(stop, dtype=float)
+        self.blen = np.array(blen, dtype=float)
+        self.radius = np.array(radius, dtype=float)
+        self.k = np.array(k, dtype=float)
+        self.rs = np.array(rs, dtype=float)
+        for name, rows in (("start", start), ("end", end), ("dirn", dirn),
+                           ("centre", centre), ("e1", e1), ("e2", e2), ("lin", lin),
+                           ("helix", helix)):
+            setattr(self, name, np.array(rows, dtype=float).reshape(n, dim))
+        self.lengths = np.array([el.length for el in elements], dtype=float)
+        self.curvature = np.array([el.max_curvature for el in elements], dtype=float)
+
+    def sliced(self, a: int, b: int | None = None) -> ElementTable:
+        """The table of elements[a:b] (rows a..b-1)."""
+        out = object.__new__(ElementTable)
+        out.elements = self.elements[a:b]
+        for name in _FIELDS:
+            setattr(out, name, getattr(self, name)[a:b])
+        return out
+
+    def concat(self, other: ElementTable) -> ElementTable:
+        """This table's elements followed by `other`'s."""
+        out = object.__new__(ElementTable)
+        out.elements = tuple(self.elements) + tuple(other.elements)
+        for name in _FIELDS:
+            setattr(out, name, np.concatenate([getattr(self, name), getattr(other, name)]))
+        return out
 
     def _base_s(self, k: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Local s on the evaluated element: a Trimmed adds its offset (capped at its end
