@@ -256,6 +256,18 @@ def test_sync_solves_stretch_precisely():
         assert last.v == pytest.approx(0.0, abs=1e-9)
 
 
+def test_sync_tiny_distance_beside_a_long_move():
+    """A distance of 1e-200 synced to a move of 1 pulse: its cruise cap is ~1e-200 pps,
+    whose square underflows (the Python cap search raised ZeroDivisionError here)."""
+    for tiny in (8.276690573396938e-252, 1e-200):
+        long_move, short = jerk_limited_sync([1.0, tiny], 1.0, 1.0, 1.0)
+        assert short.duration == long_move.duration
+        assert short.end.p == tiny and short.end.v == 0.0
+        assert np.isfinite(short.dt).all() and short.dt.sum() == pytest.approx(
+            short.duration, rel=1e-12)
+        assert_valid_move(short, start=(0.0,), target=tiny, v_max=1.0, a_max=1.0, j_max=1.0)
+
+
 # ------------------------------------------------------------------ validation
 @pytest.mark.parametrize(
     ("kwargs", "name"),
@@ -317,12 +329,14 @@ def test_tiny_distances_and_extreme_magnitudes_never_fail():
 @given(st.floats(-1e6, 1e6), st.floats(1e-3, 1e5), st.floats(1e-3, 1e5), st.floats(1e-3, 1e5),
        st.floats(1e-3, 1e5), st.floats(-1e3, 1e3))
 def test_direct_build_equals_profile_builder_bit_for_bit(d, v, a, j, dd, start):
-    from openmotion.profile import jerk as J
+    """The compiled builder's profile is ProfileBuilder's, segment call by call, from the
+    oracle's phase times (tests/jerk_oracle.py)."""
+    import jerk_oracle as O
 
-    times = J.phase_times(abs(d), v, a, dd, j)
+    times = O.phase_times(abs(d), v, a, dd, j)
     assume(all(math.isfinite(x) for x in times))
-    p1 = J._build(start, d, times, a, dd, j)
-    p2 = J._build_with_builder(start, d, times, a, dd, j)
+    p1 = jerk_limited(d, v, a, j, d_max=dd, start=start)
+    p2 = O.build_with_builder(start, d, times, a, dd, j)
     for f in ("t0", "p0", "v0", "a0", "j", "dt"):
         x, y = getattr(p1, f), getattr(p2, f)
         assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes(), f
