@@ -31,7 +31,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .. import _profile as _c
-from ..errors import MotionError, check_distance
+from ..errors import COUNTER28_MAX, MotionError, check_distance
 from ..limits import (
     PPS2_MAX,
     PPS2_MIN,
@@ -39,6 +39,7 @@ from ..limits import (
     PPS3_MIN,
     PPS_MAX,
     PPS_MIN,
+    PULSES_MAX,
     check_pulses,
     check_quantity,
 )
@@ -146,18 +147,42 @@ def _per_axis(name: str, value: float | Sequence[float] | None, n: int) -> list:
     return vals
 
 
-def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float],
-                      a_max: float | Sequence[float], j_max: float | Sequence[float], *,
-                      d_max: float | Sequence[float] | None = None,
-                      starts: Sequence[float] | None = None) -> list[Profile]:
-    """Jerk-limited moves of several axes that start together and all last T.
+def _plain(vals: object, n: int, lo: float, hi: float) -> Sequence[float] | None:
+    """`vals` when it is n floats within [lo, hi] (a float: repeated n times), else None:
+    what the per-value checks would return, decided without them (the common case)."""
+    if type(vals) is float:
+        return (vals,) * n if lo <= vals <= hi else None
+    if (type(vals) is not list and type(vals) is not tuple) or len(vals) != n:
+        return None
+    for x in vals:
+        if type(x) is not float or not lo <= x <= hi:
+            return None
+    return vals
 
-    T is the longest per-axis optimum; every other axis cruises slower so that its profile
-    lasts exactly T (within its own limits). A zero-distance axis dwells for T.
-    Limits are scalars or one value per axis.
-    """
+
+def _plain_axes(distances: object, v_max: object, a_max: object, j_max: object,
+                d_max: object, starts: object) -> tuple[Sequence[float], ...] | None:
+    """(distances, starts, v, a, d, j) per axis when every value is a float within its
+    range, else None (then `_checked_axes` checks one by one and names the bad value)."""
+    if (type(distances) is not list and type(distances) is not tuple) or not distances:
+        return None
+    n = len(distances)
+    dists = _plain(distances, n, -float(COUNTER28_MAX), float(COUNTER28_MAX))
+    st = (0.0,) * n if starts is None else _plain(starts, n, -PULSES_MAX, PULSES_MAX)
+    vs = _plain(v_max, n, PPS_MIN, PPS_MAX)
+    as_ = _plain(a_max, n, PPS2_MIN, PPS2_MAX)
+    js = _plain(j_max, n, PPS3_MIN, PPS3_MAX)
+    ds = as_ if d_max is None else _plain(d_max, n, PPS2_MIN, PPS2_MAX)
+    if dists is None or st is None or vs is None or as_ is None or js is None or ds is None:
+        return None
+    return dists, st, vs, as_, ds, js
+
+
+def _checked_axes(distances: object, v_max: object, a_max: object, j_max: object,
+                  d_max: object, starts: object) -> tuple[Sequence[float], ...]:
+    """(distances, starts, v, a, d, j) per axis, every value checked by name."""
     try:
-        dists = list(distances)
+        dists = list(distances)  # type: ignore[call-overload]
     except TypeError:
         raise MotionError("distances must be a sequence of numbers") from None
     n = len(dists)
@@ -177,6 +202,23 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
         except MotionError as e:
             raise MotionError(f"axis {i}: {e}") from None
     vs, as_, ds, js = zip(*lims, strict=True)
+    return dists, st, vs, as_, ds, js
+
+
+def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float],
+                      a_max: float | Sequence[float], j_max: float | Sequence[float], *,
+                      d_max: float | Sequence[float] | None = None,
+                      starts: Sequence[float] | None = None) -> list[Profile]:
+    """Jerk-limited moves of several axes that start together and all last T.
+
+    T is the longest per-axis optimum; every other axis cruises slower so that its profile
+    lasts exactly T (within its own limits). A zero-distance axis dwells for T.
+    Limits are scalars or one value per axis.
+    """
+    axes = _plain_axes(distances, v_max, a_max, j_max, d_max, starts)
+    if axes is None:
+        axes = _checked_axes(distances, v_max, a_max, j_max, d_max, starts)
+    dists, st, vs, as_, ds, js = axes
     solved = _c.synced(dists, st, vs, as_, ds, js)
     if solved is None:
         raise MotionError(_TIMES_RANGE)
@@ -184,7 +226,8 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
     if t_sync <= 0.0:  # nothing moves (or only by amounts below the times' resolution)
         return [_profile(bytearray(), 0, x, 0.0, 0.0) for x in st]
     out: list[Profile] = []
-    cols = np.frombuffer(buf).reshape(6, -1)  # every moving axis's pieces, end to end
+    flat = np.frombuffer(buf)  # every moving axis's pieces end to end, field by field
+    m = len(flat) // 6
     k = 0
     for i, mask in enumerate(masks):
         if mask < 0:  # not moving: a dwell of T
@@ -193,9 +236,11 @@ def jerk_limited_sync(distances: Sequence[float], v_max: float | Sequence[float]
             out.append(b.build(end_p=st[i]))
             continue
         labels = _LABELS[mask]
-        n_k = len(labels)
-        t0, p0, v0, a0, jk, dt = cols[:, k:k + n_k]
-        k += n_k
+        e = k + len(labels)
+        t0, p0, v0, a0 = flat[k:e], flat[m + k:m + e], flat[2 * m + k:2 * m + e], \
+            flat[3 * m + k:3 * m + e]
+        jk, dt = flat[4 * m + k:4 * m + e], flat[5 * m + k:5 * m + e]
+        k = e
         z = 0.0 if dists[i] >= 0.0 else -0.0
         prof = object.__new__(Profile)
         # every axis pinned to T (float sums of phase times differ from T in the last ulp)
