@@ -76,6 +76,30 @@ static double fsum(const double *xs, int n)
     return hi;
 }
 
+/* math.fsum of seven finite values, fast: a cascade of exact two-sums gives the float sum
+ * s and error terms e_k with s + sum(e_k) exact; r = fl(s + fl(sum e_k)) is the exactly
+ * rounded sum whenever the rest, bounded by |e2| + 8u*sum|e_k|, stays strictly inside half
+ * the gap to r's neighbours. Otherwise (near a tie, or r = 0) the full `fsum` decides. */
+static double fsum7(const double *x)
+{
+    double s = x[0], c = 0.0, ca = 0.0;
+    for (int k = 1; k < 7; k++) {
+        double t = s + x[k];
+        double bp = t - s;
+        double e = (s - (t - bp)) + (x[k] - bp);
+        s = t;
+        c += e;
+        ca += fabs(e);
+    }
+    double r = s + c;
+    double bp = r - s;
+    double e2 = (s - (r - bp)) + (c - bp);
+    double up = nextafter(r, INFINITY) - r, down = r - nextafter(r, 0.0);
+    double half = 0.5 * (up < down ? up : down);
+    if (fabs(e2) + 8.0 * 1.1102230246251565e-16 * ca < half) return r;
+    return fsum(x, 7);
+}
+
 /* ------------------------------------------------------------ closed-form pieces */
 static void ramp(double v, double x, double j, double *tj, double *ta)
 {
@@ -330,7 +354,7 @@ static PyObject *py_duration(PyObject *self, PyObject *const *args, Py_ssize_t n
     if (floats(args, nargs, 5, x, "duration") < 0) return NULL;
     phase_times(x[0], x[1], x[2], x[3], x[4], t);
     if (!all_finite(t)) Py_RETURN_NONE;
-    return PyFloat_FromDouble(fsum(t, 7));
+    return PyFloat_FromDouble(fsum7(t));
 }
 
 PyDoc_STRVAR(rest_to_rest_doc,
@@ -416,7 +440,7 @@ static PyObject *py_synced(PyObject *self, PyObject *const *args, Py_ssize_t nar
         }
     }
     for (Py_ssize_t i = 0; i < n; i++) { /* max() of the fsum durations, first on ties */
-        double d = fsum(mem + 14 * i + 6, 7);
+        double d = fsum7(mem + 14 * i + 6);
         if (first || d > t_sync) t_sync = d;
         first = 0;
     }
@@ -427,7 +451,7 @@ static PyObject *py_synced(PyObject *self, PyObject *const *args, Py_ssize_t nar
         for (Py_ssize_t i = 0; i < n; i++) {
             double *ax = mem + 14 * i, *tm = ax + 6;
             if (ax[0] == 0.0) continue;
-            if (fsum(tm, 7) < t_sync) {
+            if (fsum7(tm) < t_sync) {
                 double len = fabs(ax[0]);
                 double cap = synced_cap(len, t_sync, ax[3], ax[4], ax[5], ax[13]);
                 times_at(len, ax[2], ax[3], ax[4], ax[5], ax[13], 1, cap, tm);
@@ -512,7 +536,7 @@ static PyObject *py_phases_many(PyObject *self, PyObject *const *args, Py_ssize_
         double t[7];
         phase_times(L[i], V[i], A[i], D[i], J[i], t);
         if (totals)
-            out[i] = all_finite(t) ? fsum(t, 7) : NAN;
+            out[i] = all_finite(t) ? fsum7(t) : NAN;
         else
             memcpy(out + 7 * i, t, sizeof t);
     }
