@@ -11,7 +11,11 @@ ruckig plans the same (position or velocity interface, 1 DoF). Counted:
   exactly on the target at rest (the target velocity); ruckig's = an error result;
 - durations where both succeed: within 1e-9 relative, within 1e-6, ours longer beyond
   1e-9 and by which case class (the a_max > d_max gap where ours stops and comes back,
-  a start above v_max where ruckig brakes to v_max first), the largest difference;
+  a start above v_max), the largest difference;
+- the same on the same problem only: ruckig's limits are signed (given here in the frame
+  of our final approach), ours hold in the frame of the final approach; where ruckig's
+  own plan arrives from the other side, it solved a different problem (it brakes harder
+  than our limits allow for that approach: the a_max > d_max gap);
 - CPU time per case of each planner (ruckig with reused objects).
 
     python bench/bench_retarget.py [N] [--seed S]      (default N = 100000; the issue's
@@ -136,6 +140,15 @@ class Ruckig:
         self.inp = ruckig.InputParameter(1)
         self.traj = ruckig.Trajectory(1)
 
+    def approach(self) -> float:
+        """Side the last calculated plan arrives from (+1/-1; 0: it does not move)."""
+        p = self.traj.profiles[0][0]
+        moving = [k for k in range(7) if p.t[k] > 0.0]
+        if not moving:
+            return 0.0
+        dp = p.p[moving[-1] + 1] - p.p[moving[-1]]
+        return 1.0 if dp > 0.0 else -1.0 if dp < 0.0 else 0.0
+
     def duration(self, c: Case, frame: float) -> float | None:
         r, inp = self.mod, self.inp
         inp.current_position, inp.current_velocity = [c.state.p], [c.state.v]
@@ -171,6 +184,10 @@ class Stats:
     within_1e6: int = 0
     longer: dict[str, int] = field(default_factory=dict)
     shorter: dict[str, int] = field(default_factory=dict)
+    other_side: int = 0  # ruckig's plan arrives from the other side: a different problem
+    same: int = 0  # compared on the same problem
+    same_1e9: int = 0
+    same_longer: int = 0
     max_rel: float = 0.0
     worst: Case | None = None
     t_ours: float = 0.0
@@ -205,6 +222,13 @@ def run(n: int, seed: int = 1, with_ruckig: bool = True) -> Stats:
             continue
         st.compared += 1
         r = (prof.duration - ref) / ref if ref > 0 else prof.duration
+        arrives = rk.approach() if c.v_target is None else frame
+        if arrives not in (0.0, frame):
+            st.other_side += 1
+        else:
+            st.same += 1
+            st.same_1e9 += abs(r) <= 1e-9
+            st.same_longer += r > 1e-9
         if abs(r) <= 1e-9:
             st.within_1e9 += 1
         if abs(r) <= 1e-6:
@@ -237,13 +261,19 @@ def report(st: Stats) -> None:
               f"{dict(st.longer) or ''}; ours shorter < -1e-9: {sum(st.shorter.values())} "
               f"{dict(st.shorter) or ''}; "
               f"max |rel diff| {st.max_rel:.2e}")
+        print(f"  same problem (ruckig's plan arrives from our approach side; {st.other_side} "
+              f"where it arrives from the other, a different problem): {st.same} cases, "
+              f"within 1e-9 {st.same_1e9} ({100 * st.same_1e9 / max(1, st.same):.3f} %), "
+              f"ours longer > 1e-9: {st.same_longer}")
         ours_us = 1e6 * st.t_ours / st.n
         ruckig_us = 1e6 * st.t_ruckig / max(1, st.compared + st.ruckig_fail)
         print(f"  CPU per case: openmotion {ours_us:.1f} us, ruckig {ruckig_us:.1f} us "
               f"(reused objects); ratio {ruckig_us / ours_us:.2f}x")
         ok = fails == 0 and st.within_1e9 == st.compared
         print(f"  goal (0 failures, every duration within 1e-9 of ruckig's): "
-              f"{'met' if ok else 'not met'}")
+              f"{'met' if ok else 'not met'}; on the same problem: 0 failures and never "
+              f"longer than ruckig: {'met' if fails == 0 and st.same_longer == 0 else 'not met'}"
+              f", within 1e-9: {'met' if st.same_1e9 == st.same else 'not met'}")
         if st.worst is not None:
             print(f"  largest difference at {st.worst}")
 

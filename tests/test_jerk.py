@@ -256,6 +256,38 @@ def test_sync_solves_stretch_precisely():
         assert last.v == pytest.approx(0.0, abs=1e-9)
 
 
+def test_sync_plain_float_path_equals_the_checked_path():
+    """Floats within range skip the per-value checks; other number types take them: the
+    same profiles either way, and a bad value in either form is refused by name."""
+    dists, v, a, j, d = [120.0, -35.5, 0.0], [400.0, 50.0, 9.0], 1000.0, [1e4, 1e3, 10.0], 700.0
+    fast = jerk_limited_sync(dists, v, a, j, d_max=d, starts=(1.0, 2.0, 3.0))
+    slow = jerk_limited_sync(np.array(dists), [np.float64(x) for x in v], 1000, j,
+                             d_max=np.float64(d), starts=[1, 2, 3])
+    for p, q in zip(fast, slow, strict=True):
+        assert p.t0.tobytes() == q.t0.tobytes() and p.p0.tobytes() == q.p0.tobytes()
+        assert (p.duration, p.start, p.end, p.labels) == (q.duration, q.start, q.end, q.labels)
+    for kw, name in (({"distances": [1.0, 2.0**27]}, r"distances\[1\]"),
+                     ({"v_max": [1.0, 2e9]}, r"axis 1: v_max"),
+                     ({"d_max": [1.0, float("nan")]}, r"axis 1: d_max"),
+                     ({"starts": (0.0, 2.0**41)}, r"starts\[1\]")):
+        args = {"distances": [1.0, 2.0], "v_max": 1.0, "a_max": 1.0, "j_max": 1.0} | kw
+        with pytest.raises(MotionError, match=name):
+            jerk_limited_sync(args.pop("distances"), args.pop("v_max"), args.pop("a_max"),
+                              args.pop("j_max"), **args)
+
+
+def test_sync_tiny_distance_beside_a_long_move():
+    """A distance of 1e-200 synced to a move of 1 pulse: its cruise cap is ~1e-200 pps,
+    whose square underflows (the Python cap search raised ZeroDivisionError here)."""
+    for tiny in (8.276690573396938e-252, 1e-200):
+        long_move, short = jerk_limited_sync([1.0, tiny], 1.0, 1.0, 1.0)
+        assert short.duration == long_move.duration
+        assert short.end.p == tiny and short.end.v == 0.0
+        assert np.isfinite(short.dt).all() and short.dt.sum() == pytest.approx(
+            short.duration, rel=1e-12)
+        assert_valid_move(short, start=(0.0,), target=tiny, v_max=1.0, a_max=1.0, j_max=1.0)
+
+
 # ------------------------------------------------------------------ validation
 @pytest.mark.parametrize(
     ("kwargs", "name"),
@@ -317,12 +349,16 @@ def test_tiny_distances_and_extreme_magnitudes_never_fail():
 @given(st.floats(-1e6, 1e6), st.floats(1e-3, 1e5), st.floats(1e-3, 1e5), st.floats(1e-3, 1e5),
        st.floats(1e-3, 1e5), st.floats(-1e3, 1e3))
 def test_direct_build_equals_profile_builder_bit_for_bit(d, v, a, j, dd, start):
-    from openmotion.profile import jerk as J
+    """The compiled builder's profile is ProfileBuilder's, segment call by call, from the
+    oracle's phase times (tests/jerk_oracle.py)."""
+    import jerk_oracle as O
+    from openmotion.limits import check_pulses
 
-    times = J.phase_times(abs(d), v, a, dd, j)
+    times = O.phase_times(abs(d), v, a, dd, j)
     assume(all(math.isfinite(x) for x in times))
-    p1 = J._build(start, d, times, a, dd, j)
-    p2 = J._build_with_builder(start, d, times, a, dd, j)
+    p1 = jerk_limited(d, v, a, j, d_max=dd, start=start)
+    # from the start as validated (check_pulses makes -0.0 a 0.0)
+    p2 = O.build_with_builder(check_pulses("start", start), d, times, a, dd, j)
     for f in ("t0", "p0", "v0", "a0", "j", "dt"):
         x, y = getattr(p1, f), getattr(p2, f)
         assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes(), f

@@ -5,8 +5,9 @@
   exact stops, dwells and element breaks.
 - `plan_speeds` checks per-element feeds/accelerations in one pass: a bad value is still
   refused by name and index.
-- `jerk_limited_sync` (one array for all axes, peak velocities reused) against profiles
-  built axis by axis through `ProfileBuilder`.
+- `jerk_limited_sync` (one compiled call for all axes, peak velocities reused) against
+  profiles built axis by axis through `ProfileBuilder` from the oracle's phase times
+  (tests/jerk_oracle.py).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import jerk_oracle as O
 from openmotion.control.groups import pathexec as px
 from openmotion.errors import InfeasibleError, MotionError
 from openmotion.path import Line, plan_speeds
@@ -100,15 +102,15 @@ def test_per_element_values_still_refused_by_index(bad, rule):
 
 def _axis_by_axis(dists, v, a, j, d):
     """The synced profiles built one axis at a time through ProfileBuilder."""
-    times = [J.phase_times(abs(x), v[i], a[i], d[i], j[i]) for i, x in enumerate(dists)]
+    times = [O.phase_times(abs(x), v[i], a[i], d[i], j[i]) for i, x in enumerate(dists)]
     t_sync = max(math.fsum(t) for t in times)
     out = []
     for i, x in enumerate(dists):
         tm = times[i]
         if math.fsum(tm) < t_sync:
-            cap = J._synced_cap(abs(x), t_sync, v[i], a[i], d[i], j[i])
-            tm = J.phase_times(abs(x), v[i], a[i], d[i], j[i], v_cap=cap)
-        out.append((J._build_with_builder(0.0, x, tm, a[i], d[i], j[i]), t_sync))
+            cap = O._synced_cap(abs(x), t_sync, v[i], a[i], d[i], j[i])
+            tm = O.phase_times(abs(x), v[i], a[i], d[i], j[i], v_cap=cap)
+        out.append((O.build_with_builder(0.0, x, tm, a[i], d[i], j[i]), t_sync))
     return out
 
 

@@ -13,8 +13,11 @@ the distance of the fastest stop (a ramp to v = 0):
         then the fastest stop; the distance grows with t1 in [0, -a/J] (t1 = 0 is the
         fastest stop, t1 = -a/J is F1 at V = v_stop).
     If v_stop > v_max, F1 ramps down to V <= v_max; if even V = v_max overshoots, V is
-    searched in [0, v_max] (a braking dip at V; d(0) is the fastest stop). This competes
-    with ruckig's way (brake at full jerk until v = v_max, then F1/F2): the faster wins.
+    searched in [0, v_max] (a braking dip at V; d(0) is the fastest stop).
+  A state outside the limits (|v| > v_max, a swinging v past it, a beyond its limit) is
+  first braked at full jerk until it is within them, ruckig's rule (`brake`): the axis is
+  back under its speed limit as early as the jerk allows (safety first, even where a
+  plan that stays above v_max longer would arrive sooner); F1/F2 continue from there.
   L < d_stop: reverse through v = 0. Planned in the opposite frame, where the target now
     lies ahead of the stopping point (F1 with V > 0 from a negative velocity).
 Limits are in the frame of the final approach: a_max towards it, d_max against it (as
@@ -113,22 +116,56 @@ def _solve(f: Callable[[float], float], lo: float, hi: float) -> float:
     return lo if -flo <= fhi else hi  # keeps the root side that undershoots least
 
 
-def _brake_to_vmax(v: float, a: float, v_max: float, d_max: float, j: float) -> list[Phase]:
-    """Full-jerk braking (holding -d_max) until v = v_max, as ruckig's brake; needs
-    v_stop > v_max. Ends with a <= 0."""
-    if a < -d_max:  # beyond the braking limit: ease back to it while braking
-        t1 = (-d_max - a) / j
-        _, v_end, _ = advance(v, a, [(t1, j, None)])
-        if v_end <= v_max:  # v + a t + j t^2/2 = v_max, first crossing
-            t = (-a - math.sqrt(max(0.0, a * a - 2.0 * j * (v - v_max)))) / j
-            return [(t, j, None)]
-        return [(t1, j, None), ((v_end - v_max) / d_max, 0.0, -d_max)]
-    t = (a + math.sqrt(a * a + 2.0 * j * (v - v_max))) / j  # v + a t - j t^2/2 = v_max
-    if a - j * t >= -d_max:
-        return [(t, -j, None)]
-    t1 = (a + d_max) / j
-    _, v1, _ = advance(v, a, [(t1, -j, None)])
-    return [(t1, -j, None), (max(0.0, (v1 - v_max) / d_max), 0.0, -d_max)]
+def _velocity_brake(v: float, a: float, v_hi: float, v_lo: float, a_lo: float,
+                    j: float) -> list[Phase]:
+    """Jerk -j from (v, a) until v = v_hi, or shorter where releasing at once would swing
+    below v_lo; a held at a_lo (< 0) if it gets there first."""
+    t_a = (a - a_lo) / j
+    t_hi = a / j + math.sqrt(max(0.0, a * a + 2.0 * j * (v - v_hi))) / j
+    t_lo = a / j + math.sqrt(max(0.0, a * a / 2.0 + j * (v - v_lo))) / j
+    t_v = min(t_hi, t_lo)
+    if t_a < t_v:
+        v_a = v + t_a * (a - j * t_a / 2.0)
+        t_c = max(min(-(v_a - v_hi) / a_lo, a_lo / (2.0 * j) - (v_a - v_lo) / a_lo), 0.0)
+        return [(max(t_a, 0.0), -j, None), (t_c, 0.0, a_lo)]
+    return [(max(t_v, 0.0), -j, None)]
+
+
+def _brake_up(v: float, a: float, v_hi: float, v_lo: float, a_hi: float, a_lo: float,
+              j: float) -> list[Phase]:
+    """The brake of a state above the limits on the high side (see `brake`)."""
+    if a > a_hi:  # acceleration beyond its limit: bring it down at full jerk first
+        t_a = (a - a_hi) / j
+        if v + a * a / (2.0 * j) > v_hi:
+            return _velocity_brake(v, a, v_hi, v_lo, a_lo, j)
+        v_a = v + t_a * (a - j * t_a / 2.0)
+        if v_a < v_lo:
+            t_c = max(min(-(v_a - v_lo) / a_hi, -a_hi / (2.0 * j) - (v_a - v_hi) / a_hi), 0.0)
+            return [(t_a, -j, None), (t_c, 0.0, a_hi)]
+        return [(t_a, -j, None)]
+    return _velocity_brake(v, a, v_hi, v_lo, a_lo, j)
+
+
+def _mirror(phases: list[Phase]) -> list[Phase]:
+    return [(dt, -jk, None if pin is None else -pin) for dt, jk, pin in phases]
+
+
+def brake(v: float, a: float, v_max: float, a_max: float, d_max: float,
+          j: float) -> list[Phase]:
+    """The pre-brake of a state outside the limits (|v| > v_max, or a swinging v past it,
+    or a beyond [-d_max, a_max]), ruckig's rule: full jerk until the state is within
+    them, so the axis is back under its limits as early as the jerk allows; [] if it is
+    within. The plan to the target continues from the braked state."""
+    v_up, v_dn = v + a * a / (2.0 * j), v - a * a / (2.0 * j)  # v where a reaches 0
+    if a > a_max:
+        return _brake_up(v, a, v_max, -v_max, a_max, -d_max, j)
+    if a < -d_max:
+        return _mirror(_brake_up(-v, -a, v_max, -v_max, d_max, -a_max, j))
+    if (v > v_max and v_dn > -v_max) or (a > 0.0 and v_up > v_max):
+        return _velocity_brake(v, a, v_max, -v_max, -d_max, j)
+    if (v < -v_max and v_up < v_max) or (a < 0.0 and v_dn < -v_max):
+        return _mirror(_velocity_brake(-v, -a, v_max, -v_max, -a_max, j))
+    return []
 
 
 def _duration(phases: list[Phase]) -> float:
@@ -143,21 +180,18 @@ def plan_ahead(v: float, a: float, length: float, v_max: float, a_max: float, d_
     slack; with `reversal` the target must lie strictly beyond the stopping point (the
     approach must really come from this frame's direction).
 
-    Above v_max (v_stop > v_max) two valid plans compete and the faster wins: ramping
-    straight down to V <= v_max, or ruckig's way, braking at full jerk until v = v_max
-    (a < 0 there) and planning from that state (used only if that state cannot swing
-    past -v_max)."""
+    A state outside the limits is first braked by ruckig's rule (`brake`) and the plan
+    continues from there; if no plan continues (the target lies behind the braked
+    state's stopping point) the plan without the brake is taken."""
     direct = _plan(v, a, length, v_max, a_max, d_max, j, pos_scale, reversal)
-    if direct is None or v + a * abs(a) / (2.0 * j) <= v_max:
+    if direct is None:
+        return None
+    pre = brake(v, a, v_max, a_max, d_max, j)
+    if not pre:
         return direct
-    brake = _brake_to_vmax(v, a, v_max, d_max, j)
-    d_b, v_b, a_b = advance(v, a, brake)
-    if v_b + a_b * abs(a_b) / (2.0 * j) < -v_max:
-        return direct
+    d_b, v_b, a_b = advance(v, a, pre)
     rest = _plan(v_b, a_b, length - d_b, v_max, a_max, d_max, j, pos_scale, reversal)
-    if rest is None or _duration(brake + rest) >= _duration(direct):
-        return direct
-    return brake + rest
+    return None if rest is None else pre + rest
 
 
 def _plan(v: float, a: float, length: float, v_max: float, a_max: float, d_max: float,
