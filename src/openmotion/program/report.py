@@ -1,11 +1,14 @@
 """What a program run did: a summary (text) and an interactive HTML report (report_html.py).
 
-The runner keeps one trace sample per controller cycle (time, command index, positions in
-machine units). From it: run time, path length (linear axes), the largest contour error
-against the PROGRAMMED geometry (lines: distance to the segment; arcs: radial distance in
-the arc's plane; G0 rapids are not contour moves and are skipped; at a sample the error is
-the smallest over the executing command and its neighbours, so a blended corner counts its
-deviation from the corner, not from one side), the I/O events and faults.
+The runner keeps one trace sample per controller cycle (time, command index, commanded
+and actual (feedback) positions in machine units). From it: run time, path length (linear
+axes), the largest contour error against the PROGRAMMED geometry (lines: distance to the
+segment; arcs: radial distance in the arc's plane; G0 rapids are not contour moves and are
+skipped; at a sample the error is the smallest over the executing command and its
+neighbours, so a blended corner counts its deviation from the corner, not from one side),
+measured on the actual positions (what the machine did: planner deviation, tracking lag and
+the count quantisation) and on the commanded ones (the planner's share alone); the largest
+following error per moving axis; the I/O events and faults.
 """
 
 from __future__ import annotations
@@ -26,6 +29,16 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
+class AxisFollowing:
+    """The largest following error of one axis during a run."""
+    letter: str
+    max_error: float                # machine units (deg on rotary axes), absolute value
+    line: int                       # source line executing then (0: none)
+    time: float                     # s after the run started
+    units: str = "mm"
+
+
+@dataclass(frozen=True)
 class RunSummary:
     state: str
     passes: int
@@ -37,6 +50,12 @@ class RunSummary:
     faults: list[str] = field(default_factory=list)
     lines: int = 0                  # program lines with motion
     units: str = "mm"
+    # the contour error of the commanded positions (the planner's share; max_contour_error
+    # is measured on the actual positions the back end reported)
+    commanded_contour_error: float = 0.0
+    commanded_error_line: int = 0
+    # per moving axis: the largest |commanded - actual| and the line where it occurred
+    following: tuple[AxisFollowing, ...] = ()
 
 
 def _seg_dist(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -49,25 +68,70 @@ def _seg_dist(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _arc_dist(p: np.ndarray, arc: canon.ArcMove) -> np.ndarray:
+    """Distance in the arc's plane: radial within the arc's sweep (a slight spiral counts
+    its radius change as error, an upper bound), to the nearer end point outside it."""
     i, j = arc.plane
-    rho = np.hypot(p[:, i] - arc.centre[i], p[:, j] - arc.centre[j])
-    return np.abs(rho - 0.5 * (arc.radius + arc.end_radius)) + 0.5 * abs(arc.end_radius
-                                                                          - arc.radius)
+    dx, dy = p[:, i] - arc.centre[i], p[:, j] - arc.centre[j]
+    rho = np.hypot(dx, dy)
+    radial = np.abs(rho - 0.5 * (arc.radius + arc.end_radius)) \
+        + 0.5 * abs(arc.end_radius - arc.radius)
+    if arc.sweep >= 2.0 * math.pi:
+        return radial
+    a0 = math.atan2(arc.start[j] - arc.centre[j], arc.start[i] - arc.centre[i])
+    turn = 1.0 if arc.direction == canon.Direction.CCW else -1.0
+    phi = np.mod(turn * (np.arctan2(dy, dx) - a0), 2.0 * math.pi)
+    ends = np.minimum(np.hypot(p[:, i] - arc.start[i], p[:, j] - arc.start[j]),
+                      np.hypot(p[:, i] - arc.end[i], p[:, j] - arc.end[j]))
+    return np.where(phi <= arc.sweep, radial, ends)
 
 
-def contour_errors(run: ProgramRunner) -> tuple[np.ndarray, np.ndarray]:
+def _lag_cycles(t: np.ndarray, cmd: np.ndarray, act: np.ndarray) -> int:
+    """How many cycles the actual positions trail the commanded ones, generously: twice
+    the largest |following error| / commanded speed over the samples moving at >= 10 % of
+    the peak speed, plus one cycle (0 when actual follows commanded within a cycle)."""
+    if len(t) < 3:
+        return 0
+    speed = np.linalg.norm(np.gradient(cmd, t, axis=0), axis=1)
+    lag = np.linalg.norm(cmd - act, axis=1)
+    moving = speed >= 0.1 * float(speed.max()) if speed.max() > 0.0 else speed > 0.0
+    if not moving.any():
+        return 0
+    period = float(np.median(np.diff(t)))
+    worst = float(np.max(lag[moving] / speed[moving]))
+    if period <= 0.0 or worst <= period:
+        return 0
+    return min(len(t), int(np.ceil(2.0 * worst / period)) + 1)
+
+
+def contour_errors(run: ProgramRunner, actual: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Per trace sample: contour error (machine units, NaN when no contour move runs) and
-    the command index executing."""
+    the command index executing. `actual`: measured on the actual (feedback) positions,
+    which trail the commanded ones: a sample is then compared with every command executed
+    over the lag (`_lag_cycles`) besides its neighbours; False: the commanded positions."""
     t, idx, pos = run.trace()
+    lag = 0
+    if actual:
+        act = run.actual_trace()
+        lag = _lag_cycles(t, pos, act)
+        pos = act
     err = np.full(len(t), np.nan)
     starts = run.starts_of
+    # the lowest command a sample may still be on: the one executing `lag` cycles before
+    # (forward-filled over samples where none runs; the first one run if none ran then)
+    ran = idx[idx >= 0]
+    n_of = np.arange(len(idx))
+    last = np.maximum.accumulate(np.where(idx >= 0, n_of, 0)) if len(idx) else n_of
+    before = idx[last[np.maximum(n_of - lag, 0)]]
+    if len(ran):
+        before = np.where(before >= 0, before, ran[0])
     for k in np.unique(idx[idx >= 0]):
         op = run.op_of.get(int(k))
         if op is None or op.rapid or op.kind not in ("line", "arc"):
             continue
         sel = np.nonzero(idx == k)[0]
+        low = np.minimum(before[sel], k) - 1
         best = np.full(len(sel), np.inf)
-        for n in (k - 1, k, k + 1):
+        for n in range(int(low.min()), int(k) + 2):
             o = run.op_of.get(int(n))
             # a rapid neighbour counts: a G64 blend joins it to the cut, and the blend
             # starts on the rapid (the executed path is within P of the programmed one)
@@ -79,7 +143,7 @@ def contour_errors(run: ProgramRunner) -> tuple[np.ndarray, np.ndarray]:
                 assert o.target is not None
                 d = _seg_dist(pos[sel], starts[int(n)] / run.scales.ppu,
                               o.target / run.scales.ppu)
-            best = np.minimum(best, d)
+            best = np.minimum(best, np.where(low <= n, d, np.inf))
         err[sel] = best
     return err, idx
 
@@ -90,18 +154,35 @@ def following_errors(run: ProgramRunner) -> np.ndarray:
     return run.trace()[2] - run.actual_trace()
 
 
+def moving_axes(pos: np.ndarray) -> list[int]:
+    """Columns of a trace's positions that move during the run."""
+    return [k for k in range(pos.shape[1]) if len(pos) and np.ptp(pos[:, k]) > 1e-9]
+
+
+def worst(err: np.ndarray, idx: np.ndarray, run: ProgramRunner) -> tuple[float, int, int]:
+    """The largest contour error, its sample and source line; (0, -1, 0) when none."""
+    if not np.any(np.isfinite(err)):
+        return 0.0, -1, 0
+    k = int(np.nanargmax(err))
+    return float(err[k]), k, run.line_of(int(idx[k]))
+
+
 def summarize(run: ProgramRunner) -> RunSummary:
     """Figures of a finished (or stopped) run."""
     t, idx, pos = run.trace()
     lin = ~run.scales.rotary
     dist = float(np.sum(np.linalg.norm(np.diff(pos[:, lin], axis=0), axis=1))) \
         if len(t) > 1 and lin.any() else 0.0
-    err, _ = contour_errors(run)
-    if np.all(np.isnan(err)):
-        emax, eline = 0.0, 0
-    else:
-        k = int(np.nanargmax(err))
-        emax, eline = float(err[k]), run.line_of(int(idx[k]))
+    emax, _, eline = worst(contour_errors(run, actual=True)[0], idx, run)
+    cmax, _, cline = worst(contour_errors(run)[0], idx, run)
+    fe = np.abs(following_errors(run))
+    following = []
+    for k in moving_axes(pos):
+        w = int(np.argmax(fe[:, k]))
+        following.append(AxisFollowing(
+            letter=run.letters[k], max_error=float(fe[w, k]), line=run.line_of(int(idx[w])),
+            time=float(t[w] - run.t_start),
+            units="deg" if run.scales.rotary[k] else run.machine_units))
     end = run.t_end if run.t_end > 0.0 else (t[-1] if len(t) else run.t_start)
     return RunSummary(
         state=run.state.value, passes=run.passes_done, run_time=float(end - run.t_start),
@@ -109,17 +190,25 @@ def summarize(run: ProgramRunner) -> RunSummary:
         outputs=sum(e.kind in ("output", "sync_output") for e in run.events),
         faults=[e.text for e in run.events if e.kind == "fault"],
         lines=len({o.line for o in run.ops if o.kind in ("line", "arc")}),
-        units=run.machine_units)
+        units=run.machine_units, commanded_contour_error=cmax, commanded_error_line=cline,
+        following=tuple(following))
 
 
 def format_summary(s: RunSummary) -> str:
     """The text `openmotion run` prints."""
+    def at(line: int) -> str:
+        return f" (line {line})" if line else ""
+
     out = [f"state          {s.state} ({s.passes} pass(es))",
            f"run time       {s.run_time:.3f} s",
            f"distance       {s.distance:.3f} {s.units}",
-           f"contour error  {s.max_contour_error:.6f} {s.units} max"
-           + (f" (line {s.max_error_line})" if s.max_error_line else ""),
-           f"motion lines   {s.lines}",
+           f"contour error  {s.max_contour_error:.6f} {s.units} max{at(s.max_error_line)}"
+           " of the actual positions",
+           f"  commanded    {s.commanded_contour_error:.6f} {s.units} max"
+           f"{at(s.commanded_error_line)}"]
+    out += [f"following {f.letter:<4} {f.max_error:.6f} {f.units} max{at(f.line)}"
+            f" at {f.time:.3f} s" for f in s.following]
+    out += [f"motion lines   {s.lines}",
            f"I/O events     {s.outputs}",
            f"faults         {len(s.faults)}"]
     out += [f"  fault: {f}" for f in s.faults]
@@ -153,7 +242,7 @@ def write_report(run: ProgramRunner, out_dir: str | Path, name: str = "report",
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     s = summarize(run)
-    err, _ = contour_errors(run)
+    err, _ = contour_errors(run, actual=True)
     zero = None if origin is None else np.array([float(origin.get(k, 0.0))
                                                  for k in run.letters])
     return write_page(run, s, format_summary(s), err, out / f"{name}.html", options, zero)

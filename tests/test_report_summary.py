@@ -1,0 +1,108 @@
+"""The run summary's following-error lines and the contour error of the ACTUAL positions
+(what the machine did), against independent computations from the runner's trace."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from openmotion.config import AxisConfig, DriveConfig, MachineConfig
+from openmotion.control import Controller
+from openmotion.program import report
+from openmotion.program.runner import RunState, run_program
+
+ARC = "G21 G90 G64 G1 X5 Y2 F1200\nG2 X9 Y2 R2\nG1 Y-1\nM2\n"
+# 30 collinear 0.1 mm cuts: a 20 Hz servo trails about 0.29 mm, three cuts behind
+STRAIGHT = "G21 G90 G64\n" + "".join(f"G1 X{0.1 * i:.1f} F1200\n" for i in range(1, 31)) \
+    + "M2\n"
+
+
+def _run(program: str, servo: bool):
+    kw = {"drive": DriveConfig(type="servo", bandwidth_hz=20.0)} if servo else {}
+    axes = (AxisConfig(name="x", lead=10.0, max_speed=200.0, **kw),
+            AxisConfig(name="y", lead=5.0, max_speed=200.0, **kw),
+            AxisConfig(name="z", lead=10.0, max_speed=200.0))
+    ctl = Controller(MachineConfig(name="servo" if servo else "stepper", axes=axes))
+    ctl.enable_all()
+    run = run_program(ctl, program, timeout=60)
+    assert run.state is RunState.DONE
+    return run
+
+
+def _programmed_polyline(step: float = 2e-4) -> np.ndarray:
+    """ARC's programmed XY path, densely sampled (independent of the report's geometry)."""
+    pts = [np.column_stack([np.linspace(0, 5, 25001), np.linspace(0, 2, 25001)])]
+    # G2 X9 Y2 R2 from (5,2): centre (7,2), clockwise over the top
+    a = np.linspace(np.pi, 0.0, int(np.pi * 2 / step))
+    pts.append(np.column_stack([7 + 2 * np.cos(a), 2 + 2 * np.sin(a)]))
+    pts.append(np.column_stack([np.full(15001, 9.0), np.linspace(2, -1, 15001)]))
+    return np.concatenate(pts)
+
+
+def test_summary_has_the_largest_following_error_of_each_moving_axis():
+    run = _run(ARC, servo=True)
+    s = report.summarize(run)
+    t, idx, cmd = run.trace()
+    fe = np.abs(cmd - run.actual_trace())
+    assert [f.letter for f in s.following] == ["X", "Y"]  # Z does not move
+    for f, k in zip(s.following, (0, 1), strict=True):
+        w = int(np.argmax(fe[:, k]))
+        assert f.max_error == fe[w, k] > 0.2          # the 20 Hz servo lags ~0.29 mm
+        assert f.line == run.line_of(int(idx[w])) and f.line in (1, 2, 3)
+        assert f.time == pytest.approx(t[w] - run.t_start)
+    text = report.format_summary(s)
+    for f in s.following:
+        assert re.search(rf"^following {f.letter} +{f.max_error:.6f} mm max \(line {f.line}\)",
+                         text, re.M)
+    assert "following Z" not in text
+
+
+def test_contour_error_is_measured_on_the_actual_positions():
+    run = _run(ARC, servo=True)
+    err, idx = report.contour_errors(run, actual=True)
+    cmd_err, _ = report.contour_errors(run)
+    act = run.actual_trace()
+    # the oracle: distance of each actual point to the densely sampled programmed path
+    # (this path never comes back near itself, so the nearest point is the right one)
+    poly = _programmed_polyline()
+    sel = np.nonzero(np.isfinite(err))[0]
+    near = np.array([np.min(np.hypot(*(poly - act[i, :2]).T)) for i in sel[::7]])
+    np.testing.assert_allclose(err[sel[::7]], near, atol=2e-4)
+    s = report.summarize(run)
+    assert s.max_contour_error == pytest.approx(np.nanmax(err))
+    assert s.commanded_contour_error == pytest.approx(np.nanmax(cmd_err))
+    assert s.max_contour_error > 10 * s.commanded_contour_error  # the servo cuts the arc
+    assert "of the actual positions" in report.format_summary(s)
+
+
+def test_actual_positions_trailing_several_short_cuts_are_on_the_contour(monkeypatch):
+    run = _run(STRAIGHT, servo=True)
+    s = report.summarize(run)
+    assert s.following[0].max_error > 0.25   # about three 0.1 mm cuts behind
+    assert s.max_contour_error < 1e-9        # but always on the programmed line
+    # compared with the executing command and its neighbours only, the lag would count
+    monkeypatch.setattr(report, "_lag_cycles", lambda *a: 0)
+    assert np.nanmax(report.contour_errors(run, actual=True)[0]) > 0.1
+
+
+def test_on_an_ideal_stepper_actual_and_commanded_differ_by_the_count_only():
+    run = _run(ARC, servo=False)
+    s = report.summarize(run)
+    t, idx, cmd = run.trace()
+    assert report._lag_cycles(t, cmd, run.actual_trace()) == 0
+    count = 1.0 / run.scales.ppu
+    assert all(f.max_error <= count[0 if f.letter == "X" else 1] for f in s.following)
+    assert s.max_contour_error <= s.commanded_contour_error + float(np.max(count))
+
+
+def test_report_marks_the_worst_contour_error_where_the_machine_was(tmp_path):
+    run = _run(ARC, servo=True)
+    html = report.write_report(run, tmp_path, "servo").read_text()
+    err, idx = report.contour_errors(run, actual=True)
+    w = int(np.nanargmax(err))
+    assert f"worst contour error {err[w]:.4g} mm (line {run.line_of(int(idx[w]))}, " \
+        "actual position)" in html
+    assert '"name":"actual (feedback)"' in html.replace(": ", ":")
+    assert "contour error (actual positions)" in html and "commanded positions" in html
