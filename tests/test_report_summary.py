@@ -56,7 +56,7 @@ def test_summary_has_the_largest_following_error_of_each_moving_axis():
     for f in s.following:
         assert re.search(rf"^following {f.letter} +{f.max_error:.6f} mm max \(line {f.line}\)",
                          text, re.M)
-    assert "following Z" not in text
+    assert "following Z" not in text and "within one count" not in text
 
 
 def test_contour_error_is_measured_on_the_actual_positions():
@@ -74,7 +74,7 @@ def test_contour_error_is_measured_on_the_actual_positions():
     assert s.max_contour_error == pytest.approx(np.nanmax(err))
     assert s.commanded_contour_error == pytest.approx(np.nanmax(cmd_err))
     assert s.max_contour_error > 10 * s.commanded_contour_error  # the servo cuts the arc
-    assert "of the actual positions" in report.format_summary(s)
+    assert ", actual positions" in report.format_summary(s)
 
 
 def test_actual_positions_trailing_several_short_cuts_are_on_the_contour(monkeypatch):
@@ -92,8 +92,11 @@ def test_on_an_ideal_stepper_actual_and_commanded_differ_by_the_count_only():
     s = report.summarize(run)
     t, idx, cmd = run.trace()
     assert report._lag_cycles(t, cmd, run.actual_trace()) == 0
-    count = 1.0 / run.scales.ppu
+    count = 1.0 / np.abs(run.scales.ppu)
     assert all(f.max_error <= count[0 if f.letter == "X" else 1] for f in s.following)
+    assert all(f.count == count[0 if f.letter == "X" else 1] for f in s.following)
+    text = report.format_summary(s)
+    assert text.count(", within one count") == len(s.following) == 2
     assert s.max_contour_error <= s.commanded_contour_error + float(np.max(count))
 
 

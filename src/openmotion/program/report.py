@@ -36,6 +36,7 @@ class AxisFollowing:
     line: int                       # source line executing then (0: none)
     time: float                     # s after the run started
     units: str = "mm"
+    count: float = 0.0              # one feedback count in the same units (quantisation)
 
 
 @dataclass(frozen=True)
@@ -182,7 +183,8 @@ def summarize(run: ProgramRunner) -> RunSummary:
         following.append(AxisFollowing(
             letter=run.letters[k], max_error=float(fe[w, k]), line=run.line_of(int(idx[w])),
             time=float(t[w] - run.t_start),
-            units="deg" if run.scales.rotary[k] else run.machine_units))
+            units="deg" if run.scales.rotary[k] else run.machine_units,
+            count=float(1.0 / abs(run.scales.ppu[k]))))
     end = run.t_end if run.t_end > 0.0 else (t[-1] if len(t) else run.t_start)
     return RunSummary(
         state=run.state.value, passes=run.passes_done, run_time=float(end - run.t_start),
@@ -202,12 +204,13 @@ def format_summary(s: RunSummary) -> str:
     out = [f"state          {s.state} ({s.passes} pass(es))",
            f"run time       {s.run_time:.3f} s",
            f"distance       {s.distance:.3f} {s.units}",
-           f"contour error  {s.max_contour_error:.6f} {s.units} max{at(s.max_error_line)}"
-           " of the actual positions",
+           f"contour error  {s.max_contour_error:.6f} {s.units} max{at(s.max_error_line)},"
+           " actual positions",
            f"  commanded    {s.commanded_contour_error:.6f} {s.units} max"
            f"{at(s.commanded_error_line)}"]
     out += [f"following {f.letter:<4} {f.max_error:.6f} {f.units} max{at(f.line)}"
-            f" at {f.time:.3f} s" for f in s.following]
+            f" at {f.time:.3f} s" + (", within one count" if f.max_error <= f.count * (1 + 1e-9)
+                                     else "") for f in s.following]
     out += [f"motion lines   {s.lines}",
            f"I/O events     {s.outputs}",
            f"faults         {len(s.faults)}"]
