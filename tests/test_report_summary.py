@@ -109,3 +109,28 @@ def test_report_marks_the_worst_contour_error_where_the_machine_was(tmp_path):
         "actual position)" in html
     assert '"name":"actual (feedback)"' in html.replace(": ", ":")
     assert "contour error (actual positions)" in html and "commanded positions" in html
+
+
+def test_an_aborted_run_is_traced_until_the_axes_are_at_rest():
+    from openmotion.program.runner import ProgramRunner
+
+    ctl = Controller()
+    ctl.enable_all()
+    run = ProgramRunner(ctl, "G21 G90 G1 X100 F3000\nM2\n")
+    run.start()
+    assert ctl.run_until(lambda: ctl.time - run.t_start > 0.5, 10)
+    run.abort()                                  # a decelerating stop along the path
+    t_abort = run.t_end
+    x = ctl.axis("x")
+    assert x.is_moving
+    assert ctl.run_until(lambda: not x.is_moving, 10)
+    t, idx, pos = run.trace()
+    assert t[-1] > t_abort + 0.01                # the stop is in the trace ...
+    assert pos[-1, 0] == pytest.approx(x.position / run.scales.ppu[0])   # ... to rest
+    assert idx[-1] == idx[np.searchsorted(t, t_abort)]   # as part of the aborted line
+    n = len(t)
+    t_more = ctl.time + 0.2
+    ctl.run_until(lambda: ctl.time >= t_more, 1)
+    assert len(run.trace()[0]) == n              # and stops there
+    s = report.summarize(run)
+    assert s.state == "aborted" and s.run_time == pytest.approx(t[-1] - run.t_start)

@@ -185,7 +185,8 @@ def summarize(run: ProgramRunner) -> RunSummary:
             time=float(t[w] - run.t_start),
             units="deg" if run.scales.rotary[k] else run.machine_units,
             count=float(1.0 / abs(run.scales.ppu[k]))))
-    end = run.t_end if run.t_end > 0.0 else (t[-1] if len(t) else run.t_start)
+    end = run.t_end if run.t_end > 0.0 else run.t_start
+    end = max(end, float(t[-1])) if len(t) else end   # an abort's stop is traced to rest
     return RunSummary(
         state=run.state.value, passes=run.passes_done, run_time=float(end - run.t_start),
         distance=dist, max_contour_error=emax, max_error_line=eline,
