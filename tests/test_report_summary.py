@@ -8,9 +8,10 @@ import re
 import numpy as np
 import pytest
 
+from contour_oracle import loop_contour_errors
 from openmotion.config import AxisConfig, DriveConfig, MachineConfig
 from openmotion.control import Controller
-from openmotion.program import report
+from openmotion.program import canon, report
 from openmotion.program.runner import RunState, run_program
 
 ARC = "G21 G90 G64 G1 X5 Y2 F1200\nG2 X9 Y2 R2\nG1 Y-1\nM2\n"
@@ -134,3 +135,25 @@ def test_an_aborted_run_is_traced_until_the_axes_are_at_rest():
     assert len(run.trace()[0]) == n              # and stops there
     s = report.summarize(run)
     assert s.state == "aborted" and s.run_time == pytest.approx(t[-1] - run.t_start)
+
+
+# arcs in the three planes, a multi-turn helix, a slight spiral, G0 between G64 P cuts
+MIXED = ("G21 G90 G64 P0.01\nG0 X1 Y1\nG1 X6 Y1 F1500\nG3 X10 Y5 I0 J4\nG18 G2 X14 Z-4 I4 K0\n"
+         "G19 G3 Y9 Z0 J4 K0\nG17 G2 X10 Y9 Z-3 I-2 J0 P2\nG1 X8.0005 Y9.0005\nG0 X2 Y2\n"
+         "G1 X2 Y6\nG2 X2 Y6 I2 J0\nM2\n")
+
+
+@pytest.mark.parametrize("program, servo", [(ARC, True), (STRAIGHT, True), (MIXED, False),
+                                            (MIXED, True)])
+def test_vectorised_contour_errors_equal_the_command_by_command_oracle(program, servo):
+    run = _run(program, servo)
+    if program is MIXED:   # the oracle's every branch: three planes, part/whole/multi-turn
+        arcs = [o.source for o in run.ops if isinstance(o.source, canon.ArcMove)]
+        assert {a.plane for a in arcs} == {(0, 1), (2, 0), (1, 2)}
+        assert min(a.sweep for a in arcs) < 3 and max(a.sweep for a in arcs) > 7
+    for actual in (False, True):
+        err, idx = report.contour_errors(run, actual=actual)
+        want, widx = loop_contour_errors(run, actual=actual)
+        np.testing.assert_array_equal(idx, widx)
+        np.testing.assert_array_equal(np.isnan(err), np.isnan(want))
+        np.testing.assert_allclose(err, want, rtol=0, atol=1e-12)

@@ -59,33 +59,6 @@ class RunSummary:
     following: tuple[AxisFollowing, ...] = ()
 
 
-def _seg_dist(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    d = b - a
-    dd = float(d @ d)
-    if dd == 0.0:
-        return np.linalg.norm(p - a, axis=1)
-    u = np.clip((p - a) @ d / dd, 0.0, 1.0)
-    return np.linalg.norm(p - (a + u[:, None] * d), axis=1)
-
-
-def _arc_dist(p: np.ndarray, arc: canon.ArcMove) -> np.ndarray:
-    """Distance in the arc's plane: radial within the arc's sweep (a slight spiral counts
-    its radius change as error, an upper bound), to the nearer end point outside it."""
-    i, j = arc.plane
-    dx, dy = p[:, i] - arc.centre[i], p[:, j] - arc.centre[j]
-    rho = np.hypot(dx, dy)
-    radial = np.abs(rho - 0.5 * (arc.radius + arc.end_radius)) \
-        + 0.5 * abs(arc.end_radius - arc.radius)
-    if arc.sweep >= 2.0 * math.pi:
-        return radial
-    a0 = math.atan2(arc.start[j] - arc.centre[j], arc.start[i] - arc.centre[i])
-    turn = 1.0 if arc.direction == canon.Direction.CCW else -1.0
-    phi = np.mod(turn * (np.arctan2(dy, dx) - a0), 2.0 * math.pi)
-    ends = np.minimum(np.hypot(p[:, i] - arc.start[i], p[:, j] - arc.start[j]),
-                      np.hypot(p[:, i] - arc.end[i], p[:, j] - arc.end[j]))
-    return np.where(phi <= arc.sweep, radial, ends)
-
-
 def _lag_cycles(t: np.ndarray, cmd: np.ndarray, act: np.ndarray) -> int:
     """How many cycles the actual positions trail the commanded ones, generously: twice
     the largest |following error| / commanded speed over the samples moving at >= 10 % of
@@ -116,7 +89,6 @@ def contour_errors(run: ProgramRunner, actual: bool = False) -> tuple[np.ndarray
         lag = _lag_cycles(t, pos, act)
         pos = act
     err = np.full(len(t), np.nan)
-    starts = run.starts_of
     # the lowest command a sample may still be on: the one executing `lag` cycles before
     # (forward-filled over samples where none runs; the first one run if none ran then)
     ran = idx[idx >= 0]
@@ -125,28 +97,98 @@ def contour_errors(run: ProgramRunner, actual: bool = False) -> tuple[np.ndarray
     before = idx[last[np.maximum(n_of - lag, 0)]]
     if len(ran):
         before = np.where(before >= 0, before, ran[0])
-    for k in np.unique(idx[idx >= 0]):
-        op = run.op_of.get(int(k))
-        if op is None or op.rapid or op.kind not in ("line", "arc"):
+    geo = _Geometry(run)
+    kind = geo.kind[np.clip(idx, 0, len(geo.kind) - 1)]
+    rows = np.nonzero((idx >= 0) & (idx < len(geo.kind)) & (kind == _CUT))[0]
+    if not len(rows):
+        return err, idx
+    k, p = idx[rows], pos[rows]
+    low = np.minimum(before[rows], k) - 1
+    best = np.full(len(rows), np.inf)
+    # every candidate command from the lowest one a sample may be on to the next one; a
+    # rapid neighbour counts: a G64 blend joins it to the cut, and the blend starts on the
+    # rapid (the executed path is within P of the programmed one)
+    for back in range(int(np.max(k - low)) + 2):
+        n = k + 1 - back
+        ok = (n >= low) & (n >= 0) & (n < len(geo.kind))
+        n = np.where(ok, n, 0)
+        ok &= geo.kind[n] != _NONE
+        if not ok.any():
             continue
-        sel = np.nonzero(idx == k)[0]
-        low = np.minimum(before[sel], k) - 1
-        best = np.full(len(sel), np.inf)
-        for n in range(int(low.min()), int(k) + 2):
-            o = run.op_of.get(int(n))
-            # a rapid neighbour counts: a G64 blend joins it to the cut, and the blend
-            # starts on the rapid (the executed path is within P of the programmed one)
-            if o is None or o.kind not in ("line", "arc"):
+        d = np.full(len(rows), np.inf)
+        line = ok & ~geo.arc[n]
+        if line.any():
+            d[line] = _seg_dists(p[line], geo.a[n[line]], geo.b[n[line]])
+        arc = ok & geo.arc[n]
+        if arc.any():
+            d[arc] = geo.arc_dists(p[arc], n[arc])
+        best = np.minimum(best, d)
+    err[rows] = best
+    return err, idx
+
+
+_NONE, _MOVE, _CUT = 0, 1, 2   # no line/arc; a rapid line/arc; a contour (feed) move
+
+
+class _Geometry:
+    """The programmed lines and arcs by group command index, as arrays (machine units), so
+    contour errors are computed for all samples at once."""
+
+    def __init__(self, run: ProgramRunner) -> None:
+        m = max(run.op_of, default=-1) + 1
+        dim = len(run.letters)
+        ppu = run.scales.ppu
+        self.kind = np.zeros(m, dtype=np.int8)
+        self.arc = np.zeros(m, dtype=bool)
+        self.a = np.zeros((m, dim))
+        self.b = np.zeros((m, dim))
+        arcs: dict[int, canon.ArcMove] = {}
+        for n, o in run.op_of.items():
+            if o.kind not in ("line", "arc") or n < 0:
                 continue
+            self.kind[n] = _MOVE if o.rapid else _CUT
             if isinstance(o.source, canon.ArcMove):
-                d = _arc_dist(pos[sel], o.source)
+                self.arc[n] = True
+                arcs[n] = o.source
             else:
                 assert o.target is not None
-                d = _seg_dist(pos[sel], starts[int(n)] / run.scales.ppu,
-                              o.target / run.scales.ppu)
-            best = np.minimum(best, np.where(low <= n, d, np.inf))
-        err[sel] = best
-    return err, idx
+                self.a[n] = run.starts_of[n] / ppu
+                self.b[n] = o.target / ppu
+        # arc parameters: plane axes, centre, start/end in the plane, radii, sweep, sense
+        self.pi = np.zeros(m, dtype=int)
+        self.pj = np.ones(m, dtype=int) if dim > 1 else np.zeros(m, dtype=int)
+        self.par = np.zeros((m, 11))
+        for n, arc in arcs.items():
+            i, j = arc.plane
+            self.pi[n], self.pj[n] = i, j
+            a0 = math.atan2(arc.start[j] - arc.centre[j], arc.start[i] - arc.centre[i])
+            turn = 1.0 if arc.direction == canon.Direction.CCW else -1.0
+            self.par[n] = (arc.centre[i], arc.centre[j], arc.start[i], arc.start[j],
+                           arc.end[i], arc.end[j], arc.radius, arc.end_radius, arc.sweep,
+                           a0, turn)
+
+    def arc_dists(self, p: np.ndarray, n: np.ndarray) -> np.ndarray:
+        """Distance of each point p[r] to arc n[r] in the arc's plane: radial within the
+        arc's sweep (a slight spiral counts its radius change as error, an upper bound),
+        to the nearer end point outside it."""
+        r = np.arange(len(n))
+        x, y = p[r, self.pi[n]], p[r, self.pj[n]]
+        cx, cy, sx, sy, ex, ey, r0, r1, sweep, a0, turn = self.par[n].T
+        dx, dy = x - cx, y - cy
+        radial = np.abs(np.hypot(dx, dy) - 0.5 * (r0 + r1)) + 0.5 * np.abs(r1 - r0)
+        phi = np.mod(turn * (np.arctan2(dy, dx) - a0), 2.0 * math.pi)
+        ends = np.minimum(np.hypot(x - sx, y - sy), np.hypot(x - ex, y - ey))
+        inside = (sweep >= 2.0 * math.pi) | (phi <= sweep)
+        return np.where(inside, radial, ends)
+
+
+def _seg_dists(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each point p[r] to the segment a[r]-b[r]."""
+    d = b - a
+    dd = np.einsum("ij,ij->i", d, d)
+    u = np.einsum("ij,ij->i", p - a, d) / np.where(dd > 0.0, dd, 1.0)
+    u = np.where(dd > 0.0, np.clip(u, 0.0, 1.0), 0.0)
+    return np.linalg.norm(p - (a + u[:, None] * d), axis=1)
 
 
 def following_errors(run: ProgramRunner) -> np.ndarray:
