@@ -277,9 +277,15 @@ def test_load_machine_error_names_file(tmp_path):
     p.write_text("[axes.x]\nlead = 0\n")
     with pytest.raises(MotionError, match=r"bad\.toml: axes\.x\.lead must be > 0"):
         load_machine(p)
-    with pytest.raises(FileNotFoundError):
+    # every public entry point raises the project's error, naming the file and the cause
+    with pytest.raises(MotionError, match=r"missing\.toml': no such file"):
         load_machine(tmp_path / "missing.toml")
-    with pytest.raises(MotionError, match="path must be"):
+    with pytest.raises(MotionError, match="is a folder"):
+        load_machine(tmp_path)
+    (tmp_path / "latin1.toml").write_bytes(b"name = '\xe9'\n")
+    with pytest.raises(MotionError, match="not a UTF-8"):
+        load_machine(tmp_path / "latin1.toml")
+    with pytest.raises(MotionError, match="must be a str or path"):
         load_machine(3)
     with pytest.raises(MotionError, match="text must be a str"):
         loads_machine(b"name = 'x'")

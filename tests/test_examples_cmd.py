@@ -37,3 +37,13 @@ def test_every_listed_example_is_in_the_wheel():
     for name, _ in list_examples():
         assert any(PurePosixPath("examples/" + name).match(g) for g in globs), name
     assert (examples_root() / "xyzu.toml").is_file()
+
+
+def test_descriptions_are_whole_first_sentences_of_a_line_at_most():
+    from openmotion.examples_cmd import DESCRIBE_WIDTH, list_examples
+
+    got = dict(list_examples())
+    assert got["lathe_xz.toml"].endswith("G7 programs diameters) and Z (carriage).")
+    for name, text in got.items():
+        assert text and len(text) <= DESCRIBE_WIDTH, name
+        assert not text.endswith((",", ";", " and", " the", " on")), (name, text)

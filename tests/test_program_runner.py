@@ -84,7 +84,7 @@ def test_anisotropic_machine_runs_true_arcs():
     sel = np.isin(idx, [k for k, o in run.op_of.items() if o.kind == "arc"])
     sel &= np.hypot(p[:, 0] - 20.0, p[:, 1] - 10.0) > 0.05  # past the G64 P corner blend
     assert np.max(np.abs(np.hypot(p[sel, 0] - 25.0, p[sel, 1] - 10.0) - 5.0)) < 1e-6
-    assert summarize(run).max_contour_error < 0.001 + 1e-6
+    assert summarize(run).commanded_contour_error < 0.001 + 1e-6
 
 
 def _cruise_speeds(run: ProgramRunner, kind: str) -> np.ndarray:
@@ -140,7 +140,7 @@ def test_spiral_arc_end_is_sent_as_chords_within_tolerance():
     assert units(run)[0] == pytest.approx(-10.0005, abs=1e-9)
     assert sum(o.kind == "line" for o in run.ops) > 10
     assert not any(o.kind == "arc" for o in run.ops)
-    assert summarize(run).max_contour_error < 0.002 + 1e-3
+    assert summarize(run).commanded_contour_error < 0.002 + 1e-3
 
 
 def test_inch_units_and_work_offset():

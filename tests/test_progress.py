@@ -54,3 +54,22 @@ def test_silent_when_not_a_terminal():
     bar.status("writing the report ...")
     bar.close()
     assert out.getvalue() == ""
+
+
+def test_a_long_helix_advances_the_fraction_while_it_runs():
+    """A 3-turn helix weighs its whole length (not the 3 mm between its end points), and
+    the bar moves on while it runs instead of waiting for the next command."""
+    ctl = Controller()
+    ctl.enable_all()
+    run = ProgramRunner(ctl, "G21 G90 G17\nG1 X5 F600\nG3 X5 Y0 Z-3 I-5 J0 P3\nG1 X0\nM2\n")
+    bar = RunProgress(ctl, run, io.StringIO(), force_terminal=True)
+    run.start()
+    assert ctl.run_until(lambda: run.current_line == 3, 30)
+    t0, f0 = ctl.time, bar.fraction()
+    helix_s = 3 * 2 * 3.141592653589793 * 5.0 / 10.0    # 94 mm at 10 mm/s
+    seen = [f0]
+    while ctl.time - t0 < helix_s - 0.5:
+        ctl.run_until(lambda: False, 1.0)
+        seen.append(bar.fraction())
+    assert all(b > a for a, b in zip(seen, seen[1:], strict=False))   # moves every second
+    assert seen[-1] - f0 > 0.5          # the helix is most of the job: 94 of ~104 mm

@@ -93,7 +93,7 @@ def test_bad_pso_setups_are_refused_and_start_nothing(machine, params, message):
     svc, m = machine
     with pytest.raises(RemoteError, match=message):
         m.call("pso.set", **params)
-    assert m.call("pso.get") == {"jobs": [], "firings": 0}
+    assert m.call("pso.get") == {"jobs": [], "firings": 0, "dropped": []}
 
 
 def test_points_job_fires_once_per_point_within_its_window(machine):

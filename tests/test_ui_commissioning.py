@@ -8,8 +8,7 @@ from __future__ import annotations
 import pytest
 
 import ui_browser
-from test_ui_creator import field, goto, ready_axis
-from ui_browser import shot, status, wait_status
+from ui_browser import field, goto, ready_axis, shot, status, wait_status
 
 server = ui_browser.server
 browser = ui_browser.browser

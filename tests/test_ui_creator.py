@@ -14,7 +14,7 @@ import tomllib
 import pytest
 
 import ui_browser
-from ui_browser import shot, status, wait_status
+from ui_browser import error_of, field, goto, ready_axis, shot, status, wait_status
 
 # the fixtures of ui_browser (pytest finds them as names of this module)
 server = ui_browser.server
@@ -25,40 +25,6 @@ pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
 PAGES = ["machine", "interface", "operation", "homing", "tuning", "scope", "path", "program",
          "simulation"]
-
-
-def goto(pg, name: str) -> None:
-    pg.evaluate(f"location.hash = '#{name}'")
-    pg.wait_for_selector(f"#page-{name}.active")
-
-
-def ready_axis(pg, axis: str = "x") -> None:
-    """Operation page on `axis`, E-stop released, axis reset and servo on (through the UI)."""
-    if status(pg, "s.estop"):
-        pg.click("#estop-reset")
-        wait_status(pg, "!s.estop")
-    goto(pg, "operation")
-    pg.select_option("#axis-select", axis)
-    pg.wait_for_selector("#op-state")
-    if status(pg, f"s.axes.{axis}.state") == "ErrorStop":
-        pg.click("#op-reset")
-        wait_status(pg, f"s.axes.{axis}.state !== 'ErrorStop'")
-    if not status(pg, f"s.axes.{axis}.servo"):
-        pg.click("#op-servo")
-        try:
-            wait_status(pg, f"s.axes.{axis}.servo", 5)
-        except Exception as exc:
-            raise AssertionError(f"servo on {axis} failed: {pg.inner_text('#log')}") from exc
-    wait_status(pg, f"!s.axes.{axis}.moving", 15)
-
-
-def field(pg, form: str, name: str):
-    row = f"#{form} [data-name='{name}']"
-    return pg.locator(f"{row} input, {row} select").first
-
-
-def error_of(pg, form: str, name: str) -> str:
-    return pg.inner_text(f"#{form} [data-name='{name}'] .field-error")
 
 
 def test_every_page_opens_and_shows_the_machine(page):

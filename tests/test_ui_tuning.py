@@ -13,8 +13,7 @@ from pathlib import Path
 import pytest
 
 import ui_browser
-from test_ui_creator import error_of, field, goto, ready_axis
-from ui_browser import shot, status, wait_status
+from ui_browser import error_of, field, goto, ready_axis, shot, status, wait_status
 
 browser = ui_browser.browser
 page = ui_browser.page

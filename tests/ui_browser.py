@@ -127,9 +127,9 @@ def page(browser: object, server: Server | External) -> Iterator[object]:
     errors: list[str] = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
     pg.goto(server.url)
-    pg.wait_for_selector("#conn[data-state=open]", timeout=15000)
+    pg.wait_for_selector("#conn[data-state=open]", timeout=30_000)
     pg.wait_for_function("() => window.openmotion && window.openmotion.status !== null",
-                         timeout=15000)
+                         timeout=30_000)
     pg.page_errors = errors   # type: ignore[attr-defined]
     try:
         yield pg
@@ -161,3 +161,39 @@ def shot(pg: object, name: str) -> None:
         SHOTS.mkdir(parents=True, exist_ok=True)
         pg.screenshot(path=str(SHOTS / f"creator-{name}.png"), full_page=True)   # type: ignore[attr-defined]
 
+
+def goto(pg: object, name: str) -> None:
+    """Show the UI page `name` (its nav hash) and wait until it is the active one."""
+    pg.evaluate(f"location.hash = '#{name}'")
+    pg.wait_for_selector(f"#page-{name}.active")
+
+
+def ready_axis(pg: object, axis: str = "x") -> None:
+    """Operation page on `axis`, E-stop released, axis reset and servo on (through the UI)."""
+    if status(pg, "s.estop"):
+        pg.click("#estop-reset")
+        wait_status(pg, "!s.estop")
+    goto(pg, "operation")
+    pg.select_option("#axis-select", axis)
+    pg.wait_for_selector("#op-state")
+    if status(pg, f"s.axes.{axis}.state") == "ErrorStop":
+        pg.click("#op-reset")
+        wait_status(pg, f"s.axes.{axis}.state !== 'ErrorStop'")
+    if not status(pg, f"s.axes.{axis}.servo"):
+        pg.click("#op-servo")
+        try:
+            wait_status(pg, f"s.axes.{axis}.servo")
+        except Exception as exc:
+            raise AssertionError(f"servo on {axis} failed: {pg.inner_text('#log')}") from exc
+    wait_status(pg, f"!s.axes.{axis}.moving")
+
+
+def field(pg: object, form: str, name: str) -> object:
+    """The input (or select) of field `name` in the form with id `form` (a locator)."""
+    row = f"#{form} [data-name='{name}']"
+    return pg.locator(f"{row} input, {row} select").first
+
+
+def error_of(pg: object, form: str, name: str) -> str:
+    """The error text shown beside field `name` of form `form`."""
+    return pg.inner_text(f"#{form} [data-name='{name}'] .field-error")

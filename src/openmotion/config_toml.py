@@ -36,7 +36,7 @@ from openmotion.errors import MotionError
 
 __all__ = ["HOME_KEYS", "RESPONSE_KEYS", "check_home_table", "check_responses",
            "default_responses", "dumps_machine", "load_machine", "load_machine_settings",
-           "loads_machine", "loads_machine_settings", "machine_from_dict",
+           "loads_machine", "loads_machine_settings", "machine_from_dict", "read_machine_text",
            "machine_settings_from_dict", "machine_to_dict", "save_machine"]
 
 _TOP_KEYS = ("name", "cycle_s", "digital_inputs", "digital_outputs", "axes")
@@ -267,12 +267,30 @@ def loads_machine_settings(text: str) -> dict[str, dict[str, Any]]:
     return {a.name: settings[a.name] for a in cfg.axes}
 
 
-def load_machine_settings(path: str | os.PathLike[str]) -> dict[str, dict[str, Any]]:
-    """Read a machine file's responses and home tables (OSError if it cannot be read)."""
+def read_machine_text(path: str | os.PathLike[str], what: str = "machine file") -> str:
+    """The text of a machine file; a file that cannot be read is a MotionError naming
+    `what`, the file and the cause (no such file, a folder, not UTF-8, permission)."""
     if not isinstance(path, (str, os.PathLike)):
-        raise MotionError(f"path must be a str or path, got {path!r}")
-    with open(path, encoding="utf-8") as f:
-        text = f.read()
+        raise MotionError(f"{what} must be a str or path, got {path!r}")
+    try:
+        with open(path, encoding="utf-8") as f:
+            return f.read()
+    except FileNotFoundError:
+        raise MotionError(f"{what} {os.fspath(path)!r}: no such file") from None
+    except IsADirectoryError:
+        raise MotionError(f"{what} {os.fspath(path)!r} is a folder, not a TOML machine "
+                          "file") from None
+    except OSError as exc:
+        raise MotionError(f"{what} {os.fspath(path)!r}: cannot read "
+                          f"({exc.strerror or exc})") from None
+    except UnicodeDecodeError:
+        raise MotionError(f"{what} {os.fspath(path)!r} is not a UTF-8 TOML text file") from None
+
+
+def load_machine_settings(path: str | os.PathLike[str]) -> dict[str, dict[str, Any]]:
+    """Read a machine file's responses and home tables (MotionError if it cannot be read
+    or a table is bad)."""
+    text = read_machine_text(path)
     try:
         return loads_machine_settings(text)
     except MotionError as e:
@@ -355,11 +373,11 @@ def loads_machine(text: str) -> MachineConfig:
 
 
 def load_machine(path: str | os.PathLike[str]) -> MachineConfig:
-    """Read, parse and validate a machine file (OSError if it cannot be read)."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise MotionError(f"path must be a str or path, got {path!r}")
-    with open(path, encoding="utf-8") as f:
-        text = f.read()
+    """Read, parse and validate a machine file: the mechanism (MachineConfig; MotionError
+    if it cannot be read or is invalid). `Controller(load_machine(path))` keeps the
+    power-on stop responses and has no homing settings: the file's [axes.<name>.responses]
+    and [axes.<name>.home] tables are applied by `openmotion.open_machine(path)`."""
+    text = read_machine_text(path)
     try:
         return loads_machine(text)
     except MotionError as e:

@@ -29,18 +29,37 @@ def list_examples() -> list[tuple[str, str]]:
     return out
 
 
+#: A comment line ending in one of these goes on in the next line (a sentence cut).
+_GOES_ON = re.compile(r"(?:[,;]|\b(?:and|or|the|a|an|on|of|in|with|to|for|by|from))$",
+                      re.IGNORECASE)
+#: The longest description `openmotion examples` prints (cut at a word, with "...").
+DESCRIBE_WIDTH = 100
+
+
 def _describe(path: Path) -> str:
-    """The first comment of the file: `(name: what it is)` in G-code, `# ...` in TOML."""
+    """The first sentence of the file's leading comment (`(name: what it is)` lines in
+    G-code, `# ...` in TOML), joined over lines that break it, at most DESCRIBE_WIDTH."""
     try:
-        head = path.read_text(encoding="utf-8", errors="replace")[:400]
+        head = path.read_text(encoding="utf-8", errors="replace")[:2000]
     except OSError:
         return ""
-    m = re.match(r"\s*\(([^)]*)\)", head) or re.match(r"\s*#\s*(.*)", head)
-    if not m:
-        return ""
-    text = m.group(1).strip()
-    return text.split(":", 1)[1].strip() if text.lower().startswith(path.name.lower() + ":") \
-        else text
+    parts: list[str] = []
+    for line in head.splitlines():
+        m = re.match(r"\s*\(([^)]*)\)\s*$", line) or re.match(r"\s*#\s*(.*)", line)
+        if not m or not m.group(1).strip():
+            break
+        parts.append(m.group(1).strip())
+        if not _GOES_ON.search(parts[-1]):
+            break
+    text = " ".join(parts)
+    if text.lower().startswith(path.name.lower() + ":"):
+        text = text.split(":", 1)[1].strip()
+    end = re.search(r"\.(?:\s|$)", text)
+    if end:
+        text = text[:end.start() + 1]
+    if len(text) > DESCRIBE_WIDTH:
+        text = text[:DESCRIBE_WIDTH - 3].rsplit(" ", 1)[0].rstrip(",;:") + "..."
+    return text
 
 
 def find_example(name: str) -> Path:

@@ -12,7 +12,7 @@ import os
 from typing import Any
 
 from .config import MachineConfig
-from .config_toml import loads_machine, loads_machine_settings
+from .config_toml import loads_machine, loads_machine_settings, read_machine_text
 from .control import Controller, HomeConfig
 from .control.guard.responses import apply_machine_responses
 from .control.home.homeconf import home_configs
@@ -26,21 +26,7 @@ def read_machine_file(path: str | os.PathLike[str], what: str = "machine file"
     """The machine and its per-axis settings ({axis: {"responses", "home"}}) from one read
     of `path`; every failure is a MotionError naming `what` and the file (a bad table names
     its key, e.g. `axes.x.responses.el`)."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise MotionError(f"{what} must be a str or path, got {path!r}")
-    try:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-    except FileNotFoundError:
-        raise MotionError(f"{what} {os.fspath(path)!r}: no such file") from None
-    except IsADirectoryError:
-        raise MotionError(f"{what} {os.fspath(path)!r} is a folder, not a TOML machine "
-                          "file") from None
-    except OSError as exc:
-        raise MotionError(f"{what} {os.fspath(path)!r}: cannot read "
-                          f"({exc.strerror or exc})") from None
-    except UnicodeDecodeError:
-        raise MotionError(f"{what} {os.fspath(path)!r} is not a UTF-8 TOML text file") from None
+    text = read_machine_text(path, what)
     try:
         return loads_machine(text), loads_machine_settings(text)
     except MotionError as e:

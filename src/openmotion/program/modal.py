@@ -199,14 +199,20 @@ class Modal:
         for ax, lim in enumerate(limits):
             if lim is None:
                 continue
+            u = self._unit(ax)
             if lo[ax] < lim[0] - 1e-9 * max(1.0, abs(lim[0])):
                 raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
-                              f"machine {lo[ax]:.6g} < min {lim[0]:g}"
+                              f"machine {lo[ax]:.6g} < min {lim[0]:g} {u}"
                               f"{self._offset_note(ax)}", pos, word)
             if hi[ax] > lim[1] + 1e-9 * max(1.0, abs(lim[1])):
                 raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
-                              f"machine {hi[ax]:.6g} > max {lim[1]:g}"
+                              f"machine {hi[ax]:.6g} > max {lim[1]:g} {u}"
                               f"{self._offset_note(ax)}", pos, word)
+
+    def _unit(self, ax: int) -> str:
+        """The unit of machine axis `ax`'s positions: degrees on A/B/C, else the machine's."""
+        names = [L for L, (a, _) in self.letters.items() if a == ax]
+        return "deg" if names and names[0] in "ABC" else self.opt.machine_units
 
     def _limit_axis(self, ax: int) -> str:
         """The program's letter for machine axis `ax` (soft-limit messages)."""

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .report import following_errors
+from .report import contour_errors, following_errors, moving_axes
 
 if TYPE_CHECKING:
     from .runner import ProgramRunner
@@ -88,8 +88,10 @@ def _derivatives(t: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def _figures(run: ProgramRunner, err: np.ndarray,
              origin: np.ndarray | None = None) -> list[tuple[str, object]]:
-    """The report's figures, (heading, plotly figure) in page order. `origin`: machine
-    position of program zero per runner axis (None: drawn in machine coordinates)."""
+    """The report's figures, (heading, plotly figure) in page order. `err`: the contour
+    error per sample of the ACTUAL positions (`contour_errors(run, actual=True)`; its worst
+    point is marked where the machine was); `origin`: machine position of program zero per
+    runner axis (None: drawn in machine coordinates)."""
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
 
@@ -102,7 +104,11 @@ def _figures(run: ProgramRunner, err: np.ndarray,
     unit_of = [("deg" if rot[k] else units) for k in range(len(run.letters))]
     tt = t - run.t_start
     v, a, j = _derivatives(t, pos)
-    moving = [k for k in range(pos.shape[1]) if np.ptp(pos[:, k]) > 1e-9]
+    moving = moving_axes(pos)
+    act = run.actual_trace()
+    # the back end reports a following error beyond the count quantisation: the actual
+    # path is drawn beside the commanded one
+    lags = bool(np.any(np.abs(pos - act) > 1.5 / run.scales.ppu))
     lin = [k for k in moving if not rot[k]]
     # ---- path in program coordinates: rapids dashed, feeds coloured by the programmed
     # feed (units/min), output-on stretches over it, soft-limit box, worst contour error
@@ -112,6 +118,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
     off = np.zeros(pos.shape[1]) if origin is None else np.asarray(origin, dtype=float)
     frame = "machine" if origin is None else "program"
     ppos = pos - off
+    pact = act - off
     if len(lin) >= 2:
         cols = lin[:3]
         fig = go.Figure()
@@ -149,6 +156,10 @@ def _figures(run: ProgramRunner, err: np.ndarray,
                                mode="markers+lines", name="feed", customdata=lines,
                                text=hover, line={"color": "#bbb", "width": 1},
                                marker={"color": f, "size": 4, **scale}))
+        if lags:
+            fig.add_trace(kind(**xyz(_f32(pact[keep])), mode="lines",
+                               name="actual (feedback)", hoverinfo="skip",
+                               line={"color": "#d62728", "width": 2 if three else 1}))
         box = soft_limit_box(run, [int(c) for c in cols], off)
         if box is not None:
             # a part (its cuts) far smaller than the travel is a dot inside the box: the box
@@ -161,8 +172,9 @@ def _figures(run: ProgramRunner, err: np.ndarray,
                                line={"dash": "dot", "color": "#c33"}))
         if np.any(np.isfinite(err)):
             w = int(np.nanargmax(err))
-            fig.add_trace(kind(**xyz(ppos[w:w + 1]), mode="markers", name="worst contour "
-                               f"error {err[w]:.4g} {units} (line {run.line_of(int(idx[w]))})",
+            fig.add_trace(kind(**xyz(pact[w:w + 1]), mode="markers", name="worst contour "
+                               f"error {err[w]:.4g} {units} (line {run.line_of(int(idx[w]))}, "
+                               "actual position)",
                                marker={"symbol": "x", "size": 8 if three else 14,
                                        "color": "red"}))
         fig.add_trace(kind(**xyz(np.zeros((0, pos.shape[1]))), mode="lines",
@@ -212,16 +224,20 @@ def _figures(run: ProgramRunner, err: np.ndarray,
         fig.update_xaxes(title_text="time (s)", row=4, col=1)
         fig.update_layout(height=900, legend={"orientation": "h"})
         figs.append(("Axes (only those that move)", fig))
-    # ---- contour error against time, worst marked
+    # ---- contour error against time (actual and commanded positions), worst marked
     if np.any(np.isfinite(err)):
-        keep = screen_indices(err)
+        cerr = contour_errors(run)[0]
+        keep = screen_indices(np.column_stack([err, cerr]))
         w = int(np.nanargmax(err))
         fig = go.Figure()
-        fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(err[keep]), name="contour error"))
+        fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(err[keep]),
+                                 name="contour error (actual positions)"))
+        fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(cerr[keep]),
+                                 name="commanded positions", line={"dash": "dot"}))
         fig.add_trace(go.Scatter(x=[tt[w]], y=[err[w]], mode="markers", name=f"worst, line "
                                  f"{run.line_of(int(idx[w]))}",
                                  marker={"symbol": "x", "size": 12, "color": "red"}))
-        fig.update_layout(height=300, xaxis_title="time (s)",
+        fig.update_layout(height=300, xaxis_title="time (s)", legend={"orientation": "h"},
                           yaxis_title=f"contour error ({units})")
         figs.append(("Contour error", fig))
     # ---- following error (commanded - actual) per moving axis

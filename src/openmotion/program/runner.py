@@ -356,6 +356,8 @@ class ProgramRunner:
         self._event(state.value, self.current_line, text)
         self._ctl.remove_cycle_hook(self._on_cycle)
         self._ctl.remove_jump_observer(self._on_jump)
+        if self.group is not None and any(ax.is_moving for ax in self.group.axes):
+            self._ctl.add_cycle_hook(self._trace_to_rest)   # an abort's or fault's stop
         self.synced.detach()
         if self.options.probe_input is not None:
             self._ctl.remove_edge_hook(self._on_probe_edge)
@@ -365,6 +367,21 @@ class ProgramRunner:
             else:
                 self._closing = True
                 self._ctl.add_cycle_hook(self._close_when_idle, due=self._close_due)
+
+    def _trace_to_rest(self, ctl: Controller, t: float) -> None:
+        """After an abort or a fault the axes still decelerate: the trace goes on (as part
+        of the command that was executing) until they are at rest, so the summary and the
+        report show where the machine stopped."""
+        g = self.group
+        if g is None:
+            ctl.remove_cycle_hook(self._trace_to_rest)
+            return
+        self._trace_t.append(t)
+        self._trace_i.append(self._trace_i[-1] if self._trace_i else -1)
+        self._trace_p.append([ax.position for ax in g.axes])
+        self._trace_a.append([ax.counters.actual() for ax in g.axes])
+        if not any(ax.is_moving for ax in g.axes):
+            ctl.remove_cycle_hook(self._trace_to_rest)
 
     def _close_due(self, ctl: Controller) -> float:
         from ..control.groups.group import GroupState

@@ -6,9 +6,13 @@ compare engine (control.trigger.compare, the ZMotion PSO / HSL CMP model): `dist
 fires every `every` user units of path length over the axes (HW_PSWITCH2 mode 4 style),
 `points` fires at each point of a table when the axes pass within `window` of it (mode
 25/35 style). Each firing is a pulse of `pulse_s`. The engine is made on the first job
-(its cycle hook costs nothing before); a rebuilt machine (a power cycle) starts without
-jobs. `firings(t_lo, t_hi)` gives the engine's log with every axis's position, in the
-frame of `Axis.position`, for the path recorder.
+(its cycle hook costs nothing before). When a setting change restarts the machine (a power
+cycle: positions 0), `restore(old)` sets the old session's jobs up again on the new one
+from their user-unit setups (a points job with the points it had not reached yet; a
+finished one is not re-armed); a job the new machine cannot take (an axis or output it no
+longer has) is listed in `dropped` with the reason. `firings(t_lo, t_hi)` gives the
+engine's log with every axis's position, in the frame of `Axis.position`, for the path
+recorder.
 """
 
 from __future__ import annotations
@@ -36,6 +40,8 @@ class PsoSession:
         self.ctl = ctl
         self.engine: CompareEngine | None = None
         self._jobs: dict[int, dict[str, Any]] = {}
+        self._setups: dict[int, dict[str, Any]] = {}   # job id -> add()'s arguments
+        self.dropped: list[str] = []   # jobs a restart could not set up again, and why
 
     def add(self, kind: str, axes: list[int], output: int, pulse_s: float, *,
             every: float | None = None, start: float | None = None,
@@ -84,12 +90,42 @@ class PsoSession:
         job_id = eng.add(job)
         self._jobs[job_id] = {"id": job_id, "kind": kind, "axes": self._names(axes),
                               "output": output, "pulse_s": pulse_s, "what": what}
+        self._setups[job_id] = {"kind": kind, "axes": self._names(axes), "output": output,
+                                "pulse_s": pulse_s, "every": every, "start": start,
+                                "points": None if points is None else pts.tolist(),
+                                "window": window}
         return self._job_info(job_id)
 
     def clear(self) -> None:
         if self.engine is not None:
             self.engine.clear()
         self._jobs.clear()
+        self._setups.clear()
+        self.dropped.clear()
+
+    def restore(self, old: PsoSession) -> list[int]:
+        """Set `old`'s jobs up again on this (restarted) machine, in their order; the axes
+        they use (indices, for the path view). Never raises: a job this machine refuses
+        goes to `dropped` with the reason."""
+        used: list[int] = []
+        self.dropped = list(old.dropped)
+        for job_id, setup in old._setups.items():
+            s = dict(setup)
+            if s["kind"] == "points":
+                job = old.engine.jobs.get(job_id) if old.engine is not None else None
+                left = s["points"][job.index:] if job is not None and not job.done else []
+                if not left:
+                    continue                      # finished before the restart
+                s["points"] = left
+            try:
+                axes = [self.ctl.axis(a).index for a in s["axes"]]
+                self.add(s["kind"], axes, s["output"], s["pulse_s"], every=s["every"],
+                         start=s["start"], points=s["points"], window=s["window"])
+            except MotionError as exc:
+                self.dropped.append(f"job {job_id} ({old._jobs[job_id]['what']}): {exc}")
+                continue
+            used = axes
+        return used
 
     def _names(self, axes: list[int]) -> list[str]:
         return [self.ctl.axes[a].name for a in axes]
@@ -111,7 +147,8 @@ class PsoSession:
 
     def info(self) -> dict[str, Any]:
         n = len(self.engine.log) if self.engine is not None else 0
-        return {"jobs": [self._job_info(j) for j in self._jobs], "firings": n}
+        return {"jobs": [self._job_info(j) for j in self._jobs], "firings": n,
+                "dropped": list(self.dropped)}
 
     def firings(self, t_lo: float, t_hi: float) -> list[dict[str, Any]]:
         """Firings with t_lo < t <= t_hi: time, job, output, state and every axis's

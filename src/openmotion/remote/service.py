@@ -93,7 +93,7 @@ class MachineService:
                 self.scope.configure(scope["channels"], scope["divider"], scope["seconds"],
                                      Trigger(**scope["trigger"]))
         self.program = ProgramSession(ctl)
-        self.pso = PsoSession(ctl)   # compare jobs start anew with the machine
+        self.pso = PsoSession(ctl)   # a rebuild sets the old jobs up again (rebuild)
         self.tuning = Tuning(ctl)
         self.program.path.firing_sources.append(self.pso.firings)
         self._cmp_firings: deque[dict[str, Any]] = deque(maxlen=EVENT_KEEP)
@@ -259,9 +259,10 @@ class MachineService:
             raise MotionError(f"{what} needs every axis at rest; moving: {', '.join(busy)}")
         self.program._check_idle(what)
 
-    def rebuild(self, config: MachineConfig) -> None:
+    def rebuild(self, config: MachineConfig, keep_pso: bool = True) -> None:
         """Run `config`: the simulated machine restarts (as a power cycle of the card:
-        positions 0) with the servo state, responses, homing and scope settings kept."""
+        positions 0) with the servo state, responses, homing, scope settings and (unless
+        `keep_pso` is False: another machine file was loaded) the PSO jobs kept."""
         self._check_at_rest("changing the machine")
         enabled = {a.name for a in self.ctl.axes if a.powered}
         info = self.scope.info()
@@ -269,7 +270,7 @@ class MachineService:
                  "seconds": info["seconds"], "trigger": info["trigger"]}
         was_running = self.running
         self.stop()
-        old = self.ctl
+        old, old_pso = self.ctl, self.pso
         try:
             for name in list(self.responses):
                 if name not in config.axis_names:
@@ -278,7 +279,7 @@ class MachineService:
                 self.responses.setdefault(a.name, default_responses())
             self._build(config, scope)
         except Exception:
-            self.ctl = old
+            self.ctl, self.pso = old, old_pso
             raise
         finally:
             if was_running:
@@ -287,6 +288,10 @@ class MachineService:
             if ax.name in enabled:
                 with contextlib.suppress(MotionError):
                     ax.enable()
+        with self.ctl.lock:
+            used = self.pso.restore(old_pso) if keep_pso else []
+            if used:
+                self.program.path.follow(used)   # as pso.set does
 
     def set_interface(self, axis: Any, changes: Any) -> Path | None:
         ax = self.ctl.axis(axis)
@@ -339,7 +344,7 @@ class MachineService:
         old = (self.responses, self._home_user)
         self.responses, self._home_user = resp, home
         try:
-            self.rebuild(cfg)
+            self.rebuild(cfg, keep_pso=False)   # another machine: its jobs start anew
         except Exception:
             self.responses, self._home_user = old
             raise

@@ -38,6 +38,7 @@ from ...profile.segments import Profile, ProfileBuilder
 from ..core import planning
 from ..core.states import AxisState
 from ..guard.safety import Safety
+from .homeconf import default_home
 from .homing_modes import (
     EZ_COUNT_BASE,
     HomeConfig,
@@ -62,14 +63,26 @@ def _has_index(axis: Axis) -> bool:
 
 
 class Homing:
-    """The home sequence of one axis. `start()`, then run the controller; `status`."""
+    """The home sequence of one axis. `start()`, then run the controller; `status`.
 
-    def __init__(self, ctl: Controller, axis: int | str, config: HomeConfig, *,
-                 safety: Safety | None = None, escape_only: bool = False) -> None:
+    `config` None: the machine file's homing settings for the axis (`ctl.home_settings`,
+    which `openmotion.open_machine` fills from `[axes.<name>.home]`), else the default
+    (`homeconf.default_home`: mode 0 towards -1 at 2 % / 20 % of the axis's max speed, as
+    open_machine gives an axis without a home table)."""
+
+    def __init__(self, ctl: Controller, axis: int | str, config: HomeConfig | None = None,
+                 *, safety: Safety | None = None, escape_only: bool = False) -> None:
+        ax = ctl.axis(axis)
+        what = "config"
+        if config is None:
+            config = ctl.home_settings.get(ax.name)
+            what = f"ctl.home_settings[{ax.name!r}]"
+            if config is None:
+                config = default_home(ax)
         if not isinstance(config, HomeConfig):
-            raise MotionError(f"config must be a HomeConfig, got {type(config).__name__}")
+            raise MotionError(f"{what} must be a HomeConfig, got {type(config).__name__}")
         self.ctl = ctl
-        self.axis = ctl.axis(axis)
+        self.axis = ax
         self.config = config
         self.status = HomeStatus()
         table = config.phases()

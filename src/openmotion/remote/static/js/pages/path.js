@@ -152,7 +152,8 @@ async function refreshPso() {
 function showPso(r) {
   if (!psoInfo || !r) return;
   const jobs = r.jobs.map((j) => `#${j.id} DO${j.output}: ${j.what}${j.active ? "" : " (done)"}`);
-  psoInfo.textContent = jobs.length ? `${jobs.join(" · ")} · ${r.firings} firings` : `no PSO job · ${r.firings} firings`;
+  const dropped = (r.dropped || []).map((d) => ` · dropped at the machine restart: ${d}`).join("");
+  psoInfo.textContent = (jobs.length ? `${jobs.join(" · ")} · ${r.firings} firings` : `no PSO job · ${r.firings} firings`) + dropped;
 }
 
 function marker() {

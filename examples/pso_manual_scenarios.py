@@ -1,4 +1,4 @@
-"""The seeds' compare scenarios on the simulated machine:
+"""The compare scenarios of the ZMotion and HSL-4XMO manuals on the simulated machine:
 
 1. ZMotion HW_PSWITCH2 mode 25: the 2-D table of 8 points with maxerr 10 (UNITS=100), the
    XY axes driven through the points by straight lines; OUT0 inverts at each point.
@@ -7,7 +7,7 @@
    pulse ("="), 34,000 CMP pulses.
 
 Writes <outdir>/pso_2d.png, pso_2d.csv and pso_ccd.npz (default outdir: out/).
-Run: python examples/pso_seed_scenarios.py [outdir]
+Run: python examples/pso_manual_scenarios.py [outdir]
 """
 
 import sys
