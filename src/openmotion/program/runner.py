@@ -376,10 +376,8 @@ class ProgramRunner:
         if g is None:
             ctl.remove_cycle_hook(self._trace_to_rest)
             return
-        self._trace_t.append(t)
-        self._trace_i.append(self._trace_i[-1] if self._trace_i else -1)
-        self._trace_p.append([ax.position for ax in g.axes])
-        self._trace_a.append([ax.counters.actual() for ax in g.axes])
+        self._trace.add(t, self._trace.last_index(), [ax.position for ax in g.axes],
+                        [ax.counters.actual() for ax in g.axes])
         if not any(ax.is_moving for ax in g.axes):
             ctl.remove_cycle_hook(self._trace_to_rest)
 

@@ -48,6 +48,16 @@ class CycleTrace:
         self._a.append(actual)
         self._count += 1
 
+    def last_index(self) -> int:
+        """The command index of the last traced cycle (-1 before any): an abort's or
+        fault's stop is traced as part of the command that was executing."""
+        if self._i:
+            return self._i[-1]
+        for block in reversed(self._blocks):
+            if len(block[1]):
+                return int(block[1][-1])
+        return -1
+
     def add_span(self, ctl: Controller, group: Group, first: int, last: int,
                  positions: np.ndarray, actual: np.ndarray) -> None:
         """The rows of cycles first..last a jump crossed (`Controller.add_jump_observer`:
