@@ -46,10 +46,14 @@ def test_state_changing_endless_loop_stops_at_the_iteration_limit() -> None:
     assert "500 iterations" in msg and "O2 repeat" in msg
 
 
-def test_default_limit_is_finite_and_small() -> None:
-    msg = refused("#1 = 0\nO100 while [1]\n#1 = [#1 + 1]\nO100 endwhile\n",
-                  max_blocks=10_000_000)
-    assert "max_loop_iterations" in msg
+def test_default_limit_is_finite_and_small(long_run: bool) -> None:
+    limit = opts().max_loop_iterations  # (the default: opts() does not set it)
+    assert isinstance(limit, int) and 0 < limit <= 1_000_000
+    if long_run:  # the default limit's refusal itself (1 M iterations, ~6 s; the same
+        # guard as the small limits above)
+        msg = refused("#1 = 0\nO100 while [1]\n#1 = [#1 + 1]\nO100 endwhile\n",
+                      max_blocks=10_000_000)
+        assert "max_loop_iterations" in msg
 
 
 def test_finite_loops_run_to_the_end() -> None:
