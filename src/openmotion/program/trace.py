@@ -5,15 +5,17 @@ runs, and from the controller's jump observer for the cycles a jump crosses
 (control/core/jump.py). A jump crosses up to a few hundred cycles at once; recording them
 row by row (a command-index lookup and four list appends per cycle) was the largest part
 of a landing's Python work in real time. Here a crossed span is recorded as one block of
-arrays: the command indices come from one vectorised lookup over the span's cycle ends
-(`Group.indices_at`, the very values `Group.index_at` gives cycle by cycle), the positions
-are column picks of the observer's arrays. Single rows are gathered in lists and turned
-into a block when a span arrives, so the rows keep their cycle order.
+arrays: the positions are column picks of the observer's arrays, and the command indices
+are looked up in one vectorised pass over the cycle ends of all the spans one plan ran
+(`Group.index_lookup`: the very values `Group.index_at` gives cycle by cycle), when the
+next plan's first span arrives or the trace is read - once per plan, not per landing.
+Single rows are gathered in lists and turned into a block when a span arrives, so the
+rows keep their cycle order.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,7 +32,10 @@ class CycleTrace:
 
     def __init__(self, axes: Sequence[int]) -> None:
         self._axes = np.asarray(axes, dtype=np.intp)
-        self._blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        # (times, command indices or the lookup that gives them, positions, actual)
+        self._blocks: list[tuple[np.ndarray, Any, np.ndarray, np.ndarray]] = []
+        self._pending: list[int] = []  # blocks whose indices `_lookup` gives (one run/plan)
+        self._lookup: Any = None
         self._t: list[float] = []
         self._i: list[int] = []
         self._p: list[list[float]] = []
@@ -66,10 +71,27 @@ class CycleTrace:
         if m <= 0:
             return
         self._flush()
+        lookup = group.index_lookup()
+        if lookup is not self._lookup:  # another run or plan: look the last one's up now
+            self._resolve()
+            self._lookup = lookup
         t = ctl._t_origin + np.arange(first, last + 1) * ctl.period
-        self._blocks.append((t, group.indices_at(t), positions[:m, self._axes],
-                             actual[:m, self._axes]))
+        self._pending.append(len(self._blocks))
+        self._blocks.append((t, None, positions[:m, self._axes], actual[:m, self._axes]))
         self._count += m
+
+    def _resolve(self) -> None:
+        """The command indices of the pending spans, in one pass over their times."""
+        if not self._pending:
+            return
+        ts = [self._blocks[k][0] for k in self._pending]
+        idx = self._lookup(np.concatenate(ts) if len(ts) > 1 else ts[0])
+        at = 0
+        for k, t in zip(self._pending, ts, strict=True):
+            b = self._blocks[k]
+            self._blocks[k] = (b[0], idx[at:at + len(t)], b[2], b[3])
+            at += len(t)
+        self._pending = []
 
     def _flush(self) -> None:
         if self._t:
@@ -83,6 +105,7 @@ class CycleTrace:
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """All rows: times (s), command indices, command and actual positions (pulses)."""
         self._flush()
+        self._resolve()
         n = len(self._axes)
         if not self._blocks:
             return (np.zeros(0), np.zeros(0, dtype=np.int64), np.zeros((0, n)),

@@ -71,7 +71,24 @@ _WINDOW = 65536
  RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST, RT_INTERRUPTED, RT_LASTK,
  RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_CPU0, RT_NFIELDS) = range(20)
 
-AVAILABLE = _kernel is not None and hasattr(_kernel, "rt_paced")
+
+
+def _built_to_match() -> bool:
+    """Whether the built extension has the pacing functions this module calls, with its
+    context layout (an extension built from older sources would refuse every run): a
+    stale build falls back to the Python pacer instead."""
+    if _kernel is None or not hasattr(_kernel, "rt_paced"):
+        return False
+    st = np.zeros(RT_NFIELDS)
+    st[RT_PENDING] = -1.0  # nothing pending, no cycle counted: rt_close changes nothing
+    try:
+        _kernel.rt_close(st, *(np.zeros(1) for _ in range(4)))
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+AVAILABLE = _built_to_match()
 
 
 class HandoverLock:

@@ -155,6 +155,7 @@ class Group(GroupSettings):
         self._pre: dict[int, tuple[Any, ...]] = {}  # corners blended ahead (groupexec)
         self._index_memo: tuple[Any, ...] | None = None  # (t, run, plan, index): index_at
         self._owners_memo: tuple[Any, np.ndarray] | None = None  # (chain, owners): indices_at
+        self._lookup_memo: tuple[Any, ...] | None = None  # (run, plan, lookup): index_lookup
         self._pre_tail: tuple[int, Any] | None = None
         self._queue_size = queue_size
         self._next_index = 0
@@ -262,24 +263,43 @@ class Group(GroupSettings):
 
     def indices_at(self, ts: np.ndarray) -> np.ndarray:
         """`index_at` at each of the times `ts` (float64 array) in one vectorised pass,
-        the same values (the same arithmetic as `Profile.state_at`, `Chain.locate`): the
-        trace of the cycles a jump crossed (program/trace.py)."""
+        the same values (the same arithmetic as `Profile.state_at`, `Chain.locate`)."""
+        return self.index_lookup()(ts)
+
+    def index_lookup(self) -> Callable[[np.ndarray], np.ndarray]:
+        """`indices_at` for the present run, kept: it gives the same values later, when
+        the group runs something else (plans never change once made), so a trace of the
+        cycles a jump crossed can look them up when it is read (program/trace.py)."""
         r = self._run or self._held
-        if r is None:
-            return np.full(len(ts), -1, dtype=np.int64)
+        plan = r.plan if r is not None else None
+        memo = self._lookup_memo  # one object per run and plan (program/trace.py groups by it)
+        if memo is not None and memo[0] is r and memo[1] is plan:
+            return memo[2]
+        fn = self._make_lookup(r)
+        self._lookup_memo = (r, plan, fn)
+        return fn
+
+    def _make_lookup(self, r: Any) -> Callable[[np.ndarray], np.ndarray]:
+        if r is None or r.plan is None:
+            idx = -1 if r is None else r.cmds[0].index
+            return lambda ts: np.full(len(ts), idx, dtype=np.int64)
         plan = r.plan
-        if plan is None:
-            return np.full(len(ts), r.cmds[0].index, dtype=np.int64)
         sprof, chain = plan.sprof, plan.chain
-        if not sprof.n_segments:  # (Profile.sample needs segments; state_at: the end)
-            return np.array([self.index_at(float(t)) for t in ts], dtype=np.int64)
-        u = np.minimum(np.maximum(ts - plan.t0, 0.0), sprof.duration)
-        k = np.searchsorted(chain.cum, sprof.sample(u).p, side="right") - 1
-        np.clip(k, 0, len(chain.elements) - 1, out=k)
+        if not sprof.n_segments:  # (Profile.sample needs segments): as index_at does
+            return lambda ts: np.array([chain.owners[chain.locate(plan.s_at(float(t)))]
+                                        for t in ts], dtype=np.int64)
         owners = self._owners_memo
         if owners is None or owners[0] is not chain:  # chains never change once made
             owners = self._owners_memo = (chain, np.asarray(chain.owners, dtype=np.int64))
-        return owners[1][k]
+        table, t0, last = owners[1], plan.t0, len(chain.elements) - 1
+
+        def lookup(ts: np.ndarray) -> np.ndarray:
+            u = np.minimum(np.maximum(ts - t0, 0.0), sprof.duration)
+            k = np.searchsorted(chain.cum, sprof.sample(u).p, side="right") - 1
+            np.clip(k, 0, last, out=k)
+            return table[k]
+
+        return lookup
 
     def start_time(self, index: int, t0: float, t1: float) -> float | None:
         """The exact time in [t0, t1] at which the running (or held) chain starts command
