@@ -36,7 +36,8 @@ def test_no_failures_and_ruckig_durations(long_run):
     assert st.longer.get("start above v_max", 0) <= 1e-4 * st.compared
     assert st.within_1e9 >= 0.97 * st.compared
     # on the same problem (ruckig's plan arriving from our approach side) longer only
-    # rarely: 26 in 1e6 (seed 1; 19 of them starting above v_max, open, issue #14 note)
+    # rarely: 26 in 1e6 (seed 1): 19 start above v_max, longer by <= 1.5e-8 (ruckig ends
+    # its brake 2.2e-14 s early under a jerk of ~5e6), 7 in the a_max > d_max gap
     assert st.same_longer <= 1e-4 * st.same and st.same >= 0.99 * st.compared
     assert st.same_1e9 >= 0.995 * st.same
     # ours shorter than ruckig outside the braking-from-above case: ruckig's own slack
