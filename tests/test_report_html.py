@@ -183,3 +183,18 @@ def test_report_page_links_the_listing_and_the_path_in_the_browser(laser_page):
             assert not errors, errors
         finally:
             b.close()
+
+
+def test_a_100k_line_listing_is_small_and_cut_at_the_limit():
+    from types import SimpleNamespace
+
+    from openmotion.program.report_page import MAX_LISTING_LINES, _listing
+
+    text = "".join(f"X{30 * np.cos(k / 1e4):.4f} Y{30 * np.sin(k / 1e4):.4f}\n"
+                   for k in range(100_000))
+    ops = [SimpleNamespace(kind="line", line=n) for n in range(1, 100_001)]
+    part = _listing(SimpleNamespace(ops=ops), text)
+    data = json.loads(re.search(r"id=listing-data>(.*?)</script>", part, re.S).group(1))
+    assert len(data["lines"]) == MAX_LISTING_LINES and data["moves"] == [[1, MAX_LISTING_LINES]]
+    assert f"{100_000 - MAX_LISTING_LINES} more lines not listed" in part
+    assert len(part) < 25 * MAX_LISTING_LINES    # 20,000 lines of ~17 characters
