@@ -311,6 +311,7 @@ class ProgramRunner:
         self.synced_analog = SyncedAnalog(self._write_analog)
         self._pushed = 0
         self._last_line = 0
+        self._exec_line = 0   # line of the last command the trace saw executing
         self._step_line: int | None = None
         self.t_start = self.t_end = 0.0
         self._trace_t: list[float] = []
@@ -453,12 +454,17 @@ class ProgramRunner:
 
     @property
     def current_line(self) -> int:
-        """Source line of the command executing now (or last handled)."""
+        """Source line of the command executing now (or last handled). With commands queued
+        but none executing (before the first starts, or between two) the last one that
+        executed, else the first queued: not the last handed to the queue, which is
+        lines ahead (a progress display would jump forward and back)."""
         g = self.group
         if g is not None:
             idx = g.current_index
             if idx >= 0 and idx in self._line_of:
                 return self._line_of[idx]
+            if g.queue_length > 0:
+                return self._exec_line or next(iter(self._line_of.values()), self._last_line)
         return self._last_line
 
     @property
@@ -625,6 +631,8 @@ class ProgramRunner:
             self._trace_i.append(g.index_at(t))
             self._trace_p.append([row[i] for i in idx])
             self._trace_a.append([act[i] for i in idx])
+        if self._trace_i and self._trace_i[-1] >= 0:
+            self._exec_line = self._line_of.get(self._trace_i[-1], self._exec_line)
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         from ..control.groups.group import GroupError, GroupState
@@ -650,6 +658,8 @@ class ProgramRunner:
         self._trace_i.append(g.current_index)
         self._trace_p.append([ax.position for ax in g.axes])
         self._trace_a.append([ax.counters.actual() for ax in g.axes])
+        if self._trace_i[-1] >= 0:
+            self._exec_line = self._line_of.get(self._trace_i[-1], self._exec_line)
         self.synced.fire(g.current_index, self._idle_past)
         self.synced_analog.fire(g.current_index, self._idle_past)
         if self.state is not RunState.RUNNING:
