@@ -73,3 +73,22 @@ def test_a_long_helix_advances_the_fraction_while_it_runs():
         seen.append(bar.fraction())
     assert all(b > a for a, b in zip(seen, seen[1:], strict=False))   # moves every second
     assert seen[-1] - f0 > 0.5          # the helix is most of the job: 94 of ~104 mm
+
+
+def test_the_current_line_never_runs_ahead_of_the_machine():
+    """Before the first command starts the runner has queued lines 3..7 already: the line
+    shown is the one executing (or the last executed), never the last one queued (it
+    showed 7, then 4, 5, 6, 7: the UI's current line jumped forward and back)."""
+    import itertools
+
+    ctl = Controller()
+    ctl.enable_all()
+    run = ProgramRunner(ctl, "(square)\nG21 G90 G17\nG1 F1200 X10 Y0\nG1 X10 Y10\n"
+                        "G1 X0 Y10\nG1 X0 Y0\nM0\nG1 X5 Y5\nM30\n")
+    seen: list[int] = []
+    ctl.add_cycle_hook(lambda c, t: seen.append(run.current_line) if run.running else None)
+    run.start()
+    assert run.wait(60) and run.state is RunState.PAUSED
+    shown = [k for k, _ in itertools.groupby(x for x in seen if x)]
+    assert shown == [3, 4, 5, 6], shown
+    assert run.current_line == 7            # paused at the M0

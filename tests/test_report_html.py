@@ -3,6 +3,7 @@ for long programs, figures only for axes that move."""
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -97,9 +98,22 @@ def test_report_marks_outputs_on_the_path_and_lists_the_program(laser_page):
     assert '"name":"do0 on"' in page                # the laser's on-stretches on the path
     assert '"name":"selected line"' in page
     assert "commanded feed (programmed x 100 %)" in page
-    # every source line listed, the motion lines marked as such
-    assert "id=L1 data-line=1><td" in page
-    assert "id=L7 data-line=7 class=moves>" in page and "id=L13 data-line=13>" in page
+    # every source line listed, the motion lines marked as such (the page's script makes
+    # the rows from this data; the browser test below clicks them)
+    data = json.loads(re.search(r"<script type=application/json id=listing-data>(.*?)"
+                                r"</script>", page, re.S).group(1))
+    src = LASER.read_text().splitlines()
+    assert data["lines"] == src
+    moving = {n for a, b in data["moves"] for n in range(a, b + 1)}
+    assert 7 in moving and 13 not in moving and 1 not in moving
+    from openmotion.control import Controller
+    from openmotion.program.runjob import work_origin
+    from openmotion.program.runner import ProgramRunner
+
+    ctl = Controller()
+    ops = ProgramRunner(ctl, LASER, gcode={"parameters": work_origin(ctl)}).ops
+    assert moving == {o.line for o in ops if o.kind in ("line", "arc")}
+    assert "<tr id=L1 " not in page   # no markup per line: 20,000 rows cost 1.8 MB
 
 
 def test_output_levels_follow_the_events_of_the_run():
@@ -169,3 +183,18 @@ def test_report_page_links_the_listing_and_the_path_in_the_browser(laser_page):
             assert not errors, errors
         finally:
             b.close()
+
+
+def test_a_100k_line_listing_is_small_and_cut_at_the_limit():
+    from types import SimpleNamespace
+
+    from openmotion.program.report_page import MAX_LISTING_LINES, _listing
+
+    text = "".join(f"X{30 * np.cos(k / 1e4):.4f} Y{30 * np.sin(k / 1e4):.4f}\n"
+                   for k in range(100_000))
+    ops = [SimpleNamespace(kind="line", line=n) for n in range(1, 100_001)]
+    part = _listing(SimpleNamespace(ops=ops), text)
+    data = json.loads(re.search(r"id=listing-data>(.*?)</script>", part, re.S).group(1))
+    assert len(data["lines"]) == MAX_LISTING_LINES and data["moves"] == [[1, MAX_LISTING_LINES]]
+    assert f"{100_000 - MAX_LISTING_LINES} more lines not listed" in part
+    assert len(part) < 25 * MAX_LISTING_LINES    # 20,000 lines of ~17 characters

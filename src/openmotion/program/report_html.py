@@ -108,7 +108,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
     act = run.actual_trace()
     # the back end reports a following error beyond the count quantisation: the actual
     # path is drawn beside the commanded one
-    lags = bool(np.any(np.abs(pos - act) > 1.5 / run.scales.ppu))
+    lags = bool(np.any(np.abs(pos - act) > 1.5 / np.abs(run.scales.ppu)))
     lin = [k for k in moving if not rot[k]]
     # ---- path in program coordinates: rapids dashed, feeds coloured by the programmed
     # feed (units/min), output-on stretches over it, soft-limit box, worst contour error

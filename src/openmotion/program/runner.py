@@ -184,6 +184,7 @@ class ProgramRunner:
         self.synced_analog = SyncedAnalog(self._write_analog)
         self._pushed = 0
         self._last_line = 0
+        self._exec_line = 0   # line of the last command the trace saw executing
         self._step_line: int | None = None
         self.t_start = self.t_end = 0.0
         self._trace = CycleTrace(self.axis_indices)  # per cycle (program/trace.py)
@@ -293,12 +294,17 @@ class ProgramRunner:
 
     @property
     def current_line(self) -> int:
-        """Source line of the command executing now (or last handled)."""
+        """Source line of the command executing now (or last handled). With commands queued
+        but none executing (before the first starts, or between two) the last one that
+        executed, else the first queued: not the last handed to the queue, which is
+        lines ahead (a progress display would jump forward and back)."""
         g = self.group
         if g is not None:
             idx = g.current_index
             if idx >= 0 and idx in self._line_of:
                 return self._line_of[idx]
+            if g.queue_length > 0:
+                return self._exec_line or next(iter(self._line_of.values()), self._last_line)
         return self._last_line
 
     @property
@@ -426,6 +432,9 @@ class ProgramRunner:
         """A jump crossed cycles first..last: their trace rows, as `_on_cycle` records."""
         assert self.group is not None
         self._trace.add_span(ctl, self.group, first, last, positions, actual)
+        last_index = self._trace.last_index()
+        if last_index >= 0:
+            self._exec_line = self._line_of.get(last_index, self._exec_line)
 
     def _on_cycle(self, ctl: Controller, t: float) -> None:
         from ..control.groups.group import GroupError, GroupState
@@ -449,6 +458,8 @@ class ProgramRunner:
                 follow_per_rev(self, g)
         self._trace.add(t, g.current_index, [ax.position for ax in g.axes],
                         [ax.counters.actual() for ax in g.axes])
+        if g.current_index >= 0:
+            self._exec_line = self._line_of.get(g.current_index, self._exec_line)
         self.synced.fire(g.current_index, self._idle_past)
         self.synced_analog.fire(g.current_index, self._idle_past)
         if self.state is not RunState.RUNNING:
