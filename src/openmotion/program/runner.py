@@ -432,7 +432,9 @@ class ProgramRunner:
         """A jump crossed cycles first..last: their trace rows, as `_on_cycle` records."""
         assert self.group is not None
         self._trace.add_span(ctl, self.group, first, last, positions, actual)
-        last_index = self._trace.last_index()
+        if last < first:
+            return
+        last_index = self.group.index_at(ctl._t_origin + last * ctl.period)
         if last_index >= 0:
             self._exec_line = self._line_of.get(last_index, self._exec_line)
 

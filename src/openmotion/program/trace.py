@@ -58,6 +58,7 @@ class CycleTrace:
         fault's stop is traced as part of the command that was executing."""
         if self._i:
             return self._i[-1]
+        self._resolve()
         for block in reversed(self._blocks):
             if len(block[1]):
                 return int(block[1][-1])
