@@ -431,6 +431,7 @@ class SimMachine(SimAnalogOutputs):
         now = self._t
         items: list[tuple[float, str, bool]] = []
         at_now = False
+        slots = self.__dict__.setdefault("_do_slots", {})  # (as _set_do)
         for times, signal, levels in writes:
             if len(times) != len(levels):
                 raise MotionError(f"times and levels must have one entry each, got "
@@ -443,7 +444,8 @@ class SimMachine(SimAnalogOutputs):
             at_now = at_now or first == now
             if not set(map(type, levels)) <= {bool}:
                 raise MotionError(f"levels must be bools, got {list(levels)!r}")
-            self._board_index(signal, "do", len(self._do))
+            if signal not in slots:
+                slots[signal] = self._board_index(signal, "do", len(self._do))
         if at_now:  # (a write at the present instant goes out at once)
             for times, signal, levels in writes:
                 self.write_outputs_at(times, None, signal, levels)

@@ -41,8 +41,8 @@ class TimedOutputs:
 
     def push_rows(self, rows: list[tuple[float, str, bool]]) -> None:
         """`push(t, None, signal, level)` for every (t, signal, level) row, in order."""
-        seq = self._seq
-        self._heap.extend([(t, next(seq), None, sig, lv) for t, sig, lv in rows])
+        self._heap.extend([(t, k, None, sig, lv)
+                           for (t, sig, lv), k in zip(rows, self._seq, strict=False)])
         heapq.heapify(self._heap)
 
     def next_time(self) -> float | None:
