@@ -429,7 +429,6 @@ class SimMachine(SimAnalogOutputs):
         in order, in one call (the compare engine's lines of a cycle). Everything is
         checked first: on refusal nothing is scheduled."""
         now = self._t
-        items: list[tuple[float, str, bool]] = []
         at_now = False
         slots = self.__dict__.setdefault("_do_slots", {})  # (as _set_do)
         for times, signal, levels in writes:
@@ -450,9 +449,7 @@ class SimMachine(SimAnalogOutputs):
             for times, signal, levels in writes:
                 self.write_outputs_at(times, None, signal, levels)
             return
-        for times, signal, levels in writes:
-            items.extend(zip(times, [signal] * len(times), levels, strict=True))
-        self._timed.push_rows(items)
+        self._timed.push_lines([(list(t), sig, list(lv)) for t, sig, lv in writes])
 
     def _timed_axis_output(self, axis: int, signal: str, level: bool, raw: list) -> None:
         self.write_output(axis, signal, level)
