@@ -6,8 +6,10 @@ line at 100,000 pps for 0.5 s; the CPU time (time.process_time, so the figures h
 loaded machine) spent inside the engine's hooks (pre-advance and cycle hook) is measured,
 beside issue 13's goal (16 jobs <= 200 us per cycle). With --oracle each row also runs on
 the plain-Python solvers (tests/compare_oracle.py, what the engine ran before they were
-compiled) in the same run, and prints the ratio.
-Run: python bench/bench_compare.py [--oracle]
+compiled) in the same run, and prints the ratio. With --loop each row also runs with the
+compiled scan driver off (every job through the engine's per-job Python loop, every
+output line sent on its own: the engine before the driver) and prints the ratio.
+Run: python bench/bench_compare.py [--oracle] [--loop]
 """
 
 from __future__ import annotations
@@ -95,15 +97,39 @@ def on_oracle(kind: str, n_jobs: int) -> tuple[float, int]:
         compare_math._ck = built
 
 
+def per_job_loop(kind: str, n_jobs: int) -> tuple[float, int]:
+    """`run` with the scan driver off: each job scanned and each line sent from Python."""
+    from openmotion.control.trigger import compare, compare_io
+
+    actions, send = compare._ACTIONS, compare.send_lines
+
+    def one_by_one(lines, hw, t0, t1):  # noqa: ANN001, ANN202
+        for line in lines:
+            line.send(hw, t0, t1)
+
+    compare._ACTIONS, compare.send_lines = {}, one_by_one
+    try:
+        return run(kind, n_jobs)
+    finally:
+        compare._ACTIONS, compare.send_lines = actions, send
+        assert compare_io.send_lines is send
+
+
 def main() -> None:
     oracle = "--oracle" in sys.argv
+    loop = "--loop" in sys.argv
     head = f"{'kind':8s} {'jobs':>4s} {'us/cycle':>9s} {'firings':>8s} {'goal':>6s}"
-    print(head + (f" {'python us':>10s} {'ratio':>6s}" if oracle else ""))
+    print(head + (f" {'loop us':>8s} {'ratio':>6s}" if loop else "")
+          + (f" {'python us':>10s} {'ratio':>6s}" if oracle else ""))
     for kind in ("axis", "vector", "window"):
         for n in (1, 4, 16):
             cost, fired = run(kind, n)
             goal = "" if n != 16 else ("met" if cost <= 200e-6 else "no")
             row = f"{kind:8s} {n:4d} {cost * 1e6:9.1f} {fired:8d} {goal:>6s}"
+            if loop:
+                ref, ref_fired = per_job_loop(kind, n)
+                assert ref_fired == fired, "the per-job loop fired differently"
+                row += f" {ref * 1e6:8.1f} {ref / cost:5.1f}x"
             if oracle:
                 ref, ref_fired = on_oracle(kind, n)
                 assert ref_fired == fired, "the oracle fired differently"

@@ -392,3 +392,23 @@ def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # n
     positions(pos_tracks, [x[0] for x in f], pos)
     return (np.array(f, dtype=np.float64).reshape(-1, 2).tobytes(),
             np.array(k, dtype=np.int64).reshape(-1, 4).tobytes(), pos.tobytes(), done)
+
+
+def lines_send(lines, t0: float, t1: float):  # noqa: ANN001, ANN201
+    """OutputLine.send's bookkeeping for all lines (None when a line needs send itself)."""
+    cuts = []
+    for line in lines:
+        a = bisect.bisect_right(line._t, t0)
+        if (line._lv[a - 1] if a else line.initial) != line._written:
+            return None
+        cuts.append((a, bisect.bisect_right(line._t, t1)))
+    writes = []
+    for line, (a, b) in zip(lines, cuts, strict=True):
+        line._sent = (line._t[a:b], line._lv[a:b])
+        line._written = line._lv[b - 1] if b else line.initial
+        line._sent_until = t1
+        line._late.clear()
+        line._hold = False
+        if b > a:
+            writes.append((line._t[a:b], line.signal, line._lv[a:b]))
+    return writes

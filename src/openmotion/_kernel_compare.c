@@ -1610,6 +1610,94 @@ out:
     return res;
 }
 
+
+PyDoc_STRVAR(lines_send_doc,
+"lines_send(lines, t0, t1) -> list of (times, signal, levels) or None\n\n"
+"OutputLine.send's bookkeeping for every line at once, when each line's physical level\n"
+"(`_written`) is its waveform's level at t0 (nothing late or stretched pending): sets\n"
+"_sent, _written, _sent_until = t1, clears _late and _hold, and returns the edges in\n"
+"(t0, t1] of the lines that have some. None (nothing changed) when a line needs send.");
+
+static int lv_at(PyObject *tl, PyObject *ll, int initial, double t, Py_ssize_t lo,
+                 Py_ssize_t *k_out)
+{
+    Py_ssize_t hi = PyList_GET_SIZE(tl);
+    while (lo < hi) {  /* bisect_right */
+        Py_ssize_t mid = (lo + hi) / 2;
+        if (t < as_double(PyList_GET_ITEM(tl, mid))) hi = mid; else lo = mid + 1;
+    }
+    *k_out = lo;
+    return lv_of(ll, lo - 1, initial);
+}
+
+static PyObject *lines_send(PyObject *self, PyObject *args)
+{
+    PyObject *lines_o;
+    double t0, t1;
+    if (!PyArg_ParseTuple(args, "Odd", &lines_o, &t0, &t1)) return NULL;
+    PyObject *seq = PySequence_Fast(lines_o, "lines must be a sequence");
+    if (seq == NULL) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    Py_ssize_t *ab = malloc((size_t)(2 * n + 1) * sizeof(Py_ssize_t));
+    int *wr = malloc((size_t)(n + 1) * sizeof(int));
+    PyObject *res = NULL;
+    if (ab == NULL || wr == NULL) { PyErr_NoMemory(); goto done; }
+    for (Py_ssize_t i = 0; i < n; i++) {  /* check every line first: all or nothing */
+        PyObject *line = PySequence_Fast_GET_ITEM(seq, i);
+        LineRef L;
+        if (line_ref(line, &L) < 0) goto done;
+        PyObject *w = PyObject_GetAttrString(line, "_written");
+        if (w == NULL) goto done;
+        int written = PyObject_IsTrue(w);
+        Py_DECREF(w);
+        if (PyList_GET_SIZE(L.tl) != PyList_GET_SIZE(L.ll)) {
+            PyErr_SetString(PyExc_ValueError, "OutputLine: t and lv differ in length");
+            goto done;
+        }
+        Py_ssize_t a, b;
+        int l0 = lv_at(L.tl, L.ll, L.initial, t0, 0, &a);
+        if (l0 != written) { res = Py_NewRef(Py_None); goto done; }
+        wr[i] = lv_at(L.tl, L.ll, L.initial, t1, a, &b);
+        ab[2 * i] = a;
+        ab[2 * i + 1] = b;
+    }
+    res = PyList_New(0);
+    if (res == NULL) goto done;
+    PyObject *t1o = PyFloat_FromDouble(t1);
+    if (t1o == NULL) { Py_CLEAR(res); goto done; }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *line = PySequence_Fast_GET_ITEM(seq, i);
+        LineRef L;
+        if (line_ref(line, &L) < 0) { Py_CLEAR(res); break; }
+        PyObject *ts = PyList_GetSlice(L.tl, ab[2 * i], ab[2 * i + 1]);
+        PyObject *ls = PyList_GetSlice(L.ll, ab[2 * i], ab[2 * i + 1]);
+        PyObject *sent = ts && ls ? PyTuple_Pack(2, ts, ls) : NULL;
+        int bad = sent == NULL
+            || PyObject_SetAttrString(line, "_sent", sent) < 0
+            || PyObject_SetAttrString(line, "_written", wr[i] ? Py_True : Py_False) < 0
+            || PyObject_SetAttrString(line, "_sent_until", t1o) < 0
+            || PyObject_SetAttrString(line, "_hold", Py_False) < 0
+            || PyList_SetSlice(L.late, 0, PyList_GET_SIZE(L.late), NULL) < 0;
+        if (!bad && ab[2 * i + 1] > ab[2 * i]) {
+            PyObject *sig = PyObject_GetAttrString(line, "signal");
+            PyObject *item = sig ? PyTuple_Pack(3, ts, sig, ls) : NULL;
+            bad = item == NULL || PyList_Append(res, item) < 0;
+            Py_XDECREF(item);
+            Py_XDECREF(sig);
+        }
+        Py_XDECREF(sent);
+        Py_XDECREF(ts);
+        Py_XDECREF(ls);
+        if (bad) { Py_CLEAR(res); break; }
+    }
+    Py_DECREF(t1o);
+done:
+    free(ab);
+    free(wr);
+    Py_DECREF(seq);
+    return res;
+}
+
 PyDoc_STRVAR(solver_checks_doc,
 "solver_checks(on) -> (refined, rejected)\n\n"
 "Tests: with on, every window candidate dropped unrefined is refined anyway and\n"
@@ -1644,6 +1732,7 @@ static PyMethodDef methods[] = {
     {"solver_checks", solver_checks, METH_VARARGS, solver_checks_doc},
     {"bank_new", bank_new, METH_VARARGS, bank_new_doc},
     {"bank_scan", bank_scan, METH_VARARGS, bank_scan_doc},
+    {"lines_send", lines_send, METH_VARARGS, lines_send_doc},
     {NULL, NULL, 0, NULL},
 };
 

@@ -53,7 +53,7 @@ class OutputLine:
         self.timed = False       # the hardware switches it at exact times (send)
         self._sent_until = -math.inf
         self._late: list[float] = []  # times of edges added at or before _sent_until
-        self._sent: list[tuple[float, bool]] = []  # the edges of the last send
+        self._sent: tuple[list[float], list[bool]] = ([], [])  # the last send's edges
         self._hold = False       # a late pulse is being shown stretched
 
     def attach(self, hw: Hardware) -> None:
@@ -143,28 +143,11 @@ class OutputLine:
                 for k in range(a, b):
                     hw.write_output_at(self._t[k], None, self.signal,  # type: ignore[attr-defined]
                                        bool(self._lv[k]))
-        self._sent = list(zip(self._t[a:b], self._lv[a:b], strict=True))
+        self._sent = (self._t[a:b], self._lv[a:b])
         self._written = self.level_at(t1)
         self._sent_until = t1
         self._late.clear()
         self._hold = False
-
-    def _plain_send(self, t0: float, t1: float) -> tuple[list[float], list[bool]] | None:
-        """`send`'s bookkeeping when nothing late or stretched is pending (the physical
-        line shows the level at t0): the cycle's edges to hand over, or None (use send)."""
-        t = self._t
-        a = bisect.bisect_right(t, t0)
-        lvl0 = self._lv[a - 1] if a else self.initial
-        if lvl0 != self._written:
-            return None
-        b = bisect.bisect_right(t, t1, a)
-        times, levels = t[a:b], self._lv[a:b]
-        self._sent = list(zip(times, levels, strict=True))
-        self._written = self._lv[b - 1] if b else self.initial
-        self._sent_until = t1
-        self._late.clear()
-        self._hold = False
-        return times, levels
 
     def flush(self, hw: Hardware, t0: float, t1: float) -> None:
         """Write the physical line for the cycle (t0, t1] (see module docstring)."""
@@ -177,7 +160,7 @@ class OutputLine:
                 return
             a = bisect.bisect_right(self._t, t0)
             b = bisect.bisect_right(self._t, t1)
-            sent = set(self._sent)
+            sent = set(zip(*self._sent, strict=True))
             changed = any(e not in sent for e in zip(self._t[a:b], self._lv[a:b], strict=True))
         else:
             changed = self._changed(t0, t1)
@@ -197,24 +180,15 @@ class OutputLine:
 
 
 def send_lines(lines: Sequence[OutputLine], hw: Hardware, t0: float, t1: float) -> None:
-    """`line.send(hw, t0, t1)` for every line, with the edges of all of them handed to the
-    hardware in one `write_outputs_many` call when it has one (the simulator does)."""
+    """`line.send(hw, t0, t1)` for every line. When the hardware has `write_outputs_many`
+    (the simulator) and no line has a late or stretched edge pending, the bookkeeping of
+    all lines is one compiled call (`lines_send`) and their edges go out in one call."""
     bulk = getattr(hw, "write_outputs_many", None)
-    if bulk is None:
+    writes = None if bulk is None else _cm._solvers().lines_send(lines, t0, t1)
+    if writes is None:
         for line in lines:
             line.send(hw, t0, t1)
-        return
-    writes = []
-    for line in lines:
-        w = line._plain_send(t0, t1)
-        if w is None:  # (the writes so far first: the hardware sees the lines in order)
-            if writes:
-                bulk(writes)
-                writes = []
-            line.send(hw, t0, t1)
-        elif w[0]:
-            writes.append((w[0], line.signal, w[1]))
-    if writes:
+    elif writes:
         bulk(writes)
 
 

@@ -468,8 +468,8 @@ class SimMachine(SimAnalogOutputs):
         in order, in one call (the compare engine's lines of a cycle). Everything is
         checked first: on refusal nothing is scheduled."""
         now = self._t
-        items: list[tuple[float, str, bool]] = []
         at_now = False
+        slots = self.__dict__.setdefault("_do_slots", {})  # (as _set_do)
         for times, signal, levels in writes:
             if len(times) != len(levels):
                 raise MotionError(f"times and levels must have one entry each, got "
@@ -482,14 +482,13 @@ class SimMachine(SimAnalogOutputs):
             at_now = at_now or first == now
             if not set(map(type, levels)) <= {bool}:
                 raise MotionError(f"levels must be bools, got {list(levels)!r}")
-            self._board_index(signal, "do", len(self._do))
+            if signal not in slots:
+                slots[signal] = self._board_index(signal, "do", len(self._do))
         if at_now:  # (a write at the present instant goes out at once)
             for times, signal, levels in writes:
                 self.write_outputs_at(times, None, signal, levels)
             return
-        for times, signal, levels in writes:
-            items.extend(zip(times, [signal] * len(times), levels, strict=True))
-        self._timed.push_rows(items)
+        self._timed.push_lines([(list(t), sig, list(lv)) for t, sig, lv in writes])
 
     def _timed_axis_output(self, axis: int, signal: str, level: bool, raw: list) -> None:
         self.write_output(axis, signal, level)

@@ -39,11 +39,14 @@ class TimedOutputs:
             for it in items:
                 heapq.heappush(self._heap, it)
 
-    def push_rows(self, rows: list[tuple[float, str, bool]]) -> None:
-        """`push(t, None, signal, level)` for every (t, signal, level) row, in order."""
-        seq = self._seq
-        self._heap.extend([(t, next(seq), None, sig, lv) for t, sig, lv in rows])
-        heapq.heapify(self._heap)
+    def push_lines(self, writes: list[tuple[list[float], str, list[bool]]]) -> None:
+        """`push(t, None, signal, level)` for every edge of every (times, signal, levels),
+        in order (the heap entries are built by zip, one heapify for all)."""
+        heap, seq = self._heap, self._seq
+        for times, sig, levels in writes:
+            heap.extend(zip(times, seq, itertools.repeat(None), itertools.repeat(sig), levels,
+                            strict=False))
+        heapq.heapify(heap)
 
     def next_time(self) -> float | None:
         return self._heap[0][0] if self._heap else None
