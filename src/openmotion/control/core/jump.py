@@ -303,13 +303,22 @@ def _level_word(inputs: dict[str, bool]) -> int:
     return w
 
 
+def _state_codes() -> dict:
+    """Controller.STATE_CODES (imported late: the controller imports this module)."""
+    if not _STATE_CODES:
+        from .controller import STATE_CODES
+        _STATE_CODES.update(STATE_CODES)
+    return _STATE_CODES
+
+
+_STATE_CODES: dict = {}
+
+
 def record_now(ctl: Controller, n: int) -> bool:
     """Record the row of cycle n (its end, now) as `Controller._record` does, in one
     compiled call: the back end's readback of every axis in one call (BulkReadback), the
     cached one of an axis already read in this cycle (what its counters and inputs show).
     False (nothing done) without the compiled kernel or a bulk readback."""
-    from .controller import STATE_CODES  # the controller imports this module
-
     kern = _motion._kernel
     hw = ctl.hardware
     t = type(hw)
@@ -325,6 +334,7 @@ def record_now(ctl: Controller, n: int) -> bool:
             cnt = axes[i].counters
             rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
     cnt_all = [ax.counters for ax in axes]
+    codes = _STATE_CODES or _state_codes()
     origin, period = ctl._t_origin, ctl.period
     args = (origin, period, n - 1, rows.reshape(1, -1, 3),
             np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
@@ -332,7 +342,7 @@ def record_now(ctl: Controller, n: int) -> bool:
             np.array([c._fb_internal for c in cnt_all], dtype=np.int64),
             np.array([c._fb_off for c in cnt_all], dtype=np.int64), _nc_words(ctl),
             _io_table(), bool(ctl._estop),
-            np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int32))
+            np.array([codes[ax.state] for ax in axes], dtype=np.int32))
 
     def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
         try:
