@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 import ui_browser
-from ui_browser import field, goto, ready_axis, shot, status, wait_status
+from ui_browser import field, goto, ready_axis, shot, status, wait_jogged, wait_status
 
 server = ui_browser.server
 browser = ui_browser.browser
@@ -227,8 +227,9 @@ def test_path_marks_the_output_firings_and_keyboard_jog_survives_a_job(page):
     if not page.is_checked("#op-keyboard"):
         page.check("#op-keyboard")
     page.locator("#op-chart").click()
+    here = status(page, "s.axes.x.position")
     page.keyboard.down("ArrowRight")
-    wait_status(page, "s.axes.x.velocity > 0", 5)
+    wait_jogged(page, "x", here, +1)
     page.keyboard.up("ArrowRight")
     wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
 
@@ -289,8 +290,9 @@ def test_a_jog_stops_when_the_connection_drops(page):
     ready_axis(page)
     plus = page.locator("#op-jog-plus").bounding_box()
     page.mouse.move(plus["x"] + plus["width"] / 2, plus["y"] + plus["height"] / 2)
+    here = status(page, "s.axes.x.position")
     page.mouse.down()
-    wait_status(page, "s.axes.x.velocity > 0", 5)
+    wait_jogged(page, "x", here, +1)
     page.evaluate("window.openmotion.rpc.ws.close()")      # the button is still held
     page.wait_for_selector("#conn[data-state=open]", timeout=30_000)
     wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 5)

@@ -14,7 +14,7 @@ import tomllib
 import pytest
 
 import ui_browser
-from ui_browser import error_of, field, goto, ready_axis, shot, status, wait_status
+from ui_browser import error_of, field, goto, ready_axis, shot, status, wait_jogged, wait_status
 
 # the fixtures of ui_browser (pytest finds them as names of this module)
 server = ui_browser.server
@@ -126,28 +126,40 @@ def test_jog_runs_while_held_and_stops_on_release(page):
     plus = page.locator("#op-jog-plus")
     box = plus.bounding_box()
     page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
-    page.mouse.down()
-    wait_status(page, "s.axes.x.velocity > 0", 5)
-    page.wait_for_timeout(600)   # held longer than the deadman: the confirmations keep it going
-    assert status(page, "s.axes.x.velocity") > 0, page.inner_text("#log")
-    page.mouse.up()
-    wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
+    # held longer than the deadman: the confirmations keep it going. A browser stalled for
+    # longer than the deadman on a loaded machine lets the server stop it, by design, so
+    # the hold is tried up to three times; without confirmations every try stops.
+    kept = []
+    for _ in range(3):
+        here = status(page, "s.axes.x.position")
+        page.mouse.down()
+        wait_jogged(page, "x", here, +1)
+        page.wait_for_timeout(600)
+        kept.append(status(page, "s.axes.x.velocity") > 0)
+        page.mouse.up()
+        wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
+        if kept[-1]:
+            break
+    assert kept[-1], (kept, page.inner_text("#log"))
     # keyboard jog: key down moves, key up stops
     page.check("#op-keyboard")
     page.locator("#op-chart").click()
+    here = status(page, "s.axes.x.position")
     page.keyboard.down("ArrowLeft")
-    wait_status(page, "s.axes.x.velocity < 0", 5)
+    wait_jogged(page, "x", here, -1)
     page.keyboard.up("ArrowLeft")
     wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
     # leaving the window stops a jog whose key is still down
+    here = status(page, "s.axes.x.position")
     page.keyboard.down("ArrowRight")
-    wait_status(page, "s.axes.x.velocity > 0", 5)
+    wait_jogged(page, "x", here, +1)
     page.evaluate("window.dispatchEvent(new Event('blur'))")
     wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
     page.keyboard.up("ArrowRight")
     # a page that stops confirming (frozen) is stopped by the server's deadman
+    here = status(page, "s.axes.x.position")
     page.keyboard.down("ArrowRight")
-    wait_status(page, "s.axes.x.velocity > 0", 5)
+    wait_jogged(page, "x", here, +1)
     page.evaluate("window.__freeze = Date.now(); while (Date.now() - window.__freeze < 700) {}")
     wait_status(page, "s.axes.x.velocity === 0 && !s.axes.x.moving", 3)
     page.keyboard.up("ArrowRight")

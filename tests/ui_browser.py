@@ -155,6 +155,15 @@ def wait_status(pg: object, cond: str, timeout_s: float = MIN_WAIT_S) -> None:
         timeout=max(timeout_s, MIN_WAIT_S) * 1000)
 
 
+def wait_jogged(pg: object, axis: str, before: float, sign: int) -> None:
+    """Wait until a deadman jog moved `axis` from `before` in the direction `sign`. The
+    moved position lasts; the jog's speed does not: a browser stalled for longer than the
+    deadman (a loaded machine) lets the server stop the jog, by design, before a status
+    shows it moving."""
+    op = ">" if sign > 0 else "<"
+    wait_status(pg, f"s.axes.{axis}.position {op} {before!r}")
+
+
 def shot(pg: object, name: str) -> None:
     """Save docs/img/creator-<name>.png when OPENMOTION_SHOTS=1 (the committed screenshots)."""
     if os.environ.get("OPENMOTION_SHOTS") == "1":
