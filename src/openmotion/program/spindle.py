@@ -336,7 +336,10 @@ class OrientMove:
             self.target = self._goal()
             ratio = ax.counters.move_ratio
             if abs(self.target - d.count()) >= 0.5:
-                ax.move_absolute(self.target / ratio,
+                # in the command frame: just stopped, the feedback still lags the command
+                # (servo), and an absolute move measures from the feedback (HSL), so it
+                # would end that lag past the goal once the drive settles
+                ax.move_relative(self.target / ratio - ax.position,
                                  max_vel=ORIENT_RPM / 60.0 * d.counts_per_rev / ratio,
                                  tacc=0.05)
             return self.deadline is None
