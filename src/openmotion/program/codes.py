@@ -27,12 +27,9 @@ G_GROUP = {
 G_REFUSED: dict[int, str] = {}
 #: Why some well-known M-codes are refused.
 M_REFUSED = {
-    48: "override switches (M48) are not supported", 49: "override switches (M49)"
-    " are not supported", 50: "feed override control (M50) is not supported",
-    51: "spindle override control (M51) is not supported",
-    52: "adaptive feed (M52) is not supported", 53: "feed stop control (M53) is not supported",
     60: "pallet change (M60) is not supported",
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 19: 7, 7: 8, 8: 8, 9: 8,
            62: 5, 63: 5, 64: 5, 65: 5, 66: 5, 67: 5, 68: 5, 98: 11, 99: 11, 61: 6,
-           70: 12, 71: 12, 72: 12, 73: 12}
+           70: 12, 71: 12, 72: 12, 73: 12,
+           48: 9, 49: 9, 50: 9, 51: 9, 52: 9, 53: 9}  # overrides.py

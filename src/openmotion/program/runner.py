@@ -56,6 +56,9 @@ from .rigidtap import RigidTap
 from .runaxes import gcode_fields, machine_axes, travel_limits
 from .runcompile import RunPass
 from .runfeed import follow_per_rev
+from .runoverride import apply as apply_overrides
+from .runoverride import check_percent
+from .runoverride import reset as reset_overrides
 from .runrequests import answer, begin_request, on_probe_edge
 from .runtypes import RunEvent, RunOptions, RunState
 from .runwait import InputWait, ProbeMove
@@ -154,7 +157,9 @@ class ProgramRunner:
         self.rigid_taps: list = []  # G33.1 taps run against the spindle (RigidTapMove)
         self._per_rev = False  # feeding a G95 stretch
         self._per_rev_ops: dict[int, float] = {}  # group index -> planned spindle rps
-        self._feed_pct = 100.0  # override the G95 follower set last
+        self.feed_override = 100.0  # the operator's, % (set_feed_override)
+        self.spindle_override = 100.0
+        self.feed_override_on = self.spindle_override_on = True  # M48-M51 (overrides.py)
         self._feed_tick = 0
         self._spindle_index: int | None = None
         if self.options.spindle_axis is not None:
@@ -247,8 +252,21 @@ class ProgramRunner:
         self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._ctl.add_jump_observer(self._on_jump)
         self.synced.attach(self.group.start_time)
+        reset_overrides(self)
         if self.options.probe_input is not None:
             self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
+
+    def set_feed_override(self, percent: float) -> None:
+        """The operator's feed override, 1 .. 200 % of the programmed feed, at any time
+        (re-plans a running path); ignored while the program has it off (M50 P0, M49)."""
+        self.feed_override = check_percent("feed override", percent)
+        apply_overrides(self)
+
+    def set_spindle_override(self, percent: float) -> None:
+        """The operator's spindle-speed override, 1 .. 200 % of S (the spindle's maximum
+        caps it); ignored while the program has it off (M51 P0, M49)."""
+        self.spindle_override = check_percent("spindle override", percent)
+        apply_overrides(self)
 
     def pause(self) -> None:
         """Hold: decelerate along the path and stop; resume() continues."""
