@@ -24,12 +24,12 @@ from openmotion.program import (
 from openmotion.program.overrides import OverrideSwitch
 
 XZ = GCodeOptions(axes={"X": 0, "Z": 2})
-SWITCHES = "M49\nM48\nM50 P0\nM50\nM51 P0\nM51 P1\nM50 P1\nM52 P0\n"
+SWITCHES = "M49\nM48\nM50 P0\nM50\nM51 P0\nM51 P1\nM50 P1\nM53 P0\nM53\nM52 P0\n"
 
 
 def switches(text: str) -> list[tuple[bool | None, bool | None]]:
     return [(c.feed, c.spindle) for c in compile_text(text, XZ)
-            if isinstance(c, OverrideSwitch)]
+            if isinstance(c, OverrideSwitch) and c.feed_hold is None]
 
 
 def test_records_of_each_word():
@@ -44,15 +44,16 @@ def test_the_same_switches_as_rs274():
         pytest.skip("LinuxCNC rs274 is not installed")
     res = lcnc.run_rs274("G21\n" + SWITCHES + "M2\n", exe)
     assert res.error is None
-    calls = re.findall(r"(ENABLE|DISABLE)_(FEED_OVERRIDE|SPEED_OVERRIDE|ADAPTIVE_FEED)",
-                       res.listing)
+    calls = re.findall(r"(ENABLE|DISABLE)_(FEED_OVERRIDE|SPEED_OVERRIDE|FEED_HOLD|"
+                       r"ADAPTIVE_FEED)", res.listing)
     assert calls[-1] == ("DISABLE", "ADAPTIVE_FEED")  # M52 P0: the only M52 accepted
     ours = []
-    for feed, spindle in switches(SWITCHES):
-        if feed is not None:
-            ours.append(("ENABLE" if feed else "DISABLE", "FEED_OVERRIDE"))
-        if spindle is not None:
-            ours.append(("ENABLE" if spindle else "DISABLE", "SPEED_OVERRIDE"))
+    for c in compile_text(SWITCHES, XZ):
+        if isinstance(c, OverrideSwitch):
+            for on, what in ((c.feed, "FEED_OVERRIDE"), (c.spindle, "SPEED_OVERRIDE"),
+                             (c.feed_hold, "FEED_HOLD")):
+                if on is not None:
+                    ours.append(("ENABLE" if on else "DISABLE", what))
     assert ours == calls[:-1]
 
 
@@ -61,7 +62,7 @@ def test_the_same_switches_as_rs274():
     ("M51 P-1", "P-1", "P must be 0"),
     ("M52 P1", "M52", "adaptive feed"),
     ("M52", "M52", "adaptive feed"),
-    ("M53 P0", "M53", "feed stop switch"),
+    ("M53 P3", "P3", "P must be 0"),
     ("M48 M50", "M50", "same modal group"),
 ])
 def test_refusals_name_line_column_word(line, word, msg):
@@ -142,12 +143,12 @@ def test_spindle_override_scales_s_unless_m51_p0():
 def test_predefined_parameters_read_the_switches():
     from openmotion.program import Message
 
-    text = ("(DEBUG, #<_feed_override> #<_speed_override>)\nM50 P0\n"
-            "(DEBUG, #<_feed_override> #<_speed_override>)\nM49\n"
-            "(DEBUG, #<_feed_override> #<_speed_override>)\nM48\n"
-            "(DEBUG, #<_feed_override> #<_speed_override>)\nM2\n")
+    show = "(DEBUG, #<_feed_override> #<_speed_override> #<_feed_hold>)\n"
+    text = (show + "M50 P0\n" + show + "M49\nM53 P0\n" + show + "M48\nM53\n" + show
+            + "M2\n")
     msgs = [c.text for c in compile_text(text, XZ) if isinstance(c, Message)]
-    assert [[float(x) for x in m.split()] for m in msgs] == [[1, 1], [0, 1], [0, 0], [1, 1]]
+    assert [[float(x) for x in m.split()] for m in msgs] == [
+        [1, 1, 1], [0, 1, 1], [0, 0, 0], [1, 1, 1]]
 
 
 def test_cli_feed_override_and_m50_p0(tmp_path, capsys):
@@ -183,3 +184,28 @@ def test_g95_feeds_follow_the_feed_override():
     base = g95_time(100.0)  # 1 mm per revolution at 10 rev/s: 0.3 s for the 3 mm
     assert g95_time(50.0) - base == pytest.approx(0.3, abs=0.05)
     assert g95_time(50.0, "M50 P0\n") == pytest.approx(base, abs=5e-3)
+
+
+def test_m53_feed_stop_input_holds_the_path_unless_switched_off():
+    def held_run(text: str, **opts) -> tuple[float, list[str]]:
+        ctl = machine()
+        sc = ctl.hardware.scenario
+        sc.set_input("di1", True, at=0.2)
+        sc.set_input("di1", False, at=0.8)
+        run = ProgramRunner(ctl, text, options=RunOptions(**opts))
+        run.start()
+        ctl.run_until(lambda: run.state in (RunState.DONE, RunState.ERROR), 10.0)
+        assert run.state is RunState.DONE, run.error
+        return run.t_end - run.t_start, [e.text for e in run.events
+                                         if e.kind == "feed_hold"]
+
+    job = "G21 G1 X6 F600\nM2\n"
+    base, none = held_run(job)  # no feed_hold_input: no switch
+    assert none == []
+    t, texts = held_run(job, feed_hold_input="di1")
+    assert texts == ["feed stop di1 active: holding", "feed stop di1 released"]
+    assert t - base == pytest.approx(0.6, abs=0.12)  # held 0.6 s (+ the ramps)
+    t_off, none = held_run("M53 P0\n" + job, feed_hold_input="di1")
+    assert none == [] and t_off == pytest.approx(base, abs=2e-3)
+    with pytest.raises(MotionError, match="feed_hold_input"):
+        RunOptions(feed_hold_input="X1")

@@ -75,7 +75,7 @@ _TABLE: dict[str, Callable[[Modal], float]] = {
     "_SPEED_OVERRIDE": lambda m: _flag(m.speed_override_on),
     "_FEED_OVERRIDE": lambda m: _flag(m.feed_override_on),
     "_ADAPTIVE_FEED": lambda m: 0.0,
-    "_FEED_HOLD": lambda m: 1.0,
+    "_FEED_HOLD": lambda m: _flag(m.feed_hold_on),
     "_FEED": lambda m: m.feed_program_units(),
     "_RPM": lambda m: abs(m.speed),
     "_CURRENT_TOOL": lambda m: float(m.tool),

@@ -1,5 +1,5 @@
-"""M48-M53: the program switches the operator's overrides on and off (LinuxCNC modal group
-9, run after the spindle and coolant words of the line).
+"""M48-M53: the program switches the operator's overrides and the feed-stop switch on and
+off (LinuxCNC modal group 9, run after the spindle and coolant words of the line).
 
 M48 / M49: feed and spindle overrides on / off. M50 [P1] / M50 P0: the feed override on /
 off. M51 [P1] / M51 P0: the spindle-speed override. While an override is off the program
@@ -8,8 +8,11 @@ runs at 100 % whatever the operator set; switched on again, the operator's setti
 --feed-override`). Both are on at the start of every pass and after M2/M30 (LinuxCNC's M2).
 #<_feed_override> / #<_speed_override> read the switches.
 M52 P0 (adaptive feed off) is accepted: there is no adaptive-feed input, so it is always
-off; M52 [P1] is refused. M53 (the feed-stop switch) is refused: there is no feed-stop
-input (ProgramRunner.pause() always holds, as LinuxCNC's pause does).
+off; M52 [P1] is refused. M53 [P1] / M53 P0: the feed-stop switch (RunOptions.
+feed_hold_input, a board input: while it is active the path holds, decelerating along it,
+and goes on when it is released) is obeyed / ignored; on at the start of every pass;
+#<_feed_hold> reads it. Without a feed_hold_input there is no switch and M53 changes
+nothing (ProgramRunner.pause() always holds, as LinuxCNC's pause does).
 """
 
 from __future__ import annotations
@@ -35,11 +38,14 @@ class OverrideSwitch:
     spindle: bool | None
     line: int
     file: str = ""
+    feed_hold: bool | None = None  # M53: the feed-stop switch on / off
 
     @property
     def text(self) -> str:
-        parts = [f"{name} override {'on' if on else 'off'}"
-                 for name, on in (("feed", self.feed), ("spindle", self.spindle))
+        parts = [f"{name} {'on' if on else 'off'}"
+                 for name, on in (("feed override", self.feed),
+                                  ("spindle override", self.spindle),
+                                  ("feed stop switch", self.feed_hold))
                  if on is not None]
         return ", ".join(parts)
 
@@ -66,8 +72,9 @@ def m48_m53(m: Modal, b: Block, code: int, pos: int, words: dict[str, Word],
                           "machine has none (M52 P0 is accepted)", pos, f"M{code}")
         return
     if code == 53:
-        raise b.error("the feed stop switch (M53) needs a feed-stop input; this machine "
-                      "has none (the runner's pause() always holds)", pos, f"M{code}")
+        m.feed_hold_on = on
+        out.append(OverrideSwitch(None, None, b.line, b.file, feed_hold=on))
+        return
     if code in (48, 49):
         sw = OverrideSwitch(code == 48, code == 48, b.line, b.file)
     elif code == 50:

@@ -57,7 +57,7 @@ from .runaxes import gcode_fields, machine_axes, travel_limits
 from .runcompile import RunPass
 from .runfeed import follow_per_rev
 from .runoverride import apply as apply_overrides
-from .runoverride import check_percent
+from .runoverride import check_percent, feed_hold_step
 from .runoverride import reset as reset_overrides
 from .runrequests import answer, begin_request, on_probe_edge
 from .runtypes import RunEvent, RunOptions, RunState
@@ -160,6 +160,11 @@ class ProgramRunner:
         self.feed_override = 100.0  # the operator's, % (set_feed_override)
         self.spindle_override = 100.0
         self.feed_override_on = self.spindle_override_on = True  # M48-M51 (overrides.py)
+        self.feed_hold_on = True  # M53: the feed-stop switch obeyed (feed_hold_input)
+        self._fh_check = False  # a feed-stop edge or an M53 to look at next cycle
+        self._fh_paused = False  # paused by the feed-stop input (not by the operator)
+        if self.options.feed_hold_input is not None:
+            ctl.hardware.read_input(self.options.feed_hold_input)  # validates the input
         self._feed_tick = 0
         self._spindle_index: int | None = None
         if self.options.spindle_axis is not None:
@@ -255,6 +260,9 @@ class ProgramRunner:
         reset_overrides(self)
         if self.options.probe_input is not None:
             self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
+        if self.options.feed_hold_input is not None:
+            self._ctl.add_edge_hook(self._on_feed_hold_edge,
+                                    signals=(self.options.feed_hold_input,))
 
     def set_feed_override(self, percent: float) -> None:
         """The operator's feed override, 1 .. 200 % of the programmed feed, at any time
@@ -290,6 +298,8 @@ class ProgramRunner:
             g.cont()
         self._step_line = None
         self.state = RunState.RUNNING
+        self._fh_paused = False
+        self._fh_check = True  # a feed-stop input still active holds again
         self._event("resume", self.current_line, "resumed")
 
     def abort(self) -> None:
@@ -382,6 +392,8 @@ class ProgramRunner:
         self.synced.detach()
         if self.options.probe_input is not None:
             self._ctl.remove_edge_hook(self._on_probe_edge)
+        if self.options.feed_hold_input is not None:
+            self._ctl.remove_edge_hook(self._on_feed_hold_edge)
         if self.group is not None:
             if state is not RunState.ABORTED:
                 self.group.close()
@@ -419,7 +431,7 @@ class ProgramRunner:
         if g.state is GroupState.ERROR or self.synced.armed or self.synced_analog.armed:
             return -math.inf
         if self._request is not None or self._stray_trip is not None \
-                or self.spindle is not None:
+                or self.spindle is not None or self._fh_check:
             # a probe move or M66 wait polls its input every cycle; the spindle is sampled
             return -math.inf
         if self.state is not RunState.RUNNING:
@@ -469,6 +481,8 @@ class ProgramRunner:
         self._trace_a.append([ax.counters.actual() for ax in g.axes])
         self.synced.fire(g.current_index, self._idle_past)
         self.synced_analog.fire(g.current_index, self._idle_past)
+        if self._fh_check:
+            feed_hold_step(self, g)
         if self.state is not RunState.RUNNING:
             return
         try:
@@ -488,6 +502,10 @@ class ProgramRunner:
 
     def _feed(self, g: Group) -> None:
         runqueue.feed(self, g)
+
+    def _on_feed_hold_edge(self, ctl: Controller, e: InputEdge) -> None:
+        if e.axis is None and e.signal == self.options.feed_hold_input:
+            self._fh_check = True
 
     def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
         on_probe_edge(self, ctl, e)

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from ..errors import MotionError, check_finite
 
 if TYPE_CHECKING:
+    from ..control.groups.group import Group
     from .overrides import OverrideSwitch
     from .runner import ProgramRunner
 
@@ -54,15 +55,48 @@ def apply(run: ProgramRunner) -> None:
 
 
 def switch(run: ProgramRunner, sw: OverrideSwitch) -> None:
-    """M48-M51 reached (the motion before it has ended)."""
+    """M48-M53 reached (the motion before it has ended)."""
     if sw.feed is not None:
         run.feed_override_on = sw.feed
     if sw.spindle is not None:
         run.spindle_override_on = sw.spindle
+    if sw.feed_hold is not None:
+        run.feed_hold_on = sw.feed_hold
+        run._fh_check = True
     apply(run)
 
 
 def reset(run: ProgramRunner) -> None:
-    """A pass starts: both overrides on (LinuxCNC's M2/M30 switch them on again)."""
-    run.feed_override_on = run.spindle_override_on = True
+    """A pass starts: both overrides and the feed-stop switch on (LinuxCNC's M2/M30 switch
+    them on again)."""
+    run.feed_override_on = run.spindle_override_on = run.feed_hold_on = True
+    run._fh_check = True
     apply(run)
+
+
+def feed_hold_step(run: ProgramRunner, g: Group) -> None:
+    """Per cycle after a feed-stop edge or an M53 (`run._fh_check`): hold the path while
+    the input is active and the switch on; go on once it is released (only a hold it made
+    itself: an operator's pause() or an M0 stays paused)."""
+    from ..control.groups.group import GroupState
+    from .runtypes import RunState
+
+    name = run.options.feed_hold_input
+    if name is None:
+        run._fh_check = False
+        return
+    active = run.feed_hold_on and bool(run._ctl.hardware.read_input(name))
+    if active and run.state is RunState.RUNNING:
+        run._hold()
+        run.state = RunState.PAUSED
+        run._fh_paused = True
+        run._event("feed_hold", run.current_line, f"feed stop {name} active: holding")
+    elif not active and run._fh_paused and run.state is RunState.PAUSED:
+        if g.state is GroupState.HOLDING:
+            return  # still decelerating: check again next cycle
+        if g.state is GroupState.HELD:
+            g.cont()
+        run.state = RunState.RUNNING
+        run._fh_paused = False
+        run._event("feed_hold", run.current_line, f"feed stop {name} released")
+    run._fh_check = False
