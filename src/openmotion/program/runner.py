@@ -89,7 +89,7 @@ class ProgramRunner:
                  *, axes: Mapping[str, int | str] | None = None,
                  options: RunOptions | None = None, gcode: Mapping[str, object] | None = None,
                  file: str = "", compare: CompareEngine | None = None) -> None:
-        from ..control.trigger.analog import AnalogOutputs
+        from ..control.trigger.analog import AnalogInputs, AnalogOutputs
         from ..control.trigger.compare import CompareEngine
 
         if compare is not None and (not isinstance(compare, CompareEngine)
@@ -114,7 +114,8 @@ class ProgramRunner:
         file = os.fspath(file)
         self._gextra.setdefault("n_outputs", ctl.config.digital_outputs)
         self._gextra.setdefault("n_inputs", ctl.config.digital_inputs)
-        self._gextra.setdefault("n_analog_inputs", 0)  # no analog inputs in the hardware
+        self.analog_in = AnalogInputs(ctl)
+        self._gextra.setdefault("n_analog_inputs", self.analog_in.count)
         self.analog = AnalogOutputs(ctl)
         self._gextra.setdefault("n_analog_outputs", self.analog.count)
         if "soft_limits" not in self._gextra:  # moves past the EL switches fail to compile
