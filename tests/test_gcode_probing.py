@@ -260,6 +260,7 @@ def test_runner_m66_waits_for_inputs_and_times_out():
 
 def test_runner_m66_analog_is_refused_without_analog_inputs():
     ctl = Controller()
+    ctl.hardware.configure_analog_inputs(0)
     with pytest.raises(GCodeError, match="analog input number must be < 0"):
         ProgramRunner(ctl, "M66 E0\nM2\n")
 

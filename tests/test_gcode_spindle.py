@@ -206,3 +206,23 @@ def test_spindle_options_are_checked():
     run.start()
     run.wait(5)
     assert run.state is RunState.ERROR and "maximum is 6000 rpm" in run.error
+
+
+def test_g87_orients_before_it_enters_the_hole_and_restarts_the_spindle():
+    ctl, run = runner("G21 S1200 M3\nG4 P0.3\nG0 X0 Y0 Z1\n"
+                      "G87 X0.2 Y0 R0.5 Z-0.5 I0.1 J0 K-0.2 F1200\nG80\nM2\n")
+    run.start()
+    run.wait(60)
+    assert run.state is RunState.DONE, run.error
+    assert [e.text for e in run.events if "M19" in e.text] == ["M19 R0 P0"] * 2
+    sp = run.spindle
+    assert sp is not None and sp.index_count is not None
+
+
+def test_g87_stops_when_the_spindle_cannot_orient():
+    ctl, run = runner("G21 S300 M3\nG0 X0 Y0 Z5\nG87 X1 Y0 R2 Z-2 I0.5 J0 K-1 F600\nM2\n")
+    run.start()  # the index has never passed: the tool must not go down into the hole
+    run.wait(30)
+    assert run.state is RunState.ERROR and "index pulse" in run.error
+    z = ctl.axes[2]
+    assert z.position / z.units.pulses_per_unit == pytest.approx(2.0)  # stopped at R

@@ -236,7 +236,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="seconds from rest to the programmed feed (path acceleration = "
                    "feed / acc-time)")
     r.add_argument("--feed-override", type=float, default=100.0,
-                   help="feed override in %% of the programmed feed (1 .. 200)")
+                   help="feed override in %% of the programmed feed (1 .. 200; the "
+                   "program's M50 P0 / M49 run at 100 %%)")
+    r.add_argument("--spindle-override", type=float, default=100.0,
+                   help="spindle speed override in %% of S (1 .. 200; M51 P0 / M49 ignore "
+                   "it)")
     r.add_argument("--probe-input", metavar="di<n>",
                    help="board input the G38.x probe is wired to (a simulated probe)")
     r.add_argument("--probe-box", action="append", metavar="'X10:50 Y8:38 Z:20'",

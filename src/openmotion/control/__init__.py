@@ -21,7 +21,7 @@ from .loops.compensation import BACKLASH_COMPENSATING, Compensation, PitchCompTa
 from .loops.servo import PIDFF, Compensator, FollowingErrorMonitor, FollowingErrorResult, LeadFilter
 from .loops.servoloop import ServoLoop, attach_servo_loops
 from .manual.jog import jog_conti, jog_pulse, jog_space, stop_jog
-from .trigger.analog import AnalogOutputs
+from .trigger.analog import AnalogInputs, AnalogOutputs
 from .trigger.compare import CompareEngine
 from .trigger.compare_io import EventLog as CompareLog
 from .trigger.compare_io import plot_firings
@@ -54,7 +54,7 @@ register_attachment("safety", lambda ctl, wanted: Safety(ctl) if wanted else Non
 
 __all__ = [
     "COUNTER_MAX", "COUNTER_MIN", "ActiveMotion", "Axis", "AxisState", "Controller",
-    "Counters", "CycleStats", "MotionDone", "wrap28", "AnalogOutputs",
+    "Counters", "CycleStats", "MotionDone", "wrap28", "AnalogOutputs", "AnalogInputs",
     "PIDFF", "Compensator", "FollowingErrorMonitor", "FollowingErrorResult", "LeadFilter",
     "ServoLoop", "BACKLASH_COMPENSATING", "Compensation", "PitchCompTable", "INPOS_TIMEOUT",
     "InPositionControl", "Group", "GroupError", "GroupState", "jog_conti", "jog_pulse",

@@ -155,6 +155,20 @@ class TimedOutputHardware(Protocol):
 
 
 @runtime_checkable
+class AnalogInputHardware(Protocol):
+    """Optional extension: board analog inputs `ai<n>` (an ADC, in the unit the board reports),
+    as LinuxCNC's motion.analog-in-NN pins that M66 E reads. The control layer checks
+    `isinstance(hw, AnalogInputHardware)`; a back end without analog inputs lacks these."""
+
+    @property
+    def n_analog_inputs(self) -> int:
+        """Number of analog inputs (channels 0 .. n - 1)."""
+
+    def read_analog_input(self, channel: int) -> float:
+        """The value of channel `channel` now (MotionError for a channel out of range)."""
+
+
+@runtime_checkable
 class AnalogOutputHardware(Protocol):
     """Optional extension: board analog outputs `ao<n>` (a DAC: volts, or the unit the
     board's range is given in), as LinuxCNC's motion.analog-out-NN pins that M67/M68 drive.

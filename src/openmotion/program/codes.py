@@ -3,14 +3,12 @@ it does not implement are refused (the error names the feature)."""
 
 from __future__ import annotations
 
-from .cycles import REFUSED as CYCLE_REFUSED
-
 # G codes are held as int(round(10 * value)): G1 -> 10, G90.1 -> 901.
 G_GROUP = {
     40: 0, 100: 0, 520: 0, 280: 0, 281: 0, 300: 0, 301: 0, 530: 0, 920: 0, 921: 0, 922: 0, 923: 0,
     0: 1, 10: 1, 20: 1, 30: 1, 50: 1, 51: 1, 52: 1, 53: 1, 330: 1, 331: 1, 760: 1, 800: 1, 730: 1,
     740: 1, 810: 1, 820: 1,
-    830: 1, 840: 1, 850: 1, 860: 1, 880: 1, 890: 1, 382: 1, 383: 1, 384: 1, 385: 1,
+    830: 1, 840: 1, 850: 1, 860: 1, 870: 1, 880: 1, 890: 1, 382: 1, 383: 1, 384: 1, 385: 1,
     700: 1, 710: 1, 711: 1, 712: 1, 720: 1, 721: 1, 722: 1,  # lathe cycles (latheprofile.py)
     170: 2, 180: 2, 190: 2,
     900: 3, 910: 3,
@@ -26,17 +24,12 @@ G_GROUP = {
     70: 15, 80: 15,
 }
 #: Why some well-known codes are refused (others get a generic "unsupported").
-G_REFUSED = {
-    **{k: f"{v} is not supported" for k, v in CYCLE_REFUSED.items()},
-}
+G_REFUSED: dict[int, str] = {}
 #: Why some well-known M-codes are refused.
 M_REFUSED = {
-    48: "override switches (M48) are not supported", 49: "override switches (M49)"
-    " are not supported", 50: "feed override control (M50) is not supported",
-    51: "spindle override control (M51) is not supported",
-    52: "adaptive feed (M52) is not supported", 53: "feed stop control (M53) is not supported",
     60: "pallet change (M60) is not supported",
 }
 M_GROUP = {0: 4, 1: 4, 2: 4, 30: 4, 6: 6, 3: 7, 4: 7, 5: 7, 19: 7, 7: 8, 8: 8, 9: 8,
            62: 5, 63: 5, 64: 5, 65: 5, 66: 5, 67: 5, 68: 5, 98: 11, 99: 11, 61: 6,
-           70: 12, 71: 12, 72: 12, 73: 12}
+           70: 12, 71: 12, 72: 12, 73: 12,
+           48: 9, 49: 9, 50: 9, 51: 9, 52: 9, 53: 9}  # overrides.py

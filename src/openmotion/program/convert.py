@@ -41,6 +41,7 @@ from .analogout import AnalogOut
 from .css import FeedMode, SpindleMode
 from .options import MM_PER_INCH, ROTARY_LETTERS
 from .orient import Orient
+from .overrides import OverrideSwitch
 from .probing import Probe, WaitInput
 from .rigidtap import RigidTap
 from .source import GCodeError
@@ -54,7 +55,8 @@ UNBOUNDED_BLEND = 1e12
 class Op:
     """One runner operation. kind: line, arc, delay, blend, pause, end, output, action,
     analog (M67/M68; `source` the AnalogOut), wait (M66; `source` the WaitInput), orient
-    (M19; `source` the Orient). A probe move is
+    (M19; `source` the Orient), override (M48-M51; `source` the OverrideSwitch). A probe
+    move is
     a line whose `source` is a Probe, a spindle-synchronised one (G33/G76) a line whose
     `source` is the SyncedFeed.
 
@@ -196,6 +198,9 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         elif isinstance(cmd, Orient):
             ops.append(Op("orient", cmd.line, cmd.file, seconds=cmd.timeout or 0.0,
                           text=f"M19 R{cmd.angle:g} P{cmd.mode}", barrier=True, source=cmd))
+        elif isinstance(cmd, OverrideSwitch):  # after the motion before it
+            ops.append(Op("override", cmd.line, cmd.file, text=cmd.text, barrier=True,
+                          source=cmd))
         elif isinstance(cmd, AnalogOut):
             ops.append(Op("analog", cmd.line, cmd.file, index=cmd.index, synced=cmd.synced,
                           text=f"ao{cmd.index} = {cmd.value:g}", source=cmd))

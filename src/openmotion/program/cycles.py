@@ -1,4 +1,4 @@
-"""Canned cycles G73, G74, G81-G86, G88, G89 with G98/G99 and L repeats, expanded
+"""Canned cycles G73, G74, G81-G89 with G98/G99 and L repeats, expanded
 into canonical motion exactly as LinuxCNC's interp_cycles.cc does.
 
 Per repeat (CYCLE_MACRO): rapid parallel to the plane to the hole (on the first repeat
@@ -14,6 +14,15 @@ up to R. The cycle runs in exact-path mode and restores the blend mode after.
 G74/G84 are floating-chuck tapping (LinuxCNC 2.9): feed in, spindle reversed, dwell P
 (optional, sticky across cycles, 0 at start), feed out to the clearance, spindle restored;
 G84 needs M3, G74 M4.
+G87 is back boring (LinuxCNC's convert_cycle_g87): from R, move to the offset point (hole +
+I/J/K along the plane axes, always relative), stop the spindle and orient it (0 degrees, in
+its turning direction), rapid down to the bottom, over to the hole, restart the spindle,
+feed up to the third-axis word of the plane (K in G17, J in G18, I in G19: absolute in
+G90, relative to the bottom in G91) and back down, stop and orient again, rapid to the
+offset point, up to the clearance height, back over the hole, restart the spindle. I, J, K
+are sticky while G87 continues. Unlike LinuxCNC (whose ORIENT_SPINDLE goes on at once),
+the tool waits for each orientation (at most G87_ORIENT_TIMEOUT s) before it moves into
+the hole: the oriented tool is what lets it pass.
 Planes: G17 (hole at X/Y, depth along Z), G18 (Z/X, depth along Y), G19 (Y/Z, along X).
 """
 
@@ -24,6 +33,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from . import canon
+from .orient import Orient
 from .parser import Block
 from .words import Word, fmt
 
@@ -31,13 +41,15 @@ if TYPE_CHECKING:
     from .modal import Modal
 
 #: Motion codes (G * 10) of the cycles built here.
-CYCLES = frozenset({730, 740, 810, 820, 830, 840, 850, 860, 880, 890})
-#: Cycles refused, with the feature named.
-REFUSED = {870: "back boring G87 (needs spindle orientation)"}
+CYCLES = frozenset({730, 740, 810, 820, 830, 840, 850, 860, 870, 880, 890})
 #: Plane -> (first, second, depth) axis letters.
 CYCLE_AXES = {170: ("X", "Y", "Z"), 180: ("Z", "X", "Y"), 190: ("Y", "Z", "X")}
 #: LinuxCNC's peck retract for G73 (chip break) and G83 (rapid back down), program units.
 PECK_CLEARANCE = {"mm": 0.254, "inch": 0.010}
+#: G87: the offset / back-bore word of each axis letter.
+G87_WORD = {"X": "I", "Y": "J", "Z": "K"}
+#: G87: the most seconds the tool waits for each spindle orientation before the run stops.
+G87_ORIENT_TIMEOUT = 30.0
 
 
 @dataclass
@@ -48,6 +60,7 @@ class CycleState:
     c: float | None = None
     p: float | None = None
     q: float | None = None
+    ijk: dict[str, float] | None = None  # G87's I, J, K as written
     initial: float | None = None  # program coordinate of the depth axis before the series
 
 
@@ -158,8 +171,16 @@ def canned_cycle(m: Modal, b: Block, code: int, gpos: int, axes: dict[str, Word]
             raise b.error(f"{gword} needs the spindle turning "
                           f"{'clockwise (M3)' if code == 840 else 'counterclockwise (M4)'}",
                           gpos, gword)
-    if code in (860, 880) and not m.spindle_on:
+    if code in (860, 870, 880) and not m.spindle_on:
         raise b.error(f"{gword} needs the spindle turning (M3 or M4)", gpos, gword)
+    back_words: tuple[float, float, float] | None = None
+    if code == 870:  # I, J, K: offsets of the plane axes, back-bore height on the third
+        old = st.ijk or {}
+        got = {G87_WORD[L]: _need(m, b, code, words, G87_WORD[L], old.get(G87_WORD[L]),
+                                  used, gword, gpos, "back boring offset or height")
+               for L in (la, lb, lc)}
+        st.ijk = got
+        back_words = (got[G87_WORD[la]], got[G87_WORD[lb]], got[G87_WORD[lc]])
     if peck > 0 and (r_word - c_word if not m.incremental else -c_word) / peck * repeats \
             > m.opt.max_blocks:
         raise b.error(f"{gword}: Q{peck:g} makes more pecks than max_blocks "
@@ -210,7 +231,12 @@ def canned_cycle(m: Modal, b: Block, code: int, gpos: int, axes: dict[str, Word]
             cyc.traverse(a, bb, clear)
             if clear > r:
                 cyc.traverse(a, bb, r)
-        _body(m, cyc, code, a, bb, r, clear, bottom, dwell, peck, delta)
+        if back_words is not None:
+            oa, ob, mid = back_words
+            _back_bore(m, cyc, a, bb, a + oa, bb + ob, r, clear,
+                       bottom + mid if m.incremental else mid, bottom)
+        else:
+            _body(m, cyc, code, a, bb, r, clear, bottom, dwell, peck, delta)
     if restore is None or restore[0] != "exact_path":
         mode, tol, cam = restore if restore is not None else ("blend", None, None)
         out.append(canon.SetBlend(mode, tol, b.line, b.file, cam))
@@ -274,3 +300,24 @@ def _body(m: Modal, cyc: _Cycle, code: int, a: float, b: float, r: float, clear:
         cyc.feed_to(a, b, bottom)
         out.append(canon.Dwell(dwell, blk.line, blk.file))
         cyc.feed_to(a, b, clear)
+
+
+def _back_bore(m: Modal, cyc: _Cycle, a: float, b: float, oa: float, ob: float, r: float,
+               clear: float, middle: float, bottom: float) -> None:
+    """G87's moves of one hole after positioning at R (module doc)."""
+    out, blk = cyc.out, cyc.b
+    orient = Orient(0.0, 0 if m.spindle_cw else 1, G87_ORIENT_TIMEOUT, blk.line, blk.file)
+    cyc.traverse(oa, ob, r)
+    out.append(m.spindle_record(False, blk))
+    out.append(orient)
+    cyc.traverse(oa, ob, bottom)
+    cyc.traverse(a, b, bottom)
+    out.append(m.spindle_record(True, blk))
+    cyc.feed_to(a, b, middle)
+    cyc.feed_to(a, b, bottom)
+    out.append(m.spindle_record(False, blk))
+    out.append(orient)
+    cyc.traverse(oa, ob, bottom)
+    cyc.traverse(oa, ob, clear)
+    cyc.traverse(a, b, clear)
+    out.append(m.spindle_record(True, blk))

@@ -1,8 +1,8 @@
 """Modal state machine: executes one parsed line (a `Block`) into canonical commands.
 
 The order of execution within a line is RS-274/NGC's (LinuxCNC "G-code order of
-execution"): comments/messages, feed mode G93/G94, F, S, T, M6, M3/M4/M5, M7/M8/M9, M62-M65,
-G4, plane, units, cutter compensation, tool length, coordinate system, path control,
+execution"): comments/messages, feed mode G93/G94, F, S, T, M6, M3/M4/M5, M7/M8/M9, M48-M53,
+M62-M65, G4, plane, units, cutter compensation, tool length, coordinate system, path control,
 distance modes, G10/G28/G30/G92, motion (G0-G3, G53, G80), M0/M1/M2/M30.
 
 Positions are held in machine coordinates (machine units). A program coordinate p of axis
@@ -34,6 +34,7 @@ from .modalstate import SavedState, state_word
 from .named import READ_ONLY, predefined
 from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
 from .orient import m19
+from .overrides import m48_m53
 from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
@@ -87,6 +88,8 @@ class Modal:
         self.speed = 0.0
         self.mist = False
         self.flood = False
+        self.feed_override_on = self.speed_override_on = True  # M48-M51 (overrides.py)
+        self.feed_hold_on = True  # M53
         self.ended = False
         #: M98 (call: P number, L count) or M99 for the interpreter, after the line ran:
         #: (kind, P, L, column)
@@ -367,6 +370,8 @@ class Modal:
             self.flood = self.flood or 8 in coolant
             out.append(canon.Coolant(self.mist, self.flood, self.opt.mist_output,
                                      self.opt.flood_output, line, file))
+        if 9 in ms:
+            m48_m53(self, b, ms[9][0], ms[9][1], words, used, out)
         if 5 in ms and ms[5][0] == 66:
             m66(self, b, ms[5][1], words, used, out)
         elif 5 in ms and ms[5][0] in (67, 68):

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from .runoverride import feed_percent
+
 if TYPE_CHECKING:
     from ..control.groups.group import Group
     from .convert import Op
@@ -21,19 +23,20 @@ if TYPE_CHECKING:
 
 def follow_per_rev(run: ProgramRunner, g: Group) -> None:
     """G95 on a spindle axis: the moves run at F x the measured speed (the group's feed
-    override = measured / planned spindle speed, 1 .. 200 %)."""
+    override = the operator's override x measured / planned spindle speed, 1 .. 200 %);
+    outside G95 the operator's override (runoverride.py)."""
     assert run.spindle is not None
     planned = run._per_rev_ops.get(g.current_index)
     run._feed_tick += 1
+    base = feed_percent(run)  # the operator's override, or 100 under M50 P0 / M49
     if planned is None:
-        pct = 100.0
+        pct = base
     else:  # the speed averaged over the measuring window (a re-plan costs)
-        pct = min(200.0, max(1.0, 100.0 * abs(run.spindle.revs_per_s()) / planned))
-    step = abs(pct - run._feed_pct)
-    if (pct == 100.0 != run._feed_pct) or step >= 5.0 or (
+        pct = min(200.0, max(1.0, base * abs(run.spindle.revs_per_s()) / planned))
+    step = abs(pct - g.override)
+    if (planned is None and step > 0.0) or step >= 5.0 or (
             step >= 1.0 and run._feed_tick >= 10):
         g.set_override(pct)
-        run._feed_pct = pct
         run._feed_tick = 0
 
 

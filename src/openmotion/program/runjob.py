@@ -43,6 +43,9 @@ def run_job(args: argparse.Namespace) -> int:
     override = getattr(args, "feed_override", 100.0)
     if not (isinstance(override, float | int) and 1.0 <= override <= 200.0):
         raise MotionError(f"--feed-override must be in [1, 200] %, got {override!r}")
+    spindle_pct = getattr(args, "spindle_override", 100.0)
+    if not (isinstance(spindle_pct, float | int) and 1.0 <= spindle_pct <= 200.0):
+        raise MotionError(f"--spindle-override must be in [1, 200] %, got {spindle_pct!r}")
     cfg, settings = (read_machine_arg(args.machine, "--machine") if args.machine
                      else (default_machine(), {}))
     path = Path(args.program)
@@ -83,9 +86,9 @@ def run_job(args: argparse.Namespace) -> int:
         print(f"{path}: {len(run.commands)} commands, {len(run.ops)} moves/actions on "
               f"{''.join(run.letters)} of machine '{cfg.name}', acceleration time "
               f"{acc_time:g} s, feed override {override:g} %", file=sys.stderr)
+        run.set_feed_override(float(override))  # the whole job (M50 P0 / M49 ignore it)
+        run.set_spindle_override(float(spindle_pct))
         run.start()
-        if override != 100.0 and run.group is not None:
-            run.group.set_override(float(override))  # before the first cycle: the whole job
         _drive(ctl, run, stop, args.realtime, bar)
         if run.state is RunState.ERROR:   # a fault's decelerating stop (e.g. the machine
             _axes_to_rest(ctl, args.realtime)   # file's el = "decel") ends before the summary

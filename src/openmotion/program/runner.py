@@ -56,6 +56,9 @@ from .rigidtap import RigidTap
 from .runaxes import gcode_fields, machine_axes, travel_limits
 from .runcompile import RunPass
 from .runfeed import follow_per_rev
+from .runoverride import apply as apply_overrides
+from .runoverride import check_percent, feed_hold_step
+from .runoverride import reset as reset_overrides
 from .runrequests import answer, begin_request, on_probe_edge
 from .runtypes import RunEvent, RunOptions, RunState
 from .runwait import InputWait, ProbeMove
@@ -87,7 +90,7 @@ class ProgramRunner:
                  *, axes: Mapping[str, int | str] | None = None,
                  options: RunOptions | None = None, gcode: Mapping[str, object] | None = None,
                  file: str = "", compare: CompareEngine | None = None) -> None:
-        from ..control.trigger.analog import AnalogOutputs
+        from ..control.trigger.analog import AnalogInputs, AnalogOutputs
         from ..control.trigger.compare import CompareEngine
 
         if compare is not None and (not isinstance(compare, CompareEngine)
@@ -112,7 +115,8 @@ class ProgramRunner:
         file = os.fspath(file)
         self._gextra.setdefault("n_outputs", ctl.config.digital_outputs)
         self._gextra.setdefault("n_inputs", ctl.config.digital_inputs)
-        self._gextra.setdefault("n_analog_inputs", 0)  # no analog inputs in the hardware
+        self.analog_in = AnalogInputs(ctl)
+        self._gextra.setdefault("n_analog_inputs", self.analog_in.count)
         self.analog = AnalogOutputs(ctl)
         self._gextra.setdefault("n_analog_outputs", self.analog.count)
         if "soft_limits" not in self._gextra:  # moves past the EL switches fail to compile
@@ -155,7 +159,14 @@ class ProgramRunner:
         self.rigid_taps: list = []  # G33.1 taps run against the spindle (RigidTapMove)
         self._per_rev = False  # feeding a G95 stretch
         self._per_rev_ops: dict[int, float] = {}  # group index -> planned spindle rps
-        self._feed_pct = 100.0  # override the G95 follower set last
+        self.feed_override = 100.0  # the operator's, % (set_feed_override)
+        self.spindle_override = 100.0
+        self.feed_override_on = self.spindle_override_on = True  # M48-M51 (overrides.py)
+        self.feed_hold_on = True  # M53: the feed-stop switch obeyed (feed_hold_input)
+        self._fh_check = False  # a feed-stop edge or an M53 to look at next cycle
+        self._fh_paused = False  # paused by the feed-stop input (not by the operator)
+        if self.options.feed_hold_input is not None:
+            ctl.hardware.read_input(self.options.feed_hold_input)  # validates the input
         self._feed_tick = 0
         self._spindle_index: int | None = None
         if self.options.spindle_axis is not None:
@@ -246,8 +257,24 @@ class ProgramRunner:
         self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._ctl.add_jump_observer(self._on_jump)
         self.synced.attach(self.group.start_time)
+        reset_overrides(self)
         if self.options.probe_input is not None:
             self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
+        if self.options.feed_hold_input is not None:
+            self._ctl.add_edge_hook(self._on_feed_hold_edge,
+                                    signals=(self.options.feed_hold_input,))
+
+    def set_feed_override(self, percent: float) -> None:
+        """The operator's feed override, 1 .. 200 % of the programmed feed, at any time
+        (re-plans a running path); ignored while the program has it off (M50 P0, M49)."""
+        self.feed_override = check_percent("feed override", percent)
+        apply_overrides(self)
+
+    def set_spindle_override(self, percent: float) -> None:
+        """The operator's spindle-speed override, 1 .. 200 % of S (the spindle's maximum
+        caps it); ignored while the program has it off (M51 P0, M49)."""
+        self.spindle_override = check_percent("spindle override", percent)
+        apply_overrides(self)
 
     def pause(self) -> None:
         """Hold: decelerate along the path and stop; resume() continues."""
@@ -271,6 +298,8 @@ class ProgramRunner:
             g.cont()
         self._step_line = None
         self.state = RunState.RUNNING
+        self._fh_paused = False
+        self._fh_check = True  # a feed-stop input still active holds again
         self._event("resume", self.current_line, "resumed")
 
     def abort(self) -> None:
@@ -367,6 +396,8 @@ class ProgramRunner:
         self.synced.detach()
         if self.options.probe_input is not None:
             self._ctl.remove_edge_hook(self._on_probe_edge)
+        if self.options.feed_hold_input is not None:
+            self._ctl.remove_edge_hook(self._on_feed_hold_edge)
         if self.group is not None:
             if state is not RunState.ABORTED:
                 self.group.close()
@@ -417,7 +448,7 @@ class ProgramRunner:
         if g.state is GroupState.ERROR or self.synced.armed or self.synced_analog.armed:
             return -math.inf
         if self._request is not None or self._stray_trip is not None \
-                or self.spindle is not None:
+                or self.spindle is not None or self._fh_check:
             # a probe move or M66 wait polls its input every cycle; the spindle is sampled
             return -math.inf
         if self.state is not RunState.RUNNING:
@@ -464,6 +495,8 @@ class ProgramRunner:
             self._exec_line = self._line_of.get(g.current_index, self._exec_line)
         self.synced.fire(g.current_index, self._idle_past)
         self.synced_analog.fire(g.current_index, self._idle_past)
+        if self._fh_check:
+            feed_hold_step(self, g)
         if self.state is not RunState.RUNNING:
             return
         try:
@@ -483,6 +516,10 @@ class ProgramRunner:
 
     def _feed(self, g: Group) -> None:
         runqueue.feed(self, g)
+
+    def _on_feed_hold_edge(self, ctl: Controller, e: InputEdge) -> None:
+        if e.axis is None and e.signal == self.options.feed_hold_input:
+            self._fh_check = True
 
     def _on_probe_edge(self, ctl: Controller, e: InputEdge) -> None:
         on_probe_edge(self, ctl, e)

@@ -19,9 +19,12 @@ from . import canon
 from .analogout import AnalogOut
 from .convert import Op
 from .css import SpindleMode
+from .overrides import OverrideSwitch
 from .probing import Probe
 from .rigidtap import RigidTap
 from .runfeed import ceiling_rps, planned_rps, x_reader
+from .runoverride import reset as reset_overrides
+from .runoverride import switch as switch_overrides
 from .runtypes import RunEvent, RunState
 from .source import GCodeError
 
@@ -155,6 +158,10 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
                 for index, level in op.outputs:
                     run._set_output(op, index, level, "output")
                 run._event("action", op.line, op.text)
+            elif op.kind == "override":
+                assert isinstance(op.source, OverrideSwitch)
+                switch_overrides(run, op.source)
+                run._event("action", op.line, op.text)
             elif op.kind == "pause" and (not op.optional or opts.optional_stop):
                 p.pc += 1
                 run._last_line = op.line
@@ -195,6 +202,7 @@ def end_of_pass(run: ProgramRunner) -> None:
         run._finish(RunState.DONE, f"{run.passes_done} pass(es) done")
         return
     run._event("repeat", run._last_line, f"pass {run.passes_done + 1}")
+    reset_overrides(run)
     pos = run._positions()
     run._cursor = pos
     if run._live:

@@ -52,7 +52,7 @@ def begin_request(run: ProgramRunner, g: Group, op: Op) -> None:
             run.op_of[idx] = op
             run.starts_of[idx] = pos
     elif isinstance(op.source, WaitInput):
-        run._request = InputWait(run._ctl, op.source)
+        run._request = InputWait(run._ctl, op.source, run.analog_in)
         run._event("wait", op.line, f"M66 P{op.index} L{op.source.mode}")
     elif isinstance(op.source, RigidTap):
         assert run.spindle is not None

@@ -43,6 +43,7 @@ class RunOptions:
     single_block: bool = False
     optional_stop: bool = False
     probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
+    feed_hold_input: str | None = None  # the feed-stop switch ("di<n>", M53; runoverride)
     spindle_axis: int | str | None = None  # the controller axis that is the spindle
     spindle_acc_time: float = 0.5   # s of a spindle speed ramp
 
@@ -64,7 +65,8 @@ class RunOptions:
         sp = self.spindle_axis
         if sp is not None and (isinstance(sp, bool) or not isinstance(sp, (int, str))):
             raise MotionError(f"spindle_axis must be an axis index or name, got {sp!r}")
-        pi = self.probe_input
-        if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
-                                   and pi[2:].isdigit()):
-            raise MotionError(f"probe_input must be a board input 'di<n>' or None, got {pi!r}")
+        for name in ("probe_input", "feed_hold_input"):
+            pi = getattr(self, name)
+            if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
+                                       and pi[2:].isdigit()):
+                raise MotionError(f"{name} must be a board input 'di<n>' or None, got {pi!r}")

@@ -27,6 +27,7 @@ from .probing import InputResult, Probe, ProbeResult, WaitInput
 
 if TYPE_CHECKING:
     from ..control.core.controller import Controller
+    from ..control.trigger.analog import AnalogInputs
 
 
 class ProbeMove:
@@ -90,14 +91,22 @@ class ProbeMove:
 class InputWait:
     """An M66 wait on a digital input (see the module doc)."""
 
-    def __init__(self, ctl: Controller, wait: WaitInput) -> None:
-        if wait.analog:
-            raise MotionError(f"M66 E{wait.index}: this hardware has no analog inputs")
+    def __init__(self, ctl: Controller, wait: WaitInput,
+                 analog: AnalogInputs | None = None) -> None:
         self._ctl = ctl
         self.wait = wait
+        self._hooked = False
+        if wait.analog:  # M66 E: L0 only (checked when compiled): the reading now
+            if analog is None or analog.count == 0:
+                raise MotionError(f"M66 E{wait.index}: this hardware has no analog inputs")
+            try:
+                self.value: float | None = analog.read(wait.index)
+            except MotionError as exc:
+                raise MotionError(f"M66 E{wait.index}: {exc}") from None
+            return
         self.signal = f"di{wait.index}"
         level = ctl.hardware.read_input(self.signal)
-        self.value: float | None = None
+        self.value = None
         if wait.mode == 0 or (wait.mode == 3 and level) or (wait.mode == 4 and not level):
             self.value = 1.0 if level else 0.0
             return

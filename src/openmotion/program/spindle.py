@@ -64,6 +64,7 @@ class SpindleDrive:
         self.css: SpindleMode | None = None  # G96 in force
         self._x_now = None  # G96: reads the tool's machine X
         self._cmd: canon.Spindle | None = None  # the M3/M4/S in force
+        self.override = 1.0  # the operator's spindle-speed factor (runoverride.py)
         self._css_tick = 0
         self.axis.fix_speed_range(self.axis.max_speed)  # speed changes up to the maximum
         ctl.add_edge_hook(self._on_edge, signals=("ez",))
@@ -109,6 +110,15 @@ class SpindleDrive:
         ax.change_speed(abs(v), tacc)
         self.rpm = rpm if self.rpm >= 0.0 else -rpm
 
+    def set_override(self, factor: float) -> None:
+        """The spindle-speed override (a factor on S, capped at the spindle's maximum): a
+        turning spindle changes speed at once."""
+        if factor == self.override:
+            return
+        self.override = factor
+        if self._cmd is not None and self._cmd.on and self.rpm != 0.0:
+            self.apply(self._cmd)
+
     def set_mode(self, mode: SpindleMode, x_now) -> None:
         """G96 (follow X through `x_now()`, machine units) or G97."""
         self.css = mode if mode.per_s_unit > 0.0 else None
@@ -124,8 +134,11 @@ class SpindleDrive:
         """The rpm the command asks for now (G96: at the tool's X, limited by D and by the
         spindle's maximum, as LinuxCNC limits it)."""
         if self.css is None or self._x_now is None:
-            return cmd.speed
-        return min(self.css.rpm(cmd.speed, float(self._x_now())), self.max_rpm)
+            if self.override == 1.0:
+                return cmd.speed
+            return min(cmd.speed * self.override, self.max_rpm)
+        return min(self.css.rpm(cmd.speed, float(self._x_now())) * self.override,
+                   self.max_rpm)
 
     def revs_per_s(self) -> float:
         """Measured speed (signed revolutions per second) over the last cycles."""
@@ -336,7 +349,10 @@ class OrientMove:
             self.target = self._goal()
             ratio = ax.counters.move_ratio
             if abs(self.target - d.count()) >= 0.5:
-                ax.move_absolute(self.target / ratio,
+                # in the command frame: just stopped, the feedback still lags the command
+                # (servo), and an absolute move measures from the feedback (HSL), so it
+                # would end that lag past the goal once the drive settles
+                ax.move_relative(self.target / ratio - ax.position,
                                  max_vel=ORIENT_RPM / 60.0 * d.counts_per_rev / ratio,
                                  tacc=0.05)
             return self.deadline is None

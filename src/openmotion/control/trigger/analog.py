@@ -1,4 +1,5 @@
-"""Analog outputs of the board (M67/M68, a laser power or a pump speed set from a program).
+"""Analog outputs of the board (M67/M68, a laser power or a pump speed set from a program),
+and its analog inputs (M66 E: `AnalogInputs`, hw.interface.AnalogInputHardware).
 
 `AnalogOutputs(ctl)` is the control layer's view of the back end's analog outputs
 (hw.interface.AnalogOutputHardware): it validates in the user's terms (channel number,
@@ -13,7 +14,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ...errors import MotionError
-from ...hw.interface import AnalogOutputHardware
+from ...hw.interface import AnalogInputHardware, AnalogOutputHardware
 
 if TYPE_CHECKING:
     from ..core.controller import Controller
@@ -76,3 +77,26 @@ class AnalogOutputs:
                               f"{channel!r}" if n else "this hardware has no analog outputs")
         assert self._hw is not None
         return float(self._hw.read_analog_output(channel))
+
+
+class AnalogInputs:
+    """Read the analog inputs `ai<n>` of a controller's hardware (M66 E)."""
+
+    def __init__(self, ctl: Controller) -> None:
+        hw = ctl.hardware
+        self._hw = hw if isinstance(hw, AnalogInputHardware) else None
+
+    @property
+    def count(self) -> int:
+        """Number of analog inputs (0: the hardware has none)."""
+        return 0 if self._hw is None else int(self._hw.n_analog_inputs)
+
+    def read(self, channel: int) -> float:
+        """The value of input `channel` now; MotionError naming the rule otherwise."""
+        n = self.count
+        if n == 0:
+            raise MotionError("this hardware has no analog inputs")
+        if isinstance(channel, bool) or not isinstance(channel, int) or not 0 <= channel < n:
+            raise MotionError(f"channel must be an integer in 0..{n - 1}, got {channel!r}")
+        assert self._hw is not None
+        return float(self._hw.read_analog_input(channel))

@@ -35,6 +35,7 @@ from openmotion.hw.interface import (
 
 from . import kernel
 from .analog import SimAnalogOutputs
+from .analog_in import SimAnalogInputs
 from .cubic import Cubic
 from .encoder import Decoder, EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
@@ -49,7 +50,7 @@ from .switches import Switch
 SWITCH_SIGNALS = ("pel", "mel", "org", "sd", "ltc")
 
 
-class SimMachine(SimAnalogOutputs):
+class SimMachine(SimAnalogOutputs, SimAnalogInputs):
     """A simulated multi-axis machine implementing `openmotion.hw.interface.Hardware`.
 
     `wiring` optionally overrides the physical encoder of some axes (axis -> EncoderWiring)

@@ -140,6 +140,12 @@ class Scenario:
         t = self._at(at)
         self._push(t, lambda raw: self._m._knock(axis, c, raw))
 
+    def set_analog_input(self, channel: int, value: float, at: float | None = None) -> None:
+        """Set analog input `ai<channel>` to `value` (what M66 E reads from then on)."""
+        k, v = self._m._check_ai(channel, value)
+        t = self._at(at)
+        self._push(t, lambda raw: self._m._set_ai(k, v))
+
     def set_input(self, signal: str, level: bool, at: float | None = None) -> None:
         """Drive general input `di<n>` to an electrical level."""
         n = len(self._m._di)
