@@ -189,6 +189,17 @@ static int get_ctx(PyObject *const *o, Buf *bufs, RtCtx *c)
     return 0;
 }
 
+/* The five context arrays as a call's only arguments (st, busy, late, work, cpu); on
+ * failure the buffers are released and a Python error is set. */
+static int ctx_args(PyObject *args, Buf *bufs, RtCtx *c)
+{
+    PyObject *o[5];
+    memset(bufs, 0, 5 * sizeof *bufs);
+    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) return -1;
+    if (get_ctx(o, bufs, c) < 0) { release(bufs, 5); return -1; }
+    return 0;
+}
+
 const char rt_paced_doc[] =
 "rt_paced(st, busy, late, work, cpu, fn, args) -> fn(*args)\n\n"
 "Call fn(*args) with the pacing context bound to this thread: every compiled cycle run\n"
@@ -242,12 +253,9 @@ const char rt_close_doc[] =
 
 PyObject *rt_close(PyObject *self, PyObject *args)
 {
-    PyObject *o[5];
-    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) return NULL;
     Buf bufs[5];
-    memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
+    if (ctx_args(args, bufs, &c) < 0) return NULL;
     if (c.st[RT_PENDING] >= 0.0) close_pending(&c, now_s());
     else extend_last(&c, now_s());
     release(bufs, 5);
@@ -296,12 +304,9 @@ const char rt_yield_doc[] =
 
 PyObject *rt_yield(PyObject *self, PyObject *args)
 {
-    PyObject *o[5];
-    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) return NULL;
     Buf bufs[5];
-    memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
+    if (ctx_args(args, bufs, &c) < 0) return NULL;
     Py_BEGIN_ALLOW_THREADS
     double end = now_s() + 0.02;
     while (vread(&c.st[RT_WAITERS]) > 0.0 && vread(&c.st[RT_STOPPING]) == 0.0

@@ -36,7 +36,7 @@ the very rows `Controller._record` writes cycle by cycle.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -242,28 +242,12 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
         return
     axes = ctl.axes
     kern = _motion._kernel
-    if kern is not None:  # the rows straight into the recorder's ring, in C
-        origin, period = ctl._t_origin, ctl.period
-        cnt = [ax.counters for ax in axes]
-        args = (origin, period, n, np.ascontiguousarray(trace, dtype=np.int64),
-                np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
-                np.array([ax.index for ax in movers], dtype=np.int64),
-                tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
-                np.array([ax.counters._cmd_off for ax in movers], dtype=float),
-                np.array([c._fb_internal for c in cnt], dtype=np.int64),
-                np.array([c._fb_off for c in cnt], dtype=np.int64), _nc_words(ctl),
-                _io_table(), bool(ctl._estop),
-                np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int32))
-
-        def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
-            try:
-                kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
-            except ValueError as exc:
-                raise MotionError(f"record_block: {exc}") from None
-
-        t_first = origin + (n + 1) * period
-        if ctl.recorder.record_into(m, t_first, origin + (n + m) * period, fill):
-            return
+    if kern is not None and _record_rows(  # the rows straight into the recorder's ring, in C
+            ctl, kern, n, np.ascontiguousarray(trace, dtype=np.int64),
+            np.array([ax.index for ax in movers], dtype=np.int64),
+            tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
+            np.array([ax.counters._cmd_off for ax in movers], dtype=float), "record_block"):
+        return
     t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
     pos = np.empty((m, len(axes)))
     vel = np.empty((m, len(axes)))
@@ -333,14 +317,24 @@ def record_now(ctl: Controller, n: int) -> bool:
         if c == ctl._n:  # read in this cycle: the values the controller holds
             cnt = axes[i].counters
             rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
-    cnt_all = [ax.counters for ax in axes]
+    return _record_rows(ctl, kern, n - 1, rows.reshape(1, -1, 3), _NO_MOVERS, (),
+                        _NO_OFFSETS, "record")
+
+
+def _record_rows(ctl: Controller, kern: Any, n: int, trace: np.ndarray,
+                 movers: np.ndarray, ends: tuple, offsets: np.ndarray, what: str) -> bool:
+    """Write the recorder rows of cycles n+1 .. n+len(trace) in one compiled call
+    (`_kernel.record_rows`) from the back end's readback `trace` and the movers' piece ends;
+    the axes' held values fill the rest. False when the recorder cannot take them so."""
+    axes = ctl.axes
+    cnt = [ax.counters for ax in axes]
     codes = _STATE_CODES or _state_codes()
     origin, period = ctl._t_origin, ctl.period
-    args = (origin, period, n - 1, rows.reshape(1, -1, 3),
+    args = (origin, period, n, trace,
             np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
-            _NO_MOVERS, (), _NO_OFFSETS,
-            np.array([c._fb_internal for c in cnt_all], dtype=np.int64),
-            np.array([c._fb_off for c in cnt_all], dtype=np.int64), _nc_words(ctl),
+            movers, ends, offsets,
+            np.array([c._fb_internal for c in cnt], dtype=np.int64),
+            np.array([c._fb_off for c in cnt], dtype=np.int64), _nc_words(ctl),
             _io_table(), bool(ctl._estop),
             np.array([codes[ax.state] for ax in axes], dtype=np.int32))
 
@@ -348,10 +342,11 @@ def record_now(ctl: Controller, n: int) -> bool:
         try:
             kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
         except ValueError as exc:
-            raise MotionError(f"record: {exc}") from None
+            raise MotionError(f"{what}: {exc}") from None
 
-    t1 = origin + n * period
-    return ctl.recorder.record_into(1, t1, t1, fill)
+    m = len(trace)
+    return ctl.recorder.record_into(m, origin + (n + 1) * period, origin + (n + m) * period,
+                                    fill)
 
 
 _IO_TABLE: list[np.ndarray] = []
