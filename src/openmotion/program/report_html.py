@@ -187,7 +187,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
         else:
             fig.update_xaxes(title=labels[0])
             fig.update_yaxes(title=labels[1], scaleanchor="x", scaleratio=1)
-        fig.update_layout(height=620, legend={"orientation": "h"}, clickmode="event")
+        fig.update_layout(height=620, clickmode="event")
         figs.append(("Path", fig))
     # ---- path speed: commanded (programmed feed times the override) against executed
     if lin:
@@ -202,7 +202,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
         fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(speed[keep]),
                                  name="executed path speed"))
         fig.update_layout(height=320, xaxis_title="time (s)",
-                          yaxis_title=f"speed ({units}/min)", legend={"orientation": "h"})
+                          yaxis_title=f"speed ({units}/min)")
         figs.append(("Path speed", fig))
     # ---- per moving axis: position, velocity, acceleration, jerk
     if moving:
@@ -222,7 +222,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
             fig.update_yaxes(title_text=" or ".join(f"{u}{per}" for u in shown), row=row,
                              col=1)
         fig.update_xaxes(title_text="time (s)", row=4, col=1)
-        fig.update_layout(height=900, legend={"orientation": "h"})
+        fig.update_layout(height=900)
         figs.append(("Axes (only those that move)", fig))
     # ---- contour error against time (actual and commanded positions), worst marked
     if np.any(np.isfinite(err)):
@@ -237,7 +237,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
         fig.add_trace(go.Scatter(x=[tt[w]], y=[err[w]], mode="markers", name=f"worst, line "
                                  f"{run.line_of(int(idx[w]))}",
                                  marker={"symbol": "x", "size": 12, "color": "red"}))
-        fig.update_layout(height=300, xaxis_title="time (s)", legend={"orientation": "h"},
+        fig.update_layout(height=300, xaxis_title="time (s)", yaxis_tickformat="~g",
                           yaxis_title=f"contour error ({units})")
         figs.append(("Contour error", fig))
     # ---- following error (commanded - actual) per moving axis
@@ -249,8 +249,9 @@ def _figures(run: ProgramRunner, err: np.ndarray,
             fig.add_trace(go.Scatter(x=_f32(tt[keep]), y=_f32(fe[keep, k]),
                                      name=f"{run.letters[k]} ({unit_of[k]})",
                                      line={"color": _COLOURS[k % len(_COLOURS)]}))
-        fig.update_layout(height=300, xaxis_title="time (s)", legend={"orientation": "h"},
-                          yaxis_title="following error (commanded - actual)")
+        shown = " or ".join(sorted({unit_of[k] for k in moving}))
+        fig.update_layout(height=300, xaxis_title="time (s)", yaxis_tickformat="~g",
+                          yaxis_title=f"commanded - actual ({shown})")
         figs.append(("Following error", fig))
     # ---- outputs: off/on lanes
     io_ev = [e for e in run.events if e.index is not None]
@@ -267,7 +268,19 @@ def _figures(run: ProgramRunner, err: np.ndarray,
                          ticktext=[f"do{n} {s}" for n in chans for s in ("off", "on")])
         fig.update_layout(height=120 + 60 * len(chans), xaxis_title="time (s)")
         figs.append(("Outputs", fig))
+    for _, fig in figs:
+        _tidy(fig)
     return figs
+
+
+def _tidy(fig: object) -> None:
+    """One layout for every figure: the legend in a row above the plot (clear of the axis
+    titles below it), and margins no wider than the titles need."""
+    titled = bool(fig.layout.annotations)  # type: ignore[attr-defined]  # subplot titles
+    legend = ({"yref": "container", "y": 1.0, "yanchor": "top"} if titled
+              else {"yref": "paper", "y": 1.0, "yanchor": "bottom"})
+    fig.update_layout(margin={"t": 70 if titled else 40, "b": 50, "l": 70, "r": 30},  # type: ignore[attr-defined]
+                      legend={"orientation": "h", "x": 0.0, **legend})
 
 
 _COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
