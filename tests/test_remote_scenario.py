@@ -158,7 +158,9 @@ def test_program_pause_resume_abort_and_override(machine):
     svc, m = machine
     for ax in ("z", "u"):
         m.call("axis.servo", axis=ax, on=True)
-    m.call("program.load", text="G21 G90\nM64 P3\nG1 X20 F300\nM0\nG1 X0\nM2\n")
+    # relative moves: the program's X0 is the G54 origin at mid-travel, 150 mm away from where
+    # the machine starts; the second move is long enough to be aborted while it runs
+    m.call("program.load", text="G21 G91\nM64 P3\nG1 X5 F300\nM0\nG1 X20\nM2\n")
     m.call("program.run", feed_override=50.0)
     assert m.wait(lambda s: s["program"]["state"] == "running", WAIT)
     m.call("program.feed_override", percent=150.0)
