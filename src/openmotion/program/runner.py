@@ -256,7 +256,7 @@ class ProgramRunner:
                                         self.options.spindle_acc_time)
         self._ctl.add_cycle_hook(self._on_cycle, due=self._due)
         self._ctl.add_jump_observer(self._on_jump)
-        self.synced.attach(self.group.start_time)
+        self.synced.attach(self.group.start_time, self.group.start_of)
         reset_overrides(self)
         if self.options.probe_input is not None:
             self._ctl.add_edge_hook(self._on_probe_edge, signals=(self.options.probe_input,))
@@ -438,22 +438,30 @@ class ProgramRunner:
 
     def _due(self, ctl: Controller) -> float:
         """When `_on_cycle` may next act beyond its trace (Controller.add_cycle_hook): now
-        when the group is in error, an M62/M63 is armed (it watches the command index) or
-        `_feed` has work; otherwise the group's own hook acts first and this one follows
-        in the same cycle, so never. The crossed cycles' trace comes from `_on_jump`."""
+        when the group is in error or `_feed` has work; an M62/M63/M67 bound to a move at
+        the start of the move before it (syncout.py: the group's plan says when); otherwise
+        the group's own hook acts first and this one follows in the same cycle, so never.
+        The crossed cycles' trace comes from `_on_jump`."""
         from ..control.groups.group import GroupState
 
         g = self.group
         assert g is not None
-        if g.state is GroupState.ERROR or self.synced.armed or self.synced_analog.armed:
+        if g.state is GroupState.ERROR:
             return -math.inf
+        synced = math.inf
+        if self.synced.armed or self.synced_analog.armed:  # M62/M63/M67 bound to moves
+            current = g.current_index
+            synced = min(self.synced.due(current),
+                         self.synced_analog.due(ctl, current, g.start_of))
+            if synced == -math.inf:
+                return synced
         if self._request is not None or self._stray_trip is not None \
                 or self.spindle is not None or self._fh_check:
             # a probe move or M66 wait polls its input every cycle; the spindle is sampled
             return -math.inf
         if self.state is not RunState.RUNNING:
-            return math.inf
-        return -math.inf if self._feed_ready(g) else math.inf
+            return synced
+        return -math.inf if self._feed_ready(g) else synced
 
     def _feed_ready(self, g: Group) -> bool:
         return runqueue.feed_ready(self, g)

@@ -38,6 +38,15 @@ if TYPE_CHECKING:
 
 #: start_time(index, t0, t1): Group.start_time of the runner's group
 StartTime = Callable[[int, float, float], "float | None"]
+#: start_of(index): Group.start_of of the runner's group (the present run's start of it)
+StartOf = Callable[[int], "float | None"]
+
+
+def _before(t: float | None, ctl: Controller) -> float:
+    """A due time half a cycle before the instant `t` a command starts (inf: the present
+    run does not hold it), so the cycle its start falls in is never jumped over, even
+    when a bisection from that cycle's ends finds the instant a hair earlier."""
+    return math.inf if t is None else t - 0.5 * ctl.period
 
 
 @dataclass
@@ -92,21 +101,45 @@ class SyncedOutputs:
         self._set_output = set_output
         self._record = record
         self._start_time: StartTime | None = None
+        self._start_of: StartOf | None = None
         self.pending: list[Op] = []      # read, waiting for the next move to be queued
         self.armed: list[_Armed] = []    # bound to a queued move that has not started
         self.levels: dict[int, bool] = {}  # the runner's view of every output it wrote
         self._prev: int | None = None    # group index of the last queued line/arc
 
-    def attach(self, start_time: StartTime) -> None:
-        """The run starts: `start_time` is its group's; the pre-advance hook is added."""
+    def attach(self, start_time: StartTime, start_of: StartOf | None = None) -> None:
+        """The run starts: `start_time` (and `start_of`) are its group's; the pre-advance
+        hook is added."""
         self._start_time = start_time
+        self._start_of = start_of
         self._ctl.add_pre_advance_hook(self.ahead, due=self._ahead_due)
 
     def detach(self) -> None:
         self._ctl.remove_pre_advance_hook(self.ahead)
 
     def _ahead_due(self, ctl: Controller) -> float:
-        return -math.inf if self.armed else math.inf
+        """`ahead` acts in the cycle an armed move starts in (and nowhere else: its start
+        is None in every other cycle), so that cycle runs on its own."""
+        start_of = self._start_of
+        due = math.inf
+        for a in self.armed:
+            if a.t_start is None:
+                if start_of is None:
+                    return -math.inf
+                due = min(due, _before(start_of(a.index), ctl))
+        return due
+
+    def due(self, current: int) -> float:
+        """When `fire` may next act (`current`: the command executing now): now while a
+        compare job is armed (the engine scans it every cycle anyway) or one is to be
+        armed; else the start of the move before an armed one (where its job is armed)."""
+        start_of = self._start_of
+        due = math.inf
+        for a in self.armed:
+            if a.job is not None or a.prev is None or current >= a.prev or start_of is None:
+                return -math.inf
+            due = min(due, _before(start_of(a.prev), self._ctl))
+        return due
 
     def ahead(self, ctl: Controller, t0: float, t1: float) -> None:
         """Before the hardware runs (t0, t1]: the start time of each armed move the
@@ -202,6 +235,15 @@ class SyncedAnalog:
         self._write = write
         self.pending: list[Op] = []
         self.armed: list[tuple[int, Op]] = []
+
+    def due(self, ctl: Controller, current: int, start_of: StartOf) -> float:
+        """When `fire` may next act: the start of the first armed write's move."""
+        due = math.inf
+        for index, _ in self.armed:
+            if 0 <= index <= current:
+                return -math.inf
+            due = min(due, _before(start_of(index), ctl))
+        return due
 
     def bind(self, index: int) -> None:
         """The move with group index `index` was queued: pending writes wait for it."""

@@ -301,6 +301,25 @@ class Group(GroupSettings):
 
         return lookup
 
+    def start_of(self, index: int) -> float | None:
+        """The exact instant the present run starts command `index` or a later one
+        (`start_time` over the whole run: the first instant `index_at` reports one of
+        them), or None when the present run does not hold it (a later plan will: it is
+        made in a cycle the group's hook runs). Kept per run, plan and index (plans never
+        change once made), so a due function may ask it at every landing."""
+        r = self._run
+        if r is None:
+            return None
+        memo = self.__dict__.get("_start_memo")
+        if memo is not None and memo[0] is r and memo[1] is r.plan and memo[2] == index:
+            return memo[3]
+        if r.plan is None:
+            t = r.t0 if r.cmds[0].index >= index else None
+        else:
+            t = self.start_time(index, r.plan.t0, r.plan.t_end)
+        self._start_memo = (r, r.plan, index, t)
+        return t
+
     def start_time(self, index: int, t0: float, t1: float) -> float | None:
         """The exact time in [t0, t1] at which the running (or held) chain starts command
         `index` or a later one: the first instant `index_at` reports one of them (t0 when

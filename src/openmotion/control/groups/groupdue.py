@@ -8,8 +8,11 @@ the end of a blend's overlay when a hold or override waits for it. Between them 
 line or arc needs nothing from Python, so virtual time may jump (control/core/jump.py).
 `group_due` returns the earliest of those instants (a join in flight, real time: its install
 cycle); -inf ("every cycle") wherever the answer is not cheap and sure: pre-blending still
-to do, a group axis in ErrorStop or standing on a limit switch (the limit check depends on
-the velocity's sign cycle by cycle).
+to do in real time, a group axis in ErrorStop or standing on a limit switch (the limit
+check depends on the velocity's sign cycle by cycle). Pre-blending spreads a join's corner
+work over the quiet cycles before it, which matters only where a cycle has a deadline: in
+virtual time it is not due (the join blends the corners no quiet cycle prepared, the very
+same corners: tests/test_group_preblend.py), so a streamed chain jumps from join to join.
 
 The join instant is found on the very cycle grid the hook sees, by evaluating the plan's
 `remaining(t)` at the cycle ends ahead (vectorised, blocks of JOIN_BLOCK cycles, the same
@@ -62,7 +65,7 @@ def group_due(g: Any, ctl: Controller) -> float:
     elif state in (GroupState.MOVING, GroupState.IDLE):
         return -math.inf if g._queue or state is GroupState.MOVING else due
     if g._queue:
-        if _preblend_pending(g):
+        if ctl.realtime and _preblend_pending(g):
             return -math.inf
         due = min(due, _join_due(g, ctl))
     return due
