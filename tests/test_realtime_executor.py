@@ -230,3 +230,40 @@ def test_a_failure_inside_a_compiled_run_faults_and_real_time_goes_on():
     assert ctl.cycle_errors == 1 and ctl.cycle_stats().errors == 1
     assert [e.kind for e in ctl.events.events()].count("cycle_error") == 1
     assert hw.queued(2) == 0  # nothing half-queued stays behind
+
+
+def test_a_request_at_the_first_cycle_of_a_later_chunk_lands_on_a_cycle_run():
+    """A compiled run over the horizon is fed in chunks (jump.py); the C loop never returns
+    at the first cycle of a kernel run, so a lock request arriving just as a later chunk
+    starts lands after that chunk's first cycle, with the virtual-time result."""
+    def setup(ctl: Controller) -> None:
+        ctl.hardware.record_pulses()
+        ctl.enable_all()
+        ctl.axis("z").move_relative(150_000, max_vel=60_000, tacc=0.05)  # 2.5 s: no end
+        ctl.axis("u").move_velocity(-4_000, tacc=0.03)
+
+    rt = Controller(_machine())
+    setup(rt)
+    hw, st = rt.hardware, rt._lock.st
+    real = hw.run_cycles
+    forced: list[tuple[int, int]] = []
+
+    def waiter_at_later_chunks(origin, period, n, stop, *a, **k):  # noqa: ANN001, ANN002, ANN003, ANN202
+        later = n > rt._n  # not the first chunk of this jump
+        if later:
+            st[RT_WAITERS] = 1.0  # a thread waits for the lock from this chunk's start on
+        try:
+            run = real(origin, period, n, stop, *a, **k)
+        finally:
+            st[RT_WAITERS] = 0.0
+        if later:
+            forced.append((n, run.cycle))
+        return run
+
+    hw.run_cycles = waiter_at_later_chunks
+    _realtime_run(rt, 900)
+    assert forced and all(c == n + 1 for n, c in forced)  # the chunk's first cycle ran
+    vt = Controller(_machine())
+    setup(vt)
+    vt.advance(rt.cycles * vt.period)
+    assert _observe(rt) == _observe(vt)

@@ -87,7 +87,7 @@ MAPPING: dict[str, str] = {
     # groups and path execution
     "group": "groups", "group_checks": "groups", "group_corners": "groups",
     "group_settings": "groups", "groupdue": "groups", "groupexec": "groups",
-    "groupjoin": "groups", "pathaxes": "groups", "pathexec": "groups",
+    "groupjoin": "groups", "joinhandoff": "groups", "pathaxes": "groups", "pathexec": "groups",
     "pathpoints": "groups", "pathrun": "groups", "accuracy": "groups", "ptpblend": "groups",
     "overlap": "groups", "pathmove": "groups",
     # manual motion

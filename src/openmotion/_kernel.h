@@ -47,7 +47,8 @@ PyObject *record_rows(PyObject *self, PyObject *args);
 extern const char record_rows_doc[];
 
 /* _kernel_rt.c: real-time pacing of the compiled cycles (control/core/realtime.py) */
-int rt_before_cycle(long long k);  /* wait for cycle k's slot; 1: return at this boundary */
+int rt_before_cycle(long long k, int first);  /* wait for cycle k's slot; 1: return at this
+                                                 boundary (never when first: a run's first) */
 void rt_after_cycle(long long k);  /* cycle k done: record its busy time */
 PyObject *rt_paced(PyObject *self, PyObject *args);
 PyObject *rt_wait(PyObject *self, PyObject *args);

@@ -9,7 +9,9 @@
  * waits for the controller's lock or the executor is asked to stop (st[RT_WAITERS],
  * st[RT_STOPPING]): the kernel then returns at that cycle boundary and the Python side
  * lands there, so a command from another thread takes effect at the next cycle, as with
- * a cycle stepped in Python. A cycle the Python path runs (an edge to report, a landing)
+ * a cycle stepped in Python. Never at the first cycle of a kernel run (`first`): a jump
+ * fed in chunks (control/core/jump.py) then always lands on a cycle it ran, whichever
+ * chunk the request comes in; the waiter waits at most one cycle more. A cycle the Python path runs (an edge to report, a landing)
  * stays "pending" from its slot until `rt_close` (or the next cycle) ends it, so its
  * busy time includes the Python work. Cycle k's slot starts at st[RT_WALL0] + k * period
  * (CLOCK_MONOTONIC seconds); a late cycle is never skipped (catch-up, as RealtimePacer).
@@ -107,15 +109,18 @@ static void extend_last(RtCtx *c, double t)
             st[RT_LASTOVER] != 0.0);
 }
 
+/* How a cycle's wait may end early: never (the first cycle of a kernel run), when the
+ * executor stops, or also when another thread waits for the lock. */
+enum { WAIT_FIRM, WAIT_STOP, WAIT_ANY };
+
 /* sleep until `due` (absolute, CLOCK_MONOTONIC s) in steps of at most 1 ms, watching the
- * stop flag (and, when `interruptible`, the lock waiters); 1 when woken by them. A waiter
- * is seen within a period; inside a cycle's wait it is one absolute sleep, as a plain
- * pacer's. */
-static int wait_until(RtCtx *c, double due, int interruptible)
+ * stop flag and the lock waiters as `mode` says; 1 when woken by them. A waiter is seen
+ * within a period; inside a cycle's wait it is one absolute sleep, as a plain pacer's. */
+static int wait_until(RtCtx *c, double due, int mode)
 {
     for (;;) {
-        if (vread(&c->st[RT_STOPPING]) != 0.0
-                || (interruptible && vread(&c->st[RT_WAITERS]) > 0.0))
+        if ((mode >= WAIT_STOP && vread(&c->st[RT_STOPPING]) != 0.0)
+                || (mode == WAIT_ANY && vread(&c->st[RT_WAITERS]) > 0.0))
             return 1;
         double t = now_s();
         if (t >= due) return 0;
@@ -129,7 +134,7 @@ static int wait_until(RtCtx *c, double due, int interruptible)
 }
 
 /* start cycle k at its slot: the work since the last cycle ended is recorded with it */
-static int begin(RtCtx *c, long long k, int interruptible)
+static int begin(RtCtx *c, long long k, int mode)
 {
     double *st = c->st;
     if (st[RT_PENDING] == (double)k) return 0; /* already in progress (begun by the kernel) */
@@ -139,7 +144,7 @@ static int begin(RtCtx *c, long long k, int interruptible)
     if (st[RT_COUNT] >= 1.0 && st[RT_CPU0] > 0.0)  /* the last cycle and the work after it */
         c->cpu[(Py_ssize_t)((long long)(st[RT_COUNT] - 1.0) % (long long)c->cap)] =
             cpu_s() - st[RT_CPU0];
-    if (wait_until(c, st[RT_WALL0] + (double)k * st[RT_PERIOD], interruptible)) {
+    if (wait_until(c, st[RT_WALL0] + (double)k * st[RT_PERIOD], mode)) {
         /* no cycle begins: the landing work that follows still belongs to the last
          * cycle, the time spent here (planning, the wait) does not */
         st[RT_INTERRUPTED] = 1.0;
@@ -156,10 +161,10 @@ static int begin(RtCtx *c, long long k, int interruptible)
     return 0;
 }
 
-int rt_before_cycle(long long k)
+int rt_before_cycle(long long k, int first)
 {
     RtCtx *c = rt_cur;
-    return c == NULL ? 0 : begin(c, k, 1);
+    return c == NULL ? 0 : begin(c, k, first ? WAIT_FIRM : WAIT_ANY);
 }
 
 void rt_after_cycle(long long k)
@@ -241,7 +246,7 @@ PyObject *rt_wait(PyObject *self, PyObject *args)
     if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
     int stopped;
     Py_BEGIN_ALLOW_THREADS
-    stopped = begin(&c, k, 1);
+    stopped = begin(&c, k, WAIT_ANY);
     Py_END_ALLOW_THREADS
     release(bufs, 5);
     return PyBool_FromLong(stopped);
@@ -292,7 +297,7 @@ PyObject *rt_slot(PyObject *self, PyObject *args)
     RtCtx *c = rt_cur;
     if (c != NULL && c->st[RT_PENDING] != (double)k) {
         Py_BEGIN_ALLOW_THREADS
-        begin(c, k, 0);
+        begin(c, k, WAIT_STOP);
         Py_END_ALLOW_THREADS
     }
     Py_RETURN_NONE;

@@ -691,7 +691,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
     Py_BEGIN_ALLOW_THREADS
     while (k < stop) {
         double t = origin + (double)(k + 1) * period;
-        if (paced && rt_before_cycle(k + 1)) break; /* real time: its slot (_kernel_rt.c) */
+        if (paced && rt_before_cycle(k + 1, k == start)) break; /* real time: its slot (_kernel_rt.c) */
         if (t >= limit) break;
         int report = report_all;
     redo:

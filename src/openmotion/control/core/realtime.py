@@ -60,8 +60,11 @@ except ImportError:  # pragma: no cover - depends on the build
 if TYPE_CHECKING:
     from .controller import Controller
 
-#: Compiled cycles fed ahead per run (s); a run lands at the latest after this long.
-HORIZON_S = 0.2
+#: Compiled cycles fed ahead per run (s); a run lands at the latest after this long (each
+#: landing costs Python work between two cycles, so few of them). A jump longer than one
+#: chunk of pieces (jump.py) is safe to interrupt: the C loop never returns at the first
+#: cycle of a kernel run, so a run always lands on a cycle it ran.
+HORIZON_S = 1.0
 #: Interpreter switch interval while real time runs (s): the executor thread gets the GIL
 #: back this soon for the Python work between cycles (CPython's default is 5 ms).
 SWITCH_INTERVAL_S = 0.0005

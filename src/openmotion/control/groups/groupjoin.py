@@ -7,10 +7,10 @@ takes the commands off the queue and starts a worker thread that builds the join
 re-plans the running plan from t_j (`pathrun.replan` is a pure function of the immutable
 plan) and builds the axis profiles from the group position the running profiles reach at
 t_j. At the hook of cycle t_j, `_poll_join` installs the result exactly as `_launch` does
-when the running plan is still the same object and the settings are unchanged, waiting
-for the worker if it has not finished yet (at most JOIN_WAIT_S: the cycle would otherwise
-do the same re-plan itself, and which joins the worker carries must not depend on the
-thread schedule); otherwise (failed, later than that, or the plan changed by a hold, an
+when the running plan is still the same object and the settings are unchanged; a worker
+not done by then is waited for a few cycles at most, then the cycle computes the same join
+itself (joinhandoff.py: the result does not depend on who computes it, so neither does the
+motion). Otherwise (failed, no feasible option, or the plan changed by a hold, an
 override, a continue) the commands go back to the queue front; abort and faults drop them
 (`_drop_join`). After `MAX_MISSES` misses in a row the next join is synchronous.
 
@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...errors import InfeasibleError, MotionError
-from . import pathaxes, pathrun
+from . import joinhandoff, pathaxes, pathrun
 
 if TYPE_CHECKING:
     from ...profile.segments import Profile
@@ -41,11 +41,6 @@ if TYPE_CHECKING:
 JOIN_LEAD = 0.025
 #: Misses in a row (late, failed, or the plan changed) before a join is done in the cycle.
 MAX_MISSES = 2
-#: How long (wall clock, s) the install cycle waits for a worker that has not finished.
-#: The cycle would otherwise do the same re-plan itself (a wait never costs more than
-#: that), and waiting keeps which joins the worker carries independent of the thread
-#: schedule, so this only guards against a worker that never ends (then: a miss).
-JOIN_WAIT_S = 10.0
 
 
 def lead_cycles(period: float) -> int:
@@ -63,6 +58,11 @@ class _Job:
     t_j: float                    # the cycle boundary the join starts at
     key: tuple                    # the settings it was planned with
     work: Callable[[], None] | None = None
+    # the join itself, a pure function of what the launch captured: compute(stop) -> result
+    # (None: no feasible option, or stop() became true); the worker or the cycle runs it
+    compute: Callable[[Callable[[], bool]], Any] | None = None
+    queued: bool = False          # handed to the worker (not while it is stalled)
+    cancelled: bool = False       # the install computed it itself: the worker drops it
     done: threading.Event = field(default_factory=threading.Event)
     result: tuple[pathrun.PathPlan, list[Profile]] | None = None
     error: BaseException | None = None
@@ -74,8 +74,10 @@ class AsyncJoin:
     _job: _Job | None = None
     _last_job: _Job | None = None
     _jobs: queue.SimpleQueue | None = None   # the worker's input (None: no worker yet)
+    _stuck: _Job | None = None  # a job whose install stopped waiting for the worker
     _join_misses: int = 0
     async_joins: int = 0     # joins installed from the worker (for tests and figures)
+    late_joins: int = 0      # joins launched for the worker, computed by the install cycle
     sync_joins: int = 0      # joins done in the cycle in real-time mode (fallbacks)
 
     def _join_key(self) -> tuple:
@@ -115,33 +117,35 @@ class AsyncJoin:
         job = _Job(plan, r, new, t_j, self._join_key())
         k = self._k.copy()  # type: ignore[attr-defined]
 
-        def work() -> None:
-            try:
-                for chain in self._join_options(plan, have, new, pre):  # type: ignore[attr-defined]
-                    lim = replace(lim0, accel=float(np.max(chain.accels))) \
-                        if chain.accels is not None else lim0
-                    try:
-                        p2 = pathrun.replan(plan, t_j, chain=chain, limits=lim)
-                    except InfeasibleError:
-                        continue
-                    prof = pathaxes.axis_profiles(p2.chain, p2.sprof, ctl.period, starts)
-                    if not np.all(k == 1.0):
-                        prof = [pathaxes.scaled(p, float(s)) for p, s in zip(prof, k,
-                                                                              strict=True)]
-                    job.result = (p2, prof)
-                    return
-            except BaseException as exc:  # reported at install: the join is a miss
-                job.error = exc
-            finally:
-                job.done.set()
+        def compute(stop: Callable[[], bool]) -> tuple | None:
+            for chain in self._join_options(plan, have, new, dict(pre)):  # type: ignore[attr-defined]
+                if stop():
+                    return None
+                lim = replace(lim0, accel=float(np.max(chain.accels))) \
+                    if chain.accels is not None else lim0
+                try:
+                    p2 = pathrun.replan(plan, t_j, chain=chain, limits=lim)
+                except InfeasibleError:
+                    continue
+                prof = pathaxes.axis_profiles(p2.chain, p2.sprof, ctl.period, starts)
+                if not np.all(k == 1.0):
+                    prof = [pathaxes.scaled(p, float(s)) for p, s in zip(prof, k,
+                                                                          strict=True)]
+                return p2, prof
+            return None
 
-        job.work = work
+        job.compute = compute
+        job.work = lambda: joinhandoff.run_on_worker(job, compute)
+        self._job = self._last_job = job
+        if joinhandoff.worker_stalled(self._stuck):
+            return  # the install cycle computes it (joinhandoff.py)
+        self._stuck = None
         if self._jobs is None:  # one worker per group, started once: a thread start
             # per join would hand the new thread the GIL in the middle of the cycle
             self._jobs = queue.SimpleQueue()
             threading.Thread(target=_serve, args=(self._jobs,), name="openmotion-join",
                              daemon=True).start()
-        self._job = self._last_job = job
+        job.queued = True
         self._jobs.put(job)
 
     def _poll_join(self, t: float) -> bool:
@@ -156,11 +160,14 @@ class AsyncJoin:
         if same and t < job.t_j - 0.5 * self._ctl.period:  # type: ignore[attr-defined]
             return True
         self._job = None
-        if same and not job.done.is_set() and t < job.t_j + 0.5 * self._ctl.period:  # type: ignore[attr-defined]
-            job.done.wait(JOIN_WAIT_S)  # the cycle would do the same re-plan: wait for it
-        if same and job.done.is_set() and job.result is not None \
-                and t < job.t_j + 0.5 * self._ctl.period:  # type: ignore[attr-defined]
-            p2, profiles = job.result
+        how, result = "late", None
+        if same and t < job.t_j + 0.5 * self._ctl.period:  # type: ignore[attr-defined]
+            how, result = joinhandoff.collect(job, self._ctl.period,  # type: ignore[attr-defined]
+                                              joinhandoff.worker_stalled(self._stuck))
+            if job.cancelled and job.queued:
+                self._stuck = job  # the worker is still on it
+        if result is not None:
+            p2, profiles = result
             for c in job.new:
                 self._pre.pop(c.index, None)  # type: ignore[attr-defined]
             try:
@@ -169,15 +176,21 @@ class AsyncJoin:
                 self._fault(getattr(err, "code", -4), f"join refused: {err}")  # type: ignore[attr-defined]
                 return True
             self._join_misses = 0
-            self.async_joins += 1
+            if how == "worker":
+                self.async_joins += 1
+            else:
+                self.late_joins += 1
             return True
-        if same:  # late or failed (a changed plan is nobody's miss)
+        if same:  # failed, infeasible or late (a changed plan is nobody's miss)
             self._join_misses += 1
+        job.cancelled = True  # given up: a worker still on it drops it at its next option
         self._queue.extendleft(reversed(job.new))  # type: ignore[attr-defined]
         return False
 
     def _drop_join(self) -> None:
         """Abort, fault, close: forget a join in flight with its commands."""
+        if self._job is not None:
+            self._job.cancelled = True
         self._job = None
 
     def _stop_join_worker(self) -> None:
