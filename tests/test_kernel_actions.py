@@ -122,3 +122,71 @@ def test_actions_inside_a_kernel_cycle_are_the_python_path(seed):
         python_cycles.append(calls[0])
     assert runs[0] == runs[1]
     assert python_cycles[1] == 0  # not one stretch in the Python pipeline
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_a_probe_runs_in_the_kernel_as_in_python(seed):
+    """A touch probe's hidden switches (hw/sim/probe.py) run in the kernel; their edges go
+    through the probe's filter: the same di edges (exact times, every axis's count), the
+    same input level and state as the Python path; workpieces placed and removed inside
+    cycles."""
+    from openmotion.hw.sim.probe import SimProbe
+
+    rng = np.random.default_rng(seed)
+    n_axes = int(rng.integers(1, 4))
+    cfg, half_off = machine(rng, n_axes)
+    cfg = replace(cfg, digital_inputs=2)
+    period = 0.001
+    cycles = int(rng.integers(10, 80))
+    plans = [random_pieces(rng, cycles, period, 0.0) for _ in range(n_axes)]
+    places = []
+    for _ in range(int(rng.integers(1, 4))):
+        boxes = []
+        for _ in range(int(rng.integers(0, 3))):
+            box = {}
+            for a in range(n_axes):
+                if rng.random() < 0.7 or not box:
+                    lo = float(rng.uniform(-800, 400))
+                    box[a] = (lo, lo + float(rng.uniform(1, 900)))
+            boxes.append(box)
+        places.append((float(rng.uniform(0, cycles * period)), boxes))
+    wake = frozenset({"di0"}) if rng.random() < 0.5 else frozenset({"pel"})
+    stepping = bool(rng.random() < 0.4)
+    runs, python_cycles = [], []
+    for native in (False, True):
+        hw = SimMachine(cfg)
+        hw.native = native
+        calls = [0]
+        slow = hw._advance_python
+
+        def counted(t, slow=slow, calls=calls):  # noqa: ANN001, ANN202
+            calls[0] += 1
+            return slow(t)
+
+        hw._advance_python = counted  # type: ignore[method-assign]
+        if half_off:
+            hw.set_half_pulse(False)
+        probe = SimProbe.attach(hw, "di0", normally_closed=bool(seed % 2))
+        probe.place(places[0][1])
+        for at, boxes in places[1:]:
+            probe.place(boxes, at=at)
+        seen: list = []
+        if stepping:
+            for k in range(cycles):
+                for i, rows in enumerate(plans):
+                    hw.command(i, AxisCommand(*rows[k]))
+                seen.append((edges_of(hw.advance((k + 1) * period)), hw.read_input("di0")))
+        else:
+            for i, rows in enumerate(plans):
+                hw.queue_pieces(i, PieceBlock(rows))
+            k = 0
+            while k < cycles:
+                r = hw.run_cycles(0.0, period, k, cycles, wake)
+                seen.append((r.cycle, edges_of(r.edges), hw.read_input("di0")))
+                k = r.cycle
+        seen.append((state(hw), probe.in_contact))
+        runs.append(seen)
+        python_cycles.append(calls[0])
+    assert runs[0] == runs[1]
+    assert python_cycles[1] == 0
