@@ -7,7 +7,8 @@ pieces. The kernel runs the cycles in C with the GIL released. The first cycle w
 crossing on a `wake` signal is run again in report mode and ends the run: every crossing of
 that cycle comes back as an `InputEdge` with its exact time and every axis's decoded count
 at that instant. It stops before the cycle of a scenario action (`SimMachine._advance_native`
-runs that cycle in parts around the action) and before anything it cannot run exactly; board outputs at a time touch no axis and are
+runs that cycle in parts around the action) and before anything it cannot run exactly;
+board outputs at a time touch no axis and are
 emitted by SimMachine after the run. The state stays in the kernel's
 arrays (`KernelState`) between runs and goes back into the `SimAxis` objects when Python
 needs them.
