@@ -112,6 +112,11 @@ def machine(rng: np.random.Generator, n_axes: int) -> tuple[MachineConfig, bool]
                                   pullout_speed=float(rng.choice([1e12, 30_000.0])),
                                   pullout_accel=float(rng.choice([1e15, 2e6])),
                                   backlash=float(rng.choice([0.0, 0.4, 3.0])))
+        if rng.random() < 0.4:  # a pitch-error table (the screw: one revolution apart)
+            spr = kw["pulses_per_rev"] * x.gear_ratio
+            errs = tuple(float(e) for e in rng.uniform(-0.3, 0.3, int(rng.integers(1, 8)))
+                         * min(spr, 400.0))
+            kw["drive"] = replace(kw.get("drive", x.drive), pitch_error=errs)
         axes.append(replace(x, name=f"a{i}", **kw))
     return MachineConfig(name="kernel", axes=tuple(axes)), bool(rng.random() < 0.5)
 
@@ -253,7 +258,7 @@ def test_the_state_kept_in_the_kernels_arrays_reads_and_writes_back_as_python(se
     assert runs[0] == runs[1]
 
 
-def test_the_kernel_stops_before_a_scenario_action_and_the_python_path_runs_it():
+def test_the_cycle_of_a_scenario_action_runs_in_the_kernel_as_in_python():
     cfgm = default_machine()
     results = []
     for native in (False, True):
@@ -273,10 +278,11 @@ def test_the_kernel_stops_before_a_scenario_action_and_the_python_path_runs_it()
 def test_machines_the_kernel_does_not_model_run_in_python():
     x = default_machine().axes[0]
     servo = replace(x, name="s", drive=replace(x.drive, type="servo"))
+    hw = SimMachine(MachineConfig(name="m", axes=(x, servo)))
+    assert not simkernel.usable(hw._axes)
     pitch = replace(x, name="p", drive=replace(x.drive, pitch_error=(0.0, 1.0, -0.5)))
-    for ax in (servo, pitch):
-        hw = SimMachine(MachineConfig(name="m", axes=(x, ax)))
-        assert not simkernel.usable(hw._axes)
+    hw = SimMachine(MachineConfig(name="m", axes=(x, pitch)))  # pitch tables run in C
+    assert simkernel.usable(hw._axes)
     hw = SimMachine(MachineConfig(name="m", axes=(x,)))
     assert simkernel.usable(hw._axes)
     hw.arm_stop(0, "org", True)  # armed edge stops run in the kernel

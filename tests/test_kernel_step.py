@@ -4,7 +4,7 @@ pipeline gives (the oracle: `SimMachine.native = False`).
 - `SimMachine.command` + `advance` (what `Controller.step` calls every cycle) on random
   stepper machines with switches everywhere (every crossing is an edge: exact time, level,
   every axis's count at its instant), advances of whole and partial cycles, queued pieces
-  in between and scenario actions (the cycle they fall in runs in Python): the same edges
+  in between and scenario actions (inside the kernel's cycle): the same edges
   and the same state of every generator, plant, transmission, decoder and switch.
 - A controller stepped cycle by cycle (`virtual_jumps = False`) into limit switches, with
   an E-stop and a step loss: the same events (exact times), counters, states and history.

@@ -22,11 +22,14 @@
 
 /* per-axis double fields */
 enum { D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
-       D_UPP, D_STOP, ND };
+       D_UPP, D_STOP, D_SPACING, ND };
 /* per-axis int64 fields */
 enum { I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
        I_TURNF, I_TURNB, I_FWD, I_BWD = I_FWD + 5, I_PBEGIN = I_BWD + 5, I_PEND, I_CURSOR,
-       I_RECORD, I_LEVELS, I_ARMED, NI };
+       I_RECORD, I_LEVELS, I_ARMED, I_PITCH, I_NPITCH, NI };
+/* I_PITCH, I_NPITCH: the axis's pitch-error table in the flat `pitch` buffer (n nominal
+ * positions z_k, then the n errors e_k, then the n load positions y_k = z_k + e_k, from
+ * I_PITCH on; I_NPITCH 0: no table), D_SPACING its spacing (mechanics.PitchTable) */
 #define MAXSW 8
 /* per-switch double fields: kind (0 span, 1 index), lo|period, hi|width, hysteresis */
 enum { S_KIND, S_A, S_B, S_H, NSD };
@@ -36,6 +39,9 @@ enum { S_ACTIVE, S_WAKE, S_LEVELBITS, S_BIT, S_ARM, S_ARMLEVEL, S_ARMDIR, NSI };
 /* S_ARM: 0 not armed, else 1 + the switch's rank in the order the stops were armed (ties
  * at one instant go to the first armed, as SimAxis._first_armed) */
 #define LTC_BIT 4 /* AXIS_INPUTS.index("ltc"): SD shares its pin while no LTC is placed */
+/* a hidden switch (a probe's interval bound, hw/sim/probe.py) has S_BIT = HIDDEN_BIT + its
+ * slot and flips no input level (S_LEVELBITS 0): its edges feed the machine's edge filters */
+#define HIDDEN_BIT 9
 #define TIME_TOL 1e-13
 /* edge row (int64): axis, signal bit, level, own decoded count */
 #define NEI 4
@@ -73,7 +79,45 @@ typedef struct {
     int64_t *i;
     double *sd;
     int64_t *si;
+    const double *pt; /* the pitch table (z, e, y rows of I_NPITCH each) or NULL */
 } Axis;
+
+/* mechanics.PitchTable.forward: y = z + e(z), piecewise linear (bisect_right) */
+static inline double pitch_forward(const Axis *a, double z)
+{
+    int64_t n = a->i[I_NPITCH];
+    if (n == 0) return z;
+    const double *zs = a->pt, *e = a->pt + n;
+    if (z <= zs[0]) return z + e[0];
+    if (z >= zs[n - 1]) return z + e[n - 1];
+    int64_t lo = 0, hi = n;
+    while (lo < hi) { int64_t mid = (lo + hi) / 2; if (z < zs[mid]) hi = mid; else lo = mid + 1; }
+    int64_t k = lo - 1;
+    double f = (z - zs[k]) / a->d[D_SPACING];
+    return z + e[k] + f * (e[k + 1] - e[k]);
+}
+
+/* mechanics.PitchTable.inverse */
+static inline double pitch_inverse(const Axis *a, double y)
+{
+    int64_t n = a->i[I_NPITCH];
+    if (n == 0) return y;
+    const double *zs = a->pt, *e = a->pt + n, *ys = a->pt + 2 * n;
+    if (y <= ys[0]) return y - e[0];
+    if (y >= ys[n - 1]) return y - e[n - 1];
+    int64_t lo = 0, hi = n;
+    while (lo < hi) { int64_t mid = (lo + hi) / 2; if (y < ys[mid]) hi = mid; else lo = mid + 1; }
+    int64_t k = lo - 1;
+    return zs[k] + (y - ys[k]) * a->d[D_SPACING] / (ys[k + 1] - ys[k]);
+}
+
+/* Transmission.motor_level: the motor level whose crossing in direction d makes y cross
+ * y_level */
+static inline double motor_level(const Axis *a, double y_level, int d)
+{
+    double z = pitch_inverse(a, y_level);
+    return d > 0 ? z : z - a->d[D_BACKLASH];
+}
 
 typedef struct {
     double *rows;
@@ -312,7 +356,7 @@ static inline int peek(const Axis *a, const PRec *p, double m, int64_t *out)
     else if (p->dir < 0) { double mb = m + a->d[D_BACKLASH]; z = mb < p->z0 ? mb : p->z0; }
     else z = p->z0;
     int64_t q1;
-    if (index_after(a, z, p->q, p->dir, &q1)) return BAIL;
+    if (index_after(a, pitch_forward(a, z), p->q, p->dir, &q1)) return BAIL;
     *out = p->count + increment(a, p->q, q1, p->lastdir);
     return OK;
 }
@@ -369,7 +413,7 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
         double mb = m1 + ad[D_BACKLASH];
         z1 = mb < z0 ? mb : z0;
     }
-    double y1 = z1, y = ad[D_Y];
+    double y1 = pitch_forward(a, z1), y = ad[D_Y];
     r->hit_s = -1;
     if (y1 != y || r->dry) {
         int nsw = (int)ai[I_NSW];
@@ -391,7 +435,7 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
                     int64_t lv = ((ai[I_LEVELS] >> si[S_BIT]) & 1) ^ si[S_ACTIVE];
                     if (si[S_ARM] && lv == si[S_ARMLEVEL]
                             && (si[S_ARMDIR] == 0 || si[S_ARMDIR] == d)) {
-                        double level = d > 0 ? thr : thr - ad[D_BACKLASH];
+                        double level = motor_level(a, thr, d);
                         if (piece_time_at(p, level, &et, &em)) return BAIL;
                         if (r->hit_s < 0 || et < r->hit_t
                                 || (et == r->hit_t && si[S_ARM] < r->hit_rank)) {
@@ -403,7 +447,7 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
                     continue;
                 }
                 if (r->on) {
-                    double level = d > 0 ? thr : thr - ad[D_BACKLASH];
+                    double level = motor_level(a, thr, d);
                     if (piece_time_at(p, level, &et, &em)) return BAIL;
                 }
                 si[S_ACTIVE] = !si[S_ACTIVE];
@@ -412,7 +456,8 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
                     if (peek(a, p, (double)em, &own)) return BAIL;
                     int st = add_edge(r, et, bit, ((ai[I_LEVELS] >> bit) & 1) ^ act, own);
                     if (st) return st;
-                    if (si[S_LEVELBITS] != ((int64_t)1 << bit)) { /* SD is also LTC */
+                    if (si[S_LEVELBITS] && si[S_LEVELBITS] != ((int64_t)1 << bit)) {
+                        /* SD is also LTC */
                         st = add_edge(r, et, LTC_BIT, ((ai[I_LEVELS] >> LTC_BIT) & 1) ^ act,
                                       own);
                         if (st) return st;
@@ -577,8 +622,8 @@ static int run_axis_armed(Axis *a, double ta, double tb, Rec *rec, Report *r)
 }
 
 const char kernel_run_doc[] =
-"run(ad, ai, sd, si, pieces, popt, rows, trace, et, ei, enc, origin, period, start, stop,\n"
-"    now, limit, report, paced)\n"
+"run(ad, ai, sd, si, pieces, popt, rows, trace, et, ei, enc, pitch, origin, period, start,\n"
+"    stop, now, limit, report, paced)\n"
 "-> (cycle reached, hardware time, record rows used, edges, edge room short)\n\n"
 "Run cycles start+1..stop over float64 ad[n, ND], int64 ai[n, NI], float64 sd[n, 8, NSD],\n"
 "int64 si[n, 8, NSI], float64 pieces[P, 6] (t0, dt, p0, v0, a0, j) with each axis's range\n"
@@ -586,17 +631,28 @@ const char kernel_run_doc[] =
 "(pulse record), int64 trace[stop - start, n, 3] (per cycle: pulse count, decoded count,\n"
 "input levels; an empty array: no trace), the edges of the last cycle run: float64 et[E]\n"
 "(times), int64 ei[E, 4] (axis, signal bit, level, own count), int64 enc[E, n] (every\n"
-"axis's decoded count at the edge). `report` 1: every cycle reports its edges (advance);\n"
+"axis's decoded count at the edge), float64 pitch[...] (the pitch-error tables, each axis's\n"
+"at ai's I_PITCH). `report` 1: every cycle reports its edges (advance);\n"
 "0: a cycle reports only when a switch with `wake` set is crossed. `paced` 0: no\n"
 "real-time slot waits. Stops before the first cycle ending at or after `limit` or one the\n"
 "kernel cannot run exactly (the caller runs it), or after the first cycle with edges; with\n"
 "`edge room short` the edge arrays were too small for that cycle (not run: call again\n"
 "with larger ones).";
 
+/* axis x's view of the flat arrays */
+static inline Axis axis_at(double *AD, int64_t *AI, double *SD, int64_t *SI, const double *PZ,
+                           Py_ssize_t x)
+{
+    int64_t *ai = AI + x * NI;
+    Axis a = {AD + x * ND, ai, SD + x * MAXSW * NSD, SI + x * MAXSW * NSI,
+              ai[I_NPITCH] ? PZ + ai[I_PITCH] : NULL};
+    return a;
+}
+
 /* the edges of one stretch [now, tn] in time order (stable, as SimMachine._advance sorts
  * them) with every axis's decoded count at each edge's instant */
 static int finish_edges(Report *r, Py_ssize_t e0, double *AD, int64_t *AI, double *SD,
-                        int64_t *SI)
+                        int64_t *SI, const double *PZ)
 {
     for (Py_ssize_t k = e0 + 1; k < r->ne; k++) { /* insertion sort: stable */
         double t = r->et[k];
@@ -614,56 +670,64 @@ static int finish_edges(Report *r, Py_ssize_t e0, double *AD, int64_t *AI, doubl
     for (Py_ssize_t k = e0; k < r->ne; k++) {
         int64_t *enc = r->enc + k * r->n, axis = r->ei[k * NEI];
         for (Py_ssize_t x = 0; x < r->n; x++) {
-            if (x == axis) { enc[x] = r->ei[k * NEI + 3]; continue; }
-            Axis a = {AD + x * ND, AI + x * NI, SD + x * MAXSW * NSD, SI + x * MAXSW * NSI};
+            if (x == axis && r->ei[k * NEI + 1] < HIDDEN_BIT) {
+                enc[x] = r->ei[k * NEI + 3]; /* (a hidden switch's: encoder_at, as Python) */
+                continue;
+            }
+            Axis a = axis_at(AD, AI, SD, SI, PZ, x);
             if (encoder_at(&a, r, x, r->et[k], enc + x)) return BAIL;
         }
     }
     return OK;
 }
 
+#define NBUF 12
+
 PyObject *kernel_run(PyObject *self, PyObject *args)
 {
-    PyObject *o[11];
+    PyObject *o[NBUF];
     double origin, period, now, limit;
     long long start, stop;
     int report_all, paced;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOddLLddpp", &o[0], &o[1], &o[2], &o[3], &o[4],
-                          &o[5], &o[6], &o[7], &o[8], &o[9], &o[10], &origin, &period, &start,
-                          &stop, &now, &limit, &report_all, &paced))
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOddLLddpp", &o[0], &o[1], &o[2], &o[3], &o[4],
+                          &o[5], &o[6], &o[7], &o[8], &o[9], &o[10], &o[11], &origin, &period,
+                          &start, &stop, &now, &limit, &report_all, &paced))
         return NULL;
-    Buf bufs[11];
+    Buf bufs[NBUF];
     memset(bufs, 0, sizeof bufs);
-    static const char *names[11] = {"ad", "ai", "sd", "si", "pieces", "popt", "rows", "trace",
-                                    "et", "ei", "enc"};
-    for (int k = 0; k < 11; k++)
-        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, 11); return NULL; }
+    static const char *names[NBUF] = {"ad", "ai", "sd", "si", "pieces", "popt", "rows",
+                                      "trace", "et", "ei", "enc", "pitch"};
+    for (int k = 0; k < NBUF; k++)
+        if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) { release(bufs, NBUF); return NULL; }
     Py_ssize_t n = bufs[0].b.len / (8 * ND);
     Py_ssize_t ecap = bufs[8].b.len / 8;
     if (bufs[1].b.len != n * 8 * NI || bufs[2].b.len != n * 8 * MAXSW * NSD
             || bufs[3].b.len != n * 8 * MAXSW * NSI || bufs[9].b.len != ecap * 8 * NEI
             || bufs[10].b.len != ecap * 8 * n) {
-        release(bufs, 11);
+        release(bufs, NBUF);
         PyErr_SetString(PyExc_ValueError, "run: axis or edge arrays disagree in size");
         return NULL;
     }
     double *AD = bufs[0].b.buf, *SD = bufs[2].b.buf, *PC = bufs[4].b.buf;
     int64_t *AI = bufs[1].b.buf, *SI = bufs[3].b.buf;
     Py_ssize_t npieces = bufs[4].b.len / (8 * 6);
+    const double *PZ = bufs[11].b.buf;
+    Py_ssize_t npitch = bufs[11].b.len / 8;
     /* piece start times only when the caller passes room for them (pulse recording) */
     double *PT = bufs[5].b.len >= npieces * 8 ? bufs[5].b.buf : NULL;
     for (Py_ssize_t x = 0; x < n; x++) {
         int64_t *ai = AI + x * NI, *si = SI + x * MAXSW * NSI;
         if (ai[I_PBEGIN] < 0 || ai[I_PEND] > npieces || ai[I_CURSOR] < ai[I_PBEGIN]
                 || ai[I_CURSOR] > ai[I_PEND] || ai[I_NSW] < 0 || ai[I_NSW] > MAXSW
-                || ai[I_DPERIOD] < 1 || ai[I_DPERIOD] > 4) {
-            release(bufs, 11);
+                || ai[I_DPERIOD] < 1 || ai[I_DPERIOD] > 4 || ai[I_NPITCH] < 0
+                || ai[I_PITCH] < 0 || ai[I_PITCH] + 3 * ai[I_NPITCH] > npitch) {
+            release(bufs, NBUF);
             PyErr_SetString(PyExc_ValueError, "run: bad axis layout");
             return NULL;
         }
         for (int sw = 0; sw < ai[I_NSW]; sw++)
             if (si[sw * NSI + S_BIT] < 0 || si[sw * NSI + S_BIT] > 62) {
-                release(bufs, 11);
+                release(bufs, NBUF);
                 PyErr_SetString(PyExc_ValueError, "run: bad switch bit");
                 return NULL;
             }
@@ -680,7 +744,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
     int64_t *rstart = PyMem_Malloc(sizeof(int64_t) * (n + 1));
     if (!save_d || !save_i || !prec || !rix || !rstart) {
         PyMem_Free(save_d); PyMem_Free(save_i); PyMem_Free(prec); PyMem_Free(rix);
-        PyMem_Free(rstart); release(bufs, 11);
+        PyMem_Free(rstart); release(bufs, NBUF);
         return PyErr_NoMemory();
     }
     Report rep = {0, 0, 0.0, -1, 0, bufs[8].b.buf, bufs[9].b.buf, bufs[10].b.buf, 0, ecap, n, prec, 0,
@@ -725,14 +789,14 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
                     rstart[x] = AI[x * NI + I_DCOUNT];
                 }
             for (Py_ssize_t x = 0; x < n && status == OK; x++) {
-                Axis a = {AD + x * ND, AI + x * NI, SD + x * MAXSW * NSD, SI + x * MAXSW * NSI};
+                Axis a = axis_at(AD, AI, SD, SI, PZ, x);
                 rec.axis = (int)x;
                 rep.axis = (int)x;
                 AD[x * ND + D_STOP] = NAN; /* SimMachine._advance: stop_time = None */
                 status = run_axis_armed(&a, now, tn, &rec, &rep);
             }
             if (status == OK && rep.on && rep.ne > e0)
-                status = finish_edges(&rep, e0, AD, AI, SD, SI);
+                status = finish_edges(&rep, e0, AD, AI, SD, SI, PZ);
             if (status != OK) break;
             now = tn;
             if (tn >= t) break;
@@ -773,7 +837,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
     PyMem_Free(prec);
     PyMem_Free(rix);
     PyMem_Free(rstart);
-    release(bufs, 11);
+    release(bufs, NBUF);
     return Py_BuildValue("LdNni", k, now, PyLong_FromSsize_t(rec.n), rep.ne, full);
 }
 

@@ -6,14 +6,15 @@ command, pulse count, losses, load position, decoder state and switches, and its
 pieces. The kernel runs the cycles in C with the GIL released. The first cycle with a
 crossing on a `wake` signal is run again in report mode and ends the run: every crossing of
 that cycle comes back as an `InputEdge` with its exact time and every axis's decoded count
-at that instant. It stops before a scenario action (the Python path runs that cycle) and
-before anything it cannot run exactly; board outputs at a time touch no axis and are
+at that instant. It stops before the cycle of a scenario action (`SimMachine._advance_native`
+runs that cycle in parts around the action) and before anything it cannot run exactly;
+board outputs at a time touch no axis and are
 emitted by SimMachine after the run. The state stays in the kernel's
 arrays (`KernelState`) between runs and goes back into the `SimAxis` objects when Python
 needs them.
 
 The kernel takes a machine whose axes are all steppers (ideal or stalling, armed edge stops
-included) without a pitch-error table; for any other machine `usable` is False and every
+and pitch-error tables included); for any other machine `usable` is False and every
 cycle runs in Python. It is built by the package's own build (setup.py); when the module is
 missing (a source tree that was never built) `AVAILABLE` is False and the Python path runs.
 Set `SimMachine.native = False` to force the Python path (the equivalence tests do).
@@ -51,29 +52,25 @@ _NO_TRACE = np.zeros(0, dtype=np.int64)
 _BIT = {sig: i for i, sig in enumerate(AXIS_INPUTS)}
 
 # field indices, kept in step with _kernel.c (checked against its constants below)
-_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 14, 27, 8, 4, 7, 12
+_ND, _NI, _MAXSW, _NSD, _NSI, _NREC = 15, 29, 8, 4, 7, 12
 (D_P0, D_V0, D_A0, D_J, D_TC, D_TE, D_HALF, D_VMAX, D_AMAX, D_BACKLASH, D_Z, D_Y,
- D_UPP, D_STOP) = range(_ND)
+ D_UPP, D_STOP, D_SPACING) = range(_ND)
 (I_COUNT, I_LOST, I_IDEAL, I_ENABLED, I_Q, I_LASTDIR, I_DCOUNT, I_DPERIOD, I_NSW,
  I_TURNF, I_TURNB) = range(11)
-I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD, I_LEVELS, I_ARMED = (11, 16, 21, 22,
-                                                                       23, 24, 25, 26)
+(I_FWD, I_BWD, I_PBEGIN, I_PEND, I_CURSOR, I_RECORD, I_LEVELS, I_ARMED, I_PITCH,
+ I_NPITCH) = (11, 16, 21, 22, 23, 24, 25, 26, 27, 28)
 if _k is not None:
     assert (_k.ND, _k.NI, _k.MAXSW, _k.NSD, _k.NSI, _k.NREC) == (
         _ND, _NI, _MAXSW, _NSD, _NSI, _NREC), "_kernel.c layout differs from kernel.py"
 
 
 def usable(axes: list[SimAxis]) -> bool:
-    """True when the kernel models every axis (steppers, nothing armed, no pitch table, only
-    the axis's own input switches: a probe's hidden switches feed a board input through
-    the machine's edge filters, which only the Python path applies)."""
+    """True when the kernel models every axis (steppers with at most 8 switches; a probe's
+    hidden switches count: their edges come back named and go through the machine's edge
+    filters)."""
     if _k is None:
         return False
-    for ax in axes:
-        if (type(ax.plant) is not StepperPlant or ax.trans.pitch.e
-                or len(ax.switches) > _MAXSW or not _BIT.keys() >= ax.switches.keys()):
-            return False
-    return True
+    return all(type(ax.plant) is StepperPlant and len(ax.switches) <= _MAXSW for ax in axes)
 
 
 def pacing() -> bool:
@@ -95,8 +92,12 @@ def wait_slot(k: int) -> None:
         _k.rt_slot(int(k))
 
 
+#: the signal bit of a hidden switch (a probe's interval bound) in slot s: _HIDDEN + s
+_HIDDEN = len(AXIS_INPUTS)
+
+
 def _wakes(name: str, switches: dict, wake: Collection[str] | None) -> bool:
-    if wake is None or name in wake:
+    if wake is None or name in wake or name not in _BIT:  # hidden: the probe's filter
         return True
     return name == "sd" and "ltc" not in switches and "ltc" in wake
 
@@ -136,7 +137,7 @@ class KernelState:
     the objects only when Python needs them (`write_back`; SimMachine decides when). So a
     landing of a virtual-time jump costs no per-axis packing or copying."""
 
-    __slots__ = ("ad", "ai", "sd", "si", "names", "recording", "_wake", "_wake_key",
+    __slots__ = ("ad", "ai", "sd", "si", "pitch", "names", "recording", "_wake", "_wake_key",
                  "_readback", "_edges")
 
     def __init__(self, axes: list[SimAxis]) -> None:
@@ -147,13 +148,19 @@ class KernelState:
         si = np.zeros((n, _MAXSW, _NSI), dtype=np.int64)
         adl: list[tuple] = []
         ail: list[list] = []
+        tables: list[float] = []  # the pitch tables: z, e, y of each axis that has one
         self.names: list[list[str]] = []
         for x, ax in enumerate(axes):
             g, plant, dec, tr = ax.gen, ax.plant, ax.decoder, ax.trans
             c = g.cubic
+            pt = tr.pitch
+            at = len(tables)
+            if pt.e:
+                tables += map(float, [*pt.z, *pt.e, *pt.y])
             adl.append((c.p0, c.v0, c.a0, c.j, g.tc, g.te, g.half, plant.vmax, plant.amax,
                         tr.backlash, tr.z, ax.y, dec.upp,
-                        math.nan if ax.stop_time is None else ax.stop_time))
+                        math.nan if ax.stop_time is None else ax.stop_time,
+                        float(pt.spacing)))
             fwd = [*dec.fwd_pre, 0, 0, 0, 0][:5]
             bwd = [*dec.bwd_pre, 0, 0, 0, 0][:5]
             sws = ax.switches
@@ -171,16 +178,18 @@ class KernelState:
                     base ^= bits
                 arm = ax.armed.get(name) if name != "ez" else None
                 rank = list(ax.armed).index(name) + 1 if arm is not None else 0
-                si[x, s] = (sw.active, 0, bits, _BIT[name], rank,
+                si[x, s] = (sw.active, 0, bits, _BIT.get(name, _HIDDEN + s), rank,
                             arm[0] if arm else 0, arm[1] if arm else 0)
             ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
                         dec.count, dec.period, len(sws), dec.turn[1], dec.turn[-1],
                         *fwd, *bwd, 0, 0, 0, g.record is not None, base,
-                        any(name in sws and name != "ez" for name in ax.armed)])
+                        any(name in sws and name != "ez" for name in ax.armed),
+                        at, len(pt.e)])
         if n:
             ad[:] = adl
             ai[:] = ail
         self.ad, self.ai, self.sd, self.si = ad, ai, sd, si
+        self.pitch = np.array(tables, dtype=float)
         self.recording = any(ax.gen.record is not None for ax in axes)  # pulse records
         self._wake_key: object = ()  # no wake set computed yet
         self._wake = np.zeros((n, _MAXSW), dtype=np.int64)
@@ -327,8 +336,9 @@ def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin:
     tr = np.zeros((stop - start, n, 3), dtype=np.int64) if trace else _NO_TRACE
     et, ei, enc = ks._edges
     k, t, nrows, nedges, full = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, et,
-                                       ei, enc, float(origin), float(period), int(start),
-                                       int(stop), float(now), float(limit), report, paced)
+                                       ei, enc, ks.pitch, float(origin), float(period),
+                                       int(start), int(stop), float(now), float(limit),
+                                       report, paced)
     if k == start:
         return k, now, tr[:0] if trace else None, [], bool(full)
     ks._readback = None
@@ -348,7 +358,8 @@ def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin:
         for tm, (axis, bit, level, _), counts in zip(et[:nedges].tolist(),
                                                      ei[:nedges].tolist(),
                                                      enc[:nedges].tolist(), strict=True):
-            edges.append(InputEdge(tm, axis, names[bit], level == 1, tuple(counts)))
+            name = names[bit] if bit < _HIDDEN else ks.names[axis][bit - _HIDDEN]
+            edges.append(InputEdge(tm, axis, name, level == 1, tuple(counts)))
     return k, t, tr[:k - start] if trace else None, edges, bool(full)
 
 
