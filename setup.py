@@ -1,6 +1,7 @@
 """Build of the compiled inner loops (openmotion._kernel, src/openmotion/_kernel*.c, and
 openmotion._compare, src/openmotion/_kernel_compare.c: the compare engine's solvers, and
-openmotion._profile, src/openmotion/_profile.c: the jerk-limited profile builder); the rest
+openmotion._profile, src/openmotion/_profile.c: the jerk-limited profile builder, and
+openmotion._corner, src/openmotion/_corner.c: the line-line corner blend); the rest
 is declared in pyproject.toml. Plain C against the CPython API: no build tool beyond setuptools.
 -ffp-contract=off keeps the compiler from fusing a*b+c, so the kernel's floats are
 bit-identical to the Python path's."""
@@ -19,4 +20,6 @@ setup(ext_modules=[Extension("openmotion._kernel",
                    Extension("openmotion._compare", ["src/openmotion/_kernel_compare.c"],
                              extra_compile_args=flags),
                    Extension("openmotion._profile", ["src/openmotion/_profile.c"],
+                             extra_compile_args=flags),
+                   Extension("openmotion._corner", ["src/openmotion/_corner.c"],
                              extra_compile_args=flags)])

@@ -220,24 +220,38 @@ def test_centripetal_speed():
         centripetal_speed(1.0, math.inf)
 
 
-# -- the fast line-line construction equals the validated one bit for bit -------------------
-def _same_element(a, b):
+# -- the fast line-line constructions equal the validated one --------------------------------
+def _same_element(a, b, rel=0.0):
+    """a equals b bit for bit (rel 0) or within rel of the scale of each value."""
+    def same(x, y):
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        if rel == 0.0:
+            return np.array_equal(x, y, equal_nan=True)
+        scale = max(1.0, float(np.max(np.abs(y), initial=0.0, where=~np.isnan(y))))
+        return bool(np.all((np.isnan(x) & np.isnan(y)) | (np.abs(x - y) <= rel * scale)))
+
     assert type(a) is type(b)
-    assert a.length == b.length
+    assert same(a.length, b.length)
     # equal_nan: corners of subnormal size give NaN tangents, in both constructions alike
     for name in ("start", "end", "start_tangent", "end_tangent", "max_abs_tangent",
                  "axis_accel_weight"):
-        assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=True), name
-    assert a.max_curvature == b.max_curvature or (math.isnan(a.max_curvature)
-                                                  and math.isnan(b.max_curvature))
-    s = np.linspace(0.0, a.length, 7)
-    assert np.array_equal(a.point(s), b.point(s), equal_nan=True)
+        assert same(getattr(a, name), getattr(b, name)), name
+    assert same(a.max_curvature, b.max_curvature) if rel else (
+        a.max_curvature == b.max_curvature or (math.isnan(a.max_curvature)
+                                               and math.isnan(b.max_curvature)))
+    s = np.linspace(0.0, b.length, 7)
+    assert same(a.point(np.minimum(s, a.length)), b.point(s))
 
 
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.floats(-1e3, 1e3), min_size=9, max_size=9),
        st.floats(1e-6, 10.0), st.sampled_from([2, 3]))
-def test_line_blend_bit_for_bit_with_the_validated_construction(c, tol, dim):
+def test_line_blend_equals_the_validated_construction(c, tol, dim):
+    """The numpy construction (more than 64 axes) bit for bit; the compiled one
+    (openmotion._corner) within 1e-9 relative: its dot products and cos/arctan2/hypot
+    round differently from numpy's (BLAS may fuse multiply-adds), so bit for bit is not
+    defined across machines (issue 14: 'bit for bit or within 1e-9')."""
+    from openmotion.path.blend import _line_line_numpy
     from oracle_blend import blend_lines
 
     p0, p1, p2 = np.array(c[0:dim]), np.array(c[3:3 + dim]), np.array(c[6:6 + dim])
@@ -245,10 +259,31 @@ def test_line_blend_bit_for_bit_with_the_validated_construction(c, tol, dim):
     # corners of subnormal size break Arc3D (NaN tangents, a 0 radius**2): not compared
     assume(first.length > 1e-100 and second.length > 1e-100)
     b = blend_corner(first, second, tol)
-    if b is None:
+    n = _line_line_numpy(first, second, tol, 0.5)
+    if b is None or n is None:
+        assert b is None and n is None
         return
     f, arc, s, dev = blend_lines(first, second, tol)
-    _same_element(b.first, f)
-    _same_element(b.arc, arc)
-    _same_element(b.second, s)
-    assert b.deviation == dev
+    for got, rel in ((n, 0.0), (b, 1e-9)):
+        _same_element(got.first, f, rel)
+        _same_element(got.arc, arc, rel)
+        _same_element(got.second, s, rel)
+        assert abs(got.deviation - dev) <= rel * max(1.0, dev)
+    # the compiled corner joins its pieces bit for bit, as the numpy one does
+    assert b.first.end is b.arc.start and b.arc.end is b.second.start
+    assert b.first.start is first.start and b.second.end is second.end
+
+
+def test_line_blend_numpy_and_compiled_agree_in_many_axes():
+    """Six axes (the compiled corner's loops over every axis) and the numpy path."""
+    from openmotion.path.blend import _line_line_numpy
+
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        p = rng.uniform(-100.0, 100.0, (3, 6))
+        first, second = Line(p[0], p[1]), Line(p[1], p[2])
+        b, n = blend_corner(first, second, 0.5), _line_line_numpy(first, second, 0.5, 0.5)
+        assert (b is None) == (n is None)
+        if b is not None:
+            for x, y in zip(b.elements, n.elements, strict=True):
+                _same_element(x, y, 1e-9)

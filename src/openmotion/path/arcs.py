@@ -198,17 +198,28 @@ class _ArcQueries:
 
     @property
     def max_curvature(self) -> float:
-        return self._frame.kappa
+        out = self.__dict__.get("_kappa")
+        if out is None:
+            out = self.__dict__["_kappa"] = self._frame.kappa
+        return out
 
     @property
     def max_abs_tangent(self) -> Array:
-        """Per axis, the largest |tangent component| along the arc (exact for circles)."""
-        return self._frame.max_abs_tangent()
+        """Per axis, the largest |tangent component| along the arc (exact for circles;
+        computed once: the look-ahead asks for it at every re-plan)."""
+        out = self.__dict__.get("_mat")
+        if out is None:
+            out = self.__dict__["_mat"] = self._frame.max_abs_tangent()
+        return out
 
     @property
     def axis_accel_weight(self) -> Array:
-        """Per axis, an upper bound of sqrt(t_i**2 + n_i**2) along the arc (n: unit normal)."""
-        return self._frame.axis_accel_weight()
+        """Per axis, an upper bound of sqrt(t_i**2 + n_i**2) along the arc (n: unit normal;
+        computed once)."""
+        out = self.__dict__.get("_aaw")
+        if out is None:
+            out = self.__dict__["_aaw"] = self._frame.axis_accel_weight()
+        return out
 
     def point(self, s: ArrayLike) -> Array:
         """Point at path position s; shape s.shape + (N,)."""
@@ -476,6 +487,28 @@ class Arc3D(_ArcQueries):
         for name, value in (("start", start), ("via", frozen(mid)), ("end", end),
                             ("_frame", frame)):
             object.__setattr__(obj, name, value)
+        return obj
+
+
+    @classmethod
+    def _blend_arc(cls, centre: Array, e1: Array, e2: Array, radius: float, sweep: float,
+                   helix: Array, start: Array, end: Array, via: Array, length: float,
+                   lin: Array, t_start: Array, t_end: Array, kappa: float,
+                   max_abs_tangent: Array, axis_accel_weight: Array) -> Arc3D:
+        """`_planned` with every derived value computed by the caller (path/blend.py's
+        compiled corner: read-only arrays, the same formulas as `_Frame`'s)."""
+        frame = object.__new__(_Frame)
+        for name, value in (("centre", centre), ("e1", e1), ("e2", e2), ("radius", radius),
+                            ("sweep", sweep), ("helix", helix), ("start", start),
+                            ("end", end), ("length", length), ("lin", lin),
+                            ("t_start", t_start), ("t_end", t_end)):
+            object.__setattr__(frame, name, value)
+        obj = object.__new__(cls)
+        for name, value in (("start", start), ("via", via), ("end", end), ("_frame", frame)):
+            object.__setattr__(obj, name, value)
+        obj.__dict__["_mat"] = max_abs_tangent
+        obj.__dict__["_aaw"] = axis_accel_weight
+        obj.__dict__["_kappa"] = kappa
         return obj
 
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import _corner
 from ..errors import MotionError, check_nonnegative, check_positive
 from .arcs import Arc, Arc3D
 from .fillet import fillet
@@ -45,6 +46,8 @@ TANGENT_ANGLE = 1e-6
 #: Corners whose lines are within this angle (radians) of a full reversal need an exact stop.
 REVERSAL_ANGLE = 1e-6
 _SQRT2_M1 = math.sqrt(2.0) - 1.0
+#: The most axes the compiled corner (openmotion._corner) takes.
+_corner_max_dim = 64
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,15 +103,50 @@ def blend_corner(first: PathElement, second: PathElement, tolerance: float, *,
             raise MotionError(f"second.start must equal first.end, they are {gap:.6g} apart")
     if t == 0.0 or first.length == 0.0 or second.length == 0.0:
         return None
+    if isinstance(first, Line) and isinstance(second, Line):
+        return _line_line(first, second, t, frac)
     u1, u2 = first.end_tangent, second.start_tangent
     cos_t = _norm(u1 - u2) / 2.0
     sin_t = _norm(u1 + u2) / 2.0
     turn = 2.0 * math.atan2(cos_t, sin_t)  # angle between u1 and u2
     if turn < TANGENT_ANGLE or math.pi - turn < REVERSAL_ANGLE:
         return None
-    if not isinstance(first, Line) or not isinstance(second, Line):
-        f = fillet(first, second, t, cos_t, sin_t, frac)
-        return None if f is None else Blend(f.first, f.arc, f.second, f.deviation)
+    f = fillet(first, second, t, cos_t, sin_t, frac)
+    return None if f is None else Blend(f.first, f.arc, f.second, f.deviation)
+
+
+def _line_line(first: Line, second: Line, t: float, frac: float) -> Blend | None:
+    """The closed form of the module doc for two lines (None for a straight corner or a
+    reversal), computed by the compiled helper
+    (`openmotion._corner`, one call per corner: a streaming job rounds every corner) and
+    wrapped in the elements. tests/oracle_blend.py keeps the numpy construction this
+    repeats (equal within rounding)."""
+    dim = first.dim
+    if dim > _corner_max_dim:
+        return _line_line_numpy(first, second, t, frac)
+    out = np.empty((16, dim))
+    res = _corner.line_blend(out, first.start, first.end, second.end, first.direction,
+                             second.direction, first.length, second.length, t, frac)
+    if res is None:
+        return None
+    out.flags.writeable = False
+    (centre, e1, e2, a_start, a_end, via, lin, t_start, t_end, helix, mat, aaw, u1, au1,
+     u2, au2) = out
+    len1, len2, radius, turn, length, kappa, dev = res
+    arc = Arc3D._blend_arc(centre, e1, e2, radius, turn, helix, a_start, a_end, via, length,
+                           lin, t_start, t_end, kappa, mat, aaw)
+    return Blend(Line._planned(first.start, a_start, len1, u1, au1), arc,
+                 Line._planned(a_end, second.end, len2, u2, au2), dev)
+
+
+def _line_line_numpy(first: Line, second: Line, t: float, frac: float) -> Blend | None:
+    """`_line_line` in numpy (more axes than the compiled helper takes)."""
+    u1, u2 = first.end_tangent, second.start_tangent
+    cos_t = _norm(u1 - u2) / 2.0
+    sin_t = _norm(u1 + u2) / 2.0
+    turn = 2.0 * math.atan2(cos_t, sin_t)  # angle between u1 and u2
+    if turn < TANGENT_ANGLE or math.pi - turn < REVERSAL_ANGLE:
+        return None
     corner = first.end
     d_tol = t * (1.0 + sin_t) / cos_t
     d = min(frac * first.length, frac * second.length, d_tol)
@@ -130,7 +168,6 @@ def blend_corner(first: PathElement, second: PathElement, tolerance: float, *,
     dev = d * (1.0 - sin_t) / cos_t
     return Blend(Line.between(first.start, a_start), arc, Line.between(a_end, second.end),
                  dev)
-
 
 
 def corner_speed(u1: ArrayLike, u2: ArrayLike, accel: float, square_corner_velocity: float,

@@ -170,6 +170,19 @@ class Line:
         object.__setattr__(obj, "direction", u)
         return obj
 
+    @classmethod
+    def _planned(cls, start: Array, end: Array, length: float, direction: Array,
+                 abs_direction: Array) -> Line:
+        """A line whose length and direction (and |direction|) a planner computed itself
+        as `between` does (path/blend.py's compiled corner): read-only arrays, not checked."""
+        obj = object.__new__(cls)
+        object.__setattr__(obj, "start", start)
+        object.__setattr__(obj, "end", end)
+        object.__setattr__(obj, "length", length)
+        object.__setattr__(obj, "direction", direction)
+        obj.__dict__["_abs_dir"] = abs_direction
+        return obj
+
     @property
     def dim(self) -> int:
         return int(self.start.size)
