@@ -220,8 +220,7 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
                         self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
-                found, edges = edges, self._filtered(edges)
-                if found and not (wake is None or any(e.signal in wake for e in edges)
+                if edges and not (wake is None or any(e.signal in wake for e in edges)
                                   or ks.stopped()):
                     edges = []  # a cycle with edges on other signals only: run on
                     continue
@@ -312,7 +311,8 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         t = check_finite("t", t)
         if t < self._t:
             raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
-        ks = self._kernel_state() if self.native and not self._pending else None
+        ks = self._kernel_state() if self.native and not self._pending \
+            and not self._edge_filters else None
         if ks is not None:
             edges = self._advance_native(t)
             if edges is not None:
@@ -347,7 +347,7 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
             self._t = t1
             if not ks.recording:
                 self._stale = True
-            edges += self._filtered(part)
+            edges += part
             if carry is not None and sum(map(len, queues)) == left:
                 # no piece started in this part: one Python stretch with the part before
                 # (its stop times stand unless this part cut again)
@@ -358,7 +358,7 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
                 self._timed_done()
                 return edges
             carry = [ks.stop_time(x) for x in range(len(self._ax))]
-            edges += self._filtered(self._act(end))  # on the objects (arrays dropped)
+            edges += self._act(end)  # on the objects (the kernel's arrays are dropped)
             carry = [ax.stop_time if ax.stop_time is not None else c
                      for ax, c in zip(self._ax, carry, strict=True)]
             if end >= t and not (heap and heap[0][0] <= t):  # (a zero stretch is a no-op)
@@ -377,22 +377,6 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         return [InputEdge(tm, axis, sig, lv, tuple(
             own if (j == axis and own is not None) else axes[j].decoder.count
             for j in range(n))) for tm, axis, sig, lv, own in raw]
-
-    def _filtered(self, edges: list[InputEdge]) -> list[InputEdge]:
-        """The kernel's edges (time-ordered) through the machine's edge filters (probe.py:
-        hidden switch edges become edges of a board input, with every axis's count at
-        that instant), as `_advance` filters its raw edges."""
-        if not self._edge_filters or not edges:
-            return edges
-        out = []
-        for e in edges:
-            raw = [(e.time, e.axis, e.signal, e.level, None)]
-            for f in self._edge_filters:
-                raw = f(raw)
-            for tm, axis, sig, lv, _ in raw:
-                out.append(e if axis == e.axis and sig == e.signal
-                           else InputEdge(tm, axis, sig, lv, e.encoders))
-        return out
 
     def _set_stops(self, stops: list[float | None]) -> None:
         ks = self._ks
