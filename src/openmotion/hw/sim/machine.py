@@ -311,94 +311,19 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         t = check_finite("t", t)
         if t < self._t:
             raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
+        queues = self._queues
         ks = self._kernel_state() if self.native and not self._pending \
             and not self._edge_filters else None
-        if ks is not None:
-            edges = self._advance_native(t)
-            if edges is not None:
-                return edges
-        return self._advance_python(t)
-
-    def _advance_native(self, t: float) -> list[InputEdge] | None:
-        """`advance(t)` in the kernel: the stretch [now, t] as one cycle, every edge
-        reported; a scenario action due in it cuts it: the kernel runs up to the action's
-        time, the action applies to the axis objects (Python, as `_advance` does), and the
-        kernel runs on. None when the kernel ran nothing (a count beyond its exact range:
-        the Python path runs the stretch). A later part the kernel refuses runs in Python."""
-        heap = self.scenario._heap
-        queues = self._queues
-        edges: list[InputEdge] = []
-        carry: list[float | None] | None = None  # stop times of the parts before
-        first = True
-        while True:
-            ks = self._kernel_state()
-            ta = heap[0][0] if heap else math.inf
-            end = t if ta > t else max(ta, self._t)
-            if ks is None:  # (an action left a machine the kernel does not model)
-                return edges + self._advance_rest(t, carry)
-            left = sum(map(len, queues)) if carry is not None else 0
-            k, t1, _, part = kernel.run_quiet(ks, self._ax, queues, end, 1.0, -1, 0, self._t,
-                                              math.inf, None, report=True, paced=False)
-            if k != 0:  # a count left the exact range: Python from here
-                if first:
-                    return None
-                return edges + self._advance_rest(t, carry)
-            first = False
-            self._t = t1
-            if not ks.recording:
-                self._stale = True
-            edges += part
-            if carry is not None and sum(map(len, queues)) == left:
-                # no piece started in this part: one Python stretch with the part before
-                # (its stop times stand unless this part cut again)
-                now = ks.ad[:, kernel.D_STOP].tolist()
-                ks.ad[:, kernel.D_STOP] = [c if math.isnan(v) and c is not None else v
-                                           for c, v in zip(carry, now, strict=True)]
-            if ta > t:
+        if ks is not None:  # one cycle [now, t] in the kernel, every edge reported
+            k, t1, _, edges = kernel.run_quiet(ks, self._ax, queues, t, 1.0, -1, 0, self._t,
+                                               self._next_action(), None, report=True,
+                                               paced=False)
+            if k == 0:  # else an action is due in it or a count left the exact range
+                self._t = t1
                 self._timed_done()
+                if not ks.recording:
+                    self._stale = True
                 return edges
-            carry = [ks.stop_time(x) for x in range(len(self._ax))]
-            edges += self._act(end)  # on the objects (the kernel's arrays are dropped)
-            carry = [ax.stop_time if ax.stop_time is not None else c
-                     for ax, c in zip(self._ax, carry, strict=True)]
-            if end >= t and not (heap and heap[0][0] <= t):  # (a zero stretch is a no-op)
-                self._timed_done()
-                self._set_stops(carry)
-                return edges
-
-    def _act(self, tk: float) -> list[InputEdge]:
-        """The scenario actions due at time tk (now), on the axis objects; their edges
-        with every axis's decoded count now."""
-        raw: list = []
-        axes = self._axes
-        for _, action in self.scenario.pop_due(tk):
-            action(raw)
-        n = len(axes)
-        return [InputEdge(tm, axis, sig, lv, tuple(
-            own if (j == axis and own is not None) else axes[j].decoder.count
-            for j in range(n))) for tm, axis, sig, lv, own in raw]
-
-    def _set_stops(self, stops: list[float | None]) -> None:
-        ks = self._ks
-        if ks is not None and self._stale:
-            ks.ad[:, kernel.D_STOP] = [math.nan if s is None else s for s in stops]
-        else:
-            for ax, s in zip(self._axes, stops, strict=True):
-                ax.stop_time = s
-
-    def _advance_rest(self, t: float, carry: list[float | None] | None) -> list[InputEdge]:
-        """The rest of a stretch in the Python path, after parts run in the kernel."""
-        left = sum(map(len, self._queues))
-        edges = self._advance_python(t)
-        if carry is not None and sum(map(len, self._queues)) == left:
-            self._set_stops([ax.stop_time if ax.stop_time is not None else c
-                             for ax, c in zip(self._axes, carry, strict=True)])
-        return edges
-
-    def _advance_python(self, t: float) -> list[InputEdge]:
-        """`advance(t)` in the Python pipeline (the oracle; machines the kernel does not
-        model)."""
-        queues = self._queues
         if not any(len(q) for q in queues):
             return self._advance(t)
         edges: list[InputEdge] = []
