@@ -329,9 +329,25 @@ def bank_new(specs):  # noqa: ANN001, ANN201
     return [tuple(s) for s in specs]
 
 
+def spec_track(spec, ta: float, t1: float):  # noqa: ANN001, ANN201
+    """A track spec (hist, scale, offset, e0, slope, t_ref) as CompareEngine.track builds
+    it in Python: MotionHistory.rows of the window, then affine_track (a 5-tuple: as is)."""
+    if len(spec) != 6:
+        return spec
+    from openmotion.control.trigger.compare_math import Track, affine_track
+
+    h, scale, offset, e0, slope, t_ref = spec
+    lo = max(h.index_at(ta) - 1, h.lo)
+    hi = max(h.index_at(t1), lo) + 1
+    tr = Track(*(c[lo:hi] for c in (h.ts, h.p0, h.v0, h.a0, h.j)))
+    return affine_track(tr, scale, offset, e0, slope, t_ref)
+
+
 def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # noqa: ANN001, ANN201
     """CompareEngine's job loop for LevelJob (axis) / WindowJob with Toggle, SetLevel or
     Pulse, as it was in Python: each job's scan, its action on its line, its row."""
+    tracks = [spec_track(s, ta, t1) for s in tracks]
+    pos_tracks = [spec_track(s, ta, t1) for s in pos_tracks]
     ranges: dict[int, tuple[float, float]] = {}
     f: list[tuple[float, float]] = []
     k: list[tuple[int, int, int, int]] = []
@@ -388,6 +404,9 @@ def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # n
         return None
     import numpy as np
 
+    by_time = sorted(range(len(f)), key=lambda q: f[q][0])  # (stable: job, hit order)
+    f, k = [f[q] for q in by_time], [k[q] for q in by_time]
+
     pos = np.empty((len(f), len(pos_tracks)))
     positions(pos_tracks, [x[0] for x in f], pos)
     return (np.array(f, dtype=np.float64).reshape(-1, 2).tobytes(),
@@ -402,13 +421,35 @@ def lines_send(lines, t0: float, t1: float):  # noqa: ANN001, ANN201
         if (line._lv[a - 1] if a else line.initial) != line._written:
             return None
         cuts.append((a, bisect.bisect_right(line._t, t1)))
-    writes = []
+    times, signals, levels = [], [], []
     for line, (a, b) in zip(lines, cuts, strict=True):
         line._sent = (line._t[a:b], line._lv[a:b])
         line._written = line._lv[b - 1] if b else line.initial
         line._sent_until = t1
         line._late.clear()
         line._hold = False
-        if b > a:
-            writes.append((line._t[a:b], line.signal, line._lv[a:b]))
-    return writes
+        times += line._t[a:b]
+        signals += [line.signal] * (b - a)
+        levels += line._lv[a:b]
+    return times, signals, levels
+
+
+def plan_records(hists, t1: float, old=None):  # noqa: ANN001, ANN201
+    """The record in force just before t1 of each record store (MotionHistory.record_at),
+    as CompareEngine compared them in Python (old given: are they all the same?)."""
+    recs = []
+    for h in hists:
+        k = h.index_at(math.nextafter(t1, -math.inf))
+        recs.append(() if k < h.lo else (float(h.ts[k]), float(h.p0[k]), float(h.v0[k]),
+                                         float(h.a0[k]), float(h.j[k])))
+    return recs if old is None else recs == old
+
+
+def lines_snapshot(lines, t: float):  # noqa: ANN001, ANN201
+    return [line.snapshot(t) for line in lines]
+
+
+def lines_end(lines, hw, t0: float, t1: float, keep: float) -> None:  # noqa: ANN001
+    for line in lines:
+        line.flush(hw, t0, t1)
+        line.forget_before(keep)

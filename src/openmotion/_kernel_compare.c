@@ -25,6 +25,15 @@
 #define SNAP_RTOL 1e-10
 #define MAX_AXES 8
 
+/* attribute names, interned once (module init): the driver reads job, line and history
+ * objects by attribute every cycle */
+#define NAMES(X) X(_t) X(_lv) X(_late) X(initial) X(timed) X(_sent_until) X(_written) \
+    X(_sent) X(_hold) X(signal) X(index) X(hits) X(ts) X(p0) X(v0) X(a0) X(j) X(lo) X(hi) \
+    X(flush) X(forget_before) X(snapshot) X(_snap) X(_snap_t)
+#define DECL(n) static PyObject *S_##n;
+NAMES(DECL)
+#undef DECL
+
 static inline double pymax(double a, double b) { return b > a ? b : a; }
 static inline double pymin(double a, double b) { return b < a ? b : a; }
 static inline int isign(double x) { return x > 0.0 ? 1 : x < 0.0 ? -1 : 0; }
@@ -38,6 +47,7 @@ typedef struct {
 typedef struct {
     Py_buffer b[5];
     int held;
+    double *own;  /* rows built from a history spec (get_track_in), freed on release */
 } TrkBuf;
 
 static int get_vec(PyObject *o, Py_buffer *b, const char *name)
@@ -57,11 +67,14 @@ static void release_track(TrkBuf *tb)
 {
     for (int k = 0; k < tb->held; k++) PyBuffer_Release(&tb->b[k]);
     tb->held = 0;
+    free(tb->own);
+    tb->own = NULL;
 }
 
 static int get_track(PyObject *o, Trk *t, TrkBuf *tb)
 {
     tb->held = 0;
+    tb->own = NULL;
     PyObject *seq = PySequence_Fast(o, "track must be a sequence of 5 arrays");
     if (seq == NULL) return -1;
     if (PySequence_Fast_GET_SIZE(seq) != 5) {
@@ -93,6 +106,83 @@ static int get_track(PyObject *o, Trk *t, TrkBuf *tb)
     }
     t->ts = tb->b[0].buf; t->p0 = tb->b[1].buf; t->v0 = tb->b[2].buf;
     t->a0 = tb->b[3].buf; t->j = tb->b[4].buf; t->n = n;
+    return 0;
+}
+
+/* A track cut from the motion history in place (the driver's per-cycle input, no Python
+ * call per axis): spec = (hist, scale, offset, e0, slope, t_ref), hist one axis's record
+ * store (history._Track: float64 arrays ts, p0, v0, a0, j, live rows [lo, hi)). The rows
+ * of MotionHistory.rows(axis, ta, t1) (those covering [ta, t1] plus the one before), in
+ * the frame of compare_math.affine_track: scale * x(t) + offset + e0 + slope * (t - t_ref),
+ * each column with affine_track's operation order (the same floats). A 5-sequence is a
+ * plain track (get_track). */
+static Py_ssize_t search_right(const double *x, Py_ssize_t lo, Py_ssize_t hi, double t)
+{
+    while (lo < hi) {
+        Py_ssize_t mid = (lo + hi) / 2;
+        if (t < x[mid]) hi = mid; else lo = mid + 1;
+    }
+    return lo;
+}
+
+static int get_track_in(PyObject *o, double ta, double t1, Trk *t, TrkBuf *tb)
+{
+    if (!PyTuple_Check(o) || PyTuple_GET_SIZE(o) != 6) return get_track(o, t, tb);
+    tb->held = 0;
+    tb->own = NULL;
+    double sc, off, e0, slope, tref;
+    PyObject *h;
+    if (!PyArg_ParseTuple(o, "Oddddd", &h, &sc, &off, &e0, &slope, &tref)) return -1;
+    PyObject *names[5] = {S_ts, S_p0, S_v0, S_a0, S_j};
+    const double *col[5];
+    long long lo, hi;
+    PyObject *x = PyObject_GetAttr(h, S_lo);
+    if (x == NULL) return -1;
+    lo = PyLong_AsLongLong(x);
+    Py_DECREF(x);
+    if ((x = PyObject_GetAttr(h, S_hi)) == NULL) return -1;
+    hi = PyLong_AsLongLong(x);
+    Py_DECREF(x);
+    if (PyErr_Occurred()) return -1;
+    for (int k = 0; k < 5; k++) {
+        PyObject *a = PyObject_GetAttr(h, names[k]);
+        if (a == NULL) { release_track(tb); return -1; }
+        int r = get_vec(a, &tb->b[k], "history column");
+        Py_DECREF(a);
+        if (r < 0) { release_track(tb); return -1; }
+        tb->held = k + 1;
+        col[k] = tb->b[k].buf;
+        if (tb->b[k].len / 8 < hi) {
+            release_track(tb);
+            PyErr_SetString(PyExc_ValueError, "history track: rows beyond its arrays");
+            return -1;
+        }
+    }
+    if (!(0 <= lo && lo < hi)) {
+        release_track(tb);
+        PyErr_SetString(PyExc_ValueError, "history track holds no record");
+        return -1;
+    }
+    const double *ts = col[0];
+    Py_ssize_t ia = (Py_ssize_t)lo + search_right(ts + lo, 0, (Py_ssize_t)(hi - lo), ta) - 1;
+    Py_ssize_t ib = (Py_ssize_t)lo + search_right(ts + lo, 0, (Py_ssize_t)(hi - lo), t1) - 1;
+    Py_ssize_t a = ia - 1 > (Py_ssize_t)lo ? ia - 1 : (Py_ssize_t)lo;
+    Py_ssize_t b = (ib > a ? ib : a) + 1;
+    Py_ssize_t n = b - a;
+    double *m = malloc((size_t)(5 * n) * sizeof(double));
+    if (m == NULL) { release_track(tb); PyErr_NoMemory(); return -1; }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        Py_ssize_t r = a + k;
+        m[k] = ts[r];
+        m[n + k] = sc * col[1][r] + off + e0 + slope * (ts[r] - tref);
+        m[2 * n + k] = sc * col[2][r] + slope;
+        m[3 * n + k] = sc * col[3][r];
+        m[4 * n + k] = sc * col[4][r];
+    }
+    release_track(tb);  /* (the buffers: the rows are copied) */
+    tb->own = m;
+    t->ts = m; t->p0 = m + n; t->v0 = m + 2 * n; t->a0 = m + 3 * n; t->j = m + 4 * n;
+    t->n = n;
     return 0;
 }
 
@@ -1348,6 +1438,48 @@ static int rows_add(Rows *R, double t, double val, long long jid, long long idx,
     return 0;
 }
 
+/* the rows in time order, equal times in the order they were added (a stable sort: what
+ * the engine's log does with the rows of one scan) */
+static const double *sort_keys;
+
+static int cmp_row(const void *a, const void *b)
+{
+    Py_ssize_t i = *(const Py_ssize_t *)a, j = *(const Py_ssize_t *)b;
+    double x = sort_keys[2 * i], y = sort_keys[2 * j];
+    if (x < y) return -1;
+    if (x > y) return 1;
+    return i < j ? -1 : i > j;
+}
+
+static int rows_sort(Rows *R)
+{
+    Py_ssize_t m = R->m, q = 1;
+    while (q < m && R->f[2 * q] >= R->f[2 * (q - 1)]) q++;
+    if (q >= m) return 0;  /* already in order */
+    Py_ssize_t *ix = malloc((size_t)m * sizeof(Py_ssize_t));
+    double *f = malloc((size_t)m * 2 * sizeof(double));
+    long long *k = malloc((size_t)m * 4 * sizeof(long long));
+    if (ix == NULL || f == NULL || k == NULL) {
+        free(ix); free(f); free(k);
+        PyErr_NoMemory();
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < m; i++) ix[i] = i;
+    sort_keys = R->f;  /* (the GIL is held: one sort at a time) */
+    qsort(ix, (size_t)m, sizeof(Py_ssize_t), cmp_row);
+    for (Py_ssize_t i = 0; i < m; i++) {
+        memcpy(f + 2 * i, R->f + 2 * ix[i], 2 * sizeof(double));
+        memcpy(k + 4 * i, R->k + 4 * ix[i], 4 * sizeof(long long));
+    }
+    free(ix);
+    free(R->f);
+    free(R->k);
+    R->f = f;
+    R->k = k;
+    R->cap = m;
+    return 0;
+}
+
 /* an OutputLine's edit state, read once per job that fired */
 typedef struct {
     PyObject *tl, *ll, *late;
@@ -1358,26 +1490,26 @@ typedef struct {
 static int line_ref(PyObject *line, LineRef *L)
 {
     L->tl = L->ll = L->late = NULL;
-    PyObject *o = PyObject_GetAttrString(line, "_t");
+    PyObject *o = PyObject_GetAttr(line, S__t);
     if (o == NULL) return -1;
     L->tl = o; Py_DECREF(o);  /* borrowed: the line holds them during the call */
-    if ((o = PyObject_GetAttrString(line, "_lv")) == NULL) return -1;
+    if ((o = PyObject_GetAttr(line, S__lv)) == NULL) return -1;
     L->ll = o; Py_DECREF(o);
-    if ((o = PyObject_GetAttrString(line, "_late")) == NULL) return -1;
+    if ((o = PyObject_GetAttr(line, S__late)) == NULL) return -1;
     L->late = o; Py_DECREF(o);
     if (!PyList_Check(L->tl) || !PyList_Check(L->ll) || !PyList_Check(L->late)) {
         PyErr_SetString(PyExc_TypeError, "OutputLine edge lists must be lists");
         return -1;
     }
-    if ((o = PyObject_GetAttrString(line, "initial")) == NULL) return -1;
+    if ((o = PyObject_GetAttr(line, S_initial)) == NULL) return -1;
     L->initial = PyObject_IsTrue(o);
     Py_DECREF(o);
-    if ((o = PyObject_GetAttrString(line, "timed")) == NULL) return -1;
+    if ((o = PyObject_GetAttr(line, S_timed)) == NULL) return -1;
     int timed = PyObject_IsTrue(o);
     Py_DECREF(o);
     L->sent = -INFINITY;
     if (timed) {
-        if ((o = PyObject_GetAttrString(line, "_sent_until")) == NULL) return -1;
+        if ((o = PyObject_GetAttr(line, S__sent_until)) == NULL) return -1;
         L->sent = PyFloat_AsDouble(o);
         Py_DECREF(o);
         if (L->sent == -1.0 && PyErr_Occurred()) return -1;
@@ -1385,20 +1517,20 @@ static int line_ref(PyObject *line, LineRef *L)
     return L->initial < 0 || timed < 0 ? -1 : 0;
 }
 
-static int get_ll_attr(PyObject *o, const char *name, long long *out)
+static int get_ll_attr(PyObject *o, PyObject *name, long long *out)
 {
-    PyObject *v = PyObject_GetAttrString(o, name);
+    PyObject *v = PyObject_GetAttr(o, name);
     if (v == NULL) return -1;
     *out = PyLong_AsLongLong(v);
     Py_DECREF(v);
     return *out == -1 && PyErr_Occurred() ? -1 : 0;
 }
 
-static int set_ll_attr(PyObject *o, const char *name, long long v)
+static int set_ll_attr(PyObject *o, PyObject *name, long long v)
 {
     PyObject *x = PyLong_FromLongLong(v);
     if (x == NULL) return -1;
-    int r = PyObject_SetAttrString(o, name, x);
+    int r = PyObject_SetAttr(o, name, x);
     Py_DECREF(x);
     return r;
 }
@@ -1479,7 +1611,8 @@ PyDoc_STRVAR(bank_scan_doc,
 "Run the bank's jobs over (ta, t1] in order (CompareEngine._scan for them): each job's\n"
 "hits (LevelJob.scan / WindowJob.scan from its `index`), its action on lines[line]\n"
 "(apply_many from its `hits`), `index` and `hits` written back. tracks: one per slot;\n"
-"jobs: the job objects, in the bank's order. Returns the firings as f (float64[m, 2]:\n"
+"jobs: the job objects, in the bank's order. Returns the firings in time order (equal\n"
+"times in job order, then hit order) as f (float64[m, 2]:\n"
 "time, value), k (int64[m, 4]: job id, point index, output, state), pos (float64[m,\n"
 "len(pos_tracks)]: every pos_track at each time) and done (bank positions of the jobs\n"
 "that finished), or None when nothing fired or finished.");
@@ -1512,7 +1645,7 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     if (!T || !tb || !lo || !hi || !have_rng) { PyErr_NoMemory(); goto out; }
     for (Py_ssize_t i = 0; i < nt + npt; i++) {
         PyObject *o = i < nt ? PyList_GET_ITEM(tr_o, i) : PyList_GET_ITEM(pt_o, i - nt);
-        if (get_track(o, &T[i], &tb[i]) < 0) goto out;
+        if (get_track_in(o, ta, t1, &T[i], &tb[i]) < 0) goto out;
         got = i + 1;
         if (max_events(T[i].n) > evcap) evcap = max_events(T[i].n);
     }
@@ -1534,13 +1667,13 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
         const Spec *S = &B->s[i];
         PyObject *job = PyList_GET_ITEM(jobs_o, i);
         long long index, hits;
-        if (get_ll_attr(job, "index", &index) < 0) goto out;
+        if (get_ll_attr(job, S_index, &index) < 0) goto out;
         long long index0 = index;
         Py_ssize_t m = job_scan(S, T, lo, hi, &index, ta, t1, &hb, &hcap, ev, evcap);
         if (m < 0) goto out;
-        if (index != index0 && set_ll_attr(job, "index", index) < 0) goto out;
+        if (index != index0 && set_ll_attr(job, S_index, index) < 0) goto out;
         if (m > 0) {
-            if (get_ll_attr(job, "hits", &hits) < 0) goto out;
+            if (get_ll_attr(job, S_hits, &hits) < 0) goto out;
             if (S->line < 0 || S->line >= nl) {
                 PyErr_SetString(PyExc_IndexError, "bank_scan: line index");
                 goto out;
@@ -1572,7 +1705,7 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
                              S->output, st) < 0)
                     goto out;
             }
-            if (set_ll_attr(job, "hits", hits + m) < 0) goto out;
+            if (set_ll_attr(job, S_hits, hits + m) < 0) goto out;
         }
         int finished = S->kind == K_LEVEL ? (!S->repeat && index >= S->L.n + S->L.has_after)
                                           : index >= S->npts;
@@ -1583,6 +1716,7 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
         }
     }
     if (R.m == 0 && PyList_GET_SIZE(done) == 0) { res = Py_NewRef(Py_None); goto out; }
+    if (rows_sort(&R) < 0) goto out;
     res = Py_BuildValue("(y#y#y#O)", (const char *)R.f, (Py_ssize_t)(R.m * 2 * sizeof(double)),
                         (const char *)R.k, (Py_ssize_t)(R.m * 4 * sizeof(long long)),
                         "", (Py_ssize_t)0, done);
@@ -1612,11 +1746,12 @@ out:
 
 
 PyDoc_STRVAR(lines_send_doc,
-"lines_send(lines, t0, t1) -> list of (times, signal, levels) or None\n\n"
+"lines_send(lines, t0, t1) -> (times, signals, levels) or None\n\n"
 "OutputLine.send's bookkeeping for every line at once, when each line's physical level\n"
 "(`_written`) is its waveform's level at t0 (nothing late or stretched pending): sets\n"
 "_sent, _written, _sent_until = t1, clears _late and _hold, and returns the edges in\n"
-"(t0, t1] of the lines that have some. None (nothing changed) when a line needs send.");
+"(t0, t1] of every line, line after line, as three flat lists (the form of\n"
+"SimMachine.write_outputs_many). None (nothing changed) when a line needs send.");
 
 static int lv_at(PyObject *tl, PyObject *ll, int initial, double t, Py_ssize_t lo,
                  Py_ssize_t *k_out)
@@ -1630,6 +1765,14 @@ static int lv_at(PyObject *tl, PyObject *ll, int initial, double t, Py_ssize_t l
     return lv_of(ll, lo - 1, initial);
 }
 
+/* extend list `dst` by src[a:b] */
+static int extend_slice(PyObject *dst, PyObject *src, Py_ssize_t a, Py_ssize_t b)
+{
+    for (Py_ssize_t k = a; k < b; k++)
+        if (PyList_Append(dst, PyList_GET_ITEM(src, k)) < 0) return -1;
+    return 0;
+}
+
 static PyObject *lines_send(PyObject *self, PyObject *args)
 {
     PyObject *lines_o;
@@ -1640,62 +1783,236 @@ static PyObject *lines_send(PyObject *self, PyObject *args)
     Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
     Py_ssize_t *ab = malloc((size_t)(2 * n + 1) * sizeof(Py_ssize_t));
     int *wr = malloc((size_t)(n + 1) * sizeof(int));
-    PyObject *res = NULL;
-    if (ab == NULL || wr == NULL) { PyErr_NoMemory(); goto done; }
+    LineRef *LR = malloc((size_t)(n + 1) * sizeof(LineRef));
+    PyObject *res = NULL, *ot = NULL, *os = NULL, *ol = NULL, *t1o = NULL;
+    if (ab == NULL || wr == NULL || LR == NULL) { PyErr_NoMemory(); goto done; }
     for (Py_ssize_t i = 0; i < n; i++) {  /* check every line first: all or nothing */
         PyObject *line = PySequence_Fast_GET_ITEM(seq, i);
-        LineRef L;
-        if (line_ref(line, &L) < 0) goto done;
-        PyObject *w = PyObject_GetAttrString(line, "_written");
+        LineRef *L = &LR[i];
+        if (line_ref(line, L) < 0) goto done;
+        PyObject *w = PyObject_GetAttr(line, S__written);
         if (w == NULL) goto done;
         int written = PyObject_IsTrue(w);
         Py_DECREF(w);
-        if (PyList_GET_SIZE(L.tl) != PyList_GET_SIZE(L.ll)) {
+        if (PyList_GET_SIZE(L->tl) != PyList_GET_SIZE(L->ll)) {
             PyErr_SetString(PyExc_ValueError, "OutputLine: t and lv differ in length");
             goto done;
         }
         Py_ssize_t a, b;
-        int l0 = lv_at(L.tl, L.ll, L.initial, t0, 0, &a);
+        int l0 = lv_at(L->tl, L->ll, L->initial, t0, 0, &a);
         if (l0 != written) { res = Py_NewRef(Py_None); goto done; }
-        wr[i] = lv_at(L.tl, L.ll, L.initial, t1, a, &b);
+        wr[i] = lv_at(L->tl, L->ll, L->initial, t1, a, &b);
         ab[2 * i] = a;
         ab[2 * i + 1] = b;
     }
-    res = PyList_New(0);
-    if (res == NULL) goto done;
-    PyObject *t1o = PyFloat_FromDouble(t1);
-    if (t1o == NULL) { Py_CLEAR(res); goto done; }
+    ot = PyList_New(0); os = PyList_New(0); ol = PyList_New(0);
+    t1o = PyFloat_FromDouble(t1);
+    if (!ot || !os || !ol || !t1o) goto done;
     for (Py_ssize_t i = 0; i < n; i++) {
         PyObject *line = PySequence_Fast_GET_ITEM(seq, i);
-        LineRef L;
-        if (line_ref(line, &L) < 0) { Py_CLEAR(res); break; }
-        PyObject *ts = PyList_GetSlice(L.tl, ab[2 * i], ab[2 * i + 1]);
-        PyObject *ls = PyList_GetSlice(L.ll, ab[2 * i], ab[2 * i + 1]);
+        const LineRef *L = &LR[i];
+        Py_ssize_t a = ab[2 * i], b = ab[2 * i + 1];
+        PyObject *ts = PyList_GetSlice(L->tl, a, b);
+        PyObject *ls = PyList_GetSlice(L->ll, a, b);
         PyObject *sent = ts && ls ? PyTuple_Pack(2, ts, ls) : NULL;
         int bad = sent == NULL
-            || PyObject_SetAttrString(line, "_sent", sent) < 0
-            || PyObject_SetAttrString(line, "_written", wr[i] ? Py_True : Py_False) < 0
-            || PyObject_SetAttrString(line, "_sent_until", t1o) < 0
-            || PyObject_SetAttrString(line, "_hold", Py_False) < 0
-            || PyList_SetSlice(L.late, 0, PyList_GET_SIZE(L.late), NULL) < 0;
-        if (!bad && ab[2 * i + 1] > ab[2 * i]) {
-            PyObject *sig = PyObject_GetAttrString(line, "signal");
-            PyObject *item = sig ? PyTuple_Pack(3, ts, sig, ls) : NULL;
-            bad = item == NULL || PyList_Append(res, item) < 0;
-            Py_XDECREF(item);
+            || PyObject_SetAttr(line, S__sent, sent) < 0
+            || PyObject_SetAttr(line, S__written, wr[i] ? Py_True : Py_False) < 0
+            || PyObject_SetAttr(line, S__sent_until, t1o) < 0
+            || PyObject_SetAttr(line, S__hold, Py_False) < 0
+            || PyList_SetSlice(L->late, 0, PyList_GET_SIZE(L->late), NULL) < 0;
+        if (!bad && b > a) {
+            PyObject *sig = PyObject_GetAttr(line, S_signal);
+            bad = sig == NULL || extend_slice(ot, L->tl, a, b) < 0
+                  || extend_slice(ol, L->ll, a, b) < 0;
+            for (Py_ssize_t k = a; !bad && k < b; k++) bad = PyList_Append(os, sig) < 0;
             Py_XDECREF(sig);
         }
         Py_XDECREF(sent);
         Py_XDECREF(ts);
         Py_XDECREF(ls);
-        if (bad) { Py_CLEAR(res); break; }
+        if (bad) goto done;
     }
-    Py_DECREF(t1o);
+    res = PyTuple_Pack(3, ot, os, ol);
 done:
+    Py_XDECREF(ot); Py_XDECREF(os); Py_XDECREF(ol); Py_XDECREF(t1o);
     free(ab);
     free(wr);
+    free(LR);
     Py_DECREF(seq);
     return res;
+}
+
+/* ------------------------------------------------------------------ cycle bookkeeping */
+PyDoc_STRVAR(plan_records_doc,
+"plan_records(hists, t1, old=None) -> bytes, or bool with old\n\n"
+"The record in force just before t1 (MotionHistory.record_at(axis, nextafter(t1, -inf)))\n"
+"of every history record store in hists (history._Track), as bytes; with `old` (bytes of\n"
+"an earlier call on the same stores): True when every one is still the same record.");
+
+static PyObject *plan_records(PyObject *self, PyObject *args)
+{
+    PyObject *hs_o, *old = Py_None;
+    double t1;
+    if (!PyArg_ParseTuple(args, "Od|O", &hs_o, &t1, &old)) return NULL;
+    PyObject *seq = PySequence_Fast(hs_o, "hists must be a sequence");
+    if (seq == NULL) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    double *rec = malloc((size_t)(6 * n + 1) * sizeof(double));
+    PyObject *res = NULL;
+    if (rec == NULL) { PyErr_NoMemory(); goto done; }
+    double tb = nextafter(t1, -INFINITY);
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *h = PySequence_Fast_GET_ITEM(seq, i);
+        PyObject *x = PyObject_GetAttr(h, S_lo);
+        long long lo = x ? PyLong_AsLongLong(x) : -1;
+        Py_XDECREF(x);
+        x = PyErr_Occurred() ? NULL : PyObject_GetAttr(h, S_hi);
+        long long hi = x ? PyLong_AsLongLong(x) : -1;
+        Py_XDECREF(x);
+        if (PyErr_Occurred()) goto done;
+        PyObject *names[5] = {S_ts, S_p0, S_v0, S_a0, S_j};
+        Py_buffer b[5];
+        int held = 0, bad = 0;
+        for (int k = 0; k < 5 && !bad; k++) {
+            PyObject *a = PyObject_GetAttr(h, names[k]);
+            bad = a == NULL || get_vec(a, &b[k], "history column") < 0;
+            Py_XDECREF(a);
+            if (!bad) held++;
+            if (!bad && b[k].len / 8 < hi) {
+                PyErr_SetString(PyExc_ValueError, "history track: rows beyond its arrays");
+                bad = 1;
+            }
+        }
+        if (!bad && !(0 <= lo && lo <= hi)) {
+            PyErr_SetString(PyExc_ValueError, "history track: bad live rows");
+            bad = 1;
+        }
+        if (!bad) {
+            const double *ts = b[0].buf;
+            Py_ssize_t k = (Py_ssize_t)lo + search_right(ts + lo, 0, (Py_ssize_t)(hi - lo), tb)
+                           - 1;
+            double *r = rec + 6 * i;
+            if (k < lo) {
+                memset(r, 0, 6 * sizeof(double));
+            } else {
+                r[0] = 1.0;
+                for (int q = 0; q < 5; q++) r[1 + q] = ((const double *)b[q].buf)[k];
+            }
+        }
+        for (int k = 0; k < held; k++) PyBuffer_Release(&b[k]);
+        if (bad) goto done;
+    }
+    if (old == Py_None) {
+        res = PyBytes_FromStringAndSize((const char *)rec, (Py_ssize_t)(6 * n * sizeof(double)));
+    } else {
+        if (!PyBytes_Check(old) || PyBytes_GET_SIZE(old) != (Py_ssize_t)(6 * n * sizeof(double))) {
+            PyErr_SetString(PyExc_ValueError, "plan_records: old must be bytes of these stores");
+            goto done;
+        }
+        const double *o = (const double *)PyBytes_AS_STRING(old);
+        int same = 1;  /* (as the tuples compare: floats by value) */
+        for (Py_ssize_t i = 0; i < n && same; i++) {
+            if (o[6 * i] != rec[6 * i]) same = 0;
+            else if (rec[6 * i] != 0.0)
+                for (int q = 1; q < 6 && same; q++) same = o[6 * i + q] == rec[6 * i + q];
+        }
+        res = PyBool_FromLong(same);
+    }
+done:
+    free(rec);
+    Py_DECREF(seq);
+    return res;
+}
+
+PyDoc_STRVAR(lines_snapshot_doc,
+"lines_snapshot(lines, t) -> list of OutputLine.snapshot(t), one per line");
+
+static PyObject *lines_snapshot(PyObject *self, PyObject *args)
+{
+    PyObject *lines_o;
+    double t;
+    if (!PyArg_ParseTuple(args, "Od", &lines_o, &t)) return NULL;
+    PyObject *seq = PySequence_Fast(lines_o, "lines must be a sequence");
+    if (seq == NULL) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    PyObject *res = PyList_New(n);
+    for (Py_ssize_t i = 0; res != NULL && i < n; i++) {
+        PyObject *line = PySequence_Fast_GET_ITEM(seq, i);
+        LineRef L;
+        if (line_ref(line, &L) < 0) { Py_CLEAR(res); break; }
+        Py_ssize_t lo = 0, hi = PyList_GET_SIZE(L.tl);
+        while (lo < hi) {  /* bisect_left */
+            Py_ssize_t mid = (lo + hi) / 2;
+            if (as_double(PyList_GET_ITEM(L.tl, mid)) < t) lo = mid + 1; else hi = mid;
+        }
+        PyObject *ts = PyList_GetSlice(L.tl, lo, PyList_GET_SIZE(L.tl));
+        PyObject *ls = PyList_GetSlice(L.ll, lo, PyList_GET_SIZE(L.ll));
+        PyObject *it = ts && ls ? PyTuple_Pack(3, L.initial ? Py_True : Py_False, ts, ls) : NULL;
+        Py_XDECREF(ts);
+        Py_XDECREF(ls);
+        if (it == NULL) { Py_CLEAR(res); break; }
+        PyList_SET_ITEM(res, i, it);
+    }
+    Py_DECREF(seq);
+    return res;
+}
+
+PyDoc_STRVAR(lines_end_doc,
+"lines_end(lines, hw, t0, t1, keep)\n\n"
+"The cycle end of every line: line.flush(hw, t0, t1) and line.forget_before(keep), each\n"
+"called only when it has something to do (a timed line with nothing late needs no\n"
+"flush; a waveform with no edge before keep needs no forget).");
+
+static PyObject *lines_end(PyObject *self, PyObject *args)
+{
+    PyObject *lines_o, *hw, *t0o, *t1o, *keepo;
+    if (!PyArg_ParseTuple(args, "OOO!O!O!", &lines_o, &hw, &PyFloat_Type, &t0o, &PyFloat_Type,
+                          &t1o, &PyFloat_Type, &keepo))
+        return NULL;
+    double keep = PyFloat_AS_DOUBLE(keepo);
+    PyObject *seq = PySequence_Fast(lines_o, "lines must be a sequence");
+    if (seq == NULL) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *line = PySequence_Fast_GET_ITEM(seq, i);
+        PyObject *o = PyObject_GetAttr(line, S_timed);
+        int timed = o ? PyObject_IsTrue(o) : -1;
+        Py_XDECREF(o);
+        if (timed < 0) goto fail;
+        int need = !timed;
+        if (timed) {
+            if ((o = PyObject_GetAttr(line, S__late)) == NULL) goto fail;
+            Py_ssize_t nl = PyObject_Length(o);
+            Py_DECREF(o);
+            if (nl < 0) goto fail;
+            need = nl > 0;
+        }
+        if (need) {
+            PyObject *r = PyObject_CallMethodObjArgs(line, S_flush, hw, t0o, t1o, NULL);
+            if (r == NULL) goto fail;
+            Py_DECREF(r);
+        }
+        if ((o = PyObject_GetAttr(line, S__t)) == NULL) goto fail;
+        int forget = 0;
+        if (PyList_Check(o) && PyList_GET_SIZE(o) > 0) {
+            forget = as_double(PyList_GET_ITEM(o, 0)) < keep;
+        } else if (!PyList_Check(o)) {
+            forget = 1;  /* (not a list: let the method decide) */
+        }
+        Py_DECREF(o);
+        if (PyErr_Occurred()) goto fail;
+        if (forget) {
+            PyObject *r = PyObject_CallMethodObjArgs(line, S_forget_before, keepo, NULL);
+            if (r == NULL) goto fail;
+            Py_DECREF(r);
+        }
+    }
+    Py_DECREF(seq);
+    Py_RETURN_NONE;
+fail:
+    Py_DECREF(seq);
+    return NULL;
 }
 
 PyDoc_STRVAR(solver_checks_doc,
@@ -1733,6 +2050,9 @@ static PyMethodDef methods[] = {
     {"bank_new", bank_new, METH_VARARGS, bank_new_doc},
     {"bank_scan", bank_scan, METH_VARARGS, bank_scan_doc},
     {"lines_send", lines_send, METH_VARARGS, lines_send_doc},
+    {"plan_records", plan_records, METH_VARARGS, plan_records_doc},
+    {"lines_snapshot", lines_snapshot, METH_VARARGS, lines_snapshot_doc},
+    {"lines_end", lines_end, METH_VARARGS, lines_end_doc},
     {NULL, NULL, 0, NULL},
 };
 
@@ -1742,4 +2062,10 @@ static struct PyModuleDef module = {
     NULL, NULL, NULL, NULL,
 };
 
-PyMODINIT_FUNC PyInit__compare(void) { return PyModule_Create(&module); }
+PyMODINIT_FUNC PyInit__compare(void)
+{
+#define INTERN(n) if ((S_##n = PyUnicode_InternFromString(#n)) == NULL) return NULL;
+    NAMES(INTERN)
+#undef INTERN
+    return PyModule_Create(&module);
+}

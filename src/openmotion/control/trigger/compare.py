@@ -142,6 +142,7 @@ class CompareEngine:
         self._pwms: list[SpeedPwm] = []
         self._t_last = controller.time
         self._tracks: dict[AxisSource, Track] = {}
+        self._specs: dict[AxisSource, tuple[Any, float, float, float, float, float]] = {}
         self._ranges = {}
         self._vcycles: dict[VectorSource, VectorCycle] = {}
         self._mpos_e1: dict[int, float] = {}
@@ -152,7 +153,8 @@ class CompareEngine:
         self.timed = isinstance(controller.hardware, TimedOutputHardware)
         self._t_pre = self._t_last
         self._pre_rows: list[_Block] = []  # the pre-advance scan's firings
-        self._plan: list[tuple[float, ...]] | None = None  # records planned (rollback)
+        self._plan: bytes | None = None  # the records planned (rollback), plan_records
+        self._plan_hists: list[Any] = []
         self._plan_key: tuple[int, int, int] | None = None  # what _plan_axes was made for
         self._plan_axes: list[int] = []
         self._timers: dict[int, Any] = {}
@@ -353,6 +355,25 @@ class CompareEngine:
             self._tracks[src] = tr
         return tr
 
+    def track_spec(self, src: AxisSource) -> tuple[Any, float, float, float, float, float]:
+        """The source's track over this cycle as the compiled driver cuts it from the
+        history itself: (the axis's record store, scale, offset, e0, slope, t_ref), the
+        arguments of `affine_track` (cached per cycle; `track` builds the same rows)."""
+        sp = self._specs.get(src)
+        if sp is None:
+            ta, t1 = self._win
+            h = self.ctl.history._tracks[src.axis]
+            off = self._cmd_offset(src.axis)
+            if src.kind == "dpos":
+                sp = (h, 1.0, off, 0.0, 0.0, 0.0)
+            else:
+                r = self.ctl.axes[src.axis].counters.move_ratio
+                e0 = self._mpos_err[src.axis]
+                e1 = self._mpos_e1[src.axis]
+                sp = (h, r, r * off, e0, (e1 - e0) / (t1 - ta), ta)
+            self._specs[src] = sp
+        return sp
+
     def track_range(self, src: AxisSource) -> tuple[float, float]:
         """(min, max) of the source over this cycle (cached per cycle)."""
         r = self._ranges.get(src)
@@ -391,6 +412,7 @@ class CompareEngine:
     def _begin(self, ta: float, t1: float) -> None:
         self._win = (ta, t1)
         self._tracks = {}
+        self._specs = {}
         self._ranges: dict[AxisSource, tuple[float, float]] = {}
         self._vcycles = {}
         self._windows: dict[tuple[tuple[int, ...], str],
@@ -442,15 +464,15 @@ class CompareEngine:
         blocks: list[_Block] = []
         if g.bank is not None:
             res = _cm._solvers().bank_scan(
-                g.bank, g.native, [self.track(x) for x in g.slots], g.lines,
-                [self.track(AxisSource(a)) for a in range(len(self.ctl.axes))], ta, t1)
+                g.bank, g.native, [self.track_spec(x) for x in g.slots], g.lines,
+                [self.track_spec(AxisSource(a)) for a in range(len(self.ctl.axes))], ta, t1)
             if res is not None:
                 fb, kb, pb, done = res
                 f = np.frombuffer(fb, dtype=np.float64).reshape(-1, 2)
                 if f.shape[0]:
                     k = np.frombuffer(kb, dtype=np.int64).reshape(-1, 4)
                     blocks.append((f, k, np.frombuffer(pb, dtype=np.float64).reshape(
-                        f.shape[0], -1), g.order))
+                        f.shape[0], -1), g.order, True))  # (in time order)
                 for i in done:
                     self._finished(g.native[i])
         rows: list[tuple[float, int, int, float, int, int]] = []
@@ -477,7 +499,7 @@ class CompareEngine:
         if rows:
             f = np.array([(r[0], r[3]) for r in rows], dtype=np.float64)
             k = np.array([(r[1], r[2], r[4], r[5]) for r in rows], dtype=np.int64)
-            blocks.append((f, k, self._positions(rows), g.order))
+            blocks.append((f, k, self._positions(rows), g.order, False))
         return blocks
 
     def _finished(self, job: CompareJob) -> None:
@@ -527,29 +549,28 @@ class CompareEngine:
             for v in self._vectors:
                 axes.update(v.axes)
             self._plan_axes = sorted(axes)
+            self._plan_hists = [self.ctl.history._tracks[a] for a in self._plan_axes]
             self._timers = {id(x): x for x in (_timer_of(j.action)
                                                for j in self._jobs.values()) if x is not None}
             self._plan_key = key
-        self._plan = [self._last_record(a, t1) for a in self._plan_axes]
+        # the history record in force just before t1 of every compared axis (a re-plan
+        # or cut inside the cycle starts a new one there; a motion starting exactly at t1
+        # does not count), read in place from the history's record stores
+        solvers = _cm._solvers()
+        self._plan = solvers.plan_records(self._plan_hists, t1)
         timers = self._timers
+        lines = self._lines
         self._snap = (
             dict(self._jobs),
             {k: (j.index, j.hits, j.active) for k, j in self._jobs.items()},
             {k: (x.busy_until, x.overruns, x.ignored) for k, x in timers.items()}, timers,
-            {n_: ln.snapshot(ta) for n_, ln in self._lines.items()},
+            dict(zip(lines, solvers.lines_snapshot(list(lines.values()), ta), strict=True)),
             dict(self._vectors), [len(p.duties) for p in self._pwms])
-
-    def _last_record(self, axis: int, t1: float) -> tuple[float, ...]:
-        """The history record in force just before t1 (a re-plan or cut inside the cycle
-        starts a new one there; a motion starting exactly at t1 does not count)."""
-        return self.ctl.history.record_at(axis, math.nextafter(t1, -math.inf)) or ()
 
     def _moved_off_plan(self) -> bool:
         if self._plan is None:
             return False
-        t1 = self._win[1]
-        return any(self._last_record(a, t1) != rec
-                   for a, rec in zip(self._plan_axes, self._plan, strict=True))
+        return not _cm._solvers().plan_records(self._plan_hists, self._win[1], self._plan)
 
     def _rollback(self, ta: float) -> None:
         jobs, state, tstate, timers, lines, vectors, duties = self._snap
@@ -611,11 +632,9 @@ class CompareEngine:
             self._prune_mpos()
         if pre or post:
             _log_blocks(self.log, pre, post)
-        hw = ctl.hardware
-        keep = t1 - ctl.history.window_s  # waveforms are kept as long as the motion history
-        for line in self._lines.values():
-            line.flush(hw, ta, t1)
-            line.forget_before(keep)
+        # each line's flush and forget_before (waveforms are kept as long as the history)
+        _cm._solvers().lines_end(list(self._lines.values()), ctl.hardware, float(ta),
+                                 float(t1), float(t1 - ctl.history.window_s))
 
 
 def _log_blocks(log: EventLog, pre: list[_Block], post: list[_Block]) -> None:
@@ -623,8 +642,8 @@ def _log_blocks(log: EventLog, pre: list[_Block], post: list[_Block]) -> None:
     scans: pre-advance before after-cycle, then job order, then hit order (a stable sort)."""
     blocks = pre + post
     if len(blocks) == 1:  # one block is in job order: a stable sort by time alone
-        f, k, p, _ = blocks[0]
-        if f.shape[0] < 2 or bool(np.all(f[1:, 0] >= f[:-1, 0])):
+        f, k, p, _, in_order = blocks[0]
+        if in_order or f.shape[0] < 2 or bool(np.all(f[1:, 0] >= f[:-1, 0])):
             log.add_arrays(f, k, p)
         else:
             order = np.argsort(f[:, 0], kind="stable")
@@ -644,7 +663,8 @@ def _log_blocks(log: EventLog, pre: list[_Block], post: list[_Block]) -> None:
         log.add_arrays(f[order], k[order], p[order])
 
 
-_Block = tuple[Array, NDArray[np.int64], Array, dict[int, int]]  # f, k, positions, job order
+# f, k, positions, job order, in time order already (a driver block: time, job, hit order)
+_Block = tuple[Array, NDArray[np.int64], Array, dict[int, int], bool]
 
 
 class _Group:

@@ -182,14 +182,15 @@ class OutputLine:
 def send_lines(lines: Sequence[OutputLine], hw: Hardware, t0: float, t1: float) -> None:
     """`line.send(hw, t0, t1)` for every line. When the hardware has `write_outputs_many`
     (the simulator) and no line has a late or stretched edge pending, the bookkeeping of
-    all lines is one compiled call (`lines_send`) and their edges go out in one call."""
+    all lines is one compiled call (`lines_send`) and their edges go out in one call
+    (three flat lists: times, signals, levels)."""
     bulk = getattr(hw, "write_outputs_many", None)
     writes = None if bulk is None else _cm._solvers().lines_send(lines, t0, t1)
     if writes is None:
         for line in lines:
             line.send(hw, t0, t1)
-    elif writes:
-        bulk(writes)
+    elif writes[0]:
+        bulk(*writes)
 
 
 class EventLog:

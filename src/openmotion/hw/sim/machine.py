@@ -270,9 +270,8 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
 
     def _timed_done(self) -> None:
         """The board outputs due by now (after a kernel run), at their exact times."""
-        if self._timed._heap:
-            for tk, _, sig, lv in self._timed.pop_due(self._t):
-                self._set_do(tk, sig, lv)
+        if len(self._timed):
+            self._do_due(self._t)
 
     def _holding(self) -> bool:
         """Nothing moves by itself: steppers only, each holding its command's end."""
@@ -351,8 +350,8 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
             ta = tk
         self._run(ta, t, raw)
         self._t = t
-        for tk, _, sig, lv in self._timed.pop_due(t):
-            self._set_do(tk, sig, lv)
+        if len(self._timed):
+            self._do_due(t)
         raw.sort(key=lambda e: e[0])
         for f in self._edge_filters:
             raw = f(raw)
@@ -463,38 +462,50 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         for t, lv in zip(times, levels, strict=True):
             self.write_output_at(t, axis, signal, lv)
 
-    def write_outputs_many(self, writes: Sequence[tuple[Sequence[float], str, Sequence[bool]]]
-                           ) -> None:
-        """`write_outputs_at(times, None, signal, levels)` for each (times, signal, levels)
-        in order, in one call (the compare engine's lines of a cycle). Everything is
+    def write_outputs_many(self, times: Sequence[float], signals: Sequence[str],
+                           levels: Sequence[bool]) -> None:
+        """`write_output_at(times[k], None, signals[k], levels[k])` for every k in order, in
+        one call (the compare engine's edges of a cycle, every line at once). Everything is
         checked first: on refusal nothing is scheduled."""
-        now = self._t
-        at_now = False
-        slots = self.__dict__.setdefault("_do_slots", {})  # (as _set_do)
-        for times, signal, levels in writes:
-            if len(times) != len(levels):
-                raise MotionError(f"times and levels must have one entry each, got "
-                                  f"{len(times)} times and {len(levels)} levels")
-            if not all(map(math.isfinite, times)):
-                raise MotionError(f"times must be finite, got {list(times)!r}")
-            first = min(times) if times else math.inf
-            if first < now:
-                raise MotionError(f"t must be >= the current time {now!r}, got {first!r}")
-            at_now = at_now or first == now
-            if not set(map(type, levels)) <= {bool}:
-                raise MotionError(f"levels must be bools, got {list(levels)!r}")
-            if signal not in slots:
-                slots[signal] = self._board_index(signal, "do", len(self._do))
-        if at_now:  # (a write at the present instant goes out at once)
-            for times, signal, levels in writes:
-                self.write_outputs_at(times, None, signal, levels)
+        n = len(times)
+        if len(signals) != n or len(levels) != n:
+            raise MotionError(f"times, signals and levels must have one entry each, got "
+                              f"{n} times, {len(signals)} signals and {len(levels)} levels")
+        if not n:
             return
-        self._timed.push_lines([(list(t), sig, list(lv)) for t, sig, lv in writes])
+        if not all(map(math.isfinite, times)):
+            raise MotionError(f"times must be finite, got {list(times)!r}")
+        now = self._t
+        first = min(times)
+        if first < now:
+            raise MotionError(f"t must be >= the current time {now!r}, got {first!r}")
+        if not set(map(type, levels)) <= {bool}:
+            raise MotionError(f"levels must be bools, got {list(levels)!r}")
+        slots = self.__dict__.setdefault("_do_slots", {})  # (as _set_do)
+        for signal in set(signals).difference(slots):
+            slots[signal] = self._board_index(signal, "do", len(self._do))
+        if first == now:  # (a write at the present instant goes out at once)
+            for t, signal, lv in zip(times, signals, levels, strict=True):
+                self.write_output_at(t, None, signal, lv)
+            return
+        self._timed.push_flat(list(times), list(signals), list(levels))
 
     def _timed_axis_output(self, axis: int, signal: str, level: bool, raw: list) -> None:
         self.write_output(axis, signal, level)
         raw.extend(self._pending)  # RDY/INP edges it caused belong to this advance
         self._pending.clear()
+
+    def _do_due(self, t: float) -> None:
+        """The timed board writes due by t (`_set_do` of each, in their order)."""
+        slots = self.__dict__.setdefault("_do_slots", {})
+        do, add = self._do, self.output_record._edges.append
+        for tk, sig, lv in self._timed.pop_due(t):
+            k = slots.get(sig)
+            if k is None:
+                k = slots[sig] = self._board_index(sig, "do", len(do))
+            if do[k] != lv:
+                do[k] = lv
+                add((tk, None, sig, lv))
 
     def _set_do(self, t: float, signal: str, level: bool) -> None:
         slots = self.__dict__.setdefault("_do_slots", {})  # signal -> index, parsed once

@@ -9,8 +9,6 @@ where the edges landed on the physical line and how wide the pulses came out.
 
 from __future__ import annotations
 
-import heapq
-import itertools
 from collections import deque
 
 import numpy as np
@@ -18,49 +16,59 @@ from numpy.typing import NDArray
 
 
 class TimedOutputs:
-    """Pending timed writes: (time, seq, axis, signal, level), a min-heap by (time, seq)."""
+    """Pending timed board writes (time, signal, level) as three flat lists in push order;
+    `pop_due` hands them out sorted by (time, push order). A cycle's compare edges come
+    as one extend of ~100 entries and all go out at the next advance: a stable sort of
+    the flat lists then costs far less than a heap of tuples (push + pop per entry)."""
 
     def __init__(self) -> None:
-        self._heap: list[tuple[float, int, int | None, str, bool]] = []
-        self._seq = itertools.count()
+        self._t: list[float] = []
+        self._sig: list[str] = []
+        self._lv: list[bool] = []
 
     def push(self, t: float, axis: int | None, signal: str, level: bool) -> None:
-        heapq.heappush(self._heap, (t, next(self._seq), axis, signal, level))
+        self._t.append(t)
+        self._sig.append(signal)
+        self._lv.append(level)
 
     def push_many(self, times: list[float], axis: int | None, signal: str,
                   levels: list[bool]) -> None:
         """`push(times[k], axis, signal, levels[k])` for every k, in order."""
-        seq = self._seq
-        items = [(t, next(seq), axis, signal, lv) for t, lv in zip(times, levels, strict=True)]
-        if len(items) > 4:  # one heapify beats pushing one by one (same (time, seq) order)
-            self._heap.extend(items)
-            heapq.heapify(self._heap)
-        else:
-            for it in items:
-                heapq.heappush(self._heap, it)
+        self._t.extend(times)
+        self._sig.extend([signal] * len(times))
+        self._lv.extend(levels)
 
-    def push_lines(self, writes: list[tuple[list[float], str, list[bool]]]) -> None:
-        """`push(t, None, signal, level)` for every edge of every (times, signal, levels),
-        in order (the heap entries are built by zip, one heapify for all)."""
-        heap, seq = self._heap, self._seq
-        for times, sig, levels in writes:
-            heap.extend(zip(times, seq, itertools.repeat(None), itertools.repeat(sig), levels,
-                            strict=False))
-        heapq.heapify(heap)
+    def push_flat(self, times: list[float], signals: list[str], levels: list[bool]) -> None:
+        """`push(times[k], None, signals[k], levels[k])` for every k, in order."""
+        self._t.extend(times)
+        self._sig.extend(signals)
+        self._lv.extend(levels)
 
     def next_time(self) -> float | None:
-        return self._heap[0][0] if self._heap else None
+        return min(self._t) if self._t else None
 
-    def pop_due(self, t: float) -> list[tuple[float, int | None, str, bool]]:
-        """The writes due at or before t, in execution order."""
-        out = []
-        while self._heap and self._heap[0][0] <= t:
-            tk, _, axis, sig, lv = heapq.heappop(self._heap)
-            out.append((tk, axis, sig, lv))
-        return out
+    def pop_due(self, t: float) -> list[tuple[float, str, bool]]:
+        """The writes due at or before t as (time, signal, level), in execution order."""
+        ts = self._t
+        if not ts:
+            return []
+        sig, lv = self._sig, self._lv
+        order = sorted(range(len(ts)), key=ts.__getitem__)  # stable: equal times in order
+        n = len(order)
+        if ts[order[-1]] > t:  # some stay for later
+            n = 0
+            while n < len(order) and ts[order[n]] <= t:
+                n += 1
+            rest = order[n:]
+            rest.sort()  # (push order again)
+            self._t, self._sig, self._lv = ([ts[i] for i in rest], [sig[i] for i in rest],
+                                            [lv[i] for i in rest])
+        else:
+            self._t, self._sig, self._lv = [], [], []
+        return [(ts[i], sig[i], lv[i]) for i in order[:n]]
 
     def __len__(self) -> int:
-        return len(self._heap)
+        return len(self._t)
 
 
 class OutputRecord:
