@@ -24,12 +24,12 @@ from openmotion.program import (
 from openmotion.program.overrides import OverrideSwitch
 
 XZ = GCodeOptions(axes={"X": 0, "Z": 2})
-SWITCHES = "M49\nM48\nM50 P0\nM50\nM51 P0\nM51 P1\nM50 P1\nM53 P0\nM53\nM52 P0\n"
+SWITCHES = "M49\nM48\nM50 P0\nM50\nM51 P0\nM51 P1\nM50 P1\nM53 P0\nM53\nM52\nM52 P0\nM52 P1\n"
 
 
 def switches(text: str) -> list[tuple[bool | None, bool | None]]:
     return [(c.feed, c.spindle) for c in compile_text(text, XZ)
-            if isinstance(c, OverrideSwitch) and c.feed_hold is None]
+            if isinstance(c, OverrideSwitch) and c.feed_hold is None and c.adaptive is None]
 
 
 def test_records_of_each_word():
@@ -46,22 +46,22 @@ def test_the_same_switches_as_rs274():
     assert res.error is None
     calls = re.findall(r"(ENABLE|DISABLE)_(FEED_OVERRIDE|SPEED_OVERRIDE|FEED_HOLD|"
                        r"ADAPTIVE_FEED)", res.listing)
-    assert calls[-1] == ("DISABLE", "ADAPTIVE_FEED")  # M52 P0: the only M52 accepted
+    assert calls[-3:] == [("ENABLE", "ADAPTIVE_FEED"), ("DISABLE", "ADAPTIVE_FEED"),
+                          ("ENABLE", "ADAPTIVE_FEED")]
     ours = []
     for c in compile_text(SWITCHES, XZ):
         if isinstance(c, OverrideSwitch):
             for on, what in ((c.feed, "FEED_OVERRIDE"), (c.spindle, "SPEED_OVERRIDE"),
-                             (c.feed_hold, "FEED_HOLD")):
+                             (c.feed_hold, "FEED_HOLD"), (c.adaptive, "ADAPTIVE_FEED")):
                 if on is not None:
                     ours.append(("ENABLE" if on else "DISABLE", what))
-    assert ours == calls[:-1]
+    assert ours == calls
 
 
 @pytest.mark.parametrize("line, word, msg", [
     ("M50 P2", "P2", "P must be 0"),
     ("M51 P-1", "P-1", "P must be 0"),
-    ("M52 P1", "M52", "adaptive feed"),
-    ("M52", "M52", "adaptive feed"),
+    ("M52 P0.5", "P0.5", "P must be 0"),
     ("M53 P3", "P3", "P must be 0"),
     ("M48 M50", "M50", "same modal group"),
 ])

@@ -198,9 +198,8 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         elif isinstance(cmd, Orient):
             ops.append(Op("orient", cmd.line, cmd.file, seconds=cmd.timeout or 0.0,
                           text=f"M19 R{cmd.angle:g} P{cmd.mode}", barrier=True, source=cmd))
-        elif isinstance(cmd, OverrideSwitch):  # after the motion before it
-            ops.append(Op("override", cmd.line, cmd.file, text=cmd.text, barrier=True,
-                          source=cmd))
+        elif isinstance(cmd, OverrideSwitch):  # where the next motion starts
+            ops.append(Op("override", cmd.line, cmd.file, text=cmd.text, source=cmd))
         elif isinstance(cmd, AnalogOut):
             ops.append(Op("analog", cmd.line, cmd.file, index=cmd.index, synced=cmd.synced,
                           text=f"ao{cmd.index} = {cmd.value:g}", source=cmd))

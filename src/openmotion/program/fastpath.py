@@ -45,7 +45,7 @@ KNOWN_STATE = frozenset((
     "selected_tool", "tool", "spindle_on", "spindle_cw", "speed", "mist", "flood", "ended",
     "flow_request", "letters", "g92", "off", "work", "rot", "rotated", "tool_offset", "line",
     "per_rev", "css", "retract_old_z", "diameter_mode", "wait_request",
-    "feed_override_on", "speed_override_on", "feed_hold_on"))
+    "feed_override_on", "speed_override_on", "feed_hold_on", "adaptive_feed_on"))
 
 
 class _Defer(Exception):

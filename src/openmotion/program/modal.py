@@ -90,6 +90,7 @@ class Modal:
         self.flood = False
         self.feed_override_on = self.speed_override_on = True  # M48-M51 (overrides.py)
         self.feed_hold_on = True  # M53
+        self.adaptive_feed_on = False  # M52
         self.ended = False
         #: M98 (call: P number, L count) or M99 for the interpreter, after the line ran:
         #: (kind, P, L, column)

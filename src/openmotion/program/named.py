@@ -74,7 +74,7 @@ _TABLE: dict[str, Callable[[Modal], float]] = {
     "_FLOOD": lambda m: _flag(m.flood),
     "_SPEED_OVERRIDE": lambda m: _flag(m.speed_override_on),
     "_FEED_OVERRIDE": lambda m: _flag(m.feed_override_on),
-    "_ADAPTIVE_FEED": lambda m: 0.0,
+    "_ADAPTIVE_FEED": lambda m: _flag(m.adaptive_feed_on),
     "_FEED_HOLD": lambda m: _flag(m.feed_hold_on),
     "_FEED": lambda m: m.feed_program_units(),
     "_RPM": lambda m: abs(m.speed),

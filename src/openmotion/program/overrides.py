@@ -7,12 +7,16 @@ runs at 100 % whatever the operator set; switched on again, the operator's setti
 (ProgramRunner.set_feed_override / set_spindle_override, `openmotion run
 --feed-override`). Both are on at the start of every pass and after M2/M30 (LinuxCNC's M2).
 #<_feed_override> / #<_speed_override> read the switches.
-M52 P0 (adaptive feed off) is accepted: there is no adaptive-feed input, so it is always
-off; M52 [P1] is refused. M53 [P1] / M53 P0: the feed-stop switch (RunOptions.
-feed_hold_input, a board input: while it is active the path holds, decelerating along it,
-and goes on when it is released) is obeyed / ignored; on at the start of every pass;
-#<_feed_hold> reads it. Without a feed_hold_input there is no switch and M53 changes
-nothing (ProgramRunner.pause() always holds, as LinuxCNC's pause does).
+M52 [P1] / M52 P0: adaptive feed on / off (LinuxCNC's motion.adaptive-feed: the feed is
+scaled live by an analog input, RunOptions.adaptive_feed_input, runoverride.py); off at the
+start of every pass; #<_adaptive_feed> reads it. M53 [P1] / M53 P0: the feed-stop switch
+(RunOptions.feed_hold_input, a board input: while it is active the path holds,
+decelerating along it, and goes on when it is released) is obeyed / ignored; on at the
+start of every pass; #<_feed_hold> reads it. Without a feed_hold_input there is no switch
+and M53 changes nothing (ProgramRunner.pause() always holds, as LinuxCNC's pause does).
+The runner applies a switch where the next motion command starts (LinuxCNC queues the
+enables with the motion segment), without stopping a blended path. As in LinuxCNC, none of
+them may be used with cutter compensation on.
 """
 
 from __future__ import annotations
@@ -32,20 +36,23 @@ OVERRIDE_CODES = (48, 49, 50, 51, 52, 53)
 
 @dataclass(frozen=True, slots=True)
 class OverrideSwitch:
-    """M48-M51: the feed / spindle override on (True), off (False) or unchanged (None)."""
+    """M48-M53: the feed / spindle override, the feed-stop switch and adaptive feed on
+    (True), off (False) or unchanged (None)."""
 
     feed: bool | None
     spindle: bool | None
     line: int
     file: str = ""
     feed_hold: bool | None = None  # M53: the feed-stop switch on / off
+    adaptive: bool | None = None   # M52: adaptive feed on / off
 
     @property
     def text(self) -> str:
         parts = [f"{name} {'on' if on else 'off'}"
                  for name, on in (("feed override", self.feed),
                                   ("spindle override", self.spindle),
-                                  ("feed stop switch", self.feed_hold))
+                                  ("feed stop switch", self.feed_hold),
+                                  ("adaptive feed", self.adaptive))
                  if on is not None]
         return ", ".join(parts)
 
@@ -66,10 +73,12 @@ def m48_m53(m: Modal, b: Block, code: int, pos: int, words: dict[str, Word],
     if p is not None:
         used.add("P")
     on = _switch(b, code, pos, p)
+    if m.comp.side:  # LinuxCNC: "Cannot enable/disable overrides with cutter comp on"
+        raise b.error(f"M{code} cannot be used with cutter compensation on (G40 first)", pos,
+                      f"M{code}")
     if code == 52:
-        if on:
-            raise b.error("adaptive feed (M52 P1) needs an adaptive-feed input; this "
-                          "machine has none (M52 P0 is accepted)", pos, f"M{code}")
+        m.adaptive_feed_on = on
+        out.append(OverrideSwitch(None, None, b.line, b.file, adaptive=on))
         return
     if code == 53:
         m.feed_hold_on = on

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .runoverride import feed_percent
+from .runoverride import segment_percent
 
 if TYPE_CHECKING:
     from ..control.groups.group import Group
@@ -23,16 +23,18 @@ if TYPE_CHECKING:
 
 def follow_per_rev(run: ProgramRunner, g: Group) -> None:
     """G95 on a spindle axis: the moves run at F x the measured speed (the group's feed
-    override = the operator's override x measured / planned spindle speed, 1 .. 200 %);
-    outside G95 the operator's override (runoverride.py)."""
+    override = the operator's override x the adaptive factor x measured / planned spindle
+    speed, 1 .. 200 %); outside G95 the first two (runoverride.segment_percent)."""
     assert run.spindle is not None
     planned = run._per_rev_ops.get(g.current_index)
     run._feed_tick += 1
-    base = feed_percent(run)  # the operator's override, or 100 under M50 P0 / M49
+    base = segment_percent(run)  # the operator's override (100 under M50 P0 / M49), x
+    if base <= 0.0:              # the adaptive factor; 0: adaptive feed holds the path
+        return
     if planned is None:
         pct = base
     else:  # the speed averaged over the measuring window (a re-plan costs)
-        pct = min(200.0, max(1.0, base * abs(run.spindle.revs_per_s()) / planned))
+        pct = min(200.0, max(min(1.0, base), base * abs(run.spindle.revs_per_s()) / planned))
     step = abs(pct - g.override)
     if (planned is None and step > 0.0) or step >= 5.0 or (
             step >= 1.0 and run._feed_tick >= 10):

@@ -56,9 +56,11 @@ from .rigidtap import RigidTap
 from .runaxes import gcode_fields, machine_axes, travel_limits
 from .runcompile import RunPass
 from .runfeed import follow_per_rev
+from .runoverride import SegmentState, check_adaptive, check_percent, feed_hold_step
 from .runoverride import apply as apply_overrides
-from .runoverride import check_percent, feed_hold_step
+from .runoverride import due as override_due
 from .runoverride import reset as reset_overrides
+from .runoverride import step as override_step
 from .runrequests import answer, begin_request, on_probe_edge
 from .runtypes import RunEvent, RunOptions, RunState
 from .runwait import InputWait, ProbeMove
@@ -163,6 +165,8 @@ class ProgramRunner:
         self.spindle_override = 100.0
         self.feed_override_on = self.spindle_override_on = True  # M48-M51 (overrides.py)
         self.feed_hold_on = True  # M53: the feed-stop switch obeyed (feed_hold_input)
+        self.adaptive_feed_on = False  # M52 (adaptive_feed_input)
+        self._seg = SegmentState()  # switches waiting for their command (runoverride.py)
         self._fh_check = False  # a feed-stop edge or an M53 to look at next cycle
         self._fh_paused = False  # paused by the feed-stop input (not by the operator)
         if self.options.feed_hold_input is not None:
@@ -181,6 +185,7 @@ class ProgramRunner:
                                   "RunOptions(probe_input='di<n>'), the board input the "
                                   "probe is wired to")
             ctl.hardware.read_input(self.options.probe_input)  # validates the input
+        check_adaptive(self)
         self.state = RunState.READY
         self.events: list[RunEvent] = []
         self.passes_done = 0
@@ -459,9 +464,10 @@ class ProgramRunner:
                 or self.spindle is not None or self._fh_check:
             # a probe move or M66 wait polls its input every cycle; the spindle is sampled
             return -math.inf
+        t_sw = override_due(self)  # M48-M53 at their command's start, adaptive feed
         if self.state is not RunState.RUNNING:
-            return synced
-        return -math.inf if self._feed_ready(g) else synced
+            return min(synced, t_sw)
+        return -math.inf if self._feed_ready(g) else min(synced, t_sw)
 
     def _feed_ready(self, g: Group) -> bool:
         return runqueue.feed_ready(self, g)
@@ -493,6 +499,7 @@ class ProgramRunner:
             self._event("fault", self.current_line, g.error_message)
             self._finish(RunState.ERROR, self.error)
             return
+        override_step(self, g)
         if self.spindle is not None:
             self.spindle.sample(t)
             if self._request is None:

@@ -19,12 +19,13 @@ from . import canon
 from .analogout import AnalogOut
 from .convert import Op
 from .css import SpindleMode
-from .overrides import OverrideSwitch
 from .probing import Probe
 from .rigidtap import RigidTap
 from .runfeed import ceiling_rps, planned_rps, x_reader
+from .runoverride import flush as flush_overrides
+from .runoverride import pushed as override_pushed
+from .runoverride import queue_switch, starts_sync
 from .runoverride import reset as reset_overrides
-from .runoverride import switch as switch_overrides
 from .runtypes import RunEvent, RunState
 from .source import GCodeError
 
@@ -78,7 +79,9 @@ def feed_ready(run: ProgramRunner, g: Group) -> bool:
     op = p.ops[p.pc]
     if opts.single_block and run._step_line is not None and op.line != run._step_line:
         return run._idle()
-    if op.kind in ("line", "arc", "delay", "feedmode") or (
+    if starts_sync(run, op):
+        return run._idle()
+    if op.kind in ("line", "arc", "delay", "feedmode", "override") or (
             op.kind in ("analog", "output") and op.synced) or (
             op.kind == "action" and not op.barrier):
         return True
@@ -107,6 +110,8 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
             run._last_line = op.line
             return
         if op.kind in ("line", "arc", "delay"):
+            if starts_sync(run, op) and not run._idle():
+                return  # no blend into G33/G76/G33.1 (LinuxCNC stops first)
             planned = planned_rps(run, op) if (
                 run._per_rev and run.spindle is not None and op.kind != "delay") else 0.0
             if planned > 0.0:  # G95: planned at the highest speed, the override scales
@@ -139,6 +144,8 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
                 if not run._idle():
                     return
                 run._set_output(op, op.index, op.level, "output")
+        elif op.kind == "override":  # M48-M53: where the next command starts
+            queue_switch(run, op)
         elif op.kind == "action" and not op.barrier:
             run._event("message", op.line, op.text)
         else:  # barriers: blend, pause, end, spindle/coolant/tool
@@ -157,10 +164,6 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
                     run.spindle.set_mode(op.source, x_reader(run, k))
                 for index, level in op.outputs:
                     run._set_output(op, index, level, "output")
-                run._event("action", op.line, op.text)
-            elif op.kind == "override":
-                assert isinstance(op.source, OverrideSwitch)
-                switch_overrides(run, op.source)
                 run._event("action", op.line, op.text)
             elif op.kind == "pause" and (not op.optional or opts.optional_stop):
                 p.pc += 1
@@ -183,18 +186,24 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
 
 def push(run: ProgramRunner, g: Group, op: Op) -> int:
     run._pushed += 1
+    at_rest = run._idle()
     if op.kind == "delay":
-        return g.delay(op.seconds)
-    g.set_feed(op.feed)
-    assert op.end is not None
-    if op.kind == "line":
-        return g.line(op.end)
-    assert op.centre is not None
-    return g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
-                 turns=op.turns)
+        idx = g.delay(op.seconds)
+    else:
+        g.set_feed(op.feed)
+        assert op.end is not None
+        if op.kind == "line":
+            idx = g.line(op.end)
+        else:
+            assert op.centre is not None
+            idx = g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
+                        turns=op.turns)
+    override_pushed(run, idx, op, at_rest)  # M48-M53 waiting for this command
+    return idx
 
 
 def end_of_pass(run: ProgramRunner) -> None:
+    flush_overrides(run)
     run.synced.flush()
     run.synced_analog.flush()
     run.passes_done += 1

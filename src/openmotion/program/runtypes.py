@@ -44,6 +44,7 @@ class RunOptions:
     optional_stop: bool = False
     probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
     feed_hold_input: str | None = None  # the feed-stop switch ("di<n>", M53; runoverride)
+    adaptive_feed_input: str | None = None  # analog input scaling the feed ("ai<n>", M52)
     spindle_axis: int | str | None = None  # the controller axis that is the spindle
     spindle_acc_time: float = 0.5   # s of a spindle speed ramp
 
@@ -70,3 +71,8 @@ class RunOptions:
             if pi is not None and not (isinstance(pi, str) and pi.startswith("di")
                                        and pi[2:].isdigit()):
                 raise MotionError(f"{name} must be a board input 'di<n>' or None, got {pi!r}")
+        af = self.adaptive_feed_input
+        if af is not None and not (isinstance(af, str) and af.startswith("ai")
+                                   and af[2:].isdigit()):
+            raise MotionError(f"adaptive_feed_input must be an analog input 'ai<n>' or None, "
+                              f"got {af!r}")
