@@ -228,7 +228,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("program", help="G-code file (.ngc, .nc, ...) or point table (.toml, .csv)")
     r.add_argument("--machine", help="TOML machine file (default: the XYZU table)")
     r.add_argument("--realtime", action="store_true", help="pace the run to the wall clock")
-    r.add_argument("--repeat", type=int, default=1, help="run the program N times")
+    r.add_argument("--repeat", type=int, default=None,
+                   help="run the program N times (default: once; a program whose main "
+                   "program ends with M99 restarts until Ctrl-C, as in LinuxCNC)")
     r.add_argument("--out", default="out", help="folder for the report")
     r.add_argument("--report", action="store_true",
                    help="open the interactive report in the web browser when the run ends")

@@ -35,7 +35,8 @@ def run_job(args: argparse.Namespace) -> int:
     from ..control import Controller
     from ..machine_file import apply_machine_settings
 
-    if isinstance(args.repeat, bool) or not isinstance(args.repeat, int) or args.repeat < 1:
+    if args.repeat is not None and (isinstance(args.repeat, bool)
+                                    or not isinstance(args.repeat, int) or args.repeat < 1):
         raise MotionError(f"--repeat must be an integer >= 1, got {args.repeat!r}")
     acc_time = getattr(args, "acc_time", 0.05)
     if not (isinstance(acc_time, float | int) and 0.0 < acc_time < 1e3):
@@ -104,7 +105,8 @@ def run_job(args: argparse.Namespace) -> int:
     print(format_summary(summary))
     bar.status("writing the report ...")
     options = (f"machine '{cfg.name}' ({''.join(run.letters)}), acceleration time "
-               f"{acc_time:g} s, feed override {override:g} %, {args.repeat} pass(es)")
+               f"{acc_time:g} s, feed override {override:g} %, "
+               f"{run.passes_done} pass(es)")
     # drawn in program coordinates: G54 as the job set it (the program's own G10 offsets
     # are not followed: then machine coordinates)
     origin = g54_origin(run, params) if not sets_g54 else None

@@ -23,7 +23,10 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
 - G61/G61.1 disable blending, G64 [P] enables it; the change waits for the queued motion to
   end (the group applies blending when a chain starts).
 - G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
-  until resume(). M2/M30: end of one pass; `repeat` passes in all.
+  until resume(). M2/M30: end of one pass; `repeat` passes in all. M99 in the main
+  program: the motion before it ends, then the program runs again from its top with its
+  state kept (LinuxCNC's task), each restart a pass: endlessly (until abort()) unless
+  `repeat` sets the passes.
 - M64/M65: output set once the motion queued before it has ended (LinuxCNC's task waits
   for it, as for M68). M62/M63: set at the exact instant the group starts the next
   motion command (syncout.py: Group.start_time, through a compare-engine job).
@@ -149,8 +152,10 @@ class ProgramRunner:
         self._pass = self._compile(self._positions())
         # G38.x / M66: the rest of the program depends on the machine's answer, so it is
         # interpreted piece by piece while running (interp.Session, runwait.py)
-        self._live = self._text is not None and any(
-            isinstance(c, Probe | WaitInput) for c in self.commands)
+        # M99 in the main program restarts it with its state (runcompile.restart_pass)
+        self.restarts = any(isinstance(c, canon.End) and c.restart for c in self.commands)
+        self._live = self._text is not None and (self.restarts or any(
+            isinstance(c, Probe | WaitInput) for c in self.commands))
         self._session: Session | None = None
         self._request: ProbeMove | InputWait | SyncMove | OrientMove | None = None
         self._stray_trip: str | None = None
@@ -228,6 +233,14 @@ class ProgramRunner:
     @property
     def ops(self) -> list[Op]:
         return self._pass.ops
+
+    @property
+    def passes(self) -> int | None:
+        """Passes this run makes: RunOptions.repeat, else one, or None (until abort())
+        when an M99 in the main program restarts it (LinuxCNC's endless main program)."""
+        if self.options.repeat is not None:
+            return self.options.repeat
+        return None if self.restarts else 1
 
     # ------------------------------------------------------------------ control
     def start(self) -> None:

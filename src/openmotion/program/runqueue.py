@@ -22,6 +22,7 @@ from .css import SpindleMode
 from .overrides import OverrideSwitch
 from .probing import Probe
 from .rigidtap import RigidTap
+from .runcompile import at_restart, restart_pass
 from .runfeed import ceiling_rps, planned_rps, x_reader
 from .runoverride import reset as reset_overrides
 from .runoverride import switch as switch_overrides
@@ -198,10 +199,13 @@ def end_of_pass(run: ProgramRunner) -> None:
     run.synced.flush()
     run.synced_analog.flush()
     run.passes_done += 1
-    if run.passes_done >= run.options.repeat:
+    limit = run.passes  # None: until the program ends with M2/M30 (not at an M99)
+    if run.passes_done >= (limit or 0) and (limit is not None or not at_restart(run)):
         run._finish(RunState.DONE, f"{run.passes_done} pass(es) done")
         return
     run._event("repeat", run._last_line, f"pass {run.passes_done + 1}")
+    if restart_pass(run):  # M99 in the main program: the interpretation goes on
+        return
     reset_overrides(run)
     pos = run._positions()
     run._cursor = pos

@@ -39,7 +39,9 @@ class RunOptions:
     chord_tol: float = 0.001        # machine units
     acc_time: float = 0.05          # s from rest to the feed (path accel = feed / acc_time)
     window: int = 1024              # commands queued in the group at most
-    repeat: int = 1
+    #: passes: None = the program's own (one; endless when an M99 in the main program
+    #: restarts it, as in LinuxCNC, until abort()); N = N passes
+    repeat: int | None = None
     single_block: bool = False
     optional_stop: bool = False
     probe_input: str | None = None  # board input the G38.x probe is wired to ("di<n>")
@@ -54,8 +56,11 @@ class RunOptions:
             raise MotionError(f"acc_time must be a number in (0, 1000) s, got {a!r}")
         for name, lo in (("window", 1), ("repeat", 1)):
             v = getattr(self, name)
+            if name == "repeat" and v is None:
+                continue
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-                raise MotionError(f"{name} must be an integer >= {lo}, got {v!r}")
+                none = " or None (the program's own)" if name == "repeat" else ""
+                raise MotionError(f"{name} must be an integer >= {lo}{none}, got {v!r}")
         for name in ("single_block", "optional_stop"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False")
