@@ -31,7 +31,9 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
   for it, as for M68). M62/M63: set at the exact instant the group starts the next
   motion command (syncout.py: Group.start_time, through a compare-engine job).
   M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs. M6: logged,
-  ignored. (MSG)/(DEBUG): logged.
+  ignored. M100-M199: the motion before it ends, then its executable runs and the program
+  waits for it (usermcodes.py; a non-zero exit or `user_m_timeout` stops the run).
+  (MSG)/(DEBUG): logged.
 - pause() holds the path (decelerating along it), resume() continues, abort() stops along
   the path and drops the rest; single_block pauses after every source line.
 """
@@ -70,6 +72,7 @@ from .spindle import OrientMove, SpindleDrive, SyncMove
 from .splines import SplineFeed
 from .syncout import SyncedAnalog, SyncedOutputs
 from .trace import CycleTrace
+from .usermcodes import UserCommand, UserMCode
 
 __all__ = ["ProgramRunner", "RunEvent", "RunOptions", "RunState", "machine_axes",
            "run_program", "travel_limits"]
@@ -122,6 +125,8 @@ class ProgramRunner:
         self._gextra.setdefault("n_analog_inputs", self.analog_in.count)
         self.analog = AnalogOutputs(ctl)
         self._gextra.setdefault("n_analog_outputs", self.analog.count)
+        if self.options.user_m_path:  # M100-M199 are found when compiling
+            self._gextra.setdefault("user_m_path", self.options.user_m_path)
         if "soft_limits" not in self._gextra:  # moves past the EL switches fail to compile
             lims = []
             for k, i in zip(self.letters, self.axis_indices, strict=True):
@@ -143,7 +148,7 @@ class ProgramRunner:
             bad_cmd = [c for c in self._commands
                        if not isinstance(c, canon.Command | Probe | WaitInput | Orient
                                                   | SplineFeed | AnalogOut | RigidTap
-                                                  | SpindleMode | FeedMode)]
+                                                  | SpindleMode | FeedMode | UserMCode)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
@@ -157,7 +162,8 @@ class ProgramRunner:
         self._live = self._text is not None and (self.restarts or any(
             isinstance(c, Probe | WaitInput) for c in self.commands))
         self._session: Session | None = None
-        self._request: ProbeMove | InputWait | SyncMove | OrientMove | None = None
+        self._request: ProbeMove | InputWait | SyncMove | OrientMove | UserCommand | None \
+            = None
         self._stray_trip: str | None = None
         self.spindle: SpindleDrive | None = None
         self.sync_moves: list[SyncMove] = []  # G33/G76 passes run against the spindle

@@ -100,7 +100,8 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
             return
         synced = isinstance(op.source, canon.SyncedFeed | RigidTap) \
             and run.spindle is not None
-        if isinstance(op.source, Probe) or op.kind in ("wait", "orient") or synced:
+        if isinstance(op.source, Probe) or op.kind in ("wait", "orient", "usermcode") \
+                or synced:
             if not run._idle():
                 return
             run._begin_request(g, op)

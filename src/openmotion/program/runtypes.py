@@ -48,6 +48,9 @@ class RunOptions:
     feed_hold_input: str | None = None  # the feed-stop switch ("di<n>", M53; runoverride)
     spindle_axis: int | str | None = None  # the controller axis that is the spindle
     spindle_acc_time: float = 0.5   # s of a spindle speed ramp
+    #: folders holding user M-codes M100-M199 (executables named M1nn; usermcodes.py)
+    user_m_path: tuple[str, ...] = ()
+    user_m_timeout: float = 60.0    # s (wall clock) a user M-code may run
 
     def __post_init__(self) -> None:
         ConvertOptions(self.rapid_ratio, self.feed_mode, self.chord_tol)
@@ -64,6 +67,13 @@ class RunOptions:
         for name in ("single_block", "optional_stop"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False")
+        from .usermcodes import check_folders
+
+        object.__setattr__(self, "user_m_path", check_folders("user_m_path",
+                                                              self.user_m_path))
+        ut = self.user_m_timeout
+        if isinstance(ut, bool) or not isinstance(ut, (int, float)) or not 0.0 < ut <= 1e6:
+            raise MotionError(f"user_m_timeout must be a number in (0, 1e6] s, got {ut!r}")
         sa = self.spindle_acc_time
         if isinstance(sa, bool) or not isinstance(sa, (int, float)) or not 0.0 < sa < 1e3:
             raise MotionError(f"spindle_acc_time must be a number in (0, 1000) s, got {sa!r}")
