@@ -345,7 +345,6 @@ def test_soft_limits_caught_before_motion():
         ("G41 G19", "G41", "XY (G17) or XZ (G18)"),
         ("G96 M3", "G96", "S word missing with G96"),
         ("G1.5 X1", "G1.5", "unsupported"),
-        ("M99", "M99", "restarts it forever"),
         ("M97", "M97", "unsupported M-code"),
         ("G0 V1", "V1", "no machine axis"),
         ("X1", "X1", "without a motion mode"),

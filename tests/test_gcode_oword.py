@@ -278,7 +278,7 @@ def test_shipped_examples_compile(name):
 def test_m98_repeats_shares_numbered_parameters_and_m99_returns():
     prog = "#1=0\nM98 P7 L3\nG0 X#1\nM98 P7 L0\nM30\nO7\n#1=[#1+1]\nG0 X[#1*10]\nM99\n"
     assert xs(prog) == [10.0, 20.0, 30.0, 3.0]
-    assert "restarts it forever" in str(err("G0 X1\nM99\n"))
+    assert "cutter compensation" in str(err("G41.1 D1\nG1 X1 F9\nM99\n"))  # main M99
     e = err("M98 P[2.5]\nM30\n")
     assert "integer" in str(e) and e.line == 1
 

@@ -228,7 +228,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("program", help="G-code file (.ngc, .nc, ...) or point table (.toml, .csv)")
     r.add_argument("--machine", help="TOML machine file (default: the XYZU table)")
     r.add_argument("--realtime", action="store_true", help="pace the run to the wall clock")
-    r.add_argument("--repeat", type=int, default=1, help="run the program N times")
+    r.add_argument("--repeat", type=int, default=None,
+                   help="run the program N times (default: once; a program whose main "
+                   "program ends with M99 restarts until Ctrl-C, as in LinuxCNC)")
     r.add_argument("--out", default="out", help="folder for the report")
     r.add_argument("--report", action="store_true",
                    help="open the interactive report in the web browser when the run ends")
@@ -246,6 +248,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--probe-box", action="append", metavar="'X10:50 Y8:38 Z:20'",
                    help="a box of the workpiece the simulated probe touches, machine units "
                    "(repeat for more boxes; an empty bound is unbounded)")
+    r.add_argument("--user-m-path", action="append", metavar="DIR[:DIR...]",
+                   help="folders holding user M-codes M100-M199 (executables named M1nn), "
+                   "searched in order (LinuxCNC's PROGRAM_PREFIX, then USER_M_PATH); "
+                   "repeat or separate with ':'")
+    r.add_argument("--user-m-timeout", type=float, default=60.0, metavar="S",
+                   help="seconds a user M-code may run before the job stops")
     r.add_argument("--spindle-axis", metavar="NAME",
                    help="axis that is the spindle (M3/M4/M5, G33, G76, G33.1, G95, G96); "
                    "added as a simulated spindle when the machine has none")

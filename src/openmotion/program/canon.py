@@ -129,11 +129,14 @@ class Pause:
 
 @dataclass(frozen=True, slots=True)
 class End:
-    """M2 (rewind=False) or M30 (rewind=True): program end."""
+    """M2 (rewind=False) or M30 (rewind=True): program end. `restart`: M99 in the main
+    program, where LinuxCNC's task starts the program again from its top with its state
+    kept (interp.py: a compiled list ends here, a runner's session goes on)."""
 
     rewind: bool
     line: int
     file: str = ""
+    restart: bool = False
 
 
 @dataclass(frozen=True, slots=True)

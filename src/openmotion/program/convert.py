@@ -46,6 +46,7 @@ from .probing import Probe, WaitInput
 from .rigidtap import RigidTap
 from .source import GCodeError
 from .splines import SplineFeed
+from .usermcodes import UserMCode
 
 #: Blend tolerance (machine units) standing for G64 without P.
 UNBOUNDED_BLEND = 1e12
@@ -55,7 +56,8 @@ UNBOUNDED_BLEND = 1e12
 class Op:
     """One runner operation. kind: line, arc, delay, blend, pause, end, output, action,
     analog (M67/M68; `source` the AnalogOut), wait (M66; `source` the WaitInput), orient
-    (M19; `source` the Orient), override (M48-M51; `source` the OverrideSwitch). A probe
+    (M19; `source` the Orient), override (M48-M51; `source` the OverrideSwitch), usermcode
+    (M100-M199; `source` the UserMCode). A probe
     move is
     a line whose `source` is a Probe, a spindle-synchronised one (G33/G76) a line whose
     `source` is the SyncedFeed.
@@ -198,6 +200,9 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         elif isinstance(cmd, Orient):
             ops.append(Op("orient", cmd.line, cmd.file, seconds=cmd.timeout or 0.0,
                           text=f"M19 R{cmd.angle:g} P{cmd.mode}", barrier=True, source=cmd))
+        elif isinstance(cmd, UserMCode):  # after the motion before it (usermcodes.py)
+            ops.append(Op("usermcode", cmd.line, cmd.file, text=" ".join(
+                [f"M{cmd.code}", *cmd.args[1:]]), barrier=True, source=cmd))
         elif isinstance(cmd, OverrideSwitch):  # where the next motion starts
             ops.append(Op("override", cmd.line, cmd.file, text=cmd.text, source=cmd))
         elif isinstance(cmd, AnalogOut):

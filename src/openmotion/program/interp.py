@@ -223,8 +223,9 @@ class Interpreter:
         steps = self._steps()
         try:
             req = next(steps)
-            while True:
-                req = steps.send(preview_result(self.modal, req))
+            while True:  # M99 in the main program: one pass, as rs274 (False)
+                req = steps.send(False if isinstance(req, canon.End)
+                                 else preview_result(self.modal, req))
         except StopIteration as stop:
             return stop.value
 
@@ -233,9 +234,11 @@ class Interpreter:
         is given (the runner's live interpretation; see `Session`)."""
         return Session(self)
 
-    def _steps(self) -> Generator[Request, Result, list]:  # noqa: C901
+    def _steps(self) -> Generator[Request | canon.End, Result | bool, list]:  # noqa: C901
         """The interpreter loop: yields every probe / M66 request (after its line ran) and
-        continues with the result sent in; returns the command list."""
+        continues with the result sent in, and the End(restart=True) of an M99 in the main
+        program (True: run it again from the top, False: it ends there); returns the
+        command list."""
         blocks = self.blocks
         flow = self.flow
         modal = self.modal
@@ -299,6 +302,17 @@ class Interpreter:
                     pc = self._lathe_call(b, pc, frames)
                     flow = self.flow  # a profile from a file extends the program
                     n = len(blocks)
+                    continue
+                if req[0] == "M99" and len(frames) == 1:  # the main program's M99
+                    again = yield self._main_m99(b, req[3], out)
+                    if not again:  # ends as M2 (LinuxCNC's rs274 and preview)
+                        modal.ended = True
+                        break
+                    # LinuxCNC's task: back to the top, every state kept
+                    pc = steps = 0
+                    test_branch = -1
+                    frames[0].repeats.clear()
+                    frames[0].loops.clear()
                     continue
                 pc = self._fanuc(b, pc, req, frames)
                 flow = self.flow
@@ -435,6 +449,18 @@ class Interpreter:
         self._profile = reader
         return self.flow.subs[label][0] + 1
 
+    def _main_m99(self, b: Block, pos: int, out: list[canon.Command]) -> canon.End:
+        """M99 in the main program: the `End(restart=True)` record, appended and returned
+        as the request (the answer: True = start again from the top)."""
+        m = self.modal
+        if m.comp.side:  # LinuxCNC would carry a half-finished compensated path over
+            raise b.error("M99 in the main program with cutter compensation on: turn it "
+                          "off (G40) before the program restarts", pos, "M99")
+        open_block_error(m, b, pos, "M99")
+        end = canon.End(False, b.line, b.file, restart=True)
+        out.append(end)
+        return end
+
     @staticmethod
     def _label(b: Block, v: float, pos: int) -> str:
         n = round(v)
@@ -449,9 +475,6 @@ class Interpreter:
         kind, p, count, pos = req
         if kind == "M99":
             top = frames[-1]
-            if len(frames) == 1:
-                raise b.error("M99 in the main program restarts it forever (LinuxCNC's "
-                              "endless loop): end the program with M2 or M30", pos, "M99")
             if not top.fanuc:
                 raise b.error(f"O{top.label} sub must end with O{top.label} endsub or "
                               "return, not M99", pos, "M99")
@@ -489,12 +512,15 @@ class Session:
 
         s = Interpreter(program, options).session()
         cmds = s.advance()            # commands up to and including the first request
-        while s.request is not None:  # a probing.Probe or probing.WaitInput
-            ... run cmds, then the request, on the machine ...
-            cmds = s.advance(result)  # ProbeResult / InputResult -> the next piece
+        while s.request is not None:  # a probing.Probe or probing.WaitInput, or the
+            ... run cmds, then the request, on the machine ...   # End(restart=True)
+            cmds = s.advance(result)  # ProbeResult / InputResult / bool -> the next piece
 
     Each piece ends with its request (or the program's end, `done`). An error in the
     rest of the program raises GCodeError from `advance` (the machine has not run it).
+    An M99 in the main program ends its piece with `canon.End(restart=True)`: advance(True)
+    runs the program again from its top with every state kept (parameters, modal state,
+    offsets, as LinuxCNC's task does), advance(False) ends it there.
     """
 
     def __init__(self, interp: Interpreter) -> None:
@@ -502,16 +528,21 @@ class Session:
         self._steps = interp._steps()
         self._taken = 0
         self._started = False
-        self.request: Request | None = None
+        self.request: Request | canon.End | None = None
         self.done = False
 
-    def advance(self, result: Result | None = None) -> list[canon.Command]:
+    def advance(self, result: Result | bool | None = None) -> list[canon.Command]:
         """Run to the next request (the first call: from the start); the new commands."""
         if self.done:
             raise GCodeError("the program has ended: nothing to advance")
-        if self._started and result is None:
+        restart = isinstance(self.request, canon.End)
+        if self._started and result is None and not restart:
             raise GCodeError("advance needs the result of the pending request "
                              f"({type(self.request).__name__})")
+        if self._started and restart != isinstance(result, bool):
+            want = "True or False (run it again?)" if restart else "a request's result"
+            raise GCodeError(f"advance: the pending {type(self.request).__name__} needs "
+                             f"{want}, got {result!r}")
         try:
             if self._started:
                 self.request = self._steps.send(result)  # type: ignore[arg-type]
@@ -528,6 +559,9 @@ class Session:
         out = self._interp._out
         chunk = out[self._taken:]
         self._taken = len(out)
+        if isinstance(self.request, canon.End):  # a pass is over: forget its commands
+            out.clear()  # (no compensated move is pending at an M99: memory stays flat)
+            self._taken = 0
         return chunk
 
 

@@ -2,8 +2,8 @@
 
 The order of execution within a line is RS-274/NGC's (LinuxCNC "G-code order of
 execution"): comments/messages, feed mode G93/G94, F, S, T, M6, M3/M4/M5, M7/M8/M9, M48-M53,
-M62-M65, G4, plane, units, cutter compensation, tool length, coordinate system, path control,
-distance modes, G10/G28/G30/G92, motion (G0-G3, G53, G80), M0/M1/M2/M30.
+M62-M65, M100-M199, G4, plane, units, cutter compensation, tool length, coordinate system,
+path control, distance modes, G10/G28/G30/G92, motion (G0-G3, G53, G80), M0/M1/M2/M30.
 
 Positions are held in machine coordinates (machine units). A program coordinate p of axis
 letter L maps to machine coordinate  p * scale(L) + work(L) + g92(L) + tool(L)  where scale
@@ -43,6 +43,7 @@ from .rigidtap import g33_1
 from .splines import SPLINE_CODES, open_block_error, spline_move
 from .threading import g33, g76
 from .tooloffsets import set_tool_parameters, tool_length
+from .usermcodes import m100_m199
 from .words import Word, feed_length, fmt
 
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
@@ -279,9 +280,6 @@ class Modal:
                 code = round(x)
                 if abs(x - code) > 1e-6 or code not in M_GROUP:
                     msg = M_REFUSED.get(code, f"unsupported M-code M{x:g}")
-                    if 100 <= code <= 199:
-                        msg = f"user M-code M{code} (a program in M{code} files) is not " \
-                              "supported"
                     raise b.error(msg, pos, fmt("M", x))
                 grp = M_GROUP[code]
                 if grp == 8 and code != 9 and grp in ms and ms[grp][0] != 9:
@@ -388,6 +386,8 @@ class Modal:
                 raise b.error(f"output number must be < {self.opt.n_outputs}, got {idx}",
                               p.pos, fmt("P", p.value))
             out.append(canon.SetOutput(idx, code in (62, 64), code in (62, 63), line, file))
+        if 10 in ms:  # M100-M199: after the overrides and M62-M68, before G4 (LinuxCNC)
+            m100_m199(self, b, ms[10][0], ms[10][1], words, used, out)
         g0 = gs.get(0)
         if g0 is not None and g0[0] == 40:
             p = words.get("P")

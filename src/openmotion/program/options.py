@@ -58,6 +58,9 @@ class GCodeOptions:
     subroutine_path: folders searched for `O<name> call` subroutines not defined in the
         program, as <name>.ngc (then the program's own folder), like LinuxCNC's
         [RS274NGC]SUBROUTINE_PATH.
+    user_m_path: folders searched for the executables of user M-codes M100-M199 (a file
+        named M1nn), in LinuxCNC's order [DISPLAY]PROGRAM_PREFIX, then
+        [RS274NGC]USER_M_PATH (usermcodes.py); every folder must exist.
     """
 
     axes: Mapping[str, int]
@@ -82,6 +85,7 @@ class GCodeOptions:
     max_line_length: int = MAX_LINE_LENGTH
     max_bytes: int = MAX_PROGRAM_BYTES
     subroutine_path: Sequence[str | os.PathLike[str]] = ()
+    user_m_path: Sequence[str | os.PathLike[str]] = ()
     tool_table: Mapping[int, Any] | str | os.PathLike[str] | None = None
 
     def __post_init__(self) -> None:
@@ -179,6 +183,10 @@ class GCodeOptions:
                               f"{self.subroutine_path!r}")
         object.__setattr__(self, "subroutine_path", tuple(os.fspath(d)
                                                           for d in self.subroutine_path))
+        from .usermcodes import check_folders
+
+        object.__setattr__(self, "user_m_path", check_folders("user_m_path",
+                                                              self.user_m_path))
         object.__setattr__(self, "tool_table", self._tools())
         object.__setattr__(self, "axes", axes)
         object.__setattr__(self, "n_axes", n)

@@ -58,7 +58,7 @@ def executed_fraction(run: ProgramRunner, index: dict[int, int], cum: np.ndarray
     (between two commands) `last`."""
     if run.state is RunState.DONE:
         return 1.0
-    reps = run.options.repeat
+    reps = run.passes  # None: endless (M99 in the main program): the pass's own share
     total = cum[-1]
     g = run.group
     part = None
@@ -71,6 +71,8 @@ def executed_fraction(run: ProgramRunner, index: dict[int, int], cum: np.ndarray
             part = cum[min(round(run.progress * (len(cum) - 1)), len(cum) - 1)] / total
     if part is None:
         return last
+    if reps is None:
+        return part
     return max(last, min(1.0, (run.passes_done + part) / reps))
 
 
@@ -126,12 +128,14 @@ class RunProgress:
         f = self.fraction()
         wall = time.monotonic() - self._t0
         eta = "--" if f < 0.02 else _clock(wall * (1.0 - f) / f)
-        reps = run.options.repeat
+        reps = run.passes
+        if reps is None:  # endless (M99): no end to estimate
+            eta, label = "--", f"pass {run.passes_done + 1} (M99: until stopped)"
+        else:
+            label = f"pass {min(run.passes_done + 1, reps)}/{reps}" if reps > 1 else ""
         self._progress.update(
             self._task, completed=f, line=run.current_line,
-            machine=f"{self._ctl.time - run.t_start:.3f}",
-            pass_=f"pass {min(run.passes_done + 1, reps)}/{reps}" if reps > 1 else "",
-            eta=eta)
+            machine=f"{self._ctl.time - run.t_start:.3f}", pass_=label, eta=eta)
         self._progress.refresh()
 
     def status(self, text: str) -> None:

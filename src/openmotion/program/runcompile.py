@@ -2,8 +2,9 @@
 
 A pass is the whole program converted to machine units from a start position; a program
 with G38.x / M66 is interpreted piece by piece against the machine (`live_pass`, then
-`convert_chunk` after each answer, runrequests.py). M67/M68 values are checked against the
-board here, before anything moves.
+`convert_chunk` after each answer, runrequests.py), and so is one whose main program ends
+with M99: each restart is a new pass of the same interpretation (`restart_pass`). M67/M68
+values are checked against the board here, before anything moves.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from .analogout import AnalogOut
 from .convert import ConvertOptions, Op, convert
 from .interp import Interpreter, compile_text
 from .parser import parse_program
+from .runtypes import RunState
 from .source import GCodeError
 
 if TYPE_CHECKING:
@@ -79,3 +81,42 @@ def check_analog(run: ProgramRunner, cmds: Sequence[object]) -> None:
             except MotionError as exc:
                 raise GCodeError(f"M{67 if c.synced else 68}: {exc}", line=c.line,
                                  file=c.file) from None
+
+
+#: Op kinds that do nothing on the machine by themselves (a pass made only of these would
+#: repeat endlessly in no time).
+_IDLE_KINDS = ("end", "blend", "feedmode", "override")
+
+
+def at_restart(run: ProgramRunner) -> bool:
+    """Whether the pass just ended at an M99 of the main program (End(restart=True))."""
+    ops = run._pass.ops
+    return bool(ops) and ops[-1].kind == "end" and getattr(ops[-1].source, "restart", False)
+
+
+def restart_pass(run: ProgramRunner) -> bool:
+    """At the end of a pass: if it ended at an M99 of the main program, the next pass
+    (the interpretation goes on at the program's top, every state kept, from where the
+    axes are) and True; False for any other end. A fault ends the run (still True)."""
+    s = run._session
+    end = None if s is None else s.request
+    if s is None or not (isinstance(end, canon.End) and end.restart):
+        return False
+    if not any(op.kind not in _IDLE_KINDS and (op.kind != "action" or op.barrier)
+               for op in run._pass.ops):
+        run.error = (f"line {end.line}: M99 restarts the program, but the pass neither "
+                     "moved, waited nor switched anything: it would repeat endlessly")
+        run._event("fault", end.line, run.error)
+        run._finish(RunState.ERROR, run.error)
+        return True
+    pos = run._positions()
+    try:
+        ops = run._convert(s.advance(True), pos)
+    except (GCodeError, MotionError) as err:
+        run.error = str(err)
+        run._event("fault", end.line, str(err))
+        run._finish(RunState.ERROR, run.error)
+        return True
+    run._cursor = pos
+    run._pass = RunPass(ops, pos.copy())
+    return True

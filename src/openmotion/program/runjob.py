@@ -35,7 +35,8 @@ def run_job(args: argparse.Namespace) -> int:
     from ..control import Controller
     from ..machine_file import apply_machine_settings
 
-    if isinstance(args.repeat, bool) or not isinstance(args.repeat, int) or args.repeat < 1:
+    if args.repeat is not None and (isinstance(args.repeat, bool)
+                                    or not isinstance(args.repeat, int) or args.repeat < 1):
         raise MotionError(f"--repeat must be an integer >= 1, got {args.repeat!r}")
     acc_time = getattr(args, "acc_time", 0.05)
     if not (isinstance(acc_time, float | int) and 0.0 < acc_time < 1e3):
@@ -46,6 +47,15 @@ def run_job(args: argparse.Namespace) -> int:
     spindle_pct = getattr(args, "spindle_override", 100.0)
     if not (isinstance(spindle_pct, float | int) and 1.0 <= spindle_pct <= 200.0):
         raise MotionError(f"--spindle-override must be in [1, 200] %, got {spindle_pct!r}")
+    user_m = [d for arg in (getattr(args, "user_m_path", None) or [])
+              for d in str(arg).split(os.pathsep) if d]
+    user_m_timeout = getattr(args, "user_m_timeout", 60.0)
+    try:
+        user_opts = RunOptions(user_m_path=tuple(user_m),
+                               user_m_timeout=user_m_timeout)
+    except MotionError as exc:  # name the flag, not the field
+        raise MotionError(str(exc).replace("user_m_", "--user-m-").replace(
+            "_timeout", "-timeout")) from None
     cfg, settings = (read_machine_arg(args.machine, "--machine") if args.machine
                      else (default_machine(), {}))
     path = Path(args.program)
@@ -72,7 +82,9 @@ def run_job(args: argparse.Namespace) -> int:
     params = {} if sets_g54 else work_origin(ctl)
     run = ProgramRunner(ctl, program,  # type: ignore[arg-type]
                         options=RunOptions(repeat=args.repeat, acc_time=float(acc_time),
-                                           probe_input=probe_input, spindle_axis=spindle),
+                                           probe_input=probe_input, spindle_axis=spindle,
+                                           user_m_path=user_opts.user_m_path,
+                                           user_m_timeout=user_opts.user_m_timeout),
                         file=str(path), gcode={"parameters": params})
     if probe is not None:
         place_boxes(probe, run, boxes)
@@ -104,7 +116,8 @@ def run_job(args: argparse.Namespace) -> int:
     print(format_summary(summary))
     bar.status("writing the report ...")
     options = (f"machine '{cfg.name}' ({''.join(run.letters)}), acceleration time "
-               f"{acc_time:g} s, feed override {override:g} %, {args.repeat} pass(es)")
+               f"{acc_time:g} s, feed override {override:g} %, "
+               f"{run.passes_done} pass(es)")
     # drawn in program coordinates: G54 as the job set it (the program's own G10 offsets
     # are not followed: then machine coordinates)
     origin = g54_origin(run, params) if not sets_g54 else None

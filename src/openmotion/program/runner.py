@@ -23,12 +23,17 @@ streams, but joins a command or two at a time (a re-plan each). Semantics:
 - G61/G61.1 disable blending, G64 [P] enables it; the change waits for the queued motion to
   end (the group applies blending when a chain starts).
 - G4: group delay. M0 (and M1 with `optional_stop`): the queued motion ends, then PAUSED
-  until resume(). M2/M30: end of one pass; `repeat` passes in all.
+  until resume(). M2/M30: end of one pass; `repeat` passes in all. M99 in the main
+  program: the motion before it ends, then the program runs again from its top with its
+  state kept (LinuxCNC's task), each restart a pass: endlessly (until abort()) unless
+  `repeat` sets the passes.
 - M64/M65: output set once the motion queued before it has ended (LinuxCNC's task waits
   for it, as for M68). M62/M63: set at the exact instant the group starts the next
   motion command (syncout.py: Group.start_time, through a compare-engine job).
   M3/M4/M5, M7/M8/M9: wait for the motion to end, then set their outputs. M6: logged,
-  ignored. (MSG)/(DEBUG): logged.
+  ignored. M100-M199: the motion before it ends, then its executable runs and the program
+  waits for it (usermcodes.py; a non-zero exit or `user_m_timeout` stops the run).
+  (MSG)/(DEBUG): logged.
 - pause() holds the path (decelerating along it), resume() continues, abort() stops along
   the path and drops the rest; single_block pauses after every source line.
 """
@@ -69,6 +74,7 @@ from .spindle import OrientMove, SpindleDrive, SyncMove
 from .splines import SplineFeed
 from .syncout import SyncedAnalog, SyncedOutputs
 from .trace import CycleTrace
+from .usermcodes import UserCommand, UserMCode
 
 __all__ = ["ProgramRunner", "RunEvent", "RunOptions", "RunState", "machine_axes",
            "run_program", "travel_limits"]
@@ -121,6 +127,8 @@ class ProgramRunner:
         self._gextra.setdefault("n_analog_inputs", self.analog_in.count)
         self.analog = AnalogOutputs(ctl)
         self._gextra.setdefault("n_analog_outputs", self.analog.count)
+        if self.options.user_m_path:  # M100-M199 are found when compiling
+            self._gextra.setdefault("user_m_path", self.options.user_m_path)
         if "soft_limits" not in self._gextra:  # moves past the EL switches fail to compile
             lims = []
             for k, i in zip(self.letters, self.axis_indices, strict=True):
@@ -142,7 +150,7 @@ class ProgramRunner:
             bad_cmd = [c for c in self._commands
                        if not isinstance(c, canon.Command | Probe | WaitInput | Orient
                                                   | SplineFeed | AnalogOut | RigidTap
-                                                  | SpindleMode | FeedMode)]
+                                                  | SpindleMode | FeedMode | UserMCode)]
             if bad_cmd:
                 raise MotionError(f"program must hold canonical commands, got {bad_cmd[0]!r}")
         else:
@@ -151,10 +159,13 @@ class ProgramRunner:
         self._pass = self._compile(self._positions())
         # G38.x / M66: the rest of the program depends on the machine's answer, so it is
         # interpreted piece by piece while running (interp.Session, runwait.py)
-        self._live = self._text is not None and any(
-            isinstance(c, Probe | WaitInput) for c in self.commands)
+        # M99 in the main program restarts it with its state (runcompile.restart_pass)
+        self.restarts = any(isinstance(c, canon.End) and c.restart for c in self.commands)
+        self._live = self._text is not None and (self.restarts or any(
+            isinstance(c, Probe | WaitInput) for c in self.commands))
         self._session: Session | None = None
-        self._request: ProbeMove | InputWait | SyncMove | OrientMove | None = None
+        self._request: ProbeMove | InputWait | SyncMove | OrientMove | UserCommand | None \
+            = None
         self._stray_trip: str | None = None
         self.spindle: SpindleDrive | None = None
         self.sync_moves: list[SyncMove] = []  # G33/G76 passes run against the spindle
@@ -233,6 +244,14 @@ class ProgramRunner:
     @property
     def ops(self) -> list[Op]:
         return self._pass.ops
+
+    @property
+    def passes(self) -> int | None:
+        """Passes this run makes: RunOptions.repeat, else one, or None (until abort())
+        when an M99 in the main program restarts it (LinuxCNC's endless main program)."""
+        if self.options.repeat is not None:
+            return self.options.repeat
+        return None if self.restarts else 1
 
     # ------------------------------------------------------------------ control
     def start(self) -> None:

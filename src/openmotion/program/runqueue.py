@@ -21,6 +21,7 @@ from .convert import Op
 from .css import SpindleMode
 from .probing import Probe
 from .rigidtap import RigidTap
+from .runcompile import at_restart, restart_pass
 from .runfeed import ceiling_rps, planned_rps, x_reader
 from .runoverride import flush as flush_overrides
 from .runoverride import pushed as override_pushed
@@ -102,7 +103,8 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
             return
         synced = isinstance(op.source, canon.SyncedFeed | RigidTap) \
             and run.spindle is not None
-        if isinstance(op.source, Probe) or op.kind in ("wait", "orient") or synced:
+        if isinstance(op.source, Probe) or op.kind in ("wait", "orient", "usermcode") \
+                or synced:
             if not run._idle():
                 return
             run._begin_request(g, op)
@@ -207,10 +209,13 @@ def end_of_pass(run: ProgramRunner) -> None:
     run.synced.flush()
     run.synced_analog.flush()
     run.passes_done += 1
-    if run.passes_done >= run.options.repeat:
+    limit = run.passes  # None: until the program ends with M2/M30 (not at an M99)
+    if run.passes_done >= (limit or 0) and (limit is not None or not at_restart(run)):
         run._finish(RunState.DONE, f"{run.passes_done} pass(es) done")
         return
     run._event("repeat", run._last_line, f"pass {run.passes_done + 1}")
+    if restart_pass(run):  # M99 in the main program: the interpretation goes on
+        return
     reset_overrides(run)
     pos = run._positions()
     run._cursor = pos

@@ -1,7 +1,8 @@
 """The runner's requests: a probe move, an M66 wait, a synchronised move, an M19
-orientation - started when the motion before them has ended (`begin_request`), polled each
-cycle (`answer`) until done; a probe or wait answer continues the live interpretation.
-Split from runner.py (one job: what happens between two pieces of the program)."""
+orientation, a user M-code (M100-M199) - started when the motion before them has ended
+(`begin_request`), polled each cycle (`answer`) until done; a probe or wait answer
+continues the live interpretation. Split from runner.py (one job: what happens between
+two pieces of the program)."""
 
 from __future__ import annotations
 
@@ -16,8 +17,10 @@ from .orient import Orient
 from .probing import InputResult, Probe, ProbeResult, WaitInput
 from .rigidtap import RigidTap
 from .rigidtap_run import RigidTapMove
+from .runtypes import RunState
 from .runwait import InputWait, ProbeMove
 from .spindle import OrientMove, SyncMove
+from .usermcodes import UserCommand, UserMCode
 
 if TYPE_CHECKING:
     from ..control.core.controller import Controller
@@ -75,6 +78,10 @@ def begin_request(run: ProgramRunner, g: Group, op: Op) -> None:
         run._event("action", op.line, f"G33.1 rigid tap K{op.source.pitch:g}")
         run._pass.pc += 1  # the way back (the second op) is part of the tap
         op = run._pass.ops[run._pass.pc]
+    elif isinstance(op.source, UserMCode):  # LinuxCNC's task waits for it to exit
+        run._request = UserCommand(op.source, run.options.user_m_timeout,
+                                   block=not run._ctl.realtime)
+        run._event("user_mcode", op.line, op.text)
     elif isinstance(op.source, Orient):
         if run.spindle is None:
             run._event("action", op.line, f"{op.text}: no spindle axis (ignored)")
@@ -130,6 +137,20 @@ def answer(run: ProgramRunner, g: Group) -> bool:
             run._event("tap_end", run._last_line, f"rigid tap: overrun {req.overrun_in:.4g} "
                        f"past the end, {req.overrun_out:.4g} past the start (machine units)")
             req.close()
+            run._request = None
+        return done
+    if isinstance(req, UserCommand):
+        try:
+            done = req.poll()
+        except MotionError as err:  # a failed or hung program: the run stops (LinuxCNC)
+            run._request = None
+            run.error = f"line {req.cmd.line}: {err}"
+            run._event("fault", req.cmd.line, str(err))
+            run._finish(RunState.ERROR, run.error)
+            return False
+        if done:
+            run._event("user_mcode_end", req.cmd.line, f"M{req.cmd.code} exited with 0"
+                       + (f": {req.output[-200:]}" if req.output else ""))
             run._request = None
         return done
     if isinstance(req, SyncMove | OrientMove):
