@@ -451,7 +451,6 @@ def test_tool_table_g43_g10_l1_and_m61(tmp_path):
 
 
 @pytest.mark.parametrize("code, feature", [
-    ("M52", "adaptive feed"), ("M52 P1", "adaptive feed"),
     ("M101", "user M-code"), ("M60", "pallet")])
 def test_unsupported_features_are_named_before_any_motion(code, feature):
     e = err(f"G0 X5 Y5\nG1 X6 F100\n{code}\n")
