@@ -248,6 +248,13 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--probe-box", action="append", metavar="'X10:50 Y8:38 Z:20'",
                    help="a box of the workpiece the simulated probe touches, machine units "
                    "(repeat for more boxes; an empty bound is unbounded)")
+    r.add_argument("--adaptive-feed-input", metavar="ai<n>",
+                   help="analog input that scales the feed while M52 P1 is on (0 .. 1, "
+                   "LinuxCNC's motion.adaptive-feed); set its value with --analog-input")
+    r.add_argument("--analog-input", action="append", metavar="ai<n>=V[@T]",
+                   help="simulated analog input ai<n> reads V from machine time T s "
+                   "(default 0; repeat for a schedule, e.g. ai0=1 ai0=0.5@2); read by "
+                   "M66 E and --adaptive-feed-input")
     r.add_argument("--user-m-path", action="append", metavar="DIR[:DIR...]",
                    help="folders holding user M-codes M100-M199 (executables named M1nn), "
                    "searched in order (LinuxCNC's PROGRAM_PREFIX, then USER_M_PATH); "

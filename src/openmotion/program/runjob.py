@@ -65,12 +65,20 @@ def run_job(args: argparse.Namespace) -> int:
     cfg = with_spindle(cfg, spindle)
     probe_input = getattr(args, "probe_input", None)
     boxes = parse_probe_boxes(getattr(args, "probe_box", None) or [], probe_input)
+    adaptive = getattr(args, "adaptive_feed_input", None)
+    try:
+        RunOptions(adaptive_feed_input=adaptive)
+    except MotionError:
+        raise MotionError(f"--adaptive-feed-input must be an analog input 'ai<n>', "
+                          f"got {adaptive!r}") from None
+    analog = parse_analog_inputs(getattr(args, "analog_input", None) or [])
     ctl = Controller(cfg)
     try:   # the file's stop responses (e.g. decelerate on a limit) and home tables
         apply_machine_settings(ctl, settings)
     except MotionError as exc:
         raise MotionError(f"{args.machine}: {exc}") from None
     probe = attach_probe(ctl, probe_input)
+    schedule_analog_inputs(ctl, analog)
     ctl.enable_all()
     if path.suffix in (".toml", ".csv"):
         table = PointTable.load(path)
@@ -83,6 +91,7 @@ def run_job(args: argparse.Namespace) -> int:
     run = ProgramRunner(ctl, program,  # type: ignore[arg-type]
                         options=RunOptions(repeat=args.repeat, acc_time=float(acc_time),
                                            probe_input=probe_input, spindle_axis=spindle,
+                                           adaptive_feed_input=adaptive,
                                            user_m_path=user_opts.user_m_path,
                                            user_m_timeout=user_opts.user_m_timeout),
                         file=str(path), gcode={"parameters": params})
@@ -195,6 +204,42 @@ def parse_probe_boxes(texts: list[str], probe_input: str | None
             raise MotionError(f"--probe-box {text!r} names no axis (e.g. 'X10:50 Z:20')")
         out.append(box)
     return out
+
+
+_ANALOG = re.compile(r"ai(\d+)=([^@]+)(?:@(.+))?$")
+
+
+def parse_analog_inputs(texts: list[str]) -> list[tuple[int, float, float]]:
+    """`--analog-input ai<n>=V[@T]`: (channel, value, machine time s) in the given order."""
+    out = []
+    for text in texts:
+        m = _ANALOG.match(text.strip())
+        try:
+            ch, v, t = (int(m.group(1)), float(m.group(2)),
+                        float(m.group(3)) if m.group(3) else 0.0) if m else (0, 0.0, -1.0)
+        except ValueError:
+            m = None
+        if m is None or not math.isfinite(v) or not (math.isfinite(t) and t >= 0.0):
+            raise MotionError(f"--analog-input {text!r}: must be ai<n>=<value>[@<time s "
+                              f">= 0>] with finite numbers, e.g. ai0=0.5@2")
+        out.append((ch, v, t))
+    return out
+
+
+def schedule_analog_inputs(ctl, analog: list[tuple[int, float, float]]) -> None:
+    """The --analog-input values on the simulated machine's analog inputs, at their times."""
+    from ..hw.sim.machine import SimMachine
+
+    if not analog:
+        return
+    hw = ctl.hardware
+    if not isinstance(hw, SimMachine):
+        raise MotionError("--analog-input needs the simulated machine")
+    for ch, v, t in sorted(analog, key=lambda a: a[2]):  # a stable sort: order kept per time
+        try:
+            hw.scenario.set_analog_input(ch, v, at=hw.time + t)
+        except MotionError as exc:
+            raise MotionError(f"--analog-input ai{ch}: {exc}") from None
 
 
 def attach_probe(ctl, probe_input: str | None):
