@@ -157,7 +157,9 @@ def test_ctrl_c_stops_decelerating_with_partial_report(tmp_path):
     import time
 
     prog = tmp_path / "long.ngc"
-    prog.write_text("G10 L2 P1 X0 Y0 Z0\nG21 G91\nG1 X100 F600\nG1 Y100\nM2\n")
+    # the first move lasts 1000 s of machine time, so even a simulation racing far ahead of
+    # the wall clock is still inside it when Ctrl-C comes after 1 s
+    prog.write_text("G10 L2 P1 X0 Y0 Z0\nG21 G91\nG1 X100 F6\nG1 Y100\nM2\n")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.Popen([sys.executable, "-m", "openmotion", "run", str(prog), "--out",
                              str(tmp_path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
