@@ -49,6 +49,11 @@ from .words import Word, feed_length, fmt
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
 
+#: Motion codes that may stand without axis words (LinuxCNC's enhance_block): G0-G3, the
+#: NURBS block G5.2/G5.3 and the lathe cycles G70-G72; any other (G33, G38.x, G76, canned
+#: cycles) is refused without one, "All axes missing with motion code".
+AXES_OPTIONAL = frozenset({None, 0, 10, 20, 30, 52, 53, *LATHE_CYCLES})
+
 
 class Modal:
     """Modal state + positions; `execute(block, out)` appends the line's commands to out.
@@ -449,6 +454,11 @@ class Modal:
                 self.motion = None if gs[1][0] == 800 else gs[1][0]
             if self.motion not in CYCLES and (1 in gs or axes):
                 self.cycle.initial = None  # a series of cycles ends at any other motion
+            if 1 in gs and not axes and self.motion not in AXES_OPTIONAL and not (
+                    self.polar_inc is not None and self.motion in CYCLES):
+                gword = f"G{gs[1][0] / 10:g}"
+                raise b.error(f"all axes missing with motion code {gword} (it needs at least "
+                              "one axis word)", gs[1][1], gword)
             if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")) or (
                     (1 in gs or self.polar_inc is not None) and self.motion in CYCLES) or (
                     1 in gs and self.motion in (52, 53)) or self.motion in LATHE_CYCLES:
