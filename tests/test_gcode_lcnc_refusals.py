@@ -21,3 +21,25 @@ def test_a_motion_code_without_axis_words_is_refused(line):
 @pytest.mark.parametrize("line", ["G0", "G1 F100", "G2 F100", "G3"])
 def test_g0_to_g3_may_stand_alone(line):
     compile_text(f"G21\n{line}\nM2\n", XYZ)
+
+
+TABLE = "tests/gcode_oracle/tools.tbl"  # tools 1, 2, 3 and 5
+
+
+@pytest.mark.parametrize("line, word", [("T4", "T4"), ("M61 Q4", "Q4"), ("G43 H4", "H4"),
+                                        ("G43.2 H4", "H4"), ("G10 L1 P4 Z1", "P4"),
+                                        ("G10 L10 P4 Z1", "P4")])
+def test_a_tool_not_in_the_tool_table_is_refused(line, word):
+    opts = GCodeOptions(axes={"X": 0, "Y": 1, "Z": 2}, tool_table=TABLE)
+    with pytest.raises(GCodeError, match="requested tool 4 is not in the tool table") as e:
+        compile_text(f"G21\n{line}\nM2\n", opts)
+    assert e.value.line == 2 and word in str(e.value)
+
+
+def test_tools_in_the_table_and_tool_0_are_accepted():
+    opts = GCodeOptions(axes={"X": 0, "Y": 1, "Z": 2}, tool_table=TABLE)
+    compile_text("G21\nT5 M6\nG43 H5\nM61 Q0\nT0 M6\nG10 L1 P2 Z1\nM2\n", opts)
+
+
+def test_without_a_tool_table_every_tool_is_a_zero_tool():
+    compile_text("G21\nT7 M6\nG43 H7\nG10 L1 P9 Z1\nT4\nM2\n", XYZ)

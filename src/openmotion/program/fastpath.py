@@ -42,7 +42,8 @@ KNOWN_STATE = frozenset((
     "opt", "params", "pos", "machine_mm", "units", "lscale", "ldiv", "incremental",
     "arc_incremental", "plane", "inverse_time", "feed", "feed_lin", "feed_ang", "motion",
     "motion_prev", "cycle", "polar_inc", "comp", "saved_states", "blend", "coord", "tools",
-    "selected_tool", "tool", "spindle_on", "spindle_cw", "speed", "mist", "flood", "ended",
+    "has_tool_table", "selected_tool", "tool", "spindle_on", "spindle_cw", "speed", "mist",
+    "flood", "ended",
     "flow_request", "letters", "g92", "off", "work", "rot", "rotated", "tool_offset", "line",
     "per_rev", "css", "retract_old_z", "diameter_mode", "wait_request",
     "feed_override_on", "speed_override_on", "feed_hold_on", "adaptive_feed_on"))

@@ -87,6 +87,9 @@ class Modal:
         self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
         self.coord = 1
         self.tools = dict(options.tool_table)  # type: ignore[arg-type]  # G10 L1 edits
+        # with a tool table, a tool not in it is refused (LinuxCNC); without one, every
+        # tool is a tool with zero offsets and diameter
+        self.has_tool_table = bool(self.tools)
         self.selected_tool = 0
         self.tool = 0
         self.spindle_on = False
@@ -341,13 +344,13 @@ class Modal:
         t = words.get("T")
         if t is not None:
             used.add("T")
-            self.selected_tool = self.int_word(b, "T", t, 0)
+            self.selected_tool = self.tool_word(b, "T", t, "T")
         if 6 in ms and ms[6][0] == 61:  # M61 Q: the tool in the spindle, no change
             q = words.get("Q")
             if q is None:
                 raise b.error("M61 needs Q (the tool now in the spindle)", ms[6][1], "M61")
             used.add("Q")
-            self.tool = self.int_word(b, "Q", q, 0)
+            self.tool = self.tool_word(b, "Q", q, "M61")
             self.set_tool_parameters()
         elif 6 in ms:
             if self.comp.side:
@@ -488,6 +491,15 @@ class Modal:
         return True
 
     # -- pieces ----------------------------------------------------------------------
+    def tool_word(self, b: Block, letter: str, w: Word, what: str) -> int:
+        """A tool number word (T, M61 Q, G43 H, G10 L1 P): an integer >= 0 that, on a
+        machine with a tool table, must be in it (tool 0, no tool, always is)."""
+        n = self.int_word(b, letter, w, 0)
+        if n and self.has_tool_table and n not in self.tools:
+            raise b.error(f"{what}: requested tool {n} is not in the tool table", w.pos,
+                          fmt(letter, w.value))
+        return n
+
     def int_word(self, b: Block, letter: str, w: Word, lo: int) -> int:
         n = round(w.value)
         if abs(w.value - n) > 1e-4 or n < lo:
