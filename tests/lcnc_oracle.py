@@ -222,9 +222,11 @@ def inch_tool_table(path: Path = TOOLS) -> str:
 
 
 def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None,
-              extra_files: dict[str, str] | None = None, timeout: float = 60.0
-              ) -> Rs274Result:
-    """Run rs274 on program text (in a scratch folder, with `extra_files` next to it)."""
+              extra_files: dict[str, str] | None = None, timeout: float = 60.0,
+              ini: str = "", flags: tuple[str, ...] = ()) -> Rs274Result:
+    """Run rs274 on program text (in a scratch folder, with `extra_files` next to it: names
+    may hold sub-folders). `ini`: more INI sections after ours (a test's own INI file);
+    `flags`: more rs274 options (`-n 0`)."""
     tool_table = inch_tool_table() if tool_table is None else tool_table
     exe = rs274 or rs274_path()
     if exe is None:
@@ -233,11 +235,12 @@ def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None
         d = Path(tmp)
         (d / "test.ngc").write_text(text)
         (d / "tool.tbl").write_text(tool_table)
-        (d / "test.ini").write_text(INI)
+        (d / "test.ini").write_text(INI + ini)
         for name, body in (extra_files or {}).items():
+            (d / name).parent.mkdir(parents=True, exist_ok=True)
             (d / name).write_text(body)
         for _ in range(2):  # rs274 was seen dying by a signal (SIGBUS) under load: retry
-            proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", "-g",
+            proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", *flags, "-g",
                                    "test.ngc"], cwd=d, capture_output=True, text=True,
                                   timeout=timeout, env={**os.environ, "TMPDIR": tmp})
             if proc.returncode >= 0:

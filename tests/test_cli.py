@@ -115,7 +115,7 @@ def test_config_refuses_a_machine_without_axes(tmp_path, capsys):
 
 def test_empty_program_is_reported(tmp_path, capsys):
     p = tmp_path / "empty.ngc"
-    p.write_text("(nothing here)\n%\n")
+    p.write_text("(nothing here)\nM2\n")
     assert main(["run", str(p), "--out", str(tmp_path)]) == 2
     assert "no moves or actions" in capsys.readouterr().err
 

@@ -252,6 +252,7 @@ class Interpreter:
         guard = LoopGuard(modal, self.opt.max_loop_iterations)
         pc = 0
         test_branch = -1  # the ELSEIF whose condition is to be tested next
+        called: set[str] = set()  # subroutines called in this pass (an O-sub reached after)
         n = len(blocks)
         while pc < n:
             if pc == self.main_end and len(frames) == 1:
@@ -311,6 +312,7 @@ class Interpreter:
                     # LinuxCNC's task: back to the top, every state kept
                     pc = steps = 0
                     test_branch = -1
+                    called.clear()
                     frames[0].repeats.clear()
                     frames[0].loops.clear()
                     continue
@@ -324,6 +326,11 @@ class Interpreter:
             if kw == "":  # a Fanuc-style program number: a label, nothing to do
                 pc += 1
             elif kw == "SUB":  # reached by falling through: skip the definition
+                if o.label in called:  # LinuxCNC found it seeking forward for that call
+                    raise b.error(f"O{o.label} sub found in an illegal location: the program "
+                                  "runs into the definition of a subroutine it has already "
+                                  "called (end the main program with M2 or M30 before its "
+                                  "subroutines)", o.pos, f"O{o.label} sub")
                 pc = flow.subs[o.label][1] + 1
             elif kw in ("ENDSUB", "RETURN"):
                 if frames[-1].fanuc:
@@ -360,6 +367,7 @@ class Interpreter:
                 self.params.set_named("_VALUE_RETURNED", 0.0)
                 self.params.push_call(args)
                 frames.append(_Frame(label, pc + 1))
+                called.add(label)
                 pc = flow.subs[label][0] + 1
             elif kw == "ELSEIF" and pc != test_branch:  # reached from a taken branch
                 pc = flow.endif[pc] + 1
@@ -614,8 +622,20 @@ def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon
     lines = text.splitlines()
     # a G5.2 block must be closed: only the general path checks the program's end
     if len(lines) <= MAX_LINES and not _GENERAL_ONLY.search(text):  # fastpath.py
-        return compile_plain(lines, options, file, lambda: _compile_full(text, options, file))
-    return _compile_full(text, options, file)
+        out = compile_plain(lines, options, file, lambda: _compile_full(text, options, file))
+    else:
+        out = _compile_full(text, options, file)
+    if options.require_end and not (out and isinstance(out[-1], canon.End)) and not (
+            percent_closed(lines)):
+        raise GCodeError("the file ended with no percent sign or program end (M2 or M30): "
+                         "is it complete?", len(lines), 0, "", file)
+    return out
+
+
+def percent_closed(lines: list[str]) -> bool:
+    """True when the program opens with a '%' line and a second '%' line closes it."""
+    marks = [k for k, ln in enumerate(lines) if ln.strip() == "%"][:2]
+    return len(marks) == 2 and not any(ln.strip() for ln in lines[:marks[0]])
 
 
 def _compile_full(text: str, options: GCodeOptions, file: str) -> list[canon.Command]:

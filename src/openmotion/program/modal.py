@@ -525,6 +525,10 @@ class Modal:
             if isinstance(target, str) and target in READ_ONLY:
                 raise b.error(f"#<{target.lower()}> is a predefined parameter and cannot be "
                               "assigned", -1, f"#<{target.lower()}>")
+            if isinstance(target, str) and target.startswith("_INI["):
+                raise b.error(f"#<{target.lower()}> is a read-only INI variable (LinuxCNC's "
+                              "INI_VARS; openmotion reads no INI file)", -1,
+                              f"#<{target.lower()}>")
         for target, value in pending:
             if isinstance(target, int):
                 self.params.set_number(target, value)
