@@ -98,6 +98,8 @@ def contour_errors(run: ProgramRunner, actual: bool = False) -> tuple[np.ndarray
     if len(ran):
         before = np.where(before >= 0, before, ran[0])
     geo = _Geometry(run)
+    if not len(geo.kind):  # no group command at all (outputs, dwells only)
+        return err, idx
     kind = geo.kind[np.clip(idx, 0, len(geo.kind) - 1)]
     rows = np.nonzero((idx >= 0) & (idx < len(geo.kind)) & (kind == _CUT))[0]
     if not len(rows):

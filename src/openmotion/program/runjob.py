@@ -100,7 +100,7 @@ def run_job(args: argparse.Namespace) -> int:
                         file=str(path), gcode=gcode)
     if probe is not None:
         place_boxes(probe, run, boxes)
-    if not run.ops:
+    if all(op.kind in ("end", "blend") for op in run.ops):
         raise MotionError(f"{path}: the program holds no moves or actions, nothing to run")
     if params:
         print("G54 origin at the middle of the travel: " + ", ".join(
