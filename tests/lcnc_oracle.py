@@ -15,6 +15,7 @@ Run as a script for the figures: `python tests/lcnc_oracle.py tests/gcode_oracle
 
 from __future__ import annotations
 
+import fcntl
 import math
 import os
 import re
@@ -239,12 +240,18 @@ def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None
         for name, body in (extra_files or {}).items():
             (d / name).parent.mkdir(parents=True, exist_ok=True)
             (d / name).write_text(body)
-        for _ in range(2):  # rs274 was seen dying by a signal (SIGBUS) under load: retry
-            proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", *flags, "-g",
-                                   "test.ngc"], cwd=d, capture_output=True, text=True,
-                                  timeout=timeout, env={**os.environ, "TMPDIR": tmp})
-            if proc.returncode >= 0:
-                break
+        # One rs274 at a time on this machine: two at once were seen to lose their tool
+        # tables ("Requested tool N not found") or die by a signal (SIGBUS), as if they
+        # shared their tool data; a lock file serialises the test workers and survey jobs.
+        with open(os.path.join(tempfile.gettempdir(), "openmotion-rs274.lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            for _ in range(2):  # a signal death is retried once
+                proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", *flags,
+                                       "-g", "test.ngc"], cwd=d, capture_output=True,
+                                      text=True, timeout=timeout,
+                                      env={**os.environ, "TMPDIR": tmp})
+                if proc.returncode >= 0:
+                    break
     listing = proc.stdout
     msgs = re.findall(r'MESSAGE\("(.*)"\)', listing)
     error = None
