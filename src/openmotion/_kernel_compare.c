@@ -335,11 +335,6 @@ static void track_range(const Trk *T, double ta, double t1, double *lo_o, double
 }
 
 /* ------------------------------------------------------------------ window */
-typedef struct {
-    double *buf;
-    Py_ssize_t cap;
-} Scratch;
-
 /* The events of level_events(direction 0) one at a time, in time order, with each root
  * refined only when asked (`Stream`): a root inside a monotone piece is first known by its
  * bracket and a rigorous lower bound of the time refine() will return. */
@@ -549,10 +544,8 @@ static int outside_over(const Trk *T, double c, double lim, double ta, double tb
  * order from its Stream, and a root is refined only while its lower bound is the
  * smallest pending one, so the same first candidate inside is found with fewer roots. */
 static int first_inside(const Trk *T, int na, const double *centre, double maxerr, double t,
-                        double t1, const double *lo, const double *hi, Scratch *sc,
-                        double *x_out)
+                        double t1, const double *lo, const double *hi, double *x_out)
 {
-    (void)sc;
     double lim[MAX_AXES];
     Stream st[2 * MAX_AXES];
     int axis_of[2 * MAX_AXES];
@@ -624,48 +617,82 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
     return 0;
 }
 
-static int get_tracks(PyObject *seq_o, Trk *T, TrkBuf *tb, int *na_out)
+/* The track and range arguments of an entry point, parsed in one place: `tr_o` one track
+ * (single) or a sequence of 1..MAX_AXES tracks; `rg_o` NULL or None (no ranges: +-inf),
+ * one (lo, hi) pair (single) or a sequence of them, one per track. On success the caller
+ * owns the buffers until args_release; on failure nothing is held. */
+typedef struct {
+    Trk T[MAX_AXES];
+    TrkBuf tb[MAX_AXES];
+    double lo[MAX_AXES], hi[MAX_AXES];
+    int na;
+} TrackArgs;
+
+static void args_release(TrackArgs *A)
 {
-    PyObject *seq = PySequence_Fast(seq_o, "tracks must be a sequence of tracks");
-    if (seq == NULL) return -1;
-    Py_ssize_t na = PySequence_Fast_GET_SIZE(seq);
-    if (na < 1 || na > MAX_AXES) {
-        Py_DECREF(seq);
-        PyErr_Format(PyExc_ValueError, "tracks: 1..%d axes, got %zd", MAX_AXES, na);
-        return -1;
-    }
-    for (Py_ssize_t i = 0; i < na; i++) {
-        if (get_track(PySequence_Fast_GET_ITEM(seq, i), &T[i], &tb[i]) < 0) {
-            for (Py_ssize_t q = 0; q < i; q++) release_track(&tb[q]);
-            Py_DECREF(seq);
-            return -1;
-        }
-    }
-    Py_DECREF(seq);
-    *na_out = (int)na;
-    return 0;
+    for (int i = 0; i < A->na; i++) release_track(&A->tb[i]);
+    A->na = 0;
 }
 
-static int get_ranges(PyObject *o, int na, double *lo, double *hi)
+static int get_range(PyObject *o, double *lo, double *hi)
 {
-    if (o == Py_None) {
-        for (int i = 0; i < na; i++) { lo[i] = -INFINITY; hi[i] = INFINITY; }
-        return 0;
-    }
-    PyObject *seq = PySequence_Fast(o, "ranges must be a sequence of (lo, hi)");
+    PyObject *seq = PySequence_Fast(o, "a range must be a (lo, hi) pair");
     if (seq == NULL) return -1;
-    if (PySequence_Fast_GET_SIZE(seq) != na) {
-        Py_DECREF(seq);
-        PyErr_SetString(PyExc_ValueError, "ranges: one (lo, hi) per track");
-        return -1;
+    int ok = PySequence_Fast_GET_SIZE(seq) == 2;
+    if (!ok) PyErr_SetString(PyExc_ValueError, "a range must be a (lo, hi) pair");
+    if (ok) {
+        *lo = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, 0));
+        ok = !(*lo == -1.0 && PyErr_Occurred());
     }
-    for (int i = 0; i < na; i++) {
-        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(seq, i), "dd", &lo[i], &hi[i])) {
-            Py_DECREF(seq);
-            return -1;
-        }
+    if (ok) {
+        *hi = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, 1));
+        ok = !(*hi == -1.0 && PyErr_Occurred());
     }
     Py_DECREF(seq);
+    return ok ? 0 : -1;
+}
+
+static int track_args(PyObject *tr_o, PyObject *rg_o, int single, TrackArgs *A)
+{
+    A->na = 0;
+    if (single) {
+        if (get_track(tr_o, &A->T[0], &A->tb[0]) < 0) return -1;
+        A->na = 1;
+    } else {
+        PyObject *seq = PySequence_Fast(tr_o, "tracks must be a sequence of tracks");
+        if (seq == NULL) return -1;
+        Py_ssize_t na = PySequence_Fast_GET_SIZE(seq);
+        if (na < 1 || na > MAX_AXES) {
+            Py_DECREF(seq);
+            PyErr_Format(PyExc_ValueError, "tracks: 1..%d axes, got %zd", MAX_AXES, na);
+            return -1;
+        }
+        for (Py_ssize_t i = 0; i < na; i++) {
+            if (get_track(PySequence_Fast_GET_ITEM(seq, i), &A->T[i], &A->tb[i]) < 0) {
+                Py_DECREF(seq);
+                args_release(A);
+                return -1;
+            }
+            A->na = (int)i + 1;
+        }
+        Py_DECREF(seq);
+    }
+    if (rg_o == NULL || rg_o == Py_None) {
+        for (int i = 0; i < A->na; i++) { A->lo[i] = -INFINITY; A->hi[i] = INFINITY; }
+        return 0;
+    }
+    if (single) {
+        if (get_range(rg_o, &A->lo[0], &A->hi[0]) < 0) { args_release(A); return -1; }
+        return 0;
+    }
+    PyObject *seq = PySequence_Fast(rg_o, "ranges must be a sequence of (lo, hi)");
+    if (seq == NULL) { args_release(A); return -1; }
+    int bad = PySequence_Fast_GET_SIZE(seq) != A->na;
+    if (bad) PyErr_SetString(PyExc_ValueError, "ranges: one (lo, hi) per track");
+    for (int i = 0; i < A->na && !bad; i++)
+        bad = get_range(PySequence_Fast_GET_ITEM(seq, i), &A->lo[i], &A->hi[i]) < 0;
+    Py_DECREF(seq);
+    if (bad) { args_release(A); return -1; }
     return 0;
 }
 
@@ -683,14 +710,11 @@ static PyObject *window_scan(PyObject *self, PyObject *args)
     Py_ssize_t index;
     if (!PyArg_ParseTuple(args, "OOOdndd", &tr_o, &rg_o, &pt_o, &maxerr, &index, &t, &t1))
         return NULL;
-    Trk T[MAX_AXES];
-    TrkBuf tb[MAX_AXES];
-    int na;
-    if (get_tracks(tr_o, T, tb, &na) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, rg_o, 0, &A) < 0) return NULL;
+    int na = A.na;
     PyObject *res = NULL;
-    double lo[MAX_AXES], hi[MAX_AXES];
     Py_buffer pb;
-    if (get_ranges(rg_o, na, lo, hi) < 0) goto done_tracks;
     if (get_vec(pt_o, &pb, "points") < 0) goto done_tracks;
     Py_ssize_t n = pb.len / 8 / na;
     if (n * na * 8 != pb.len) {
@@ -700,10 +724,9 @@ static PyObject *window_scan(PyObject *self, PyObject *args)
     res = PyList_New(0);
     if (res == NULL) goto done_points;
     const double *pts = pb.buf;
-    Scratch sc = {NULL, 0};
     while (index < n) {
         double x;
-        int r = first_inside(T, na, pts + index * na, maxerr, t, t1, lo, hi, &sc, &x);
+        int r = first_inside(A.T, na, pts + index * na, maxerr, t, t1, A.lo, A.hi, &x);
         if (r < 0) { Py_CLEAR(res); break; }
         if (r == 0) break;
         PyObject *f = PyFloat_FromDouble(x);
@@ -712,11 +735,10 @@ static PyObject *window_scan(PyObject *self, PyObject *args)
         index++;
         t = x;
     }
-    free(sc.buf);
 done_points:
     PyBuffer_Release(&pb);
 done_tracks:
-    for (int i = 0; i < na; i++) release_track(&tb[i]);
+    args_release(&A);
     return res;
 }
 
@@ -729,28 +751,22 @@ static PyObject *first_inside_py(PyObject *self, PyObject *args)
     PyObject *tr_o, *c_o, *rg_o;
     double maxerr, t, t1;
     if (!PyArg_ParseTuple(args, "OOdddO", &tr_o, &c_o, &maxerr, &t, &t1, &rg_o)) return NULL;
-    Trk T[MAX_AXES];
-    TrkBuf tb[MAX_AXES];
-    int na;
-    if (get_tracks(tr_o, T, tb, &na) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, rg_o, 0, &A) < 0) return NULL;
     PyObject *res = NULL;
-    double lo[MAX_AXES], hi[MAX_AXES];
     Py_buffer cb;
-    if (get_ranges(rg_o, na, lo, hi) < 0) goto done;
     if (get_vec(c_o, &cb, "centre") < 0) goto done;
-    if (cb.len != 8 * na) {
+    if (cb.len != 8 * A.na) {
         PyErr_SetString(PyExc_ValueError, "centre: one coordinate per track");
     } else {
-        Scratch sc = {NULL, 0};
         double x;
-        int r = first_inside(T, na, cb.buf, maxerr, t, t1, lo, hi, &sc, &x);
-        free(sc.buf);
+        int r = first_inside(A.T, A.na, cb.buf, maxerr, t, t1, A.lo, A.hi, &x);
         if (r > 0) res = PyFloat_FromDouble(x);
         else if (r == 0) res = Py_NewRef(Py_None);
     }
     PyBuffer_Release(&cb);
 done:
-    for (int i = 0; i < na; i++) release_track(&tb[i]);
+    args_release(&A);
     return res;
 }
 
@@ -855,23 +871,24 @@ PyDoc_STRVAR(level_scan_doc,
 
 static PyObject *level_scan(PyObject *self, PyObject *args)
 {
-    PyObject *tr_o, *lv_o, *af_o;
-    double rlo, rhi, t, t1;
+    PyObject *tr_o, *rg_o, *lv_o, *af_o;
+    double t, t1;
     long long n, index;
     int direction;
-    if (!PyArg_ParseTuple(args, "O(dd)OLOLddi", &tr_o, &rlo, &rhi, &lv_o, &n, &af_o, &index,
-                          &t, &t1, &direction))
+    if (!PyArg_ParseTuple(args, "OOOLOLddi", &tr_o, &rg_o, &lv_o, &n, &af_o, &index, &t, &t1,
+                          &direction))
         return NULL;
-    Trk T;
-    TrkBuf tb;
-    if (get_track(tr_o, &T, &tb) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, rg_o, 1, &A) < 0) return NULL;
+    const Trk *T = &A.T[0];
+    double rlo = A.lo[0], rhi = A.hi[0];
     Levels L;
     Py_buffer lb;
     int held;
     PyObject *res = NULL;
     if (get_levels(lv_o, n, af_o, &L, &lb, &held) < 0) goto done;
     long long size = L.n + L.has_after;
-    Py_ssize_t cap = max_events(T.n);
+    Py_ssize_t cap = max_events(T->n);
     double *ev = malloc((size_t)cap * sizeof(double));
     if (ev == NULL) { PyErr_NoMemory(); goto done; }
     res = PyList_New(0);
@@ -879,7 +896,7 @@ static PyObject *level_scan(PyObject *self, PyObject *args)
         double lvl = level_at(&L, index);
         double slack = 1e-9 * (fabs(lvl) + 1.0);
         if (!(rlo - slack <= lvl && lvl <= rhi + slack)) break;
-        if (level_events(&T, lvl, t, t1, direction, 1, ev) == 0) break;
+        if (level_events(T, lvl, t, t1, direction, 1, ev) == 0) break;
         PyObject *it = Py_BuildValue("(dd)", ev[0], lvl);
         if (it == NULL || PyList_Append(res, it) < 0) { Py_XDECREF(it); Py_CLEAR(res); break; }
         Py_DECREF(it);
@@ -889,7 +906,7 @@ static PyObject *level_scan(PyObject *self, PyObject *args)
     free(ev);
 done:
     if (held) PyBuffer_Release(&lb);
-    release_track(&tb);
+    args_release(&A);
     return res;
 }
 
@@ -905,16 +922,15 @@ static PyObject *level_events_py(PyObject *self, PyObject *args)
     int direction = 0, first = 0;
     if (!PyArg_ParseTuple(args, "Oddd|ip", &tr_o, &level, &t, &t1, &direction, &first))
         return NULL;
-    Trk T;
-    TrkBuf tb;
-    if (get_track(tr_o, &T, &tb) < 0) return NULL;
-    Py_ssize_t cap = max_events(T.n);
+    TrackArgs A;
+    if (track_args(tr_o, NULL, 1, &A) < 0) return NULL;
+    Py_ssize_t cap = max_events(A.T[0].n);
     double *ev = malloc((size_t)cap * sizeof(double));
     PyObject *res = NULL;
     if (ev == NULL) {
         PyErr_NoMemory();
     } else {
-        Py_ssize_t m = level_events(&T, level, t, t1, direction, first, ev);
+        Py_ssize_t m = level_events(&A.T[0], level, t, t1, direction, first, ev);
         res = PyList_New(m);
         for (Py_ssize_t i = 0; res != NULL && i < m; i++) {
             PyObject *f = PyFloat_FromDouble(ev[i]);
@@ -923,7 +939,7 @@ static PyObject *level_events_py(PyObject *self, PyObject *args)
         }
         free(ev);
     }
-    release_track(&tb);
+    args_release(&A);
     return res;
 }
 
@@ -935,12 +951,11 @@ static PyObject *track_range_py(PyObject *self, PyObject *args)
     PyObject *tr_o;
     double ta, t1;
     if (!PyArg_ParseTuple(args, "Odd", &tr_o, &ta, &t1)) return NULL;
-    Trk T;
-    TrkBuf tb;
-    if (get_track(tr_o, &T, &tb) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, NULL, 1, &A) < 0) return NULL;
     double lo, hi;
-    track_range(&T, ta, t1, &lo, &hi);
-    release_track(&tb);
+    track_range(&A.T[0], ta, t1, &lo, &hi);
+    args_release(&A);
     return Py_BuildValue("(dd)", lo, hi);
 }
 
@@ -1593,8 +1608,7 @@ static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const 
     double t = ta;
     while (k < S->npts) {
         double x;
-        int r = first_inside(W, S->na, S->pts + k * S->na, S->maxerr, t, t1, wlo, whi, NULL,
-                             &x);
+        int r = first_inside(W, S->na, S->pts + k * S->na, S->maxerr, t, t1, wlo, whi, &x);
         if (r < 0) return -1;
         if (r == 0) break;
         PUSH(x, (double)k, k);
