@@ -114,8 +114,8 @@ static int get_track(PyObject *o, Trk *t, TrkBuf *tb)
  * store (history._Track: float64 arrays ts, p0, v0, a0, j, live rows [lo, hi)). The rows
  * of MotionHistory.rows(axis, ta, t1) (those covering [ta, t1] plus the one before), in
  * the frame of compare_math.affine_track: scale * x(t) + offset + e0 + slope * (t - t_ref),
- * each column with affine_track's operation order (the same floats). A 5-sequence is a
- * plain track (get_track). */
+ * each column with affine_track's operation order (the same floats). spec = (hist,): those
+ * rows as stored. A 5-sequence is a plain track (get_track). */
 static Py_ssize_t search_right(const double *x, Py_ssize_t lo, Py_ssize_t hi, double t)
 {
     while (lo < hi) {
@@ -127,12 +127,15 @@ static Py_ssize_t search_right(const double *x, Py_ssize_t lo, Py_ssize_t hi, do
 
 static int get_track_in(PyObject *o, double ta, double t1, Trk *t, TrkBuf *tb)
 {
-    if (!PyTuple_Check(o) || PyTuple_GET_SIZE(o) != 6) return get_track(o, t, tb);
+    Py_ssize_t len = PyTuple_Check(o) ? PyTuple_GET_SIZE(o) : -1;
+    if (len != 6 && len != 1) return get_track(o, t, tb);
     tb->held = 0;
     tb->own = NULL;
-    double sc, off, e0, slope, tref;
+    double sc = 1.0, off = 0.0, e0 = 0.0, slope = 0.0, tref = 0.0;
+    int raw = len == 1;  /* (hist,): the rows as stored (MotionHistory.rows) */
     PyObject *h;
-    if (!PyArg_ParseTuple(o, "Oddddd", &h, &sc, &off, &e0, &slope, &tref)) return -1;
+    if (raw) h = PyTuple_GET_ITEM(o, 0);
+    else if (!PyArg_ParseTuple(o, "Oddddd", &h, &sc, &off, &e0, &slope, &tref)) return -1;
     PyObject *names[5] = {S_ts, S_p0, S_v0, S_a0, S_j};
     const double *col[5];
     long long lo, hi;
@@ -171,7 +174,9 @@ static int get_track_in(PyObject *o, double ta, double t1, Trk *t, TrkBuf *tb)
     Py_ssize_t n = b - a;
     double *m = malloc((size_t)(5 * n) * sizeof(double));
     if (m == NULL) { release_track(tb); PyErr_NoMemory(); return -1; }
-    for (Py_ssize_t k = 0; k < n; k++) {
+    for (Py_ssize_t k = 0; k < n && raw; k++)
+        for (int c = 0; c < 5; c++) m[c * n + k] = col[c][a + k];
+    for (Py_ssize_t k = 0; k < n && !raw; k++) {
         Py_ssize_t r = a + k;
         m[k] = ts[r];
         m[n + k] = sc * col[1][r] + off + e0 + slope * (ts[r] - tref);
@@ -1127,6 +1132,188 @@ static PyObject *adaptive_py(PyObject *self, PyObject *args)
     return PyFloat_FromDouble(adaptive(q, a, b, 0, rtol, max_depth));
 }
 
+/* VectorCycle's construction (compare_math.VectorCycle.__init__, the numpy version is the
+ * oracle tests/compare_oracle.vector_pieces / vector_sums), in two steps around the two
+ * 8-point dot products, which stay numpy matrix products `(n, 8) @ w` (a BLAS product
+ * whose rounding depends on the BLAS kernel and on n: kept as it is, so S is the same
+ * floats as before on every machine). */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* add x to the breakpoints unless an equal one is there (a Python set keeps the first) */
+static void bp_add(double *bp, Py_ssize_t *nb, double x)
+{
+    for (Py_ssize_t i = 0; i < *nb; i++)
+        if (bp[i] == x) return;
+    bp[(*nb)++] = x;
+}
+
+/* numpy.maximum(y, 0.0) then sqrt: NaN stays NaN, ties give the second argument */
+static inline double sq_row(const double *q, double x)
+{
+    double y = q[0] + x * (q[1] + x * (q[2] + x * (q[3] + x * q[4])));
+    return sqrt(y > 0.0 || y != y ? y : 0.0);
+}
+
+PyDoc_STRVAR(vector_pieces_doc,
+"vector_pieces(tracks, weights, ta, t1) -> (B, Q, R1, R2) as bytes of float64\n\n"
+"VectorCycle's pieces over [ta, t1]: B the breakpoints (ta, t1, every record start and\n"
+"velocity root inside, sorted), Q (n, 5) each piece's speed^2 quartic, R1 and R2 (n, 8)\n"
+"the speed at the nodes of one and of two Gauss-Legendre panels (summed), whose products\n"
+"with the weights vector_sums takes. tracks: tracks or history specs (see bank_scan).");
+
+static PyObject *vector_pieces(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o, *w_o;
+    double ta, t1;
+    if (!PyArg_ParseTuple(args, "OOdd", &tr_o, &w_o, &ta, &t1)) return NULL;
+    if (!gl_set) {
+        PyErr_SetString(PyExc_RuntimeError, "set_gauss was not called");
+        return NULL;
+    }
+    PyObject *seq = PySequence_Fast(tr_o, "tracks must be a sequence of tracks");
+    if (seq == NULL) return NULL;
+    Py_ssize_t na = PySequence_Fast_GET_SIZE(seq);
+    Trk T[MAX_AXES];
+    TrkBuf tb[MAX_AXES];
+    int got = 0;
+    PyObject *res = NULL;
+    double *bp = NULL, *Q = NULL, *R = NULL;
+    Py_buffer wb;
+    int have_w = 0;
+    if (na < 1 || na > MAX_AXES) {
+        PyErr_Format(PyExc_ValueError, "tracks: 1..%d axes, got %zd", MAX_AXES, na);
+        goto out;
+    }
+    if (get_vec(w_o, &wb, "weights") < 0) goto out;
+    have_w = 1;
+    if (wb.len != 8 * na) {
+        PyErr_SetString(PyExc_ValueError, "weights: one per track");
+        goto out;
+    }
+    const double *w = wb.buf;
+    Py_ssize_t cap = 2;
+    for (Py_ssize_t i = 0; i < na; i++) {
+        if (get_track_in(PySequence_Fast_GET_ITEM(seq, i), ta, t1, &T[i], &tb[i]) < 0) goto out;
+        got = (int)i + 1;
+        cap += 3 * T[i].n;
+    }
+    bp = malloc((size_t)cap * sizeof(double));
+    if (bp == NULL) { PyErr_NoMemory(); goto out; }
+    Py_ssize_t nb = 0;
+    bp[nb++] = ta;
+    bp_add(bp, &nb, t1);
+    for (Py_ssize_t i = 0; i < na; i++) {
+        const Trk *tr = &T[i];
+        for (Py_ssize_t k = 0; k < tr->n; k++) {
+            double a_k = tr->ts[k];
+            double b_k = k + 1 < tr->n ? tr->ts[k + 1] : INFINITY;
+            if (ta < a_k && a_k < t1) bp_add(bp, &nb, a_k);
+            if (b_k <= ta || a_k >= t1) continue;
+            double r[2];
+            int nr = velocity_roots(tr->v0[k], tr->a0[k], tr->j[k], r);
+            for (int q = 0; q < nr; q++) {
+                double x = a_k + r[q];
+                if (ta < x && x < t1 && x < b_k) bp_add(bp, &nb, x);
+            }
+        }
+    }
+    qsort(bp, (size_t)nb, sizeof(double), cmp_double);
+    Py_ssize_t n = nb - 1;  /* pieces */
+    Q = calloc((size_t)(5 * n + 1), sizeof(double));
+    R = malloc((size_t)(16 * n + 1) * sizeof(double));
+    if (Q == NULL || R == NULL) { PyErr_NoMemory(); goto out; }
+    for (Py_ssize_t i = 0; i < na; i++) {
+        const Trk *tr = &T[i];
+        double wk = w[i];
+        for (Py_ssize_t p = 0; p < n; p++) {
+            double u = bp[p], mid = 0.5 * (bp[p] + bp[p + 1]);
+            Py_ssize_t k = search_right(tr->ts, 0, tr->n, mid) - 1;
+            if (k < 0) k = 0;
+            double d0 = u - tr->ts[k], j = tr->j[k];
+            double c0 = wk * (tr->v0[k] + d0 * (tr->a0[k] + d0 * j / 2.0));
+            double c1 = wk * (tr->a0[k] + d0 * j);
+            double c2 = wk * (j / 2.0);
+            double *q = Q + 5 * p;
+            q[0] += c0 * c0;
+            q[1] += 2.0 * c0 * c1;
+            q[2] += c1 * c1 + 2.0 * c0 * c2;
+            q[3] += 2.0 * c1 * c2;
+            q[4] += c2 * c2;
+        }
+    }
+    double *R1 = R, *R2 = R + 8 * n;
+    for (Py_ssize_t p = 0; p < n; p++) {
+        const double *q = Q + 5 * p;
+        double h = bp[p + 1] - bp[p];
+        for (int k = 0; k < 8; k++) {
+            double g = gl_x[k] + 1.0;
+            double x1 = (h / 2.0) * g, xa = (h / 4.0) * g;
+            R1[8 * p + k] = sq_row(q, x1);
+            R2[8 * p + k] = sq_row(q, xa) + sq_row(q, xa + h / 2.0);
+        }
+    }
+    res = Py_BuildValue("(y#y#y#y#)", (const char *)bp, (Py_ssize_t)(nb * 8),
+                        (const char *)Q, (Py_ssize_t)(5 * n * 8), (const char *)R1,
+                        (Py_ssize_t)(8 * n * 8), (const char *)R2, (Py_ssize_t)(8 * n * 8));
+out:
+    for (int i = 0; i < got; i++) release_track(&tb[i]);
+    if (have_w) PyBuffer_Release(&wb);
+    Py_DECREF(seq);
+    free(bp); free(Q); free(R);
+    return res;
+}
+
+PyDoc_STRVAR(vector_sums_doc,
+"vector_sums(B, Q, d1, d2, s0, rtol, max_depth) -> S as bytes of float64\n\n"
+"VectorCycle's cumulative lengths from vector_pieces: d1 = R1 @ w, d2 = R2 @ w; a\n"
+"piece's length is (h / 4) * d2 unless it differs from (h / 2) * d1 by more than rtol\n"
+"(relative), then adaptive(Q[i], 0, h, rtol, max_depth); S = s0 + [0, cumsum].");
+
+static PyObject *vector_sums(PyObject *self, PyObject *args)
+{
+    PyObject *o[4];
+    double s0, rtol;
+    int max_depth;
+    if (!PyArg_ParseTuple(args, "OOOOddi", &o[0], &o[1], &o[2], &o[3], &s0, &rtol,
+                          &max_depth))
+        return NULL;
+    if (!gl_set) {
+        PyErr_SetString(PyExc_RuntimeError, "set_gauss was not called");
+        return NULL;
+    }
+    static const char *names[4] = {"B", "Q", "d1", "d2"};
+    Py_buffer b[4];
+    int held = 0;
+    PyObject *res = NULL;
+    for (; held < 4; held++)
+        if (get_vec(o[held], &b[held], names[held]) < 0) goto out;
+    Py_ssize_t nb = b[0].len / 8, n = nb - 1;
+    if (nb < 1 || b[1].len != 5 * 8 * n || b[2].len != 8 * n || b[3].len != 8 * n) {
+        PyErr_SetString(PyExc_ValueError, "vector_sums: B (n + 1), Q (n, 5), d1 and d2 (n)");
+        goto out;
+    }
+    const double *B = b[0].buf, *Q = b[1].buf, *d1 = b[2].buf, *d2 = b[3].buf;
+    res = PyBytes_FromStringAndSize(NULL, nb * 8);
+    if (res == NULL) goto out;
+    double *S = (double *)PyBytes_AS_STRING(res), c = 0.0;
+    S[0] = s0 + 0.0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        double h = B[i + 1] - B[i];
+        double one = (h / 2.0) * d1[i], two = (h / 4.0) * d2[i];
+        if (fabs(two - one) > rtol * pymax(1e-300, fabs(two)))
+            two = adaptive(Q + 5 * i, 0.0, h, 0, rtol, max_depth);
+        c = i == 0 ? two : c + two;  /* numpy.cumsum */
+        S[i + 1] = s0 + c;
+    }
+out:
+    for (int k = 0; k < held; k++) PyBuffer_Release(&b[k]);
+    return res;
+}
+
 PyDoc_STRVAR(vector_at_doc, "vector_at(B, S, Q, t) -> s(t) (VectorCycle.at)");
 
 static PyObject *vector_at(PyObject *self, PyObject *args)
@@ -2059,6 +2246,8 @@ static PyMethodDef methods[] = {
     {"vector_at", vector_at, METH_VARARGS, vector_at_doc},
     {"time_of", time_of_py, METH_VARARGS, time_of_doc},
     {"vector_scan", vector_scan, METH_VARARGS, vector_scan_doc},
+    {"vector_pieces", vector_pieces, METH_VARARGS, vector_pieces_doc},
+    {"vector_sums", vector_sums, METH_VARARGS, vector_sums_doc},
     {"line_set", line_set, METH_VARARGS, line_set_doc},
     {"solver_checks", solver_checks, METH_VARARGS, solver_checks_doc},
     {"bank_new", bank_new, METH_VARARGS, bank_new_doc},

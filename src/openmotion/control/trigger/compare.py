@@ -403,8 +403,9 @@ class CompareEngine:
         vc = self._vcycles.get(src)
         if vc is None:
             ta, t1 = self._win
-            tracks = [history_track(self.ctl.history, a, ta, t1) for a in src.axes]
-            vc = VectorCycle(tracks, src.weights, ta, t1, self._vectors[src])
+            stores = self.ctl.history._tracks  # (the rows as stored: history.rows)
+            vc = VectorCycle([(stores[a],) for a in src.axes], src.weights, ta, t1,
+                             self._vectors[src])
             self._vcycles[src] = vc
         return vc
 
