@@ -410,9 +410,11 @@ def spec_track(spec, ta: float, t1: float):  # noqa: ANN001, ANN201
     return affine_track(tr, *spec[1:])
 
 
-def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # noqa: ANN001, ANN201
-    """CompareEngine's job loop for LevelJob (axis) / WindowJob with Toggle, SetLevel or
-    Pulse, as it was in Python: each job's scan, its action on its line, its row."""
+def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float,  # noqa: ANN001, ANN201
+              vectors=()):  # noqa: ANN001
+    """CompareEngine's job loop for LevelJob (axis or path length) / WindowJob with Toggle,
+    SetLevel or Pulse, as it was in Python: each job's scan, its action on its line, its
+    row. vectors: (B, S, Q) of each path-length source."""
     tracks = [spec_track(s, ta, t1) for s in tracks]
     pos_tracks = [spec_track(s, ta, t1) for s in pos_tracks]
     ranges: dict[int, tuple[float, float]] = {}
@@ -422,10 +424,23 @@ def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # n
     for i, (spec, job) in enumerate(zip(bank, jobs, strict=True)):
         (code, slots, direction, repeat, vals, n, after, maxerr, t_armed, jid, act, flag,
          width, ln, output) = spec
-        rng = [ranges.setdefault(s, track_range(tracks[s], ta, t1)) for s in slots]
+        rng = [] if code == 2 else [ranges.setdefault(s, track_range(tracks[s], ta, t1))
+                                    for s in slots]
         a = max(ta, t_armed)
         hits: list[tuple[float, float, int]] = []
-        if code == 0:
+        if code == 2:  # LevelJob.scan on a VectorSource
+            size = n + (after is not None)
+            B, S, Q = vectors[slots[0]]
+            if a < t1:
+                if repeat:
+                    hits = [(tf, v, 0) for tf, v in vector_scan(B, S, Q, vals, n, after, 0, a,
+                                                                True)]
+                elif job.index < size:
+                    found = vector_scan(B, S, Q, vals, n, after, job.index, a, False)
+                    hits = [(tf, v, job.index + q) for q, (tf, v) in enumerate(found)]
+                    job.index += len(found)
+            finished = not repeat and job.index >= size
+        elif code == 0:
             size = n + (after is not None)
             if a < t1:
                 if repeat:

@@ -1501,7 +1501,7 @@ done:
  * description (kind, track slots, values or points, action) is parsed once into a Bank
  * (a capsule, rebuilt when the engine's job set changes); its running state (`index`,
  * `hits`) stays on the job object, read and written here. */
-enum { K_LEVEL = 0, K_WINDOW = 1 };
+enum { K_LEVEL = 0, K_WINDOW = 1, K_VECTOR = 2 };
 enum { A_TOGGLE = 0, A_SET = 1, A_PULSE = 2 };
 
 typedef struct {
@@ -1537,6 +1537,7 @@ PyDoc_STRVAR(bank_new_doc,
 "kind 0 a "
 "LevelJob on track slots[0] (values: float64 array or (start, step), n of them, then\n"
 "after_final or None), 1 a WindowJob on slots (values: float64[n, len(slots)]); action\n"
+"2 a LevelJob on a path length, vector slots[0] (values as kind 0, direction unused);\n"
 "0 Toggle (flag = first), 1 SetLevel (flag = level), 2 Pulse (flag = active, width);\n"
 "line: the index of its OutputLine in bank_scan's `lines`, output: its number (logged).");
 
@@ -1589,7 +1590,7 @@ static PyObject *bank_new(PyObject *self, PyObject *args)
             PyErr_SetString(PyExc_ValueError, "action must be 0, 1 or 2");
             goto fail;
         }
-        if (S->kind == K_LEVEL) {
+        if (S->kind == K_LEVEL || S->kind == K_VECTOR) {
             if (get_levels(vals, nv, after, &S->L, &S->vb, &S->held) < 0) goto fail;
         } else if (S->kind == K_WINDOW) {
             if (get_vec(vals, &S->vb, "points") < 0) goto fail;
@@ -1601,7 +1602,8 @@ static PyObject *bank_new(PyObject *self, PyObject *args)
                 goto fail;
             }
         } else {
-            PyErr_SetString(PyExc_ValueError, "kind must be 0 (level) or 1 (window)");
+            PyErr_SetString(PyExc_ValueError, "kind must be 0 (level), 1 (window) or 2 "
+                            "(path length)");
             goto fail;
         }
     }
@@ -1739,7 +1741,7 @@ static int set_ll_attr(PyObject *o, PyObject *name, long long v)
 
 /* one job's scan of (ta, t1]: appends (time, value, index) to hits; returns the count or -1 */
 static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const double *hi,
-                           long long *index, double ta, double t1, double **hb,
+                           const Vc *V, long long *index, double ta, double t1, double **hb,
                            Py_ssize_t *hcap, double *ev, Py_ssize_t evcap)
 {
     Py_ssize_t m = 0;
@@ -1753,6 +1755,22 @@ static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const 
         (*hb)[3 * m] = (tt); (*hb)[3 * m + 1] = (vv); (*hb)[3 * m + 2] = (double)(ii); m++; \
     } while (0)
     ta = pymax(ta, S->t_armed);
+    if (S->kind == K_VECTOR) {  /* LevelJob.scan on a VectorSource (VectorCycle.scan) */
+        if (ta >= t1) return 0;
+        const Vc *vc = &V[S->slot[0]];
+        long long size = S->L.n + S->L.has_after, k = S->repeat ? 0 : *index;
+        double t = ta, tf;
+        while (k < size) {
+            double lvl = level_at(&S->L, k);
+            if (!time_of(vc, lvl, t, &tf)) break;
+            PUSH(tf, lvl, k);
+            if (S->repeat) return m;
+            k++;
+            t = tf;
+        }
+        *index = k;
+        return m;
+    }
     if (S->kind == K_LEVEL) {
         if (ta >= t1) return 0;
         int sl = S->slot[0];
@@ -1808,7 +1826,8 @@ static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const 
 }
 
 PyDoc_STRVAR(bank_scan_doc,
-"bank_scan(bank, jobs, tracks, lines, pos_tracks, ta, t1) -> (f, k, pos, done) or None\n\n"
+"bank_scan(bank, jobs, tracks, lines, pos_tracks, ta, t1, vectors=()) -> (f, k, pos, done)\n"
+"or None\n\n"
 "Run the bank's jobs over (ta, t1] in order (CompareEngine._scan for them): each job's\n"
 "hits (LevelJob.scan / WindowJob.scan from its `index`), its action on lines[line]\n"
 "(apply_many from its `hits`), `index` and `hits` written back. tracks: one per slot;\n"
@@ -1816,13 +1835,15 @@ PyDoc_STRVAR(bank_scan_doc,
 "times in job order, then hit order) as f (float64[m, 2]:\n"
 "time, value), k (int64[m, 4]: job id, point index, output, state), pos (float64[m,\n"
 "len(pos_tracks)]: every pos_track at each time) and done (bank positions of the jobs\n"
-"that finished), or None when nothing fired or finished.");
+"that finished), or None when nothing fired or finished. vectors: one VectorCycle's\n"
+"(B, S, Q) per vector slot (the path-length jobs' sources).");
 
 static PyObject *bank_scan(PyObject *self, PyObject *args)
 {
-    PyObject *cap, *jobs_o, *tr_o, *lines_o, *pt_o;
+    PyObject *cap, *jobs_o, *tr_o, *lines_o, *pt_o, *vc_o = NULL;
     double ta, t1;
-    if (!PyArg_ParseTuple(args, "OOOOOdd", &cap, &jobs_o, &tr_o, &lines_o, &pt_o, &ta, &t1))
+    if (!PyArg_ParseTuple(args, "OOOOOdd|O", &cap, &jobs_o, &tr_o, &lines_o, &pt_o, &ta, &t1,
+                          &vc_o))
         return NULL;
     Bank *B = PyCapsule_GetPointer(cap, "openmotion._compare.Bank");
     if (B == NULL) return NULL;
@@ -1834,6 +1855,12 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     }
     Py_ssize_t nt = PyList_GET_SIZE(tr_o), npt = PyList_GET_SIZE(pt_o);
     Py_ssize_t nl = PyList_GET_SIZE(lines_o);
+    PyObject *vseq = vc_o ? PySequence_Fast(vc_o, "vectors must be a sequence of (B, S, Q)")
+                          : PyTuple_New(0);
+    if (vseq == NULL) return NULL;
+    Py_ssize_t nv = PySequence_Fast_GET_SIZE(vseq), vgot = 0;
+    Vc *V = calloc((size_t)(nv + 1), sizeof(Vc));
+    VcBuf *vb = calloc((size_t)(nv + 1), sizeof(VcBuf));
     Trk *T = calloc((size_t)(nt + npt + 1), sizeof(Trk));
     TrkBuf *tb = calloc((size_t)(nt + npt + 1), sizeof(TrkBuf));
     double *lo = malloc((size_t)(nt + 1) * sizeof(double));
@@ -1843,7 +1870,17 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     Rows R = {NULL, NULL, 0, 0};
     double *hb = NULL, *ev = NULL;
     Py_ssize_t hcap = 0, got = 0, evcap = 0;
-    if (!T || !tb || !lo || !hi || !have_rng) { PyErr_NoMemory(); goto out; }
+    if (!T || !tb || !lo || !hi || !have_rng || !V || !vb) { PyErr_NoMemory(); goto out; }
+    for (; vgot < nv; vgot++) {
+        PyObject *bsq = PySequence_Fast_GET_ITEM(vseq, vgot);
+        if (!PyTuple_Check(bsq) || PyTuple_GET_SIZE(bsq) != 3) {
+            PyErr_SetString(PyExc_TypeError, "bank_scan: each vector must be (B, S, Q)");
+            goto out;
+        }
+        if (get_vc(PyTuple_GET_ITEM(bsq, 0), PyTuple_GET_ITEM(bsq, 1), PyTuple_GET_ITEM(bsq, 2),
+                   &V[vgot], &vb[vgot]) < 0)
+            goto out;
+    }
     for (Py_ssize_t i = 0; i < nt + npt; i++) {
         PyObject *o = i < nt ? PyList_GET_ITEM(tr_o, i) : PyList_GET_ITEM(pt_o, i - nt);
         if (get_track_in(o, ta, t1, &T[i], &tb[i]) < 0) goto out;
@@ -1855,6 +1892,13 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     if (ev == NULL || done == NULL) { if (!ev) PyErr_NoMemory(); goto out; }
     for (Py_ssize_t i = 0; i < B->n; i++) {
         const Spec *S = &B->s[i];
+        if (S->kind == K_VECTOR) {
+            if (S->slot[0] >= nv) {
+                PyErr_SetString(PyExc_IndexError, "bank_scan: vector slot");
+                goto out;
+            }
+            continue;
+        }
         for (int q = 0; q < S->na; q++) {
             int sl = S->slot[q];
             if (sl >= nt) { PyErr_SetString(PyExc_IndexError, "bank_scan: track slot"); goto out; }
@@ -1870,7 +1914,7 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
         long long index, hits;
         if (get_ll_attr(job, S_index, &index) < 0) goto out;
         long long index0 = index;
-        Py_ssize_t m = job_scan(S, T, lo, hi, &index, ta, t1, &hb, &hcap, ev, evcap);
+        Py_ssize_t m = job_scan(S, T, lo, hi, V, &index, ta, t1, &hb, &hcap, ev, evcap);
         if (m < 0) goto out;
         if (index != index0 && set_ll_attr(job, S_index, index) < 0) goto out;
         if (m > 0) {
@@ -1908,8 +1952,8 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
             }
             if (set_ll_attr(job, S_hits, hits + m) < 0) goto out;
         }
-        int finished = S->kind == K_LEVEL ? (!S->repeat && index >= S->L.n + S->L.has_after)
-                                          : index >= S->npts;
+        int finished = S->kind != K_WINDOW ? (!S->repeat && index >= S->L.n + S->L.has_after)
+                                           : index >= S->npts;
         if (finished) {
             PyObject *x = PyLong_FromSsize_t(i);
             if (x == NULL || PyList_Append(done, x) < 0) { Py_XDECREF(x); goto out; }
@@ -1939,6 +1983,9 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     }
 out:
     for (Py_ssize_t i = 0; i < got; i++) release_track(&tb[i]);
+    for (Py_ssize_t i = 0; i < vgot; i++) release_vc(&vb[i]);
+    free(V); free(vb);
+    Py_DECREF(vseq);
     free(T); free(tb); free(lo); free(hi); free(have_rng); free(hb); free(ev);
     free(R.f); free(R.k);
     Py_XDECREF(done);
