@@ -296,8 +296,21 @@ def vector_scan(B, S, Q, levels, n, after_final, index, t, first_only):  # noqa:
     return out
 
 
+def vector_cycle_numpy(tracks, weights, ta: float, t1: float, s0: float):  # noqa: ANN001, ANN201
+    """VectorCycle.__init__ as it was in numpy, whole: (B, Q, S) (tracks: Track rows)."""
+    import numpy as np
+
+    B, Q, R = (np.frombuffer(x) for x in vector_pieces(tracks, weights, ta, t1))
+    n = B.size - 1
+    Q, R = Q.reshape(n, 5), R.reshape(2, n, 8)
+    w = np.array([wg for _, wg in _GL_PAIRS])
+    d1 = np.ascontiguousarray(R[0]) @ w  # (the old code's two fresh (n, 8) @ w products)
+    d2 = np.ascontiguousarray(R[1]) @ w
+    return B, Q, np.frombuffer(vector_sums(B, Q, d1, d2, s0, 1e-13, 10))
+
+
 def vector_pieces(tracks, weights, ta: float, t1: float):  # noqa: ANN001, ANN201
-    """VectorCycle.__init__'s pieces as it was in numpy: B, Q and the node speeds R1, R2
+    """VectorCycle.__init__'s pieces as it was in numpy: B, Q and the node speeds R
     (bytes, the compiled module's form; the products with the weights stay numpy's)."""
     import numpy as np
 
@@ -344,7 +357,7 @@ def vector_pieces(tracks, weights, ta: float, t1: float):  # noqa: ANN001, ANN20
     xa = (H[:, None] / 4.0) * (gx[None, :] + 1.0)
     r1 = sq_rows(x1)
     r2 = sq_rows(xa) + sq_rows(xa + H[:, None] / 2.0)
-    return B.tobytes(), Q.tobytes(), r1.tobytes(), r2.tobytes()
+    return B.tobytes(), Q.tobytes(), r1.tobytes() + r2.tobytes()
 
 
 def vector_sums(B, Q, d1, d2, s0: float, rtol: float, max_depth: int):  # noqa: ANN001, ANN201

@@ -1159,10 +1159,10 @@ static inline double sq_row(const double *q, double x)
 }
 
 PyDoc_STRVAR(vector_pieces_doc,
-"vector_pieces(tracks, weights, ta, t1) -> (B, Q, R1, R2) as bytes of float64\n\n"
+"vector_pieces(tracks, weights, ta, t1) -> (B, Q, R) as bytes of float64\n\n"
 "VectorCycle's pieces over [ta, t1]: B the breakpoints (ta, t1, every record start and\n"
-"velocity root inside, sorted), Q (n, 5) each piece's speed^2 quartic, R1 and R2 (n, 8)\n"
-"the speed at the nodes of one and of two Gauss-Legendre panels (summed), whose products\n"
+"velocity root inside, sorted), Q (n, 5) each piece's speed^2 quartic, R (2, n, 8) the\n"
+"speed at the nodes of one and of two Gauss-Legendre panels (summed), whose products\n"
 "with the weights vector_sums takes. tracks: tracks or history specs (see bank_scan).");
 
 static PyObject *vector_pieces(PyObject *self, PyObject *args)
@@ -1256,9 +1256,9 @@ static PyObject *vector_pieces(PyObject *self, PyObject *args)
             R2[8 * p + k] = sq_row(q, xa) + sq_row(q, xa + h / 2.0);
         }
     }
-    res = Py_BuildValue("(y#y#y#y#)", (const char *)bp, (Py_ssize_t)(nb * 8),
-                        (const char *)Q, (Py_ssize_t)(5 * n * 8), (const char *)R1,
-                        (Py_ssize_t)(8 * n * 8), (const char *)R2, (Py_ssize_t)(8 * n * 8));
+    res = Py_BuildValue("(y#y#y#)", (const char *)bp, (Py_ssize_t)(nb * 8),
+                        (const char *)Q, (Py_ssize_t)(5 * n * 8), (const char *)R,
+                        (Py_ssize_t)(16 * n * 8));
 out:
     for (int i = 0; i < got; i++) release_track(&tb[i]);
     if (have_w) PyBuffer_Release(&wb);

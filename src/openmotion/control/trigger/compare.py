@@ -145,6 +145,7 @@ class CompareEngine:
         self._specs: dict[AxisSource, tuple[Any, float, float, float, float, float]] = {}
         self._ranges = {}
         self._vcycles: dict[VectorSource, VectorCycle] = {}
+        self._weights: dict[VectorSource, Array] = {}  # (a source's weights, made once)
         self._mpos_e1: dict[int, float] = {}
         self._win = (self._t_last, self._t_last)
         from ...hw.interface import TimedOutputHardware
@@ -403,9 +404,11 @@ class CompareEngine:
         vc = self._vcycles.get(src)
         if vc is None:
             ta, t1 = self._win
+            w = self._weights.get(src)
+            if w is None:
+                w = self._weights[src] = src.weights
             stores = self.ctl.history._tracks  # (the rows as stored: history.rows)
-            vc = VectorCycle([(stores[a],) for a in src.axes], src.weights, ta, t1,
-                             self._vectors[src])
+            vc = VectorCycle([(stores[a],) for a in src.axes], w, ta, t1, self._vectors[src])
             self._vcycles[src] = vc
         return vc
 

@@ -168,20 +168,19 @@ class VectorCycle:
     tracks: Track rows, or history specs as the scan driver takes them ((hist,) for the
     rows as stored). The pieces and their node speeds are compiled (vector_pieces); the
     two 8-point weight products stay numpy products `(n, 8) @ w`, as they always were
-    (their BLAS rounding depends on the kernel and on n), then vector_sums refines the
-    pieces that disagree and sums them."""
+    (their BLAS rounding depends on the kernel and on n; one stacked product makes the
+    same two calls), then vector_sums refines the pieces that disagree and sums them."""
 
     def __init__(self, tracks: list[Any], weights: Array, ta: float, t1: float,
                  s0: float) -> None:
         ck = _solvers()
         w = np.ascontiguousarray(weights, dtype=np.float64)
-        b, q, r1, r2 = ck.vector_pieces(tracks, w, float(ta), float(t1))
+        b, q, r = ck.vector_pieces(tracks, w, float(ta), float(t1))
         self.B = B = np.frombuffer(b, dtype=np.float64)
         n = B.size - 1
         self.Q = Q = np.frombuffer(q, dtype=np.float64).reshape(n, 5)
-        d1 = np.frombuffer(r1, dtype=np.float64).reshape(n, 8) @ _GL_W
-        d2 = np.frombuffer(r2, dtype=np.float64).reshape(n, 8) @ _GL_W
-        self.S = np.frombuffer(ck.vector_sums(B, Q, d1, d2, float(s0), _QUAD_RTOL,
+        d = np.frombuffer(r, dtype=np.float64).reshape(2, n, 8) @ _GL_W  # (each (n, 8) @ w)
+        self.S = np.frombuffer(ck.vector_sums(B, Q, d[0], d[1], float(s0), _QUAD_RTOL,
                                               _QUAD_DEPTH), dtype=np.float64)
 
     @property
