@@ -134,3 +134,87 @@ def test_bad_arguments_raise():
     with pytest.raises(ValueError, match="vector_sums"):
         _compare.vector_sums(np.zeros(3), np.zeros(5), np.zeros(2), np.zeros(2), 0.0,
                              1e-13, 10)
+
+
+# ---------------------------------------------------------------------------- scan driver
+class _Job:
+    """What bank_scan reads and writes on a job object."""
+
+    def __init__(self, index: int, hits: int) -> None:
+        self.index, self.hits = index, hits
+
+
+def _driver(mod, vc: VectorCycle, spec: tuple, index: int, hits: int,  # noqa: ANN001
+            ta: float, t1: float) -> tuple:
+    from openmotion.control.trigger.compare_io import OutputLine
+
+    job, line = _Job(index, hits), OutputLine(3, False)
+    res = mod.bank_scan(mod.bank_new([spec]), [job], [], [line], [], ta, t1,
+                        [(vc.B, vc.S, vc.Q)])
+    if res is not None:
+        res = (np.frombuffer(res[0]).tolist(), np.frombuffer(res[1], dtype=np.int64).tolist(),
+               list(res[3]))
+    return res, job.index, job.hits, line.edges
+
+
+@given(recs=st.lists(st.lists(rec, min_size=1, max_size=5), min_size=2, max_size=2),
+       v0=st.floats(-1e5, 1e5), s0=st.floats(0.0, 50.0), start=st.floats(-5.0, 80.0),
+       step=st.floats(0.05, 30.0), n=st.integers(1, 40),
+       after=st.one_of(st.none(), st.floats(0.0, 400.0)), repeat=st.booleans(),
+       as_seq=st.booleans(), index=st.integers(0, 3), hits=st.integers(0, 3),
+       armed=st.floats(-0.5, 1.5), act=st.sampled_from([(0, 1, 0.0), (1, 0, 0.0),
+                                                          (2, 1, 1e-5)]))
+@settings(max_examples=300, deadline=None)
+def test_driver_path_length_jobs_are_levelJob_scan(recs, v0, s0, start, step, n, after,
+                                                   repeat, as_seq, index, hits, armed, act):
+    """bank_scan's kind 2 (a LevelJob on a VectorSource) fires what LevelJob.scan fires on
+    the same VectorCycle (VectorCycle.scan), and the same as the oracle's job loop."""
+    tracks = [_rows(r, 0.0, v0 * (k + 1) / 2.0) for k, r in enumerate(recs)]
+    ta, t1 = 1e-4, 2e-3
+    vc = VectorCycle(tracks, np.array([1.0, 0.5]), ta, t1, s0)
+    if repeat:
+        n, after, index = 1, None, 0
+    levels = (start, step) if as_seq else start + step * np.arange(n, dtype=np.float64)
+    t_armed = ta + armed * (t1 - ta)
+    spec = (2, (0,), 1, repeat, levels, n, after, 0.0, t_armed, 7, *act, 0, 3)
+    got = _driver(_compare, vc, spec, index, hits, ta, t1)
+    assert got == _driver(oracle, vc, spec, index, hits, ta, t1)
+    a = max(ta, t_armed)  # LevelJob.scan
+    size = n + (after is not None)
+    want = [] if a >= t1 or (not repeat and index >= size) else \
+        vc.scan(levels, n, after, index, a, repeat)
+    res, idx, hit_count, _ = got
+    times = [] if res is None else res[0][0::2]
+    assert times == [tf for tf, _ in want]
+    assert hit_count == hits + len(want)
+    assert idx == (index if repeat else index + len(want))
+    finished = not repeat and idx >= size
+    assert (res is not None and res[2] == [0]) == finished
+
+
+def test_a_path_length_job_already_passed_finishes_in_the_driver():
+    """A distance table whose values VECTOR_MOVED has already passed is exhausted when
+    armed; the driver reports it done with no firing (empty rows, not None) and the engine
+    drops it, then a live job on the same line fires as in the Python loop."""
+    from helpers import free_axes, start_line
+    from openmotion.control.trigger.compare import (
+        CompareEngine,
+        LevelJob,
+        Pulse,
+        VectorSource,
+        every_distance,
+    )
+
+    c = free_axes(2)
+    eng = CompareEngine(c)
+    src = VectorSource((0, 1))
+    eng.set_vector_moved(src, 1000.0)
+    eng.output(2)  # (the line exists: the job is the driver's from the first cycle)
+    old = eng.add(LevelJob(src, [10.0, 20.0], Pulse(2, 1e-5)))
+    assert eng.job(old).remaining == 0 and eng.job(old).skipped == 2
+    live = eng.add(every_distance(src, 50.0, Pulse(2, 1e-5), start=1050.0))
+    start_line(c, [0.0, 0.0], [300.0, 400.0], v=5e4, a=5e6)
+    assert c.wait_motion_done(timeout=30.0)
+    assert old not in eng.jobs
+    assert eng.job(live).hits == 10  # 1050, 1100, ..., 1500 on a path of 500
+    assert sorted(set(eng.log.arrays()["job"].tolist())) == [live]

@@ -1962,8 +1962,10 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     }
     if (R.m == 0 && PyList_GET_SIZE(done) == 0) { res = Py_NewRef(Py_None); goto out; }
     if (rows_sort(&R) < 0) goto out;
-    res = Py_BuildValue("(y#y#y#O)", (const char *)R.f, (Py_ssize_t)(R.m * 2 * sizeof(double)),
-                        (const char *)R.k, (Py_ssize_t)(R.m * 4 * sizeof(long long)),
+    /* (no rows but a job done: empty bytes, not None, for a NULL buffer) */
+    res = Py_BuildValue("(y#y#y#O)", R.f ? (const char *)R.f : "",
+                        (Py_ssize_t)(R.m * 2 * sizeof(double)),
+                        R.k ? (const char *)R.k : "", (Py_ssize_t)(R.m * 4 * sizeof(long long)),
                         "", (Py_ssize_t)0, done);
     if (res == NULL) goto out;
     {
