@@ -162,6 +162,8 @@ def track_range(tr: Track, ta: float, t1: float) -> tuple[float, float]:
 # single axis or a straight line sqrt(Q) is a polynomial of degree <= 2, which 8-point
 # Gauss-Legendre integrates exactly; otherwise (curves) the piece is halved adaptively until
 # two levels agree to 1e-13 relative. s(t) = d is solved by safeguarded Newton (s' = speed).
+# (Compiled: _compare.vector_pieces / vector_sums; the numpy version is the oracle,
+# tests/compare_oracle.vector_cycle_numpy.)
 class VectorCycle:
     """Path length over one window [ta, t1] of several axes' tracks, starting at s0.
 
