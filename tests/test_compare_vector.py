@@ -113,6 +113,14 @@ def test_history_spec_reads_the_rows_in_place(segs, v0, cut, width):
     _same(got, by_rows)
 
 
+def test_many_axes_are_one_path_length():
+    """Any number of axes (no 8-axis limit): 12 axes at 100 pulses/s each."""
+    tr = Track(np.array([0.0]), np.array([0.0]), np.array([100.0]), np.zeros(1), np.zeros(1))
+    got, want = _both([tr] * 12, np.ones(12), 0.0, 1e-3, 0.0)
+    _same(got, want)
+    assert got.end == pytest.approx(0.1 * 12 ** 0.5, rel=1e-15)
+
+
 def test_constant_velocity_line_is_the_straight_length():
     tr = Track(np.array([0.0]), np.array([0.0]), np.array([300.0]), np.array([0.0]),
                np.array([0.0]))
@@ -127,7 +135,7 @@ def test_bad_arguments_raise():
     tr = Track(*(np.zeros(1) for _ in range(5)))
     with pytest.raises(ValueError, match="weights"):
         _compare.vector_pieces([tr, tr], np.ones(3), 0.0, 1.0)
-    with pytest.raises(ValueError, match="axes"):
+    with pytest.raises(ValueError, match="axis"):
         _compare.vector_pieces([], np.ones(0), 0.0, 1.0)
     with pytest.raises(TypeError):
         _compare.vector_pieces([tr], [1.0], 0.0, 1.0)  # (a list: not a float64 buffer)

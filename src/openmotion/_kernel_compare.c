@@ -1176,16 +1176,16 @@ static PyObject *vector_pieces(PyObject *self, PyObject *args)
     }
     PyObject *seq = PySequence_Fast(tr_o, "tracks must be a sequence of tracks");
     if (seq == NULL) return NULL;
-    Py_ssize_t na = PySequence_Fast_GET_SIZE(seq);
-    Trk T[MAX_AXES];
-    TrkBuf tb[MAX_AXES];
-    int got = 0;
+    Py_ssize_t na = PySequence_Fast_GET_SIZE(seq), got = 0;  /* (any number of axes) */
+    Trk *T = calloc((size_t)(na > 0 ? na : 1), sizeof(Trk));
+    TrkBuf *tb = calloc((size_t)(na > 0 ? na : 1), sizeof(TrkBuf));
     PyObject *res = NULL;
     double *bp = NULL, *Q = NULL, *R = NULL;
     Py_buffer wb;
     int have_w = 0;
-    if (na < 1 || na > MAX_AXES) {
-        PyErr_Format(PyExc_ValueError, "tracks: 1..%d axes, got %zd", MAX_AXES, na);
+    if (T == NULL || tb == NULL) { PyErr_NoMemory(); goto out; }
+    if (na < 1) {
+        PyErr_SetString(PyExc_ValueError, "tracks: at least one axis");
         goto out;
     }
     if (get_vec(w_o, &wb, "weights") < 0) goto out;
@@ -1198,7 +1198,7 @@ static PyObject *vector_pieces(PyObject *self, PyObject *args)
     Py_ssize_t cap = 2;
     for (Py_ssize_t i = 0; i < na; i++) {
         if (get_track_in(PySequence_Fast_GET_ITEM(seq, i), ta, t1, &T[i], &tb[i]) < 0) goto out;
-        got = (int)i + 1;
+        got = i + 1;
         cap += 3 * T[i].n;
     }
     bp = malloc((size_t)cap * sizeof(double));
@@ -1260,10 +1260,10 @@ static PyObject *vector_pieces(PyObject *self, PyObject *args)
                         (const char *)Q, (Py_ssize_t)(5 * n * 8), (const char *)R,
                         (Py_ssize_t)(16 * n * 8));
 out:
-    for (int i = 0; i < got; i++) release_track(&tb[i]);
+    for (Py_ssize_t i = 0; i < got; i++) release_track(&tb[i]);
     if (have_w) PyBuffer_Release(&wb);
     Py_DECREF(seq);
-    free(bp); free(Q); free(R);
+    free(T); free(tb); free(bp); free(Q); free(R);
     return res;
 }
 
