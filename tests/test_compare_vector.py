@@ -226,3 +226,50 @@ def test_a_path_length_job_already_passed_finishes_in_the_driver():
     assert old not in eng.jobs
     assert eng.job(live).hits == 10  # 1050, 1100, ..., 1500 on a path of 500
     assert sorted(set(eng.log.arrays()["job"].tolist())) == [live]
+
+
+def _untimed_run(native: bool) -> tuple:
+    from helpers import free_axes, start_line
+    from openmotion.control.trigger import compare as engine
+    from openmotion.control.trigger.compare import (
+        LevelJob,
+        LevelSeq,
+        Pulse,
+        SetLevel,
+        Toggle,
+        VectorSource,
+        every_distance,
+    )
+    from test_compare_timed import UntimedSim
+
+    actions = engine._ACTIONS
+    if not native:
+        engine._ACTIONS = {}  # every job through the Python loop
+    try:
+        c = free_axes(2, hardware=UntimedSim)
+        eng = engine.CompareEngine(c)
+        assert not eng.timed
+        src = VectorSource((0, 1), (1.0, 2.0))
+        eng.add(every_distance(src, 7.5, Pulse(1, 3e-4), start=3.0))
+        eng.add(LevelJob(src, LevelSeq(10.0, 12.5, 20), Toggle(2), after_final=400.0))
+        eng.add(LevelJob(VectorSource((1,)), [55.0], SetLevel(3), repeat=True))
+        for o in (1, 2, 3):
+            eng.output(o)
+        assert len(eng._group(None).native) == (3 if native else 0)
+        start_line(c, [0.0, 0.0], [300.0, -400.0], v=4e4, a=4e6)
+        assert c.wait_motion_done(timeout=30.0)
+        start_line(c, [300.0, -400.0], [0.0, 0.0], v=6e4, a=8e6)
+        assert c.wait_motion_done(timeout=30.0)
+        c.advance(0.002)
+        log = {k: v.tolist() for k, v in eng.log.arrays().items()}
+        return log, {n: ln.edges for n, ln in eng._lines.items()}, eng.vector_moved(src)
+    finally:
+        engine._ACTIONS = actions
+
+
+def test_untimed_hardware_driver_is_the_python_loop():
+    """Path-length jobs after the cycle (hardware without timed outputs): the driver's
+    firings, log and waveforms are the per-job Python loop's."""
+    got = _untimed_run(True)
+    assert got == _untimed_run(False)
+    assert len(got[0]["time"]) > 40
