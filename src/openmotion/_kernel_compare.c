@@ -114,8 +114,8 @@ static int get_track(PyObject *o, Trk *t, TrkBuf *tb)
  * store (history._Track: float64 arrays ts, p0, v0, a0, j, live rows [lo, hi)). The rows
  * of MotionHistory.rows(axis, ta, t1) (those covering [ta, t1] plus the one before), in
  * the frame of compare_math.affine_track: scale * x(t) + offset + e0 + slope * (t - t_ref),
- * each column with affine_track's operation order (the same floats). A 5-sequence is a
- * plain track (get_track). */
+ * each column with affine_track's operation order (the same floats). spec = (hist,): those
+ * rows as stored. A 5-sequence is a plain track (get_track). */
 static Py_ssize_t search_right(const double *x, Py_ssize_t lo, Py_ssize_t hi, double t)
 {
     while (lo < hi) {
@@ -127,12 +127,15 @@ static Py_ssize_t search_right(const double *x, Py_ssize_t lo, Py_ssize_t hi, do
 
 static int get_track_in(PyObject *o, double ta, double t1, Trk *t, TrkBuf *tb)
 {
-    if (!PyTuple_Check(o) || PyTuple_GET_SIZE(o) != 6) return get_track(o, t, tb);
+    Py_ssize_t len = PyTuple_Check(o) ? PyTuple_GET_SIZE(o) : -1;
+    if (len != 6 && len != 1) return get_track(o, t, tb);
     tb->held = 0;
     tb->own = NULL;
-    double sc, off, e0, slope, tref;
+    double sc = 1.0, off = 0.0, e0 = 0.0, slope = 0.0, tref = 0.0;
+    int raw = len == 1;  /* (hist,): the rows as stored (MotionHistory.rows) */
     PyObject *h;
-    if (!PyArg_ParseTuple(o, "Oddddd", &h, &sc, &off, &e0, &slope, &tref)) return -1;
+    if (raw) h = PyTuple_GET_ITEM(o, 0);
+    else if (!PyArg_ParseTuple(o, "Oddddd", &h, &sc, &off, &e0, &slope, &tref)) return -1;
     PyObject *names[5] = {S_ts, S_p0, S_v0, S_a0, S_j};
     const double *col[5];
     long long lo, hi;
@@ -171,7 +174,9 @@ static int get_track_in(PyObject *o, double ta, double t1, Trk *t, TrkBuf *tb)
     Py_ssize_t n = b - a;
     double *m = malloc((size_t)(5 * n) * sizeof(double));
     if (m == NULL) { release_track(tb); PyErr_NoMemory(); return -1; }
-    for (Py_ssize_t k = 0; k < n; k++) {
+    for (Py_ssize_t k = 0; k < n && raw; k++)
+        for (int c = 0; c < 5; c++) m[c * n + k] = col[c][a + k];
+    for (Py_ssize_t k = 0; k < n && !raw; k++) {
         Py_ssize_t r = a + k;
         m[k] = ts[r];
         m[n + k] = sc * col[1][r] + off + e0 + slope * (ts[r] - tref);
@@ -335,11 +340,6 @@ static void track_range(const Trk *T, double ta, double t1, double *lo_o, double
 }
 
 /* ------------------------------------------------------------------ window */
-typedef struct {
-    double *buf;
-    Py_ssize_t cap;
-} Scratch;
-
 /* The events of level_events(direction 0) one at a time, in time order, with each root
  * refined only when asked (`Stream`): a root inside a monotone piece is first known by its
  * bracket and a rigorous lower bound of the time refine() will return. */
@@ -549,10 +549,8 @@ static int outside_over(const Trk *T, double c, double lim, double ta, double tb
  * order from its Stream, and a root is refined only while its lower bound is the
  * smallest pending one, so the same first candidate inside is found with fewer roots. */
 static int first_inside(const Trk *T, int na, const double *centre, double maxerr, double t,
-                        double t1, const double *lo, const double *hi, Scratch *sc,
-                        double *x_out)
+                        double t1, const double *lo, const double *hi, double *x_out)
 {
-    (void)sc;
     double lim[MAX_AXES];
     Stream st[2 * MAX_AXES];
     int axis_of[2 * MAX_AXES];
@@ -624,48 +622,82 @@ static int first_inside(const Trk *T, int na, const double *centre, double maxer
     return 0;
 }
 
-static int get_tracks(PyObject *seq_o, Trk *T, TrkBuf *tb, int *na_out)
+/* The track and range arguments of an entry point, parsed in one place: `tr_o` one track
+ * (single) or a sequence of 1..MAX_AXES tracks; `rg_o` NULL or None (no ranges: +-inf),
+ * one (lo, hi) pair (single) or a sequence of them, one per track. On success the caller
+ * owns the buffers until args_release; on failure nothing is held. */
+typedef struct {
+    Trk T[MAX_AXES];
+    TrkBuf tb[MAX_AXES];
+    double lo[MAX_AXES], hi[MAX_AXES];
+    int na;
+} TrackArgs;
+
+static void args_release(TrackArgs *A)
 {
-    PyObject *seq = PySequence_Fast(seq_o, "tracks must be a sequence of tracks");
-    if (seq == NULL) return -1;
-    Py_ssize_t na = PySequence_Fast_GET_SIZE(seq);
-    if (na < 1 || na > MAX_AXES) {
-        Py_DECREF(seq);
-        PyErr_Format(PyExc_ValueError, "tracks: 1..%d axes, got %zd", MAX_AXES, na);
-        return -1;
-    }
-    for (Py_ssize_t i = 0; i < na; i++) {
-        if (get_track(PySequence_Fast_GET_ITEM(seq, i), &T[i], &tb[i]) < 0) {
-            for (Py_ssize_t q = 0; q < i; q++) release_track(&tb[q]);
-            Py_DECREF(seq);
-            return -1;
-        }
-    }
-    Py_DECREF(seq);
-    *na_out = (int)na;
-    return 0;
+    for (int i = 0; i < A->na; i++) release_track(&A->tb[i]);
+    A->na = 0;
 }
 
-static int get_ranges(PyObject *o, int na, double *lo, double *hi)
+static int get_range(PyObject *o, double *lo, double *hi)
 {
-    if (o == Py_None) {
-        for (int i = 0; i < na; i++) { lo[i] = -INFINITY; hi[i] = INFINITY; }
-        return 0;
-    }
-    PyObject *seq = PySequence_Fast(o, "ranges must be a sequence of (lo, hi)");
+    PyObject *seq = PySequence_Fast(o, "a range must be a (lo, hi) pair");
     if (seq == NULL) return -1;
-    if (PySequence_Fast_GET_SIZE(seq) != na) {
-        Py_DECREF(seq);
-        PyErr_SetString(PyExc_ValueError, "ranges: one (lo, hi) per track");
-        return -1;
+    int ok = PySequence_Fast_GET_SIZE(seq) == 2;
+    if (!ok) PyErr_SetString(PyExc_ValueError, "a range must be a (lo, hi) pair");
+    if (ok) {
+        *lo = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, 0));
+        ok = !(*lo == -1.0 && PyErr_Occurred());
     }
-    for (int i = 0; i < na; i++) {
-        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(seq, i), "dd", &lo[i], &hi[i])) {
-            Py_DECREF(seq);
-            return -1;
-        }
+    if (ok) {
+        *hi = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, 1));
+        ok = !(*hi == -1.0 && PyErr_Occurred());
     }
     Py_DECREF(seq);
+    return ok ? 0 : -1;
+}
+
+static int track_args(PyObject *tr_o, PyObject *rg_o, int single, TrackArgs *A)
+{
+    A->na = 0;
+    if (single) {
+        if (get_track(tr_o, &A->T[0], &A->tb[0]) < 0) return -1;
+        A->na = 1;
+    } else {
+        PyObject *seq = PySequence_Fast(tr_o, "tracks must be a sequence of tracks");
+        if (seq == NULL) return -1;
+        Py_ssize_t na = PySequence_Fast_GET_SIZE(seq);
+        if (na < 1 || na > MAX_AXES) {
+            Py_DECREF(seq);
+            PyErr_Format(PyExc_ValueError, "tracks: 1..%d axes, got %zd", MAX_AXES, na);
+            return -1;
+        }
+        for (Py_ssize_t i = 0; i < na; i++) {
+            if (get_track(PySequence_Fast_GET_ITEM(seq, i), &A->T[i], &A->tb[i]) < 0) {
+                Py_DECREF(seq);
+                args_release(A);
+                return -1;
+            }
+            A->na = (int)i + 1;
+        }
+        Py_DECREF(seq);
+    }
+    if (rg_o == NULL || rg_o == Py_None) {
+        for (int i = 0; i < A->na; i++) { A->lo[i] = -INFINITY; A->hi[i] = INFINITY; }
+        return 0;
+    }
+    if (single) {
+        if (get_range(rg_o, &A->lo[0], &A->hi[0]) < 0) { args_release(A); return -1; }
+        return 0;
+    }
+    PyObject *seq = PySequence_Fast(rg_o, "ranges must be a sequence of (lo, hi)");
+    if (seq == NULL) { args_release(A); return -1; }
+    int bad = PySequence_Fast_GET_SIZE(seq) != A->na;
+    if (bad) PyErr_SetString(PyExc_ValueError, "ranges: one (lo, hi) per track");
+    for (int i = 0; i < A->na && !bad; i++)
+        bad = get_range(PySequence_Fast_GET_ITEM(seq, i), &A->lo[i], &A->hi[i]) < 0;
+    Py_DECREF(seq);
+    if (bad) { args_release(A); return -1; }
     return 0;
 }
 
@@ -683,14 +715,11 @@ static PyObject *window_scan(PyObject *self, PyObject *args)
     Py_ssize_t index;
     if (!PyArg_ParseTuple(args, "OOOdndd", &tr_o, &rg_o, &pt_o, &maxerr, &index, &t, &t1))
         return NULL;
-    Trk T[MAX_AXES];
-    TrkBuf tb[MAX_AXES];
-    int na;
-    if (get_tracks(tr_o, T, tb, &na) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, rg_o, 0, &A) < 0) return NULL;
+    int na = A.na;
     PyObject *res = NULL;
-    double lo[MAX_AXES], hi[MAX_AXES];
     Py_buffer pb;
-    if (get_ranges(rg_o, na, lo, hi) < 0) goto done_tracks;
     if (get_vec(pt_o, &pb, "points") < 0) goto done_tracks;
     Py_ssize_t n = pb.len / 8 / na;
     if (n * na * 8 != pb.len) {
@@ -700,10 +729,9 @@ static PyObject *window_scan(PyObject *self, PyObject *args)
     res = PyList_New(0);
     if (res == NULL) goto done_points;
     const double *pts = pb.buf;
-    Scratch sc = {NULL, 0};
     while (index < n) {
         double x;
-        int r = first_inside(T, na, pts + index * na, maxerr, t, t1, lo, hi, &sc, &x);
+        int r = first_inside(A.T, na, pts + index * na, maxerr, t, t1, A.lo, A.hi, &x);
         if (r < 0) { Py_CLEAR(res); break; }
         if (r == 0) break;
         PyObject *f = PyFloat_FromDouble(x);
@@ -712,11 +740,10 @@ static PyObject *window_scan(PyObject *self, PyObject *args)
         index++;
         t = x;
     }
-    free(sc.buf);
 done_points:
     PyBuffer_Release(&pb);
 done_tracks:
-    for (int i = 0; i < na; i++) release_track(&tb[i]);
+    args_release(&A);
     return res;
 }
 
@@ -729,28 +756,22 @@ static PyObject *first_inside_py(PyObject *self, PyObject *args)
     PyObject *tr_o, *c_o, *rg_o;
     double maxerr, t, t1;
     if (!PyArg_ParseTuple(args, "OOdddO", &tr_o, &c_o, &maxerr, &t, &t1, &rg_o)) return NULL;
-    Trk T[MAX_AXES];
-    TrkBuf tb[MAX_AXES];
-    int na;
-    if (get_tracks(tr_o, T, tb, &na) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, rg_o, 0, &A) < 0) return NULL;
     PyObject *res = NULL;
-    double lo[MAX_AXES], hi[MAX_AXES];
     Py_buffer cb;
-    if (get_ranges(rg_o, na, lo, hi) < 0) goto done;
     if (get_vec(c_o, &cb, "centre") < 0) goto done;
-    if (cb.len != 8 * na) {
+    if (cb.len != 8 * A.na) {
         PyErr_SetString(PyExc_ValueError, "centre: one coordinate per track");
     } else {
-        Scratch sc = {NULL, 0};
         double x;
-        int r = first_inside(T, na, cb.buf, maxerr, t, t1, lo, hi, &sc, &x);
-        free(sc.buf);
+        int r = first_inside(A.T, A.na, cb.buf, maxerr, t, t1, A.lo, A.hi, &x);
         if (r > 0) res = PyFloat_FromDouble(x);
         else if (r == 0) res = Py_NewRef(Py_None);
     }
     PyBuffer_Release(&cb);
 done:
-    for (int i = 0; i < na; i++) release_track(&tb[i]);
+    args_release(&A);
     return res;
 }
 
@@ -855,23 +876,24 @@ PyDoc_STRVAR(level_scan_doc,
 
 static PyObject *level_scan(PyObject *self, PyObject *args)
 {
-    PyObject *tr_o, *lv_o, *af_o;
-    double rlo, rhi, t, t1;
+    PyObject *tr_o, *rg_o, *lv_o, *af_o;
+    double t, t1;
     long long n, index;
     int direction;
-    if (!PyArg_ParseTuple(args, "O(dd)OLOLddi", &tr_o, &rlo, &rhi, &lv_o, &n, &af_o, &index,
-                          &t, &t1, &direction))
+    if (!PyArg_ParseTuple(args, "OOOLOLddi", &tr_o, &rg_o, &lv_o, &n, &af_o, &index, &t, &t1,
+                          &direction))
         return NULL;
-    Trk T;
-    TrkBuf tb;
-    if (get_track(tr_o, &T, &tb) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, rg_o, 1, &A) < 0) return NULL;
+    const Trk *T = &A.T[0];
+    double rlo = A.lo[0], rhi = A.hi[0];
     Levels L;
     Py_buffer lb;
     int held;
     PyObject *res = NULL;
     if (get_levels(lv_o, n, af_o, &L, &lb, &held) < 0) goto done;
     long long size = L.n + L.has_after;
-    Py_ssize_t cap = max_events(T.n);
+    Py_ssize_t cap = max_events(T->n);
     double *ev = malloc((size_t)cap * sizeof(double));
     if (ev == NULL) { PyErr_NoMemory(); goto done; }
     res = PyList_New(0);
@@ -879,7 +901,7 @@ static PyObject *level_scan(PyObject *self, PyObject *args)
         double lvl = level_at(&L, index);
         double slack = 1e-9 * (fabs(lvl) + 1.0);
         if (!(rlo - slack <= lvl && lvl <= rhi + slack)) break;
-        if (level_events(&T, lvl, t, t1, direction, 1, ev) == 0) break;
+        if (level_events(T, lvl, t, t1, direction, 1, ev) == 0) break;
         PyObject *it = Py_BuildValue("(dd)", ev[0], lvl);
         if (it == NULL || PyList_Append(res, it) < 0) { Py_XDECREF(it); Py_CLEAR(res); break; }
         Py_DECREF(it);
@@ -889,7 +911,7 @@ static PyObject *level_scan(PyObject *self, PyObject *args)
     free(ev);
 done:
     if (held) PyBuffer_Release(&lb);
-    release_track(&tb);
+    args_release(&A);
     return res;
 }
 
@@ -905,16 +927,15 @@ static PyObject *level_events_py(PyObject *self, PyObject *args)
     int direction = 0, first = 0;
     if (!PyArg_ParseTuple(args, "Oddd|ip", &tr_o, &level, &t, &t1, &direction, &first))
         return NULL;
-    Trk T;
-    TrkBuf tb;
-    if (get_track(tr_o, &T, &tb) < 0) return NULL;
-    Py_ssize_t cap = max_events(T.n);
+    TrackArgs A;
+    if (track_args(tr_o, NULL, 1, &A) < 0) return NULL;
+    Py_ssize_t cap = max_events(A.T[0].n);
     double *ev = malloc((size_t)cap * sizeof(double));
     PyObject *res = NULL;
     if (ev == NULL) {
         PyErr_NoMemory();
     } else {
-        Py_ssize_t m = level_events(&T, level, t, t1, direction, first, ev);
+        Py_ssize_t m = level_events(&A.T[0], level, t, t1, direction, first, ev);
         res = PyList_New(m);
         for (Py_ssize_t i = 0; res != NULL && i < m; i++) {
             PyObject *f = PyFloat_FromDouble(ev[i]);
@@ -923,7 +944,7 @@ static PyObject *level_events_py(PyObject *self, PyObject *args)
         }
         free(ev);
     }
-    release_track(&tb);
+    args_release(&A);
     return res;
 }
 
@@ -935,12 +956,11 @@ static PyObject *track_range_py(PyObject *self, PyObject *args)
     PyObject *tr_o;
     double ta, t1;
     if (!PyArg_ParseTuple(args, "Odd", &tr_o, &ta, &t1)) return NULL;
-    Trk T;
-    TrkBuf tb;
-    if (get_track(tr_o, &T, &tb) < 0) return NULL;
+    TrackArgs A;
+    if (track_args(tr_o, NULL, 1, &A) < 0) return NULL;
     double lo, hi;
-    track_range(&T, ta, t1, &lo, &hi);
-    release_track(&tb);
+    track_range(&A.T[0], ta, t1, &lo, &hi);
+    args_release(&A);
     return Py_BuildValue("(dd)", lo, hi);
 }
 
@@ -1110,6 +1130,188 @@ static PyObject *adaptive_py(PyObject *self, PyObject *args)
         return NULL;
     }
     return PyFloat_FromDouble(adaptive(q, a, b, 0, rtol, max_depth));
+}
+
+/* VectorCycle's construction (compare_math.VectorCycle.__init__, the numpy version is the
+ * oracle tests/compare_oracle.vector_pieces / vector_sums), in two steps around the two
+ * 8-point dot products, which stay numpy matrix products `(n, 8) @ w` (a BLAS product
+ * whose rounding depends on the BLAS kernel and on n: kept as it is, so S is the same
+ * floats as before on every machine). */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* add x to the breakpoints unless an equal one is there (a Python set keeps the first) */
+static void bp_add(double *bp, Py_ssize_t *nb, double x)
+{
+    for (Py_ssize_t i = 0; i < *nb; i++)
+        if (bp[i] == x) return;
+    bp[(*nb)++] = x;
+}
+
+/* numpy.maximum(y, 0.0) then sqrt: NaN stays NaN, ties give the second argument */
+static inline double sq_row(const double *q, double x)
+{
+    double y = q[0] + x * (q[1] + x * (q[2] + x * (q[3] + x * q[4])));
+    return sqrt(y > 0.0 || y != y ? y : 0.0);
+}
+
+PyDoc_STRVAR(vector_pieces_doc,
+"vector_pieces(tracks, weights, ta, t1) -> (B, Q, R) as bytes of float64\n\n"
+"VectorCycle's pieces over [ta, t1]: B the breakpoints (ta, t1, every record start and\n"
+"velocity root inside, sorted), Q (n, 5) each piece's speed^2 quartic, R (2, n, 8) the\n"
+"speed at the nodes of one and of two Gauss-Legendre panels (summed), whose products\n"
+"with the weights vector_sums takes. tracks: tracks or history specs (see bank_scan).");
+
+static PyObject *vector_pieces(PyObject *self, PyObject *args)
+{
+    PyObject *tr_o, *w_o;
+    double ta, t1;
+    if (!PyArg_ParseTuple(args, "OOdd", &tr_o, &w_o, &ta, &t1)) return NULL;
+    if (!gl_set) {
+        PyErr_SetString(PyExc_RuntimeError, "set_gauss was not called");
+        return NULL;
+    }
+    PyObject *seq = PySequence_Fast(tr_o, "tracks must be a sequence of tracks");
+    if (seq == NULL) return NULL;
+    Py_ssize_t na = PySequence_Fast_GET_SIZE(seq), got = 0;  /* (any number of axes) */
+    Trk *T = calloc((size_t)(na > 0 ? na : 1), sizeof(Trk));
+    TrkBuf *tb = calloc((size_t)(na > 0 ? na : 1), sizeof(TrkBuf));
+    PyObject *res = NULL;
+    double *bp = NULL, *Q = NULL, *R = NULL;
+    Py_buffer wb;
+    int have_w = 0;
+    if (T == NULL || tb == NULL) { PyErr_NoMemory(); goto out; }
+    if (na < 1) {
+        PyErr_SetString(PyExc_ValueError, "tracks: at least one axis");
+        goto out;
+    }
+    if (get_vec(w_o, &wb, "weights") < 0) goto out;
+    have_w = 1;
+    if (wb.len != 8 * na) {
+        PyErr_SetString(PyExc_ValueError, "weights: one per track");
+        goto out;
+    }
+    const double *w = wb.buf;
+    Py_ssize_t cap = 2;
+    for (Py_ssize_t i = 0; i < na; i++) {
+        if (get_track_in(PySequence_Fast_GET_ITEM(seq, i), ta, t1, &T[i], &tb[i]) < 0) goto out;
+        got = i + 1;
+        cap += 3 * T[i].n;
+    }
+    bp = malloc((size_t)cap * sizeof(double));
+    if (bp == NULL) { PyErr_NoMemory(); goto out; }
+    Py_ssize_t nb = 0;
+    bp[nb++] = ta;
+    bp_add(bp, &nb, t1);
+    for (Py_ssize_t i = 0; i < na; i++) {
+        const Trk *tr = &T[i];
+        for (Py_ssize_t k = 0; k < tr->n; k++) {
+            double a_k = tr->ts[k];
+            double b_k = k + 1 < tr->n ? tr->ts[k + 1] : INFINITY;
+            if (ta < a_k && a_k < t1) bp_add(bp, &nb, a_k);
+            if (b_k <= ta || a_k >= t1) continue;
+            double r[2];
+            int nr = velocity_roots(tr->v0[k], tr->a0[k], tr->j[k], r);
+            for (int q = 0; q < nr; q++) {
+                double x = a_k + r[q];
+                if (ta < x && x < t1 && x < b_k) bp_add(bp, &nb, x);
+            }
+        }
+    }
+    qsort(bp, (size_t)nb, sizeof(double), cmp_double);
+    Py_ssize_t n = nb - 1;  /* pieces */
+    Q = calloc((size_t)(5 * n + 1), sizeof(double));
+    R = malloc((size_t)(16 * n + 1) * sizeof(double));
+    if (Q == NULL || R == NULL) { PyErr_NoMemory(); goto out; }
+    for (Py_ssize_t i = 0; i < na; i++) {
+        const Trk *tr = &T[i];
+        double wk = w[i];
+        for (Py_ssize_t p = 0; p < n; p++) {
+            double u = bp[p], mid = 0.5 * (bp[p] + bp[p + 1]);
+            Py_ssize_t k = search_right(tr->ts, 0, tr->n, mid) - 1;
+            if (k < 0) k = 0;
+            double d0 = u - tr->ts[k], j = tr->j[k];
+            double c0 = wk * (tr->v0[k] + d0 * (tr->a0[k] + d0 * j / 2.0));
+            double c1 = wk * (tr->a0[k] + d0 * j);
+            double c2 = wk * (j / 2.0);
+            double *q = Q + 5 * p;
+            q[0] += c0 * c0;
+            q[1] += 2.0 * c0 * c1;
+            q[2] += c1 * c1 + 2.0 * c0 * c2;
+            q[3] += 2.0 * c1 * c2;
+            q[4] += c2 * c2;
+        }
+    }
+    double *R1 = R, *R2 = R + 8 * n;
+    for (Py_ssize_t p = 0; p < n; p++) {
+        const double *q = Q + 5 * p;
+        double h = bp[p + 1] - bp[p];
+        for (int k = 0; k < 8; k++) {
+            double g = gl_x[k] + 1.0;
+            double x1 = (h / 2.0) * g, xa = (h / 4.0) * g;
+            R1[8 * p + k] = sq_row(q, x1);
+            R2[8 * p + k] = sq_row(q, xa) + sq_row(q, xa + h / 2.0);
+        }
+    }
+    res = Py_BuildValue("(y#y#y#)", (const char *)bp, (Py_ssize_t)(nb * 8),
+                        (const char *)Q, (Py_ssize_t)(5 * n * 8), (const char *)R,
+                        (Py_ssize_t)(16 * n * 8));
+out:
+    for (Py_ssize_t i = 0; i < got; i++) release_track(&tb[i]);
+    if (have_w) PyBuffer_Release(&wb);
+    Py_DECREF(seq);
+    free(T); free(tb); free(bp); free(Q); free(R);
+    return res;
+}
+
+PyDoc_STRVAR(vector_sums_doc,
+"vector_sums(B, Q, d1, d2, s0, rtol, max_depth) -> S as bytes of float64\n\n"
+"VectorCycle's cumulative lengths from vector_pieces: d1 = R1 @ w, d2 = R2 @ w; a\n"
+"piece's length is (h / 4) * d2 unless it differs from (h / 2) * d1 by more than rtol\n"
+"(relative), then adaptive(Q[i], 0, h, rtol, max_depth); S = s0 + [0, cumsum].");
+
+static PyObject *vector_sums(PyObject *self, PyObject *args)
+{
+    PyObject *o[4];
+    double s0, rtol;
+    int max_depth;
+    if (!PyArg_ParseTuple(args, "OOOOddi", &o[0], &o[1], &o[2], &o[3], &s0, &rtol,
+                          &max_depth))
+        return NULL;
+    if (!gl_set) {
+        PyErr_SetString(PyExc_RuntimeError, "set_gauss was not called");
+        return NULL;
+    }
+    static const char *names[4] = {"B", "Q", "d1", "d2"};
+    Py_buffer b[4];
+    int held = 0;
+    PyObject *res = NULL;
+    for (; held < 4; held++)
+        if (get_vec(o[held], &b[held], names[held]) < 0) goto out;
+    Py_ssize_t nb = b[0].len / 8, n = nb - 1;
+    if (nb < 1 || b[1].len != 5 * 8 * n || b[2].len != 8 * n || b[3].len != 8 * n) {
+        PyErr_SetString(PyExc_ValueError, "vector_sums: B (n + 1), Q (n, 5), d1 and d2 (n)");
+        goto out;
+    }
+    const double *B = b[0].buf, *Q = b[1].buf, *d1 = b[2].buf, *d2 = b[3].buf;
+    res = PyBytes_FromStringAndSize(NULL, nb * 8);
+    if (res == NULL) goto out;
+    double *S = (double *)PyBytes_AS_STRING(res), c = 0.0;
+    S[0] = s0 + 0.0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        double h = B[i + 1] - B[i];
+        double one = (h / 2.0) * d1[i], two = (h / 4.0) * d2[i];
+        if (fabs(two - one) > rtol * pymax(1e-300, fabs(two)))
+            two = adaptive(Q + 5 * i, 0.0, h, 0, rtol, max_depth);
+        c = i == 0 ? two : c + two;  /* numpy.cumsum */
+        S[i + 1] = s0 + c;
+    }
+out:
+    for (int k = 0; k < held; k++) PyBuffer_Release(&b[k]);
+    return res;
 }
 
 PyDoc_STRVAR(vector_at_doc, "vector_at(B, S, Q, t) -> s(t) (VectorCycle.at)");
@@ -1299,7 +1501,7 @@ done:
  * description (kind, track slots, values or points, action) is parsed once into a Bank
  * (a capsule, rebuilt when the engine's job set changes); its running state (`index`,
  * `hits`) stays on the job object, read and written here. */
-enum { K_LEVEL = 0, K_WINDOW = 1 };
+enum { K_LEVEL = 0, K_WINDOW = 1, K_VECTOR = 2 };
 enum { A_TOGGLE = 0, A_SET = 1, A_PULSE = 2 };
 
 typedef struct {
@@ -1335,6 +1537,7 @@ PyDoc_STRVAR(bank_new_doc,
 "kind 0 a "
 "LevelJob on track slots[0] (values: float64 array or (start, step), n of them, then\n"
 "after_final or None), 1 a WindowJob on slots (values: float64[n, len(slots)]); action\n"
+"2 a LevelJob on a path length, vector slots[0] (values as kind 0, direction unused);\n"
 "0 Toggle (flag = first), 1 SetLevel (flag = level), 2 Pulse (flag = active, width);\n"
 "line: the index of its OutputLine in bank_scan's `lines`, output: its number (logged).");
 
@@ -1387,7 +1590,7 @@ static PyObject *bank_new(PyObject *self, PyObject *args)
             PyErr_SetString(PyExc_ValueError, "action must be 0, 1 or 2");
             goto fail;
         }
-        if (S->kind == K_LEVEL) {
+        if (S->kind == K_LEVEL || S->kind == K_VECTOR) {
             if (get_levels(vals, nv, after, &S->L, &S->vb, &S->held) < 0) goto fail;
         } else if (S->kind == K_WINDOW) {
             if (get_vec(vals, &S->vb, "points") < 0) goto fail;
@@ -1399,7 +1602,8 @@ static PyObject *bank_new(PyObject *self, PyObject *args)
                 goto fail;
             }
         } else {
-            PyErr_SetString(PyExc_ValueError, "kind must be 0 (level) or 1 (window)");
+            PyErr_SetString(PyExc_ValueError, "kind must be 0 (level), 1 (window) or 2 "
+                            "(path length)");
             goto fail;
         }
     }
@@ -1537,7 +1741,7 @@ static int set_ll_attr(PyObject *o, PyObject *name, long long v)
 
 /* one job's scan of (ta, t1]: appends (time, value, index) to hits; returns the count or -1 */
 static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const double *hi,
-                           long long *index, double ta, double t1, double **hb,
+                           const Vc *V, long long *index, double ta, double t1, double **hb,
                            Py_ssize_t *hcap, double *ev, Py_ssize_t evcap)
 {
     Py_ssize_t m = 0;
@@ -1551,6 +1755,22 @@ static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const 
         (*hb)[3 * m] = (tt); (*hb)[3 * m + 1] = (vv); (*hb)[3 * m + 2] = (double)(ii); m++; \
     } while (0)
     ta = pymax(ta, S->t_armed);
+    if (S->kind == K_VECTOR) {  /* LevelJob.scan on a VectorSource (VectorCycle.scan) */
+        if (ta >= t1) return 0;
+        const Vc *vc = &V[S->slot[0]];
+        long long size = S->L.n + S->L.has_after, k = S->repeat ? 0 : *index;
+        double t = ta, tf;
+        while (k < size) {
+            double lvl = level_at(&S->L, k);
+            if (!time_of(vc, lvl, t, &tf)) break;
+            PUSH(tf, lvl, k);
+            if (S->repeat) return m;
+            k++;
+            t = tf;
+        }
+        *index = k;
+        return m;
+    }
     if (S->kind == K_LEVEL) {
         if (ta >= t1) return 0;
         int sl = S->slot[0];
@@ -1593,8 +1813,7 @@ static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const 
     double t = ta;
     while (k < S->npts) {
         double x;
-        int r = first_inside(W, S->na, S->pts + k * S->na, S->maxerr, t, t1, wlo, whi, NULL,
-                             &x);
+        int r = first_inside(W, S->na, S->pts + k * S->na, S->maxerr, t, t1, wlo, whi, &x);
         if (r < 0) return -1;
         if (r == 0) break;
         PUSH(x, (double)k, k);
@@ -1607,7 +1826,8 @@ static Py_ssize_t job_scan(const Spec *S, const Trk *T, const double *lo, const 
 }
 
 PyDoc_STRVAR(bank_scan_doc,
-"bank_scan(bank, jobs, tracks, lines, pos_tracks, ta, t1) -> (f, k, pos, done) or None\n\n"
+"bank_scan(bank, jobs, tracks, lines, pos_tracks, ta, t1, vectors=()) -> (f, k, pos, done)\n"
+"or None\n\n"
 "Run the bank's jobs over (ta, t1] in order (CompareEngine._scan for them): each job's\n"
 "hits (LevelJob.scan / WindowJob.scan from its `index`), its action on lines[line]\n"
 "(apply_many from its `hits`), `index` and `hits` written back. tracks: one per slot;\n"
@@ -1615,13 +1835,15 @@ PyDoc_STRVAR(bank_scan_doc,
 "times in job order, then hit order) as f (float64[m, 2]:\n"
 "time, value), k (int64[m, 4]: job id, point index, output, state), pos (float64[m,\n"
 "len(pos_tracks)]: every pos_track at each time) and done (bank positions of the jobs\n"
-"that finished), or None when nothing fired or finished.");
+"that finished), or None when nothing fired or finished. vectors: one VectorCycle's\n"
+"(B, S, Q) per vector slot (the path-length jobs' sources).");
 
 static PyObject *bank_scan(PyObject *self, PyObject *args)
 {
-    PyObject *cap, *jobs_o, *tr_o, *lines_o, *pt_o;
+    PyObject *cap, *jobs_o, *tr_o, *lines_o, *pt_o, *vc_o = NULL;
     double ta, t1;
-    if (!PyArg_ParseTuple(args, "OOOOOdd", &cap, &jobs_o, &tr_o, &lines_o, &pt_o, &ta, &t1))
+    if (!PyArg_ParseTuple(args, "OOOOOdd|O", &cap, &jobs_o, &tr_o, &lines_o, &pt_o, &ta, &t1,
+                          &vc_o))
         return NULL;
     Bank *B = PyCapsule_GetPointer(cap, "openmotion._compare.Bank");
     if (B == NULL) return NULL;
@@ -1633,6 +1855,12 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     }
     Py_ssize_t nt = PyList_GET_SIZE(tr_o), npt = PyList_GET_SIZE(pt_o);
     Py_ssize_t nl = PyList_GET_SIZE(lines_o);
+    PyObject *vseq = vc_o ? PySequence_Fast(vc_o, "vectors must be a sequence of (B, S, Q)")
+                          : PyTuple_New(0);
+    if (vseq == NULL) return NULL;
+    Py_ssize_t nv = PySequence_Fast_GET_SIZE(vseq), vgot = 0;
+    Vc *V = calloc((size_t)(nv + 1), sizeof(Vc));
+    VcBuf *vb = calloc((size_t)(nv + 1), sizeof(VcBuf));
     Trk *T = calloc((size_t)(nt + npt + 1), sizeof(Trk));
     TrkBuf *tb = calloc((size_t)(nt + npt + 1), sizeof(TrkBuf));
     double *lo = malloc((size_t)(nt + 1) * sizeof(double));
@@ -1642,7 +1870,17 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     Rows R = {NULL, NULL, 0, 0};
     double *hb = NULL, *ev = NULL;
     Py_ssize_t hcap = 0, got = 0, evcap = 0;
-    if (!T || !tb || !lo || !hi || !have_rng) { PyErr_NoMemory(); goto out; }
+    if (!T || !tb || !lo || !hi || !have_rng || !V || !vb) { PyErr_NoMemory(); goto out; }
+    for (; vgot < nv; vgot++) {
+        PyObject *bsq = PySequence_Fast_GET_ITEM(vseq, vgot);
+        if (!PyTuple_Check(bsq) || PyTuple_GET_SIZE(bsq) != 3) {
+            PyErr_SetString(PyExc_TypeError, "bank_scan: each vector must be (B, S, Q)");
+            goto out;
+        }
+        if (get_vc(PyTuple_GET_ITEM(bsq, 0), PyTuple_GET_ITEM(bsq, 1), PyTuple_GET_ITEM(bsq, 2),
+                   &V[vgot], &vb[vgot]) < 0)
+            goto out;
+    }
     for (Py_ssize_t i = 0; i < nt + npt; i++) {
         PyObject *o = i < nt ? PyList_GET_ITEM(tr_o, i) : PyList_GET_ITEM(pt_o, i - nt);
         if (get_track_in(o, ta, t1, &T[i], &tb[i]) < 0) goto out;
@@ -1654,6 +1892,13 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     if (ev == NULL || done == NULL) { if (!ev) PyErr_NoMemory(); goto out; }
     for (Py_ssize_t i = 0; i < B->n; i++) {
         const Spec *S = &B->s[i];
+        if (S->kind == K_VECTOR) {
+            if (S->slot[0] >= nv) {
+                PyErr_SetString(PyExc_IndexError, "bank_scan: vector slot");
+                goto out;
+            }
+            continue;
+        }
         for (int q = 0; q < S->na; q++) {
             int sl = S->slot[q];
             if (sl >= nt) { PyErr_SetString(PyExc_IndexError, "bank_scan: track slot"); goto out; }
@@ -1669,7 +1914,7 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
         long long index, hits;
         if (get_ll_attr(job, S_index, &index) < 0) goto out;
         long long index0 = index;
-        Py_ssize_t m = job_scan(S, T, lo, hi, &index, ta, t1, &hb, &hcap, ev, evcap);
+        Py_ssize_t m = job_scan(S, T, lo, hi, V, &index, ta, t1, &hb, &hcap, ev, evcap);
         if (m < 0) goto out;
         if (index != index0 && set_ll_attr(job, S_index, index) < 0) goto out;
         if (m > 0) {
@@ -1707,8 +1952,8 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
             }
             if (set_ll_attr(job, S_hits, hits + m) < 0) goto out;
         }
-        int finished = S->kind == K_LEVEL ? (!S->repeat && index >= S->L.n + S->L.has_after)
-                                          : index >= S->npts;
+        int finished = S->kind != K_WINDOW ? (!S->repeat && index >= S->L.n + S->L.has_after)
+                                           : index >= S->npts;
         if (finished) {
             PyObject *x = PyLong_FromSsize_t(i);
             if (x == NULL || PyList_Append(done, x) < 0) { Py_XDECREF(x); goto out; }
@@ -1717,8 +1962,10 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     }
     if (R.m == 0 && PyList_GET_SIZE(done) == 0) { res = Py_NewRef(Py_None); goto out; }
     if (rows_sort(&R) < 0) goto out;
-    res = Py_BuildValue("(y#y#y#O)", (const char *)R.f, (Py_ssize_t)(R.m * 2 * sizeof(double)),
-                        (const char *)R.k, (Py_ssize_t)(R.m * 4 * sizeof(long long)),
+    /* (no rows but a job done: empty bytes, not None, for a NULL buffer) */
+    res = Py_BuildValue("(y#y#y#O)", R.f ? (const char *)R.f : "",
+                        (Py_ssize_t)(R.m * 2 * sizeof(double)),
+                        R.k ? (const char *)R.k : "", (Py_ssize_t)(R.m * 4 * sizeof(long long)),
                         "", (Py_ssize_t)0, done);
     if (res == NULL) goto out;
     {
@@ -1738,6 +1985,9 @@ static PyObject *bank_scan(PyObject *self, PyObject *args)
     }
 out:
     for (Py_ssize_t i = 0; i < got; i++) release_track(&tb[i]);
+    for (Py_ssize_t i = 0; i < vgot; i++) release_vc(&vb[i]);
+    free(V); free(vb);
+    Py_DECREF(vseq);
     free(T); free(tb); free(lo); free(hi); free(have_rng); free(hb); free(ev);
     free(R.f); free(R.k);
     Py_XDECREF(done);
@@ -2045,6 +2295,8 @@ static PyMethodDef methods[] = {
     {"vector_at", vector_at, METH_VARARGS, vector_at_doc},
     {"time_of", time_of_py, METH_VARARGS, time_of_doc},
     {"vector_scan", vector_scan, METH_VARARGS, vector_scan_doc},
+    {"vector_pieces", vector_pieces, METH_VARARGS, vector_pieces_doc},
+    {"vector_sums", vector_sums, METH_VARARGS, vector_sums_doc},
     {"line_set", line_set, METH_VARARGS, line_set_doc},
     {"solver_checks", solver_checks, METH_VARARGS, solver_checks_doc},
     {"bank_new", bank_new, METH_VARARGS, bank_new_doc},
