@@ -30,6 +30,7 @@ from .options import GCodeOptions
 from .params import Parameters
 from .parser import MAX_LINES, Block, Program, parse_program
 from .probing import Request, Result, apply_result, preview_result
+from .progunits import CompiledProgram, program_units
 from .source import GCodeError, decode_program, read_program
 from .splines import open_block_error
 
@@ -601,7 +602,8 @@ def interpret(program: Program, options: GCodeOptions) -> list[canon.Command]:
 
 
 def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon.Command]:
-    """Parse and interpret G-code text into canonical commands (machine coordinates)."""
+    """Parse and interpret G-code text into canonical commands (machine coordinates); a
+    `CompiledProgram` list, whose `units` are the program's G20/G21 unit (progunits.py)."""
     if not isinstance(options, GCodeOptions):
         raise GCodeError(f"options must be GCodeOptions, got {type(options).__name__}")
     if isinstance(text, bytes):
@@ -621,7 +623,10 @@ def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon
 def _compile_full(text: str, options: GCodeOptions, file: str) -> list[canon.Command]:
     """The general path: parse the whole program, then interpret it."""
     program = parse_program(text, file, options.max_line_length)
-    return interpret(program, options)
+    interp = Interpreter(program, options)
+    out = interp.run()
+    return CompiledProgram(out, program_units(out, interp.modal.unit_log,
+                                              options.machine_units))
 
 
 def compile_file(path: str | os.PathLike[str], options: GCodeOptions) -> list[canon.Command]:
