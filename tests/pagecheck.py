@@ -71,3 +71,12 @@ def draw(page: Path) -> dict:
             return out
         finally:
             b.close()
+
+
+def array(v: object) -> list:
+    """A figure array as plotly writes it: a list, or {dtype, bdata} (base64 binary)."""
+    import numpy as np
+
+    if isinstance(v, dict) and "bdata" in v:
+        return np.frombuffer(base64.b64decode(v["bdata"]), dtype=v["dtype"]).tolist()
+    return list(v)  # type: ignore[call-overload]
