@@ -125,3 +125,29 @@ def test_a_program_that_switches_units_says_so(tmp_path):
     titles = {f["layout"].get("yaxis", {}).get("title", {}).get("text")
               for f in figures(page).values()}
     assert "speed (in/min)" in titles
+
+
+@pytest.mark.parametrize("machine, program, label, k", [
+    ("mm", "inch", "in", 1 / 25.4), ("inch", "mm", "mm", 25.4), ("mm", "mm", "mm", 1.0),
+    ("inch", "inch", "in", 1.0)])
+def test_drawn_units_scale_linear_axes_to_the_program_unit_and_keep_degrees(
+        machine, program, label, k):
+    from types import SimpleNamespace
+
+    from openmotion.program.report_html import drawn_units
+
+    run = SimpleNamespace(program_units=ProgramUnits(program), machine_units=machine,
+                          scales=SimpleNamespace(rotary=np.array([False, False, True])))
+    got, scale = drawn_units(run)
+    assert got == label and scale.tolist() == pytest.approx([k, k, 1.0])
+
+
+def test_a_command_list_is_drawn_in_machine_units():
+    from openmotion.control import Controller
+    from openmotion.program.runner import ProgramRunner
+
+    ctl = Controller()
+    run = ProgramRunner(ctl, "G20\nG0 X1\nM2\n")
+    assert run.program_units == ProgramUnits("inch")
+    # canonical commands carry no unit: a list given to the runner is drawn as the machine's
+    assert ProgramRunner(ctl, list(run.commands)).program_units == ProgramUnits("mm")
