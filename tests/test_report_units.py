@@ -151,3 +151,16 @@ def test_a_command_list_is_drawn_in_machine_units():
     assert run.program_units == ProgramUnits("inch")
     # canonical commands carry no unit: a list given to the runner is drawn as the machine's
     assert ProgramRunner(ctl, list(run.commands)).program_units == ProgramUnits("mm")
+
+
+def test_an_endless_main_program_keeps_its_unit_log_flat():
+    # M99 in the main program: each pass's commands are dropped, so is its unit log
+    from openmotion.program.interp import Interpreter
+    from openmotion.program.parser import parse_program
+
+    s = Interpreter(parse_program("G20\nG0 X1\nG21\nG0 X0\nM99\n", "", 1000), OPTS).session()
+    s.advance()
+    for _ in range(50):
+        s.advance(True)
+        assert len(s._interp.modal.unit_log) <= 2
+    assert compile_text("G20\nG0 X1\nG21\nG0 X0\nM99\n", OPTS).units == ProgramUnits("inch", True)

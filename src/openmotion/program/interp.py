@@ -562,6 +562,7 @@ class Session:
         self._taken = len(out)
         if isinstance(self.request, canon.End):  # a pass is over: forget its commands
             out.clear()  # (no compensated move is pending at an M99: memory stays flat)
+            self._interp.modal.unit_log.clear()  # (its positions are in the pass's commands)
             self._taken = 0
         return chunk
 
