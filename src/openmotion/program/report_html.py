@@ -7,7 +7,8 @@ soft-limit box (the travel between the limit switches) and the worst contour err
 path speed, commanded (programmed feed times the override) against executed; per moving
 axis position, velocity, acceleration and jerk against time; contour error against time;
 outputs as off/on lanes. report_page.py puts the summary, the extents table, the event
-table and the program listing (linked to the path both ways) around them.
+table and the program listing (linked to the path both ways) around them. Lengths, feeds
+and speeds are drawn in the program's units (`drawn_units`: G20 -> in, in/min).
 
 Traces are decimated to what a screen shows (`screen_indices`: per pixel column the first,
 lowest, highest and last sample), so a 100k-line program gives a page of the same size as a
