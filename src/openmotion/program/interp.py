@@ -30,6 +30,7 @@ from .options import GCodeOptions
 from .params import Parameters
 from .parser import MAX_LINES, Block, Program, parse_program
 from .probing import Request, Result, apply_result, preview_result
+from .progunits import CompiledProgram, program_units
 from .source import GCodeError, decode_program, read_program
 from .splines import open_block_error
 
@@ -569,6 +570,7 @@ class Session:
         self._taken = len(out)
         if isinstance(self.request, canon.End):  # a pass is over: forget its commands
             out.clear()  # (no compensated move is pending at an M99: memory stays flat)
+            self._interp.modal.unit_log.clear()  # (its positions are in the pass's commands)
             self._taken = 0
         return chunk
 
@@ -609,7 +611,8 @@ def interpret(program: Program, options: GCodeOptions) -> list[canon.Command]:
 
 
 def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon.Command]:
-    """Parse and interpret G-code text into canonical commands (machine coordinates)."""
+    """Parse and interpret G-code text into canonical commands (machine coordinates); a
+    `CompiledProgram` list, whose `units` are the program's G20/G21 unit (progunits.py)."""
     if not isinstance(options, GCodeOptions):
         raise GCodeError(f"options must be GCodeOptions, got {type(options).__name__}")
     if isinstance(text, bytes):
@@ -641,7 +644,10 @@ def percent_closed(lines: list[str]) -> bool:
 def _compile_full(text: str, options: GCodeOptions, file: str) -> list[canon.Command]:
     """The general path: parse the whole program, then interpret it."""
     program = parse_program(text, file, options.max_line_length)
-    return interpret(program, options)
+    interp = Interpreter(program, options)
+    out = interp.run()
+    return CompiledProgram(out, program_units(out, interp.modal.unit_log,
+                                              options.machine_units))
 
 
 def compile_file(path: str | os.PathLike[str], options: GCodeOptions) -> list[canon.Command]:

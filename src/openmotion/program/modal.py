@@ -67,6 +67,9 @@ class Modal:
         self.pos: list[float] = list(options.start or ())
         self.machine_mm = options.machine_units == "mm"
         self.units = options.machine_units  # program units, "mm" or "inch"
+        # every G20/G21 (or restore) run: (commands output before its block, line, unit)
+        self.unit_log: list[tuple[int, int, str]] = []
+        self.out_at = 0
         self.lscale = 1.0  # program length unit -> machine unit: v * lscale / ldiv
         self.ldiv = 1.0
         self.incremental = False
@@ -263,6 +266,7 @@ class Modal:
     def execute(self, b: Block, out: list[canon.Command]) -> bool:  # noqa: C901
         line, file = b.line, b.file
         self.line = line
+        self.out_at = len(out)  # where this block's commands start (unit_log)
         gs: dict[int, tuple[int, int]] = {}  # group -> (code, pos)
         ms: dict[int, tuple[int, int]] = {}
         words: dict[str, Word] = {}
@@ -541,6 +545,7 @@ class Modal:
         comment_commands(b, self.params, self.opt.keep_comments, out)
 
     def _set_units(self, units: str) -> None:
+        self.unit_log.append((self.out_at, self.line, units))  # progunits.py
         self.units = units
         self.lscale = self.ldiv = 1.0
         if units != self.opt.machine_units:
