@@ -1,7 +1,7 @@
 """The compare engine's solvers in plain Python: the test oracle of openmotion._compare.
 
 These are the Python versions the engine ran before the solvers were compiled
-(src/openmotion/_kernel_compare.c), moved here unchanged in their arithmetic (the
+(src/openmotion/_compare_*.c), moved here unchanged in their arithmetic (the
 one-implementation rule: src/ holds only the compiled one). The functions have the
 compiled module's signatures, so a test can run the whole engine on them by replacing
 `compare_math._ck` with this module (`use_oracle`), and compare every fired time, log row

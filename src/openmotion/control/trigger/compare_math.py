@@ -11,7 +11,7 @@ feedback model) and asks three questions, each answered between cycles, not at c
   the time it reaches a given distance;
 - `first_inside`: the first time all axes are within +-maxerr of a point (2-D/3-D tables).
 
-The solvers themselves are compiled (openmotion._compare, src/openmotion/_kernel_compare.c):
+The solvers themselves are compiled (openmotion._compare, src/openmotion/_compare_*.c):
 a job's whole scan of a cycle (every value or point it reaches, in turn) is one call. Their
 plain-Python versions, which give the same floats, are the test oracle in
 tests/compare_oracle.py; `_ck` is the one handle the engine calls them through.
