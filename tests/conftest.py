@@ -3,9 +3,22 @@
 from __future__ import annotations
 
 import os
+import sys
+from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+# Where PYTHONDONTWRITEBYTECODE is set (no __pycache__ beside the sources), the suite still
+# keeps the compiled modules, in .pytest_cache/pycache: otherwise every xdist worker
+# recompiles the package and re-runs pytest's assertion rewriting of every test module at
+# each run (about 9 s of CPU per worker). Child processes (the `openmotion` subprocesses
+# of the CLI and browser tests) are left as they are: they import modules that collection
+# never imports, which would then be compiled from source in each of them.
+if sys.dont_write_bytecode and not sys.pycache_prefix:
+    _PYCACHE = Path(__file__).resolve().parents[1] / ".pytest_cache" / "pycache"
+    sys.pycache_prefix = str(_PYCACHE)
+    sys.dont_write_bytecode = False
 
 # CI replays the same examples on every run (derandomize) so that a landing is decided by the
 # code, not by the draw; local runs keep drawing new examples, and a failure they find is
