@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -72,18 +73,29 @@ def _reduce_properties(items: list[pytest.Item]) -> None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Property tests reduced unless --long (see PROPERTY_SHARE). Browser tests first (a
-    stable sort: module order kept). They are the longest and run one after another on a
-    module's server, so under xdist (`--dist worksteal`, set in pyproject.toml) they start
-    at once and the short tests fill the other worker around them, instead of the browser
-    modules running alone at the end."""
+    """Property tests reduced unless --long (see PROPERTY_SHARE). Browser modules first (a
+    module with a test that uses `page` or `browser`, whole, so that its module fixtures
+    are made once; a stable sort: module order kept). They are the longest and run one
+    after another on a module's server, so under xdist (`--dist worksteal`, set in
+    pyproject.toml) they start at once and the short tests fill the other worker around
+    them, instead of the browser modules running alone at the end."""
+    browser_modules = {item.nodeid.split("::")[0] for item in items
+                       if {"page", "browser"} & set(getattr(item, "fixturenames", ()))}
+
     def browser_first(item: pytest.Item) -> int:
-        names = getattr(item, "fixturenames", ())
-        return 0 if "page" in names or "browser" in names else 1
+        return 0 if item.nodeid.split("::")[0] in browser_modules else 1
 
     if not config.getoption("--long"):
         _reduce_properties(items)
     items.sort(key=browser_first)
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[object]:
+    """Chromium for the browser tests (tests/ui_browser.py), started once per process."""
+    from ui_browser import chromium
+
+    yield from chromium()
 
 
 @pytest.fixture
