@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import os
 import sys
 from collections.abc import Iterator
@@ -88,6 +89,23 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if not config.getoption("--long"):
         _reduce_properties(items)
     items.sort(key=browser_first)
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """The modules and tests collected now live for the whole session: frozen (gc.freeze),
+    so that a full garbage collection, automatic or asked for by a test or by the realtime
+    executor, does not scan them again each time (~0.1 s of CPU per collection)."""
+    gc.collect()
+    gc.freeze()
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_runtest_teardown(item: pytest.Item, nextitem: pytest.Item | None) -> None:
+    """Freeze again after a test whose realtime executor unfroze everything (it freezes
+    the objects alive while it runs)."""
+    if gc.get_freeze_count() == 0:
+        gc.collect()
+        gc.freeze()
 
 
 @pytest.fixture(scope="session")
