@@ -1,5 +1,6 @@
 """Build of the compiled inner loops (openmotion._kernel, src/openmotion/_kernel*.c, and
-openmotion._compare, src/openmotion/_kernel_compare.c: the compare engine's solvers, and
+openmotion._compare, src/openmotion/_kernel_compare.c + _compare_*.c: the compare engine's
+solvers, and
 openmotion._profile, src/openmotion/_profile.c: the jerk-limited profile builder, and
 openmotion._corner, src/openmotion/_corner.c: the line-line corner blend); the rest
 is declared in pyproject.toml. Plain C against the CPython API: no build tool beyond setuptools.
@@ -17,7 +18,11 @@ setup(ext_modules=[Extension("openmotion._kernel",
                               "src/openmotion/_kernel_rt.c", "src/openmotion/_kernel_record.c"],
                              depends=["src/openmotion/_kernel.h"],
                              extra_compile_args=flags),
-                   Extension("openmotion._compare", ["src/openmotion/_kernel_compare.c"],
+                   Extension("openmotion._compare",
+                             ["src/openmotion/_kernel_compare.c"]
+                             + [f"src/openmotion/_compare_{job}.c"
+                                for job in ("track", "window", "vector", "lines", "scan")],
+                             depends=["src/openmotion/_compare.h"],
                              extra_compile_args=flags),
                    Extension("openmotion._profile", ["src/openmotion/_profile.c"],
                              extra_compile_args=flags),

@@ -1,7 +1,7 @@
 """The compare engine's solvers in plain Python: the test oracle of openmotion._compare.
 
 These are the Python versions the engine ran before the solvers were compiled
-(src/openmotion/_kernel_compare.c), moved here unchanged in their arithmetic (the
+(src/openmotion/_compare_*.c), moved here unchanged in their arithmetic (the
 one-implementation rule: src/ holds only the compiled one). The functions have the
 compiled module's signatures, so a test can run the whole engine on them by replacing
 `compare_math._ck` with this module (`use_oracle`), and compare every fired time, log row
@@ -296,6 +296,83 @@ def vector_scan(B, S, Q, levels, n, after_final, index, t, first_only):  # noqa:
     return out
 
 
+def vector_cycle_numpy(tracks, weights, ta: float, t1: float, s0: float):  # noqa: ANN001, ANN201
+    """VectorCycle.__init__ as it was in numpy, whole: (B, Q, S) (tracks: Track rows)."""
+    import numpy as np
+
+    B, Q, R = (np.frombuffer(x) for x in vector_pieces(tracks, weights, ta, t1))
+    n = B.size - 1
+    Q, R = Q.reshape(n, 5), R.reshape(2, n, 8)
+    w = np.array([wg for _, wg in _GL_PAIRS])
+    d1 = np.ascontiguousarray(R[0]) @ w  # (the old code's two fresh (n, 8) @ w products)
+    d2 = np.ascontiguousarray(R[1]) @ w
+    return B, Q, np.frombuffer(vector_sums(B, Q, d1, d2, s0, 1e-13, 10))
+
+
+def vector_pieces(tracks, weights, ta: float, t1: float):  # noqa: ANN001, ANN201
+    """VectorCycle.__init__'s pieces as it was in numpy: B, Q and the node speeds R
+    (bytes, the compiled module's form; the products with the weights stay numpy's)."""
+    import numpy as np
+
+    tracks = [spec_track(s, ta, t1) for s in tracks]
+    w = np.asarray(weights, dtype=np.float64)
+    bps = {ta, t1}
+    for tr in tracks:
+        n = tr.ts.size
+        for k in range(n):
+            a_k = float(tr.ts[k])
+            b_k = float(tr.ts[k + 1]) if k + 1 < n else math.inf
+            if ta < a_k < t1:
+                bps.add(a_k)
+            if b_k <= ta or a_k >= t1:
+                continue
+            for r in velocity_roots(float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])):
+                tr_ = a_k + r
+                if ta < tr_ < t1 and tr_ < b_k:
+                    bps.add(tr_)
+    B = np.array(sorted(bps))
+    u = B[:-1]
+    mid = 0.5 * (B[:-1] + B[1:])
+    Q = np.zeros((u.size, 5))
+    for tr, wk in zip(tracks, w, strict=True):
+        k = np.maximum(np.searchsorted(tr.ts, mid, side="right") - 1, 0)
+        d0 = u - tr.ts[k]
+        j = tr.j[k]
+        c0 = wk * (tr.v0[k] + d0 * (tr.a0[k] + d0 * j / 2.0))
+        c1 = wk * (tr.a0[k] + d0 * j)
+        c2 = wk * (j / 2.0)
+        Q[:, 0] += c0 * c0
+        Q[:, 1] += 2.0 * c0 * c1
+        Q[:, 2] += c1 * c1 + 2.0 * c0 * c2
+        Q[:, 3] += 2.0 * c1 * c2
+        Q[:, 4] += c2 * c2
+    H = B[1:] - u
+    gx = np.array([x for x, _ in _GL_PAIRS])
+
+    def sq_rows(x):  # noqa: ANN001, ANN202
+        y = Q[:, 0:1] + x * (Q[:, 1:2] + x * (Q[:, 2:3] + x * (Q[:, 3:4] + x * Q[:, 4:5])))
+        return np.sqrt(np.maximum(y, 0.0))
+
+    x1 = (H[:, None] / 2.0) * (gx[None, :] + 1.0)
+    xa = (H[:, None] / 4.0) * (gx[None, :] + 1.0)
+    r1 = sq_rows(x1)
+    r2 = sq_rows(xa) + sq_rows(xa + H[:, None] / 2.0)
+    return B.tobytes(), Q.tobytes(), r1.tobytes() + r2.tobytes()
+
+
+def vector_sums(B, Q, d1, d2, s0: float, rtol: float, max_depth: int):  # noqa: ANN001, ANN201
+    """VectorCycle.__init__'s sums as it was in numpy (d1, d2: the weight products)."""
+    import numpy as np
+
+    H = B[1:] - B[:-1]
+    one = (H / 2.0) * d1
+    two = (H / 4.0) * d2
+    bad = np.abs(two - one) > rtol * np.maximum(np.abs(two), 1e-300)
+    for i in np.flatnonzero(bad):
+        two[i] = adaptive(_row(Q, i), 0.0, float(H[i]), rtol, max_depth)
+    return (s0 + np.concatenate([[0.0], np.cumsum(two)])).tobytes()
+
+
 # ---------------------------------------------------------------------------- output lines
 def line_set(t_list: list[float], lv_list: list[bool], initial: bool, times, levels,  # noqa: ANN001
              sent_until: float, late: list[float]) -> None:
@@ -331,21 +408,26 @@ def bank_new(specs):  # noqa: ANN001, ANN201
 
 def spec_track(spec, ta: float, t1: float):  # noqa: ANN001, ANN201
     """A track spec (hist, scale, offset, e0, slope, t_ref) as CompareEngine.track builds
-    it in Python: MotionHistory.rows of the window, then affine_track (a 5-tuple: as is)."""
-    if len(spec) != 6:
+    it in Python: MotionHistory.rows of the window, then affine_track ((hist,): the rows;
+    a 5-tuple: as is)."""
+    if len(spec) not in (1, 6):
         return spec
     from openmotion.control.trigger.compare_math import Track, affine_track
 
-    h, scale, offset, e0, slope, t_ref = spec
+    h = spec[0]
     lo = max(h.index_at(ta) - 1, h.lo)
     hi = max(h.index_at(t1), lo) + 1
     tr = Track(*(c[lo:hi] for c in (h.ts, h.p0, h.v0, h.a0, h.j)))
-    return affine_track(tr, scale, offset, e0, slope, t_ref)
+    if len(spec) == 1:  # (hist,): the rows as stored (MotionHistory.rows)
+        return tr
+    return affine_track(tr, *spec[1:])
 
 
-def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # noqa: ANN001, ANN201
-    """CompareEngine's job loop for LevelJob (axis) / WindowJob with Toggle, SetLevel or
-    Pulse, as it was in Python: each job's scan, its action on its line, its row."""
+def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float,  # noqa: ANN001, ANN201
+              vectors=()):  # noqa: ANN001
+    """CompareEngine's job loop for LevelJob (axis or path length) / WindowJob with Toggle,
+    SetLevel or Pulse, as it was in Python: each job's scan, its action on its line, its
+    row. vectors: (B, S, Q) of each path-length source."""
     tracks = [spec_track(s, ta, t1) for s in tracks]
     pos_tracks = [spec_track(s, ta, t1) for s in pos_tracks]
     ranges: dict[int, tuple[float, float]] = {}
@@ -355,10 +437,23 @@ def bank_scan(bank, jobs, tracks, lines, pos_tracks, ta: float, t1: float):  # n
     for i, (spec, job) in enumerate(zip(bank, jobs, strict=True)):
         (code, slots, direction, repeat, vals, n, after, maxerr, t_armed, jid, act, flag,
          width, ln, output) = spec
-        rng = [ranges.setdefault(s, track_range(tracks[s], ta, t1)) for s in slots]
+        rng = [] if code == 2 else [ranges.setdefault(s, track_range(tracks[s], ta, t1))
+                                    for s in slots]
         a = max(ta, t_armed)
         hits: list[tuple[float, float, int]] = []
-        if code == 0:
+        if code == 2:  # LevelJob.scan on a VectorSource
+            size = n + (after is not None)
+            B, S, Q = vectors[slots[0]]
+            if a < t1:
+                if repeat:
+                    hits = [(tf, v, 0) for tf, v in vector_scan(B, S, Q, vals, n, after, 0, a,
+                                                                True)]
+                elif job.index < size:
+                    found = vector_scan(B, S, Q, vals, n, after, job.index, a, False)
+                    hits = [(tf, v, job.index + q) for q, (tf, v) in enumerate(found)]
+                    job.index += len(found)
+            finished = not repeat and job.index >= size
+        elif code == 0:
             size = n + (after is not None)
             if a < t1:
                 if repeat:

@@ -15,6 +15,7 @@ Run as a script for the figures: `python tests/lcnc_oracle.py tests/gcode_oracle
 
 from __future__ import annotations
 
+import fcntl
 import math
 import os
 import re
@@ -222,9 +223,11 @@ def inch_tool_table(path: Path = TOOLS) -> str:
 
 
 def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None,
-              extra_files: dict[str, str] | None = None, timeout: float = 60.0
-              ) -> Rs274Result:
-    """Run rs274 on program text (in a scratch folder, with `extra_files` next to it)."""
+              extra_files: dict[str, str] | None = None, timeout: float = 60.0,
+              ini: str = "", flags: tuple[str, ...] = ()) -> Rs274Result:
+    """Run rs274 on program text (in a scratch folder, with `extra_files` next to it: names
+    may hold sub-folders). `ini`: more INI sections after ours (a test's own INI file);
+    `flags`: more rs274 options (`-n 0`)."""
     tool_table = inch_tool_table() if tool_table is None else tool_table
     exe = rs274 or rs274_path()
     if exe is None:
@@ -233,15 +236,22 @@ def run_rs274(text: str, rs274: str | None = None, tool_table: str | None = None
         d = Path(tmp)
         (d / "test.ngc").write_text(text)
         (d / "tool.tbl").write_text(tool_table)
-        (d / "test.ini").write_text(INI)
+        (d / "test.ini").write_text(INI + ini)
         for name, body in (extra_files or {}).items():
+            (d / name).parent.mkdir(parents=True, exist_ok=True)
             (d / name).write_text(body)
-        for _ in range(2):  # rs274 was seen dying by a signal (SIGBUS) under load: retry
-            proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", "-g",
-                                   "test.ngc"], cwd=d, capture_output=True, text=True,
-                                  timeout=timeout, env={**os.environ, "TMPDIR": tmp})
-            if proc.returncode >= 0:
-                break
+        # One rs274 at a time on this machine: two at once were seen to lose their tool
+        # tables ("Requested tool N not found") or die by a signal (SIGBUS), as if they
+        # shared their tool data; a lock file serialises the test workers and survey jobs.
+        with open(os.path.join(tempfile.gettempdir(), "openmotion-rs274.lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            for _ in range(2):  # a signal death is retried once
+                proc = subprocess.run([exe, "-i", "test.ini", "-t", "tool.tbl", *flags,
+                                       "-g", "test.ngc"], cwd=d, capture_output=True,
+                                      text=True, timeout=timeout,
+                                      env={**os.environ, "TMPDIR": tmp})
+                if proc.returncode >= 0:
+                    break
     listing = proc.stdout
     msgs = re.findall(r'MESSAGE\("(.*)"\)', listing)
     error = None

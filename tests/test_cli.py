@@ -115,9 +115,16 @@ def test_config_refuses_a_machine_without_axes(tmp_path, capsys):
 
 def test_empty_program_is_reported(tmp_path, capsys):
     p = tmp_path / "empty.ngc"
-    p.write_text("(nothing here)\n%\n")
+    p.write_text("(nothing here)\nM2\n")
     assert main(["run", str(p), "--out", str(tmp_path)]) == 2
     assert "no moves or actions" in capsys.readouterr().err
+
+
+def test_a_program_without_motion_runs_and_reports(tmp_path, capsys):
+    p = tmp_path / "io.ngc"
+    p.write_text("G21\nM64 P1\nG4 P0.5\nM65 P1\nM2\n")  # outputs and a dwell only
+    assert main(["run", str(p), "--out", str(tmp_path)]) == 0
+    assert "report:" in capsys.readouterr().out and (tmp_path / "io.html").exists()
 
 
 def test_run_options_and_g54_announcement(tmp_path, capsys):

@@ -183,7 +183,7 @@ def _scenario(seed: int) -> dict:
             lambda o: SetLevel(o, bool(rng.integers(2)))]
     for k in range(int(rng.integers(3, 8))):
         act = acts[int(rng.integers(3))](k % 8)
-        kind = int(rng.integers(6))
+        kind = int(rng.integers(8))
         if kind == 0:
             eng.add(LevelJob(AxisSource(int(rng.integers(2))),
                              np.sort(rng.uniform(-600, 600, int(rng.integers(1, 40)))),
@@ -199,6 +199,14 @@ def _scenario(seed: int) -> dict:
                                       int(rng.integers(1, 200))), act))
         elif kind == 3:
             eng.add(every_distance(VectorSource((0, 1)), float(rng.uniform(5, 60)), act))
+        elif kind == 6:  # a path length in units, one value armed again and again
+            eng.add(LevelJob(VectorSource((0, 1), (2.0, 0.5)), [float(rng.uniform(0, 400))],
+                             act, repeat=True))
+        elif kind == 7:  # a path-length table, then the value after it
+            eng.add(LevelJob(VectorSource((1, 0)),
+                             np.sort(rng.uniform(0, 1500, int(rng.integers(1, 30)))), act,
+                             after_final=float(rng.uniform(1500, 2500))
+                             if rng.integers(2) else None))
         else:
             pts = rng.uniform(-600, 600, (int(rng.integers(1, 30)), 2))
             eng.add(WindowJob((0, 1), pts, float(rng.uniform(1, 400)), act,

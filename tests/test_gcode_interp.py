@@ -184,7 +184,8 @@ def test_tool_length_offset():
     opts = GCodeOptions(axes={"X": 0, "Z": 1}, tool_lengths={1: 10.0})
     assert last_end("T1 M6 G43\nG0 Z0", opts) == (0.0, 10.0)
     assert last_end("G43 H1\nG0 Z1\nG49\nG0 Z1", opts) == (0.0, 1.0)
-    assert last_end("G43 H5\nG0 Z1", opts) == (0.0, 1.0)   # unknown tool: length 0
+    with pytest.raises(GCodeError, match="requested tool 5 is not in the tool table"):
+        last_end("G43 H5\nG0 Z1", opts)  # LinuxCNC refuses a tool not in the table
 
 
 # -- arcs --------------------------------------------------------------------------------

@@ -28,6 +28,8 @@ def refused(text: str, **kw: object) -> str:
 @pytest.mark.parametrize("text, line, word", [
     ("O100 while [1]\nO100 endwhile\n", 1, "O100 while"),
     ("G0 X0\nO7 while [1]\nG1 X1 F100\nG1 X0\nO7 endwhile\n", 2, "O7 while"),
+    # G20/G21 in the loop: the unit log grows (a record, progunits.py), the state does not
+    ("G0 X0\nO8 while [1]\nG20\nG1 X1 F10\nG21\nG1 X0\nO8 endwhile\n", 2, "O8 while"),
     ("O3 do\n#1 = 5\nO3 while [1]\n", 1, "O3 do"),
     ("O1 sub\n#<_cnt> = #1\nO1 endsub\nO9 while [1]\nO1 call [3]\nO9 endwhile\n", 4, "O9 while"),
     ("O5 repeat [1]\nO6 while [#5420 LT 1]\nG90\nO6 endwhile\nO5 endrepeat\n", 2, "O6 while"),

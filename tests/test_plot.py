@@ -9,6 +9,7 @@ from openmotion.errors import MotionError
 from openmotion.plot import envelope, plot_profile, plot_trace, profile_times
 from openmotion.profile.segments import ProfileBuilder, empty_profile
 from openmotion.recording import Recorder, load_trace
+from pagecheck import assert_self_contained
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -38,12 +39,12 @@ def assert_png(path) -> None:
 
 
 def assert_html(path, title: str) -> None:
-    """An interactive plotly page (the run report's style), plotly.js beside it."""
+    """An interactive plotly page (the run report's style), one file: plotly.js embedded."""
     text = path.read_text(encoding="utf-8")
     assert text.startswith("<!DOCTYPE html>")
-    assert "Plotly.newPlot" in text and "<script src='plotly.min.js'>" in text
-    assert f"<title>{title}</title>" in text
-    assert (path.parent / "plotly.min.js").stat().st_size > 1_000_000
+    assert "application/vnd.plotly+json" in text and f"<title>{title}</title>" in text
+    assert_self_contained(text)
+    assert not (path.parent / "plotly.min.js").exists()
 
 
 def test_plot_profile_png_and_html(tmp_path) -> None:

@@ -14,6 +14,7 @@ from openmotion.errors import MotionError
 from openmotion.program.points import PointTable
 from openmotion.program.runjob import work_origin
 from openmotion.program.runner import ProgramRunner
+from pagecheck import assert_self_contained
 
 EX = Path(__file__).resolve().parent.parent / "examples" / "programs"
 
@@ -82,8 +83,9 @@ def test_openmotion_run_writes_summary_and_report(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "done (2 pass(es))" in out and "contour error" in out
     html = (tmp_path / "out" / "job.html").read_text()
-    assert "Plotly.newPlot" in html and "sync_output" in html
-    assert "<script src='plotly.min.js'>" in html and (tmp_path / "out" / "plotly.min.js").exists()
+    assert "application/vnd.plotly+json" in html and "sync_output" in html
+    assert_self_contained(html)
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["job.html"]
     for heading in ("Path", "Path speed", "Axes (only those that move)", "Contour error",
                     "Outputs", "Events"):
         assert f"<h2>{heading}</h2>" in html

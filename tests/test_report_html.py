@@ -16,6 +16,7 @@ from hypothesis.extra.numpy import arrays
 from longrun import size
 from openmotion.cli import main
 from openmotion.program.report_html import SCREEN_POINTS, path_indices, screen_indices
+from pagecheck import inflate
 
 
 @settings(max_examples=60, deadline=None)
@@ -100,8 +101,7 @@ def test_report_marks_outputs_on_the_path_and_lists_the_program(laser_page):
     assert "commanded feed (programmed x 100 %)" in page
     # every source line listed, the motion lines marked as such (the page's script makes
     # the rows from this data; the browser test below clicks them)
-    data = json.loads(re.search(r"<script type=application/json id=listing-data>(.*?)"
-                                r"</script>", page, re.S).group(1))
+    data = json.loads(inflate(page, "listing-data"))
     src = LASER.read_text().splitlines()
     assert data["lines"] == src
     moving = {n for a, b in data["moves"] for n in range(a, b + 1)}
@@ -185,7 +185,8 @@ def test_a_100k_line_listing_is_small_and_cut_at_the_limit():
                    for k in range(100_000))
     ops = [SimpleNamespace(kind="line", line=n) for n in range(1, 100_001)]
     part = _listing(SimpleNamespace(ops=ops), text)
-    data = json.loads(re.search(r"id=listing-data>(.*?)</script>", part, re.S).group(1))
+    data = json.loads(inflate(part, "listing-data"))
     assert len(data["lines"]) == MAX_LISTING_LINES and data["moves"] == [[1, MAX_LISTING_LINES]]
+    assert data["lines"] == text.splitlines()[:MAX_LISTING_LINES]
     assert f"{100_000 - MAX_LISTING_LINES} more lines not listed" in part
-    assert len(part) < 25 * MAX_LISTING_LINES    # 20,000 lines of ~17 characters
+    assert len(part) < 10 * MAX_LISTING_LINES    # 20,000 lines of ~17 characters, packed

@@ -55,8 +55,9 @@ def photograph(page: Path, out: Path, line: int, shots: list[str],
         browser = pw.chromium.launch(**kw)
         tab = browser.new_page(viewport={"width": 1280, "height": 900})
         tab.goto(page.as_uri())
-        tab.wait_for_function("window.Plotly && document.querySelectorAll('.js-plotly-plot')"
-                              ".length > 0", timeout=30_000)
+        # openmotionPick is set once plotly.js is inflated, every figure drawn and the
+        # listing built (report_page.py)
+        tab.wait_for_function("() => !!window.openmotionPick", timeout=30_000)
         tab.evaluate(f"window.openmotionPick({line})")
         tab.wait_for_timeout(500)
         for name in shots:

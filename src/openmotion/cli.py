@@ -232,6 +232,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run the program N times (default: once; a program whose main "
                    "program ends with M99 restarts until Ctrl-C, as in LinuxCNC)")
     r.add_argument("--out", default="out", help="folder for the report")
+    r.add_argument("--allow-no-end", action="store_true",
+                   help="run a G-code file that ends without M2, M30 or a closing %% (by "
+                   "default refused, as LinuxCNC does: the file may be truncated)")
     r.add_argument("--report", action="store_true",
                    help="open the interactive report in the web browser when the run ends")
     r.add_argument("--acc-time", type=float, default=0.05,

@@ -3,8 +3,8 @@
 `plot.plot_profile(..., html=True)` and `plot.plot_trace(..., html=True)` write these beside
 their PNG: the same rows (position, velocity, acceleration, jerk of a profile; velocity,
 position and the I/O and state lanes of a trace) with zoom, pan and hover, decimated to the
-screen (`screen_indices`) and loading plotly.js from `plotly.min.js` beside the page, as the
-run report does (report_page.py).
+screen (`screen_indices`), one self-contained file with plotly.js embedded as the run report
+is (program/plotly_embed.py).
 """
 
 from __future__ import annotations
@@ -22,17 +22,15 @@ _STYLE = ("body{font-family:system-ui,sans-serif;margin:1.5em auto;max-width:120
 
 
 def _page(path: Path, title: str, subtitle: str, fig: Any) -> Path:
-    from .program.report_page import write_plotly_js
+    from .program.plotly_embed import figure_html, head_scripts
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    body = fig.to_html(full_html=False, include_plotlyjs=False,
-                       config={"displaylogo": False, "responsive": True})
     path.write_text(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">"
-        f"<title>{html.escape(title)}</title><script src='plotly.min.js'></script>"
+        f"<title>{html.escape(title)}</title>{head_scripts()}"
         f"<style>{_STYLE}</style></head>\n<body>\n<h1>{html.escape(title)}</h1>\n"
-        f"<p>{html.escape(subtitle)}</p>\n{body}\n</body></html>\n", encoding="utf-8")
-    write_plotly_js(path.parent)
+        f"<p>{html.escape(subtitle)}</p>\n{figure_html(fig, 'om-fig')}\n</body></html>\n",
+        encoding="utf-8")
     return path
 
 

@@ -184,6 +184,9 @@ def _g10_tool(m: Modal, b: Block, L: int, gpos: int, axes: dict[str, Word],
         raise b.error(f"{word} needs P (the tool number)", gpos, word)
     used.add("P")
     n = m.int_word(b, "P", pw, 1)
+    if m.has_tool_table and n not in m.tools:
+        raise b.error(f"{word}: requested tool {n} is not in the tool table", pw.pos,
+                      fmt("P", pw.value))
     tool = m.tools.get(n) or Tool(n, n)
     offsets = list(tool.offsets)
     base9 = 5221 + 20 * 8

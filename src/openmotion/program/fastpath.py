@@ -32,6 +32,7 @@ from .modal import Modal
 from .options import ROTARY_LETTERS, GCodeOptions
 from .params import Parameters
 from .parser import parse_line
+from .progunits import CompiledProgram, program_units
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)"
 
@@ -42,9 +43,10 @@ KNOWN_STATE = frozenset((
     "opt", "params", "pos", "machine_mm", "units", "lscale", "ldiv", "incremental",
     "arc_incremental", "plane", "inverse_time", "feed", "feed_lin", "feed_ang", "motion",
     "motion_prev", "cycle", "polar_inc", "comp", "saved_states", "blend", "coord", "tools",
-    "selected_tool", "tool", "spindle_on", "spindle_cw", "speed", "mist", "flood", "ended",
+    "has_tool_table", "selected_tool", "tool", "spindle_on", "spindle_cw", "speed", "mist",
+    "flood", "ended",
     "flow_request", "letters", "g92", "off", "work", "rot", "rotated", "tool_offset", "line",
-    "per_rev", "css", "retract_old_z", "diameter_mode", "wait_request",
+    "per_rev", "css", "retract_old_z", "diameter_mode", "wait_request", "unit_log", "out_at",
     "feed_override_on", "speed_override_on", "feed_hold_on", "adaptive_feed_on"))
 
 
@@ -73,11 +75,16 @@ def compile_plain(lines: Iterable[str], options: GCodeOptions, file: str,
     enabled = gc.isenabled()
     gc.disable()
     try:
+        state: list[Modal] = []
         try:
-            out = list(plain_commands(lines, options, file))
+            out = list(plain_commands(lines, options, file, state))
         except Exception:  # GCodeError or _Defer: the general path says what is wrong
             out = None
-        return full() if out is None else out
+        if out is None:
+            return full()
+        m = state[0]
+        return CompiledProgram(out, program_units(out, m.unit_log, options.machine_units,
+                                                  by_line=True))
     finally:
         if enabled:
             gc.enable()
@@ -92,7 +99,7 @@ def _canonical_regex(letters: Iterable[str]) -> re.Pattern[str]:
 
 
 def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
-                   file: str) -> Iterator[canon.Command]:
+                   file: str, state: list[Modal] | None = None) -> Iterator[canon.Command]:
     """The commands of a program without O-words, line by line (module docstring).
 
     Raises the general path's GCodeError for a line that is wrong, and `_Defer` where the
@@ -101,6 +108,8 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
     """
     params = Parameters(options.parameters)
     modal = Modal(options, params)
+    if state is not None:  # the caller reads the modal state after (its unit_log)
+        state.append(modal)
     if not fast_path_available(modal):
         raise _Defer("modal state unknown to the fast path")
     general: list[canon.Command] = []

@@ -30,6 +30,7 @@ from .options import GCodeOptions
 from .params import Parameters
 from .parser import MAX_LINES, Block, Program, parse_program
 from .probing import Request, Result, apply_result, preview_result
+from .progunits import CompiledProgram, program_units
 from .source import GCodeError, decode_program, read_program
 from .splines import open_block_error
 
@@ -252,6 +253,7 @@ class Interpreter:
         guard = LoopGuard(modal, self.opt.max_loop_iterations)
         pc = 0
         test_branch = -1  # the ELSEIF whose condition is to be tested next
+        called: set[str] = set()  # subroutines called in this pass (an O-sub reached after)
         n = len(blocks)
         while pc < n:
             if pc == self.main_end and len(frames) == 1:
@@ -311,6 +313,7 @@ class Interpreter:
                     # LinuxCNC's task: back to the top, every state kept
                     pc = steps = 0
                     test_branch = -1
+                    called.clear()
                     frames[0].repeats.clear()
                     frames[0].loops.clear()
                     continue
@@ -324,6 +327,11 @@ class Interpreter:
             if kw == "":  # a Fanuc-style program number: a label, nothing to do
                 pc += 1
             elif kw == "SUB":  # reached by falling through: skip the definition
+                if o.label in called:  # LinuxCNC found it seeking forward for that call
+                    raise b.error(f"O{o.label} sub found in an illegal location: the program "
+                                  "runs into the definition of a subroutine it has already "
+                                  "called (end the main program with M2 or M30 before its "
+                                  "subroutines)", o.pos, f"O{o.label} sub")
                 pc = flow.subs[o.label][1] + 1
             elif kw in ("ENDSUB", "RETURN"):
                 if frames[-1].fanuc:
@@ -360,6 +368,7 @@ class Interpreter:
                 self.params.set_named("_VALUE_RETURNED", 0.0)
                 self.params.push_call(args)
                 frames.append(_Frame(label, pc + 1))
+                called.add(label)
                 pc = flow.subs[label][0] + 1
             elif kw == "ELSEIF" and pc != test_branch:  # reached from a taken branch
                 pc = flow.endif[pc] + 1
@@ -561,6 +570,7 @@ class Session:
         self._taken = len(out)
         if isinstance(self.request, canon.End):  # a pass is over: forget its commands
             out.clear()  # (no compensated move is pending at an M99: memory stays flat)
+            self._interp.modal.unit_log.clear()  # (its positions are in the pass's commands)
             self._taken = 0
         return chunk
 
@@ -601,7 +611,8 @@ def interpret(program: Program, options: GCodeOptions) -> list[canon.Command]:
 
 
 def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon.Command]:
-    """Parse and interpret G-code text into canonical commands (machine coordinates)."""
+    """Parse and interpret G-code text into canonical commands (machine coordinates); a
+    `CompiledProgram` list, whose `units` are the program's G20/G21 unit (progunits.py)."""
     if not isinstance(options, GCodeOptions):
         raise GCodeError(f"options must be GCodeOptions, got {type(options).__name__}")
     if isinstance(text, bytes):
@@ -614,14 +625,29 @@ def compile_text(text: str, options: GCodeOptions, file: str = "") -> list[canon
     lines = text.splitlines()
     # a G5.2 block must be closed: only the general path checks the program's end
     if len(lines) <= MAX_LINES and not _GENERAL_ONLY.search(text):  # fastpath.py
-        return compile_plain(lines, options, file, lambda: _compile_full(text, options, file))
-    return _compile_full(text, options, file)
+        out = compile_plain(lines, options, file, lambda: _compile_full(text, options, file))
+    else:
+        out = _compile_full(text, options, file)
+    if options.require_end and not (out and isinstance(out[-1], canon.End)) and not (
+            percent_closed(lines)):
+        raise GCodeError("the file ended with no percent sign or program end (M2 or M30): "
+                         "is it complete?", len(lines), 0, "", file)
+    return out
+
+
+def percent_closed(lines: list[str]) -> bool:
+    """True when the program opens with a '%' line and a second '%' line closes it."""
+    marks = [k for k, ln in enumerate(lines) if ln.strip() == "%"][:2]
+    return len(marks) == 2 and not any(ln.strip() for ln in lines[:marks[0]])
 
 
 def _compile_full(text: str, options: GCodeOptions, file: str) -> list[canon.Command]:
     """The general path: parse the whole program, then interpret it."""
     program = parse_program(text, file, options.max_line_length)
-    return interpret(program, options)
+    interp = Interpreter(program, options)
+    out = interp.run()
+    return CompiledProgram(out, program_units(out, interp.modal.unit_log,
+                                              options.machine_units))
 
 
 def compile_file(path: str | os.PathLike[str], options: GCodeOptions) -> list[canon.Command]:

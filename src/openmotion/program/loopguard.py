@@ -15,8 +15,9 @@ from typing import Any
 
 from .parser import Block
 
-#: Modal attributes that never change while a program runs (not part of the state).
-_CONSTANT = frozenset({"opt", "params", "letters"})
+#: Modal attributes that are not part of the state: constant while a program runs, or a
+#: record of what ran (the unit log and where the block's commands start, progunits.py).
+_CONSTANT = frozenset({"opt", "params", "letters", "unit_log", "out_at"})
 
 
 class _Unfreezable(Exception):

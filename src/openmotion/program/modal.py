@@ -49,6 +49,11 @@ from .words import Word, feed_length, fmt
 COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
 
+#: Motion codes that may stand without axis words (LinuxCNC's enhance_block): G0-G3, the
+#: NURBS block G5.2/G5.3 and the lathe cycles G70-G72; any other (G33, G38.x, G76, canned
+#: cycles) is refused without one, "All axes missing with motion code".
+AXES_OPTIONAL = frozenset({None, 0, 10, 20, 30, 52, 53, *LATHE_CYCLES})
+
 
 class Modal:
     """Modal state + positions; `execute(block, out)` appends the line's commands to out.
@@ -62,6 +67,9 @@ class Modal:
         self.pos: list[float] = list(options.start or ())
         self.machine_mm = options.machine_units == "mm"
         self.units = options.machine_units  # program units, "mm" or "inch"
+        # every G20/G21 (or restore) run: (commands output before its block, line, unit)
+        self.unit_log: list[tuple[int, int, str]] = []
+        self.out_at = 0
         self.lscale = 1.0  # program length unit -> machine unit: v * lscale / ldiv
         self.ldiv = 1.0
         self.incremental = False
@@ -82,6 +90,9 @@ class Modal:
         self.blend: tuple[str, float | None, float | None] | None = None  # last G61/G64
         self.coord = 1
         self.tools = dict(options.tool_table)  # type: ignore[arg-type]  # G10 L1 edits
+        # with a tool table, a tool not in it is refused (LinuxCNC); without one, every
+        # tool is a tool with zero offsets and diameter
+        self.has_tool_table = bool(self.tools)
         self.selected_tool = 0
         self.tool = 0
         self.spindle_on = False
@@ -255,6 +266,7 @@ class Modal:
     def execute(self, b: Block, out: list[canon.Command]) -> bool:  # noqa: C901
         line, file = b.line, b.file
         self.line = line
+        self.out_at = len(out)  # where this block's commands start (unit_log)
         gs: dict[int, tuple[int, int]] = {}  # group -> (code, pos)
         ms: dict[int, tuple[int, int]] = {}
         words: dict[str, Word] = {}
@@ -336,13 +348,13 @@ class Modal:
         t = words.get("T")
         if t is not None:
             used.add("T")
-            self.selected_tool = self.int_word(b, "T", t, 0)
+            self.selected_tool = self.tool_word(b, "T", t, "T")
         if 6 in ms and ms[6][0] == 61:  # M61 Q: the tool in the spindle, no change
             q = words.get("Q")
             if q is None:
                 raise b.error("M61 needs Q (the tool now in the spindle)", ms[6][1], "M61")
             used.add("Q")
-            self.tool = self.int_word(b, "Q", q, 0)
+            self.tool = self.tool_word(b, "Q", q, "M61")
             self.set_tool_parameters()
         elif 6 in ms:
             if self.comp.side:
@@ -449,6 +461,11 @@ class Modal:
                 self.motion = None if gs[1][0] == 800 else gs[1][0]
             if self.motion not in CYCLES and (1 in gs or axes):
                 self.cycle.initial = None  # a series of cycles ends at any other motion
+            if 1 in gs and not axes and self.motion not in AXES_OPTIONAL and not (
+                    self.polar_inc is not None and self.motion in CYCLES):
+                gword = f"G{gs[1][0] / 10:g}"
+                raise b.error(f"all axes missing with motion code {gword} (it needs at least "
+                              "one axis word)", gs[1][1], gword)
             if axes or (self.motion in (20, 30) and any(k in words for k in "IJK")) or (
                     (1 in gs or self.polar_inc is not None) and self.motion in CYCLES) or (
                     1 in gs and self.motion in (52, 53)) or self.motion in LATHE_CYCLES:
@@ -478,6 +495,15 @@ class Modal:
         return True
 
     # -- pieces ----------------------------------------------------------------------
+    def tool_word(self, b: Block, letter: str, w: Word, what: str) -> int:
+        """A tool number word (T, M61 Q, G43 H, G10 L1 P): an integer >= 0 that, on a
+        machine with a tool table, must be in it (tool 0, no tool, always is)."""
+        n = self.int_word(b, letter, w, 0)
+        if n and self.has_tool_table and n not in self.tools:
+            raise b.error(f"{what}: requested tool {n} is not in the tool table", w.pos,
+                          fmt(letter, w.value))
+        return n
+
     def int_word(self, b: Block, letter: str, w: Word, lo: int) -> int:
         n = round(w.value)
         if abs(w.value - n) > 1e-4 or n < lo:
@@ -503,6 +529,10 @@ class Modal:
             if isinstance(target, str) and target in READ_ONLY:
                 raise b.error(f"#<{target.lower()}> is a predefined parameter and cannot be "
                               "assigned", -1, f"#<{target.lower()}>")
+            if isinstance(target, str) and target.startswith("_INI["):
+                raise b.error(f"#<{target.lower()}> is a read-only INI variable (LinuxCNC's "
+                              "INI_VARS; openmotion reads no INI file)", -1,
+                              f"#<{target.lower()}>")
         for target, value in pending:
             if isinstance(target, int):
                 self.params.set_number(target, value)
@@ -515,6 +545,7 @@ class Modal:
         comment_commands(b, self.params, self.opt.keep_comments, out)
 
     def _set_units(self, units: str) -> None:
+        self.unit_log.append((self.out_at, self.line, units))  # progunits.py
         self.units = units
         self.lscale = self.ldiv = 1.0
         if units != self.opt.machine_units:

@@ -53,6 +53,9 @@ class GCodeOptions:
     spindle_output / mist_output / flood_output: outputs carried by Spindle/Coolant.
     block_delete: skip lines starting with '/' (the block-delete switch is on).
     keep_comments: also emit plain comments as Message(kind="comment").
+    require_end: refuse a program that ends without M2, M30 or a closing '%' (LinuxCNC's
+        "File ended with no percent sign or program end": a truncated file); off, the end
+        of the text ends the program as M2 does. `openmotion run` turns it on.
     max_call_depth: subroutine nesting limit; max_blocks: executed-line limit (loops);
     max_loop_iterations: iterations one while/do/repeat loop may run each time it is entered.
     subroutine_path: folders searched for `O<name> call` subroutines not defined in the
@@ -79,6 +82,7 @@ class GCodeOptions:
     flood_output: int | None = None
     block_delete: bool = True
     keep_comments: bool = False
+    require_end: bool = False
     max_call_depth: int = 64
     max_blocks: int = 10_000_000
     max_loop_iterations: int = 1_000_000
@@ -173,7 +177,7 @@ class GCodeOptions:
                          ("max_loop_iterations", 1), ("max_line_length", 16),
                          ("max_bytes", 1)):
             check_int(name, getattr(self, name), lo)
-        for name in ("block_delete", "keep_comments"):
+        for name in ("block_delete", "keep_comments", "require_end"):
             if not isinstance(getattr(self, name), bool):
                 raise MotionError(f"{name} must be True or False, got {getattr(self, name)!r}")
         if isinstance(self.subroutine_path, (str, bytes)) or not isinstance(

@@ -98,6 +98,8 @@ def contour_errors(run: ProgramRunner, actual: bool = False) -> tuple[np.ndarray
     if len(ran):
         before = np.where(before >= 0, before, ran[0])
     geo = _Geometry(run)
+    if not len(geo.kind):  # no group command at all (outputs, dwells only)
+        return err, idx
     kind = geo.kind[np.clip(idx, 0, len(geo.kind) - 1)]
     rows = np.nonzero((idx >= 0) & (idx < len(geo.kind)) & (kind == _CUT))[0]
     if not len(rows):
@@ -272,7 +274,7 @@ def g54_origin(run: ProgramRunner, parameters: Mapping[int, float]) -> dict[str,
 def write_report(run: ProgramRunner, out_dir: str | Path, name: str = "report",
                  options: str = "", origin: Mapping[str, float] | None = None) -> Path:
     """Write `<out_dir>/<name>.html`, the interactive report (report_html.py figures,
-    report_page.py page; plotly.min.js beside it); its path. `options`: a line on the
+    report_page.py page, one file with plotly.js embedded); its path. `options`: a line on the
     machine and run options shown above the summary. `origin`: program zero per axis
     letter in machine units (`g54_origin`): positions are drawn in program coordinates;
     None: in machine coordinates."""

@@ -7,12 +7,13 @@ soft-limit box (the travel between the limit switches) and the worst contour err
 path speed, commanded (programmed feed times the override) against executed; per moving
 axis position, velocity, acceleration and jerk against time; contour error against time;
 outputs as off/on lanes. report_page.py puts the summary, the extents table, the event
-table and the program listing (linked to the path both ways) around them.
+table and the program listing (linked to the path both ways) around them. Lengths, feeds
+and speeds are drawn in the program's units (`drawn_units`: G20 -> in, in/min).
 
 Traces are decimated to what a screen shows (`screen_indices`: per pixel column the first,
 lowest, highest and last sample), so a 100k-line program gives a page of the same size as a
-short one. plotly.js (4.8 MB) is written once next to the page (`plotly.min.js`), so the
-page itself stays small and the report folder works offline.
+short one. The page embeds plotly's gl3d partial bundle (plotly_embed.py: scatter and
+scatter3d, about 740 kB as gzip + base64), so it is one file that works offline.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .options import MM_PER_INCH
 from .report import contour_errors, following_errors, moving_axes
 
 if TYPE_CHECKING:
@@ -99,11 +101,11 @@ def _figures(run: ProgramRunner, err: np.ndarray,
     figs: list[tuple[str, object]] = []
     if len(t) < 2:
         return figs
-    units = run.machine_units
+    units, to_prog = drawn_units(run)
+    k_lin = float(to_prog[~run.scales.rotary][0]) if (~run.scales.rotary).any() else 1.0
     rot = run.scales.rotary
     unit_of = [("deg" if rot[k] else units) for k in range(len(run.letters))]
     tt = t - run.t_start
-    v, a, j = _derivatives(t, pos)
     moving = moving_axes(pos)
     act = run.actual_trace()
     # the back end reports a following error beyond the count quantisation: the actual
@@ -114,18 +116,27 @@ def _figures(run: ProgramRunner, err: np.ndarray,
     # feed (units/min), output-on stretches over it, soft-limit box, worst contour error
     rapid = np.array([bool(getattr(run.op_of.get(int(i)), "rapid", False)) for i in idx])
     cutting = np.array([run.op_of.get(int(i)) is not None for i in idx]) & ~rapid
-    feed = np.array([60.0 * float(getattr(run.op_of.get(int(i)), "feed", 0.0)) for i in idx])
+    feed = np.array([60.0 * k_lin * float(getattr(run.op_of.get(int(i)), "feed", 0.0))
+                     for i in idx])
     off = np.zeros(pos.shape[1]) if origin is None else np.asarray(origin, dtype=float)
     frame = "machine" if origin is None else "program"
-    ppos = pos - off
-    pact = act - off
+    ppos = (pos - off) * to_prog      # drawn in the program's units (drawn_units)
+    pact = (act - off) * to_prog
+    err = err * k_lin
+    v, a, j = _derivatives(t, pos * to_prog)
     if len(lin) >= 2:
         cols = lin[:3]
         fig = go.Figure()
         keep = path_indices(ppos[:, lin], idx)
         p, r, f = _f32(ppos[keep]), ~cutting[keep], _f32(feed[keep])
         lines = np.array([run.line_of(int(i)) for i in idx[keep]], dtype=np.int32)
-        hover = [f"line {ln}, feed {fe:g} {units}/min" for ln, fe in zip(lines, f, strict=True)]
+        # hover from the per-point data (customdata: the line; the colour: the feed), not
+        # a text per point (a third of a long program's path data)
+        at = "<br>" + ", ".join(f"{run.letters[c]} %{{{a}:.5g}}" for a, c in zip("xyz", cols,
+                                                                                  strict=False))
+        feed_at = ("%{line.color:.5g}" if len(cols) == 3 else "%{marker.color:.5g}")
+        hover_rapid = f"line %{{customdata}}, rapid{at}<extra></extra>"
+        hover_feed = f"line %{{customdata}}, feed {feed_at} {units}/min{at}<extra></extra>"
         cuts = f[~r]
         lo, hi = (float(cuts.min()), float(cuts.max())) if cuts.size else (0.0, 1.0)
         if hi - lo <= 1e-6 * max(abs(hi), 1.0):  # one feed: a scale from 0 to it
@@ -145,22 +156,22 @@ def _figures(run: ProgramRunner, err: np.ndarray,
                                line={"width": 12 if three else 10,
                                      "color": _COLOURS[(n + 3) % len(_COLOURS)]}))
         fig.add_trace(kind(**xyz(p * np.where(r, 1.0, np.nan)[:, None]), mode="lines",
-                           name="rapid", customdata=lines, text=hover, hoverinfo="text",
+                           name="rapid", customdata=lines, hovertemplate=hover_rapid,
                            line={"dash": "dash", "color": "#999"}))
         if three:
             fig.add_trace(kind(**xyz(p * np.where(r, np.nan, 1.0)[:, None]), mode="lines",
-                               name="feed", customdata=lines, text=hover,
-                               hoverinfo="text+x+y+z", line={"color": f, "width": 4, **scale}))
+                               name="feed", customdata=lines, hovertemplate=hover_feed,
+                               line={"color": f, "width": 4, **scale}))
         else:
             fig.add_trace(kind(**xyz(p * np.where(r, np.nan, 1.0)[:, None]),
                                mode="markers+lines", name="feed", customdata=lines,
-                               text=hover, line={"color": "#bbb", "width": 1},
+                               hovertemplate=hover_feed, line={"color": "#bbb", "width": 1},
                                marker={"color": f, "size": 4, **scale}))
         if lags:
             fig.add_trace(kind(**xyz(_f32(pact[keep])), mode="lines",
                                name="actual (feedback)", hoverinfo="skip",
                                line={"color": "#d62728", "width": 2 if three else 1}))
-        box = soft_limit_box(run, [int(c) for c in cols], off)
+        box = soft_limit_box(run, [int(c) for c in cols], off, to_prog)
         if box is not None:
             # a part (its cuts) far smaller than the travel is a dot inside the box: the box
             # is then listed in the legend (one click shows it) but not drawn at first
@@ -226,7 +237,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
         figs.append(("Axes (only those that move)", fig))
     # ---- contour error against time (actual and commanded positions), worst marked
     if np.any(np.isfinite(err)):
-        cerr = contour_errors(run)[0]
+        cerr = contour_errors(run)[0] * k_lin
         keep = screen_indices(np.column_stack([err, cerr]))
         w = int(np.nanargmax(err))
         fig = go.Figure()
@@ -242,7 +253,7 @@ def _figures(run: ProgramRunner, err: np.ndarray,
         figs.append(("Contour error", fig))
     # ---- following error (commanded - actual) per moving axis
     if moving:
-        fe = following_errors(run)
+        fe = following_errors(run) * to_prog
         fig = go.Figure()
         for k in moving:
             keep = screen_indices(fe[:, k])
@@ -299,6 +310,16 @@ def output_levels(run: ProgramRunner, times: np.ndarray) -> dict[int, np.ndarray
     return out
 
 
+def drawn_units(run: ProgramRunner) -> tuple[str, np.ndarray]:
+    """The unit the report draws lengths in, the program's at its first motion ("in" for
+    G20, "mm" for G21; `run.program_units`), and per runner axis the factor from machine
+    units to it (1 on rotary axes, which stay in degrees)."""
+    prog = run.program_units.units
+    k = 1.0 if prog == run.machine_units else (1.0 / MM_PER_INCH if prog == "inch"
+                                                else MM_PER_INCH)
+    return ("in" if prog == "inch" else "mm"), np.where(run.scales.rotary, 1.0, k)
+
+
 def soft_limits(run: ProgramRunner) -> list[tuple[float, float] | None]:
     """Per runner axis: the travel between its limit switches (machine units), the range
     the runner refuses moves beyond; None when the axis has no switch."""
@@ -310,15 +331,18 @@ def soft_limits(run: ProgramRunner) -> list[tuple[float, float] | None]:
     return [travel_limits(ctl, i) for i in run.axis_indices]
 
 
-def soft_limit_box(run: ProgramRunner, cols: list[int], off: np.ndarray) -> np.ndarray | None:
+def soft_limit_box(run: ProgramRunner, cols: list[int], off: np.ndarray,
+                   scale: np.ndarray | None = None) -> np.ndarray | None:
     """The soft-limit box of axes `cols` (2 or 3) as a polyline (NaN rows split edges), in
-    the drawn frame; None when one of them has an open side."""
+    the drawn frame (minus `off`, times `scale` per axis: `drawn_units`); None when one of
+    them has an open side."""
     lims = soft_limits(run)
     sel = [lims[c] for c in cols]
     if any(s is None or not all(map(math.isfinite, s)) for s in sel):
         return None
-    lo = np.array([s[0] for s in sel]) - off[cols]  # type: ignore[index]
-    hi = np.array([s[1] for s in sel]) - off[cols]  # type: ignore[index]
+    f = np.ones(len(run.letters)) if scale is None else np.asarray(scale, dtype=float)
+    lo = (np.array([s[0] for s in sel]) - off[cols]) * f[cols]  # type: ignore[index]
+    hi = (np.array([s[1] for s in sel]) - off[cols]) * f[cols]  # type: ignore[index]
     n = len(cols)
     corner = [lo + (hi - lo) * np.array([(k >> b) & 1 for b in range(n)]) for k in range(2 ** n)]
     rows: list[np.ndarray] = []

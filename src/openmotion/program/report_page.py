@@ -3,8 +3,9 @@ the extents table, the figures, the event table and the program listing.
 
 The listing is linked to the path both ways: a click on a listing line (or on an event)
 draws that line's stretch over the path and marks the line; a click on the path marks the
-line it belongs to in the listing. The page loads plotly.js from `plotly.min.js` beside it
-(written once), so the page itself stays small and the folder works offline.
+line it belongs to in the listing. The page is one file that works offline: plotly.js is
+embedded, compressed (plotly_embed.py), and the listing script runs once the figures are
+drawn.
 """
 
 from __future__ import annotations
@@ -40,12 +41,12 @@ _STYLE = ("body{font-family:system-ui,sans-serif;margin:1.5em auto;max-width:120
 # A click on a listing line or event: its stretch drawn on the path ("selected line"
 # trace), the line marked; a click on the path: its line marked in the listing.
 _SCRIPT = """
-(function () {
+(async function () {
   const gd = document.getElementById(%(div)s);
   let marked = null;
-  const data = document.getElementById('listing-data');
-  if (data) {  // one row per source line: <tr id=L<n> data-line=<n> [class=moves]>
-    const {lines, moves} = JSON.parse(data.textContent);
+  if (document.getElementById('listing-data')) {
+    // one row per source line: <tr id=L<n> data-line=<n> [class=moves]>
+    const {lines, moves} = JSON.parse(await window.openmotionInflate('listing-data'));
     const moving = new Uint8Array(lines.length + 2);
     for (const [a, b] of moves) for (let n = a; n <= b; n++) moving[n] = 1;
     const table = document.querySelector('#listing table');
@@ -105,29 +106,33 @@ _SCRIPT = """
 
 
 def extents(run: ProgramRunner, pos: np.ndarray, cutting: np.ndarray, off: np.ndarray,
-            lims: list[tuple[float, float] | None]) -> list[tuple[str, ...]]:
+            lims: list[tuple[float, float] | None],
+            scale: np.ndarray | None = None) -> list[tuple[str, ...]]:
     """Per moving axis: letter, lowest and highest position of the cuts (feed moves), of
-    all motion (rapids too), and the soft limits, as text in the drawn frame."""
+    all motion (rapids too), and the soft limits, as text in the drawn frame (minus `off`,
+    times `scale` per axis: report_html.drawn_units)."""
     def num(x: float) -> str:
         return f"{x:.4f}" if math.isfinite(x) else ("-inf" if x < 0 else "inf")
 
+    f = np.ones(len(run.letters)) if scale is None else np.asarray(scale, dtype=float)
     rows = []
     for k, letter in enumerate(run.letters):
         if np.ptp(pos[:, k]) <= 1e-9:
             continue
-        p = pos[:, k] - off[k]
+        p = (pos[:, k] - off[k]) * f[k]
         c = p[cutting] if cutting.any() else p[:0]
         cut = (num(c.min()), num(c.max())) if c.size else ("-", "-")
         lim = lims[k]
-        soft = ("-", "-") if lim is None else (num(lim[0] - off[k]), num(lim[1] - off[k]))
+        soft = ("-", "-") if lim is None else (num((lim[0] - off[k]) * f[k]),
+                                               num((lim[1] - off[k]) * f[k]))
         rows.append((letter, *cut, num(p.min()), num(p.max()), *soft))
     return rows
 
 
-def _extents_table(run: ProgramRunner, rows: list[tuple[str, ...]], frame: str) -> str:
+def _extents_table(rows: list[tuple[str, ...]], frame: str, units: str) -> str:
     body = "".join("<tr>" + f"<td>{html.escape(r[0])}</td>" + "".join(
         f"<td class=num>{x}</td>" for x in r[1:]) + "</tr>" for r in rows)
-    return (f"<h2>Extents ({html.escape(frame)} coordinates, {run.machine_units} or deg)</h2>"
+    return (f"<h2>Extents ({html.escape(frame)} coordinates, {units} or deg)</h2>"
             "<table id=extents><tr><th>axis</th><th>cuts lowest</th><th>cuts highest</th>"
             "<th>all motion lowest</th><th>all motion highest</th><th>soft limit low</th>"
             f"<th>soft limit high</th></tr>{body}</table>")
@@ -160,15 +165,18 @@ def listing_data(run: ProgramRunner, text: str) -> dict[str, list]:
 
 
 def _listing(run: ProgramRunner, text: str) -> str:
-    """The listing's place and its data (JSON; the script makes one row per line: markup
-    per row written out here was 1.8 of the 2.8 MB of a 100k-line program's page)."""
+    """The listing's place and its data (JSON, gzip + base64: G-code packs about 4 to 1;
+    the script makes one row per line: markup per row written out here was 1.8 of the
+    2.8 MB of a 100k-line program's page)."""
+    from .plotly_embed import gzip_b64
+
     n = len(text.splitlines())
     more = (f"<p>... {n - MAX_LISTING_LINES} more lines not listed</p>"
             if n > MAX_LISTING_LINES else "")
-    data = json.dumps(listing_data(run, text), separators=(",", ":")).replace("</", "<\\/")
+    data = gzip_b64(json.dumps(listing_data(run, text), separators=(",", ":")))
     return ("<h2>Program</h2><p>Click a line to see its stretch on the path; click the path "
             "to find its line.</p><div id=listing><table></table></div>"
-            f"<script type=application/json id=listing-data>{data}</script>{more}")
+            f"<script type=application/gzip id=listing-data>{data}</script>{more}")
 
 
 def program_text(run: ProgramRunner) -> str | None:
@@ -180,50 +188,54 @@ def program_text(run: ProgramRunner) -> str | None:
     return f.read_text(encoding="utf-8", errors="replace")
 
 
+def units_note(run: ProgramRunner, units: str) -> str:
+    """The page's line on the units it draws in (the program's, `drawn_units`)."""
+    pu = run.program_units
+    code = "G20" if pu.units == "inch" else "G21"
+    text = (f"Figures and extents are in the program's units ({units}, {code}); feeds and "
+            f"speeds in {units}/min.")
+    if pu.switched:
+        text += (" The program changes units after its first motion: drawn in the units in "
+                 "force at its first motion.")
+    machine = "in" if run.machine_units == "inch" else "mm"
+    if machine != units:
+        text += f" The summary above is in machine units ({machine})."
+    return text
+
+
 def write_page(run: ProgramRunner, summary: RunSummary, summary_text: str, err: np.ndarray,
                path: Path, options: str = "", origin: np.ndarray | None = None) -> Path:
-    """Write the page to `path` and plotly.min.js beside it; the page's path."""
-    from .report_html import _figures, soft_limits
+    """Write the page (one file: plotly.js embedded, plotly_embed.py) to `path`; its path."""
+    from .plotly_embed import after_drawing, figure_html, head_scripts
+    from .report_html import _figures, drawn_units, soft_limits
 
     del summary  # the text holds it; kept in the signature for callers that format apart
     title = html.escape(run.file or "program")
     frame = "machine" if origin is None else "program"
     parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>openmotion run: "
-             f"{title}</title><script src='plotly.min.js'></script><style>{_STYLE}</style>"
+             f"{title}</title>{head_scripts()}<style>{_STYLE}</style>"
              f"</head><body><h1>openmotion run: {title}</h1>"]
     if options:
         parts.append(f"<p>{html.escape(options)}</p>")
     parts.append(f"<pre>{html.escape(summary_text)}</pre>")
+    units, scale = drawn_units(run)
+    parts.append(f"<p id=units>{html.escape(units_note(run, units))}</p>")
     _, idx, pos = run.trace()
     if len(pos):
         off = np.zeros(pos.shape[1]) if origin is None else np.asarray(origin, dtype=float)
         ops = [run.op_of.get(int(i)) for i in idx]
         cutting = np.array([o is not None and not o.rapid and o.kind in ("line", "arc")
                             for o in ops], dtype=bool)
-        rows = extents(run, pos, cutting, off, soft_limits(run))
+        rows = extents(run, pos, cutting, off, soft_limits(run), scale)
         if rows:
-            parts.append(_extents_table(run, rows, frame))
-    for heading, fig in _figures(run, err, origin):
+            parts.append(_extents_table(rows, frame, units))
+    for k, (heading, fig) in enumerate(_figures(run, err, origin)):
         parts.append(f"<h2>{html.escape(heading)}</h2>")
-        div = {"div_id": PATH_DIV} if heading == "Path" else {}
-        parts.append(fig.to_html(full_html=False, include_plotlyjs=False,  # type: ignore[attr-defined]
-                                 config={"displaylogo": False, "responsive": True}, **div))
+        parts.append(figure_html(fig, PATH_DIV if heading == "Path" else f"om-fig{k}"))
     parts.append(_events_table(run))
     text = program_text(run)
     if text is not None:
         parts.append(_listing(run, text))
-    parts.append(f"<script>{_SCRIPT % {'div': json.dumps(PATH_DIV)}}</script></body></html>")
+    parts.append(after_drawing(_SCRIPT % {'div': json.dumps(PATH_DIV)}) + "</body></html>")
     path.write_text("\n".join(parts), encoding="utf-8")
-    write_plotly_js(path.parent)
     return path
-
-
-def write_plotly_js(folder: Path) -> Path:
-    """plotly.min.js in `folder` (once: an existing copy of the same size is kept)."""
-    from plotly.offline import get_plotlyjs
-
-    js = get_plotlyjs()
-    out = folder / "plotly.min.js"
-    if not (out.exists() and out.stat().st_size == len(js.encode("utf-8"))):
-        out.write_text(js, encoding="utf-8")
-    return out

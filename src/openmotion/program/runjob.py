@@ -80,6 +80,7 @@ def run_job(args: argparse.Namespace) -> int:
     probe = attach_probe(ctl, probe_input)
     schedule_analog_inputs(ctl, analog)
     ctl.enable_all()
+    gcode: dict[str, object] = {}
     if path.suffix in (".toml", ".csv"):
         table = PointTable.load(path)
         program: object = table.to_gcode(range(len(table)))
@@ -87,17 +88,19 @@ def run_job(args: argparse.Namespace) -> int:
     else:
         program = path
         sets_g54 = sets_work_offset(path.read_text(encoding="utf-8", errors="replace"))
+        gcode["require_end"] = not getattr(args, "allow_no_end", False)
     params = {} if sets_g54 else work_origin(ctl)
+    gcode["parameters"] = params
     run = ProgramRunner(ctl, program,  # type: ignore[arg-type]
                         options=RunOptions(repeat=args.repeat, acc_time=float(acc_time),
                                            probe_input=probe_input, spindle_axis=spindle,
                                            adaptive_feed_input=adaptive,
                                            user_m_path=user_opts.user_m_path,
                                            user_m_timeout=user_opts.user_m_timeout),
-                        file=str(path), gcode={"parameters": params})
+                        file=str(path), gcode=gcode)
     if probe is not None:
         place_boxes(probe, run, boxes)
-    if not run.ops:
+    if all(op.kind in ("end", "blend") for op in run.ops):
         raise MotionError(f"{path}: the program holds no moves or actions, nothing to run")
     if params:
         print("G54 origin at the middle of the travel: " + ", ".join(

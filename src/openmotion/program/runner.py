@@ -57,6 +57,7 @@ from .interp import Session
 from .options import AXIS_LETTERS, GCodeOptions
 from .orient import Orient
 from .probing import Probe, WaitInput
+from .progunits import ProgramUnits
 from .rigidtap import RigidTap
 from .runaxes import gcode_fields, machine_axes, travel_limits
 from .runcompile import RunPass
@@ -244,6 +245,13 @@ class ProgramRunner:
     @property
     def ops(self) -> list[Op]:
         return self._pass.ops
+
+    @property
+    def program_units(self) -> ProgramUnits:
+        """The program's G20/G21 unit at its first motion (progunits.py); the machine's
+        for a command list."""
+        u = getattr(self.commands, "units", None)
+        return u if isinstance(u, ProgramUnits) else ProgramUnits(self.machine_units)
 
     @property
     def passes(self) -> int | None:

@@ -88,6 +88,7 @@ def _check(path: str, options: GCodeOptions) -> None:
     max_len = options.max_line_length
     seen_code = False
     closed = False
+    ended = False  # an M2 / M30 line (a plain program runs every line it has)
     n = 0
     for k, text in enumerate(_text_lines(path, options.max_bytes), 1):
         n = k
@@ -109,8 +110,9 @@ def _check(path: str, options: GCodeOptions) -> None:
             seen_code = True
             if b.oword is not None:
                 raise _Unusual
-    if n > MAX_LINES:
-        raise _Unusual
+            ended = ended or any(L == "M" and v in (2.0, 30.0) for L, v, _ in b.words)
+    if n > MAX_LINES or (options.require_end and not (ended or closed)):
+        raise _Unusual  # compile_file says what is wrong
 
 
 def stream_file(path: str | os.PathLike[str],

@@ -36,7 +36,7 @@ def tool_length(m: Modal, b: Block, g: tuple[int, int], words: dict[str, Word],
         tool = m.tool
         if h is not None:
             used.add("H")
-            tool = m.int_word(b, "H", h, 0)
+            tool = m.tool_word(b, "H", h, f"G{code / 10:g}")
         if code == 432 and h is None and axes:
             extra = [0.0] * 9
             for L, w in axes.items():

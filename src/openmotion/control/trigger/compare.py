@@ -145,6 +145,7 @@ class CompareEngine:
         self._specs: dict[AxisSource, tuple[Any, float, float, float, float, float]] = {}
         self._ranges = {}
         self._vcycles: dict[VectorSource, VectorCycle] = {}
+        self._weights: dict[VectorSource, Array] = {}  # (a source's weights, made once)
         self._mpos_e1: dict[int, float] = {}
         self._win = (self._t_last, self._t_last)
         from ...hw.interface import TimedOutputHardware
@@ -403,8 +404,11 @@ class CompareEngine:
         vc = self._vcycles.get(src)
         if vc is None:
             ta, t1 = self._win
-            tracks = [history_track(self.ctl.history, a, ta, t1) for a in src.axes]
-            vc = VectorCycle(tracks, src.weights, ta, t1, self._vectors[src])
+            w = self._weights.get(src)
+            if w is None:
+                w = self._weights[src] = src.weights
+            stores = self.ctl.history._tracks  # (the rows as stored: history.rows)
+            vc = VectorCycle([(stores[a],) for a in src.axes], w, ta, t1, self._vectors[src])
             self._vcycles[src] = vc
         return vc
 
@@ -436,6 +440,7 @@ class CompareEngine:
         if any(j.action.output in shared for j in native):
             native, others = [], jobs  # one line edited by both: keep the job order
         slots: dict[AxisSource, int] = {}
+        vslots: dict[VectorSource, int] = {}
         lines: dict[int, int] = {}
         specs = []
         for j in native:
@@ -448,13 +453,15 @@ class CompareEngine:
             else:
                 srcs = [j.source]
                 vals, n, after = j._values()
-                direction, repeat, code = j.direction, j.repeat, 0
-            sl = tuple(slots.setdefault(x, len(slots)) for x in srcs)
+                direction, repeat = j.direction, j.repeat
+                code = 2 if isinstance(j.source, VectorSource) else 0  # type: ignore[attr-defined]
+            sl = ((vslots.setdefault(j.source, len(vslots)),) if code == 2  # type: ignore[attr-defined]
+                  else tuple(slots.setdefault(x, len(slots)) for x in srcs))
             specs.append((code, sl, direction, repeat, vals, n, after,
                           float(getattr(j, "maxerr", 0.0)), float(j.t_armed), j.id, kind,
                           flag, width, ln, act.output))
         g = _Group(self._jobs_ver, _cm._solvers().bank_new(specs) if specs else None, native,
-                   list(slots), [self._lines[o] for o in lines], others, order)
+                   list(slots), [self._lines[o] for o in lines], others, order, list(vslots))
         self._banks[pre] = g
         return g
 
@@ -463,9 +470,11 @@ class CompareEngine:
         g = self._group(pre)
         blocks: list[_Block] = []
         if g.bank is not None:
+            vcs = [self.vector_cycle(v) for v in g.vslots]
             res = _cm._solvers().bank_scan(
                 g.bank, g.native, [self.track_spec(x) for x in g.slots], g.lines,
-                [self.track_spec(AxisSource(a)) for a in range(len(self.ctl.axes))], ta, t1)
+                [self.track_spec(AxisSource(a)) for a in range(len(self.ctl.axes))], ta, t1,
+                [(vc.B, vc.S, vc.Q) for vc in vcs])
             if res is not None:
                 fb, kb, pb, done = res
                 f = np.frombuffer(fb, dtype=np.float64).reshape(-1, 2)
@@ -668,14 +677,15 @@ _Block = tuple[Array, NDArray[np.int64], Array, dict[int, int], bool]
 
 
 class _Group:
-    """A scan group's jobs: the compiled driver's bank (and its jobs, track sources and
-    lines, in its order) and the jobs run in Python; job id -> position in the group."""
+    """A scan group's jobs: the compiled driver's bank (and its jobs, track sources, lines
+    and path-length sources, in its order) and the jobs run in Python; job id -> position
+    in the group."""
 
     def __init__(self, ver: int, bank: Any, native: list[CompareJob], slots: list[AxisSource],
-                 lines: list[OutputLine], others: list[CompareJob], order: dict[int, int]
-                 ) -> None:
+                 lines: list[OutputLine], others: list[CompareJob], order: dict[int, int],
+                 vslots: list[VectorSource]) -> None:
         self.ver, self.bank, self.native, self.slots = ver, bank, native, slots
-        self.lines, self.others, self.order = lines, others, order
+        self.lines, self.others, self.order, self.vslots = lines, others, order, vslots
 
 
 _ACTIONS = {  # the actions the driver applies itself: (code, flag, width)
@@ -686,13 +696,11 @@ _ACTIONS = {  # the actions the driver applies itself: (code, flag, width)
 
 
 def _native(job: CompareJob) -> bool:
-    """Does the compiled driver run this job (an axis LevelJob or a WindowJob with a
-    built-in action)?"""
+    """Does the compiled driver run this job (a LevelJob on an axis or a path length, or a
+    WindowJob, with a built-in action)?"""
     if type(job.action) not in _ACTIONS:
         return False
-    if type(job) is WindowJob:
-        return True
-    return type(job) is LevelJob and isinstance(job.source, AxisSource)  # type: ignore[attr-defined]
+    return type(job) is WindowJob or type(job) is LevelJob
 
 
 def _timer_of(action: Action) -> Any:

@@ -11,7 +11,7 @@ feedback model) and asks three questions, each answered between cycles, not at c
   the time it reaches a given distance;
 - `first_inside`: the first time all axes are within +-maxerr of a point (2-D/3-D tables).
 
-The solvers themselves are compiled (openmotion._compare, src/openmotion/_kernel_compare.c):
+The solvers themselves are compiled (openmotion._compare, src/openmotion/_compare_*.c):
 a job's whole scan of a cycle (every value or point it reaches, in turn) is one call. Their
 plain-Python versions, which give the same floats, are the test oracle in
 tests/compare_oracle.py; `_ck` is the one handle the engine calls them through.
@@ -19,13 +19,11 @@ tests/compare_oracle.py; `_ck` is the one handle the engine calls them through.
 
 from __future__ import annotations
 
-import math
 from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ...crossings import velocity_roots
 from ...errors import MotionError
 from ...history import MotionHistory
 
@@ -164,63 +162,28 @@ def track_range(tr: Track, ta: float, t1: float) -> tuple[float, float]:
 # single axis or a straight line sqrt(Q) is a polynomial of degree <= 2, which 8-point
 # Gauss-Legendre integrates exactly; otherwise (curves) the piece is halved adaptively until
 # two levels agree to 1e-13 relative. s(t) = d is solved by safeguarded Newton (s' = speed).
+# (Compiled: _compare.vector_pieces / vector_sums; the numpy version is the oracle,
+# tests/compare_oracle.vector_cycle_numpy.)
 class VectorCycle:
-    """Path length over one window [ta, t1] of several axes' tracks, starting at s0."""
+    """Path length over one window [ta, t1] of several axes' tracks, starting at s0.
 
-    def __init__(self, tracks: list[Track], weights: Array, ta: float, t1: float,
+    tracks: Track rows, or history specs as the scan driver takes them ((hist,) for the
+    rows as stored). The pieces and their node speeds are compiled (vector_pieces); the
+    two 8-point weight products stay numpy products `(n, 8) @ w`, as they always were
+    (their BLAS rounding depends on the kernel and on n; one stacked product makes the
+    same two calls), then vector_sums refines the pieces that disagree and sums them."""
+
+    def __init__(self, tracks: list[Any], weights: Array, ta: float, t1: float,
                  s0: float) -> None:
-        w = np.asarray(weights, dtype=np.float64)
-        bps = {ta, t1}
-        for tr in tracks:
-            n = tr.ts.size
-            for k in range(n):
-                a_k = float(tr.ts[k])
-                b_k = float(tr.ts[k + 1]) if k + 1 < n else math.inf
-                if ta < a_k < t1:
-                    bps.add(a_k)
-                if b_k <= ta or a_k >= t1:
-                    continue
-                for r in velocity_roots(float(tr.v0[k]), float(tr.a0[k]), float(tr.j[k])):
-                    tr_ = a_k + r
-                    if ta < tr_ < t1 and tr_ < b_k:
-                        bps.add(tr_)
-        self.B = B = np.array(sorted(bps))
-        u = B[:-1]
-        mid = 0.5 * (B[:-1] + B[1:])
-        Q = np.zeros((u.size, 5))
-        for tr, wk in zip(tracks, w, strict=True):
-            k = np.maximum(np.searchsorted(tr.ts, mid, side="right") - 1, 0)
-            d0 = u - tr.ts[k]
-            j = tr.j[k]
-            c0 = wk * (tr.v0[k] + d0 * (tr.a0[k] + d0 * j / 2.0))
-            c1 = wk * (tr.a0[k] + d0 * j)
-            c2 = wk * (j / 2.0)
-            Q[:, 0] += c0 * c0
-            Q[:, 1] += 2.0 * c0 * c1
-            Q[:, 2] += c1 * c1 + 2.0 * c0 * c2
-            Q[:, 3] += 2.0 * c1 * c2
-            Q[:, 4] += c2 * c2
-        self.Q = Q
-        H = B[1:] - u
-        # all pieces at once with one and two GL panels; refine only those that disagree
-        x1 = (H[:, None] / 2.0) * (_GL_X[None, :] + 1.0)
-        one = (H / 2.0) * (self._sq_rows(x1) @ _GL_W)
-        xa = (H[:, None] / 4.0) * (_GL_X[None, :] + 1.0)
-        two = (H / 4.0) * ((self._sq_rows(xa) + self._sq_rows(xa + H[:, None] / 2.0)) @ _GL_W)
-        bad = np.abs(two - one) > _QUAD_RTOL * np.maximum(np.abs(two), 1e-300)
-        for i in np.flatnonzero(bad):
-            two[i] = self._adaptive(i, 0.0, float(H[i]), 0)
-        self.S = s0 + np.concatenate([[0.0], np.cumsum(two)])
-
-    def _sq_rows(self, x: Array) -> Array:
-        Q = self.Q
-        y = Q[:, 0:1] + x * (Q[:, 1:2] + x * (Q[:, 2:3] + x * (Q[:, 3:4] + x * Q[:, 4:5])))
-        return np.sqrt(np.maximum(y, 0.0))
-
-    def _adaptive(self, i: int, a: float, b: float, depth: int) -> float:
-        """The piece's length over [a, b], halved until two levels agree (compiled)."""
-        return _solvers().adaptive(self.Q[i].tolist(), a, b, _QUAD_RTOL,  # type: ignore[no-any-return]
-                                   _QUAD_DEPTH - depth)
+        ck = _solvers()
+        w = np.ascontiguousarray(weights, dtype=np.float64)
+        b, q, r = ck.vector_pieces(tracks, w, float(ta), float(t1))
+        self.B = B = np.frombuffer(b, dtype=np.float64)
+        n = B.size - 1
+        self.Q = Q = np.frombuffer(q, dtype=np.float64).reshape(n, 5)
+        d = np.frombuffer(r, dtype=np.float64).reshape(2, n, 8) @ _GL_W  # (each (n, 8) @ w)
+        self.S = np.frombuffer(ck.vector_sums(B, Q, d[0], d[1], float(s0), _QUAD_RTOL,
+                                              _QUAD_DEPTH), dtype=np.float64)
 
     @property
     def end(self) -> float:

@@ -1,0 +1,82 @@
+"""Checks the HTML page tests share: a page is one self-contained file (plotly.js embedded,
+nothing loaded from elsewhere), its figures' trace types, and drawing it in chromium."""
+
+from __future__ import annotations
+
+import base64
+import gzip
+import json
+import re
+from pathlib import Path
+
+_FIGURE = re.compile(r"<script type=application/vnd.plotly\+json data-div=\"([^\"]+)\">(.*?)"
+                     r"</script>", re.S)
+
+
+def assert_self_contained(text: str) -> None:
+    """No external script, style sheet, image or frame: no src= or href= attribute, no
+    <link>, no url(...); plotly.js is embedded (the gzip data script and its loader)."""
+    markup = re.sub(r"<script type=application/(?:gzip|json|vnd\.plotly\+json)[^>]*>.*?"
+                    r"</script>", "", text, flags=re.S)
+    tags = re.findall(r"<[a-zA-Z][^>]*>", markup)
+    assert not [t for t in tags if re.search(r"\b(src|href)\s*=", t)], tags
+    assert "<link" not in markup and "url(" not in markup and "import(" not in markup
+    assert "<script type=application/gzip id=om-plotly-gz>" in text
+    assert "DecompressionStream('gzip')" in text
+
+
+def inflate(text: str, div: str) -> str:
+    """The text of the page's gzip + base64 data script `div` (plotly_embed.gzip_b64)."""
+    m = re.search(rf"<script type=application/gzip id={div}>(.*?)</script>", text, re.S)
+    assert m, div
+    return gzip.decompress(base64.b64decode(m.group(1))).decode("utf-8")
+
+
+def figures(text: str) -> dict[str, dict]:
+    """The page's figures by div id, as the loader draws them."""
+    return {div: json.loads(data.replace("<\\/", "</")) for div, data in _FIGURE.findall(text)}
+
+
+def trace_types(text: str) -> set[str]:
+    return {t.get("type", "scatter") for f in figures(text).values() for t in f["data"]}
+
+
+def draw(page: Path) -> dict:
+    """Open `page` in chromium (ui_browser.CHROMIUM); once the loader has drawn every figure:
+    plotly's version, per figure div its trace count and whether an svg was drawn, and the
+    page's errors."""
+    import ui_browser
+
+    ui_browser.need_browser()
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=ui_browser.CHROMIUM, headless=True,
+                               args=["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"])
+        try:
+            pg = b.new_page(viewport={"width": 1300, "height": 900})
+            errors: list[str] = []
+            pg.on("pageerror", lambda e: errors.append(str(e)))
+            pg.goto(page.as_uri())
+            pg.wait_for_function("() => window.openmotionPlotly", timeout=30000)
+            out = pg.evaluate("""async () => {
+              await window.openmotionPlotly;
+              const figs = {};
+              for (const d of document.querySelectorAll('.plotly-graph-div'))
+                figs[d.id] = {traces: (d.data || []).length,
+                              drawn: !!d.querySelector('.main-svg')};
+              return {version: Plotly.version, figures: figs};
+            }""")
+            out["errors"] = errors
+            return out
+        finally:
+            b.close()
+
+
+def array(v: object) -> list:
+    """A figure array as plotly writes it: a list, or {dtype, bdata} (base64 binary)."""
+    import numpy as np
+
+    if isinstance(v, dict) and "bdata" in v:
+        return np.frombuffer(base64.b64decode(v["bdata"]), dtype=v["dtype"]).tolist()
+    return list(v)  # type: ignore[call-overload]
