@@ -2,10 +2,25 @@
 
 from __future__ import annotations
 
+import gc
 import os
+import sys
+from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+# Where PYTHONDONTWRITEBYTECODE is set (no __pycache__ beside the sources), the suite still
+# keeps the compiled modules, in .pytest_cache/pycache: otherwise every xdist worker
+# recompiles the package and re-runs pytest's assertion rewriting of every test module at
+# each run (about 9 s of CPU per worker). Child processes (the `openmotion` subprocesses
+# of the CLI and browser tests) are left as they are: they import modules that collection
+# never imports, which would then be compiled from source in each of them.
+if sys.dont_write_bytecode and not sys.pycache_prefix:
+    _PYCACHE = Path(__file__).resolve().parents[1] / ".pytest_cache" / "pycache"
+    sys.pycache_prefix = str(_PYCACHE)
+    sys.dont_write_bytecode = False
 
 # CI replays the same examples on every run (derandomize) so that a landing is decided by the
 # code, not by the draw; local runs keep drawing new examples, and a failure they find is
@@ -59,18 +74,49 @@ def _reduce_properties(items: list[pytest.Item]) -> None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Property tests reduced unless --long (see PROPERTY_SHARE). Browser tests first (a
-    stable sort: module order kept). They are the longest and run one after another on a
-    module's server, so under xdist (`--dist worksteal`, set in pyproject.toml) they start
-    at once and the short tests fill the other worker around them, instead of the browser
-    modules running alone at the end."""
+    """Property tests reduced unless --long (see PROPERTY_SHARE). Browser modules first (a
+    module with a test that uses `page` or `browser`, whole, so that its module fixtures
+    are made once; a stable sort: module order kept). They are the longest and run one
+    after another on a module's server, so under xdist (`--dist worksteal`, set in
+    pyproject.toml) they start at once and the short tests fill the other worker around
+    them, instead of the browser modules running alone at the end."""
+    browser_modules = {item.nodeid.split("::")[0] for item in items
+                       if {"page", "browser"} & set(getattr(item, "fixturenames", ()))}
+
     def browser_first(item: pytest.Item) -> int:
-        names = getattr(item, "fixturenames", ())
-        return 0 if "page" in names or "browser" in names else 1
+        return 0 if item.nodeid.split("::")[0] in browser_modules else 1
 
     if not config.getoption("--long"):
         _reduce_properties(items)
     items.sort(key=browser_first)
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """The modules and tests collected now live for the whole session: frozen (gc.freeze),
+    so that a full garbage collection, automatic or asked for by a test or by the realtime
+    executor, does not scan them again each time (~0.1 s of CPU per collection)."""
+    gc.collect()
+    gc.freeze()
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_runtest_teardown(item: pytest.Item, nextitem: pytest.Item | None) -> None:
+    """At the end of a module, freeze again if a realtime executor unfroze everything (it
+    freezes the objects alive while it runs). Only there: gc.get_freeze_count() walks the
+    frozen objects (~10 ms), too dear after every test."""
+    if nextitem is not None and nextitem.nodeid.split("::")[0] == item.nodeid.split("::")[0]:
+        return
+    if gc.get_freeze_count() == 0:
+        gc.collect()
+        gc.freeze()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[object]:
+    """Chromium for the browser tests (tests/ui_browser.py), started once per process."""
+    from ui_browser import chromium
+
+    yield from chromium()
 
 
 @pytest.fixture

@@ -139,22 +139,24 @@ def test_real_time_polls_and_close_interrupts_the_process_group(tmp_path):
     script(tmp_path, "M121", f'sleep 30 &\necho $! > "{tmp_path}/child"\nwait')
     cmd = UserMCode(121, -1.0, -1.0, str(tmp_path / "M121"), 1)
     uc = UserCommand(cmd, 10.0, block=False)
-    for _ in range(200):
+    deadline = time.monotonic() + 30.0  # a loaded machine may start the script late
+    while time.monotonic() < deadline:
         if (tmp_path / "child").exists() and (tmp_path / "child").read_text().strip():
             break
         time.sleep(0.01)
     assert uc.poll() is False  # still running: the cycle goes on
     child = int((tmp_path / "child").read_text())
     uc.close()
-    for _ in range(100):  # the child of the script is gone too (or a zombie, dead)
+    deadline = time.monotonic() + 10.0  # well before the child's own 30 s end
+    while True:  # the child of the script is gone too (or a zombie, dead)
         try:
             if Path(f"/proc/{child}/stat").read_text().split()[2] == "Z":
                 break
         except OSError:
             break
+        if time.monotonic() > deadline:
+            pytest.fail("the M-code's child process survived close()")
         time.sleep(0.01)
-    else:
-        pytest.fail("the M-code's child process survived close()")
 
 
 def test_missing_file_refused_before_motion_and_bad_options(tmp_path):

@@ -154,35 +154,26 @@ def test_soft_limit_box_has_the_edges_of_the_travel():
                                                    round(lims[c][1] - off[c], 9)}
 
 
-def test_report_page_links_the_listing_and_the_path_in_the_browser(laser_page):
-    import ui_browser
-
-    ui_browser.need_browser()
-    from playwright.sync_api import sync_playwright
-
+def test_report_page_links_the_listing_and_the_path_in_the_browser(laser_page, browser):
     _, out = laser_page
-    with sync_playwright() as pw:
-        b = pw.chromium.launch(executable_path=ui_browser.CHROMIUM, headless=True,
-                               args=["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"])
-        try:
-            pg = b.new_page(viewport={"width": 1300, "height": 900})
-            errors: list[str] = []
-            pg.on("pageerror", lambda e: errors.append(str(e)))
-            pg.goto((out / "laser_contour.html").as_uri())
-            pg.wait_for_function("() => { const d = document.getElementById('om-path');"
-                                 " return d && d.data; }", timeout=30000)
-            pg.click("#L8")                          # the G3 arc of the bracket
-            pg.wait_for_function("() => window.openmotionSelected", timeout=30000)
-            sel = pg.evaluate("() => window.openmotionSelected")
-            assert sel["line"] == 8 and sel["points"] > 10
-            assert "sel" in pg.get_attribute("#L8", "class")
-            pg.click("#L1")                          # a comment: no stretch, row marked
-            pg.wait_for_function("() => window.openmotionSelected.line === 1",
-                                 timeout=30000)
-            assert pg.evaluate("() => window.openmotionSelected.points") == 0
-            assert not errors, errors
-        finally:
-            b.close()
+    pg = browser.new_page(viewport={"width": 1300, "height": 900})
+    try:
+        errors: list[str] = []
+        pg.on("pageerror", lambda e: errors.append(str(e)))
+        pg.goto((out / "laser_contour.html").as_uri())
+        pg.wait_for_function("() => { const d = document.getElementById('om-path');"
+                             " return d && d.data; }", timeout=30000)
+        pg.click("#L8")                          # the G3 arc of the bracket
+        pg.wait_for_function("() => window.openmotionSelected", timeout=30000)
+        sel = pg.evaluate("() => window.openmotionSelected")
+        assert sel["line"] == 8 and sel["points"] > 10
+        assert "sel" in pg.get_attribute("#L8", "class")
+        pg.click("#L1")                          # a comment: no stretch, row marked
+        pg.wait_for_function("() => window.openmotionSelected.line === 1", timeout=30000)
+        assert pg.evaluate("() => window.openmotionSelected.points") == 0
+        assert not errors, errors
+    finally:
+        pg.context.close()
 
 
 def test_a_100k_line_listing_is_small_and_cut_at_the_limit():

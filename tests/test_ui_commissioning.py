@@ -11,7 +11,6 @@ import ui_browser
 from ui_browser import field, goto, ready_axis, shot, status, wait_jogged, wait_status
 
 server = ui_browser.server
-browser = ui_browser.browser
 page = ui_browser.page
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")

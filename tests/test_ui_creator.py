@@ -18,7 +18,6 @@ from ui_browser import error_of, field, goto, ready_axis, shot, status, wait_jog
 
 # the fixtures of ui_browser (pytest finds them as names of this module)
 server = ui_browser.server
-browser = ui_browser.browser
 page = ui_browser.page
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")

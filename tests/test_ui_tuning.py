@@ -15,7 +15,6 @@ import pytest
 import ui_browser
 from ui_browser import error_of, field, goto, ready_axis, shot, status, wait_status
 
-browser = ui_browser.browser
 page = ui_browser.page
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")

@@ -106,8 +106,11 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server | Extern
         srv.stop()
 
 
-@pytest.fixture(scope="module")
-def browser(server: Server | External) -> Iterator[object]:
+def chromium() -> Iterator[object]:
+    """Chromium under Playwright, until the generator is closed: conftest.py's session
+    fixture `browser`, one per test process, shared by every module's pages (each test
+    gets a fresh context: `page`)."""
+    need_browser()
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as pw:
