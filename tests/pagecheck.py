@@ -41,36 +41,29 @@ def trace_types(text: str) -> set[str]:
     return {t.get("type", "scatter") for f in figures(text).values() for t in f["data"]}
 
 
-def draw(page: Path) -> dict:
-    """Open `page` in chromium (ui_browser.CHROMIUM); once the loader has drawn every figure:
-    plotly's version, per figure div its trace count and whether an svg was drawn, and the
-    page's errors."""
-    import ui_browser
-
-    ui_browser.need_browser()
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as pw:
-        b = pw.chromium.launch(executable_path=ui_browser.CHROMIUM, headless=True,
-                               args=["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"])
-        try:
-            pg = b.new_page(viewport={"width": 1300, "height": 900})
-            errors: list[str] = []
-            pg.on("pageerror", lambda e: errors.append(str(e)))
-            pg.goto(page.as_uri())
-            pg.wait_for_function("() => window.openmotionPlotly", timeout=30000)
-            out = pg.evaluate("""async () => {
-              await window.openmotionPlotly;
-              const figs = {};
-              for (const d of document.querySelectorAll('.plotly-graph-div'))
-                figs[d.id] = {traces: (d.data || []).length,
-                              drawn: !!d.querySelector('.main-svg')};
-              return {version: Plotly.version, figures: figs};
-            }""")
-            out["errors"] = errors
-            return out
-        finally:
-            b.close()
+def draw(page: Path, browser) -> dict:
+    """Open `page` in `browser` (conftest's session chromium) in a fresh context; once the
+    loader has drawn every figure: plotly's version, per figure div its trace count and
+    whether an svg was drawn, and the page's errors."""
+    ctx = browser.new_context(viewport={"width": 1300, "height": 900})
+    try:
+        pg = ctx.new_page()
+        errors: list[str] = []
+        pg.on("pageerror", lambda e: errors.append(str(e)))
+        pg.goto(page.as_uri())
+        pg.wait_for_function("() => window.openmotionPlotly", timeout=30000)
+        out = pg.evaluate("""async () => {
+          await window.openmotionPlotly;
+          const figs = {};
+          for (const d of document.querySelectorAll('.plotly-graph-div'))
+            figs[d.id] = {traces: (d.data || []).length,
+                          drawn: !!d.querySelector('.main-svg')};
+          return {version: Plotly.version, figures: figs};
+        }""")
+        out["errors"] = errors
+        return out
+    finally:
+        ctx.close()
 
 
 def array(v: object) -> list:
