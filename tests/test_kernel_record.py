@@ -68,10 +68,9 @@ def test_a_bad_row_is_refused_and_nothing_stored():
     def fill(rt, rf, rstate, rio, head, slots):
         try:
             _kernel.record_rows(rt, rf, rstate, rio, head, slots, 0.0, 0.001, 0, tr,
-                                np.zeros(2), np.zeros(2), np.array([0]), ends, np.zeros(1),
-                                np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64),
-                                np.zeros(2, dtype=np.int64), np.zeros(512, dtype=np.int64),
-                                False, np.zeros(2, dtype=np.int32))
+                                [0.0] * 4, np.array([0]), ends, np.zeros(1), [0] * 6,
+                                np.zeros(2, dtype=np.int64),
+                                np.zeros(512, dtype=np.int64), False)
         except ValueError as exc:
             raise MotionError(str(exc)) from None
 

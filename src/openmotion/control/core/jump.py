@@ -313,10 +313,11 @@ def _level_word(inputs: dict[str, bool]) -> int:
 
 
 def _state_codes() -> dict:
-    """Controller.STATE_CODES (imported late: the controller imports this module)."""
+    """Controller.STATE_CODES keyed by id() of the state (an Enum member hashes slowly;
+    imported late: the controller imports this module)."""
     if not _STATE_CODES:
         from .controller import STATE_CODES
-        _STATE_CODES.update(STATE_CODES)
+        _STATE_CODES.update({id(st): code for st, code in STATE_CODES.items()})
     return _STATE_CODES
 
 
@@ -336,12 +337,15 @@ def record_now(ctl: Controller, n: int) -> bool:
         bulk = _BULK[t] = isinstance(hw, BulkReadback)
     if kern is None or not bulk:
         return False
-    axes = ctl.axes
-    rows = np.array(hw.read_axes(), dtype=np.int64)
-    for i, c in enumerate(ctl._rb_cycle):
-        if c == ctl._n:  # read in this cycle: the values the controller holds
-            cnt = axes[i].counters
-            rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
+    rows = _writable(hw.read_axes())
+    now = ctl._n
+    if now in ctl._rb_cycle:
+        rows = rows.copy()  # not the back end's own array
+        axes = ctl.axes
+        for i, c in enumerate(ctl._rb_cycle):
+            if c == now:  # read in this cycle: the values the controller holds
+                cnt = axes[i].counters
+                rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
     return _record_rows(ctl, kern, n - 1, rows.reshape(1, -1, 3), _NO_MOVERS, (),
                         _NO_OFFSETS, "record")
 
@@ -351,17 +355,18 @@ def _record_rows(ctl: Controller, kern: Any, n: int, trace: np.ndarray,
     """Write the recorder rows of cycles n+1 .. n+len(trace) in one compiled call
     (`_kernel.record_rows`) from the back end's readback `trace` and the movers' piece ends;
     the axes' held values fill the rest. False when the recorder cannot take them so."""
-    axes = ctl.axes
-    cnt = [ax.counters for ax in axes]
     codes = _STATE_CODES or _state_codes()
     origin, period = ctl._t_origin, ctl.period
-    args = (origin, period, n, trace,
-            np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
-            movers, ends, offsets,
-            np.array([c._fb_internal for c in cnt], dtype=np.int64),
-            np.array([c._fb_off for c in cnt], dtype=np.int64), _nc_words(ctl),
-            _io_table(), bool(ctl._estop),
-            np.array([codes[ax.state] for ax in axes], dtype=np.int32))
+    # per axis Axis.position, Axis.velocity and the feedback source (internal?), feedback
+    # offset, state code, read from the fields those properties return, as flat lists
+    pv: list[float] = []
+    ia: list[int] = []
+    for ax in ctl.axes:
+        c = ax.counters
+        pv += (ax._pos + c._cmd_off, ax._vel)
+        ia += (c._fb_internal, c._fb_off, codes[id(ax._state)])
+    args = (origin, period, n, trace, pv, movers, ends, offsets, ia, _nc_words(ctl),
+            _io_table(), bool(ctl._estop))
 
     def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
         try:
