@@ -183,3 +183,25 @@ def test_rows_after_a_run_overwrite_it_row_by_row(how: str, capacity: int) -> No
                 tw.rows(k, how)
                 tw.check()
                 tw.hold(1, 0, False)
+
+
+def test_a_held_readback_trace_is_the_repeated_rows() -> None:
+    from openmotion.hw.sim.kernel import joined_trace
+
+    rng = np.random.default_rng(5)
+    a = rng.integers(-9, 9, (1, 3, 3))
+    b = a.copy()
+    other = a + 1
+    block = rng.integers(-9, 9, (4, 3, 3))
+    for parts in ([a], [(a, 5)], [a, (b, 7)], [(a, 2), b, (b, 3)], [a, (other, 4)],
+                  [block], [a, block, (b, 2)], [(other, 3), a]):
+        want = np.concatenate([np.repeat(p[0], p[1], axis=0) if type(p) is tuple else p
+                               for p in parts])
+        got = joined_trace(list(parts), 3)
+        assert got.shape == want.shape and (got == want).all()
+        held = all(type(p) is tuple or len(p) == 1 for p in parts) and \
+            len({p[0].tobytes() if type(p) is tuple else p.tobytes() for p in parts}) == 1
+        assert (got.strides[0] == 0) == (held and len(got) > 1)
+        if got.strides[0] == 0:
+            assert not got.flags.writeable
+    assert joined_trace([], 3).shape == (0, 3, 3)

@@ -224,6 +224,12 @@ class KernelState:
             rb = self._readback = self.readback_rows().tolist()
         return tuple(rb[x])  # type: ignore[return-value]
 
+    def readback_row(self) -> np.ndarray:
+        """int64 [1, n, 3]: `readback_rows` as one trace row."""
+        out = np.empty((1, len(self.ai), 3), dtype=np.int64)
+        _k.readback(self.ai, self.si, out)
+        return out
+
     def readback_rows(self) -> np.ndarray:
         """int64 [n, 3]: (pulse count, decoded count, input level bits) of every axis now."""
         out = np.empty((len(self.ai), 3), dtype=np.int64)
@@ -391,6 +397,8 @@ def joined_trace(rows: list[np.ndarray | tuple[np.ndarray, int]], n: int) -> np.
     read-only view), so its rows cost nothing to make or to record."""
     if not rows:
         return np.zeros((0, n, 3), dtype=np.int64)
+    if len(rows) == 1 and type(rows[0]) is not tuple:
+        return rows[0]
     if len(rows) == 2:  # the usual idle chunk: one cycle run, then the held stretch
         a, b = rows
         if type(b) is tuple and type(a) is not tuple and len(a) == 1 \
@@ -420,8 +428,20 @@ def joined_trace(rows: list[np.ndarray | tuple[np.ndarray, int]], n: int) -> np.
 
 
 def _held_rows(row: np.ndarray, m: int) -> np.ndarray:
-    """The C-contiguous row [1, n, 3] seen m times: a read-only view, strides[0] == 0."""
-    held = np.ndarray((m, *row.shape[1:]), dtype=row.dtype, buffer=row,
-                      strides=(0, *row.strides[1:]))
-    held.flags.writeable = False
-    return held
+    """The row [1, n, 3] seen m times: a read-only view with strides[0] == 0, cut from one
+    long view kept per distinct row (an idle machine shows the same row chunk after
+    chunk, and a view costs microseconds to build; the kept copy is never written)."""
+    key = row.tobytes()
+    view = _HELD.get(key)
+    if view is None or len(view) < m:
+        if len(_HELD) >= 64:
+            _HELD.clear()
+        base = np.array(row, dtype=np.int64)
+        view = np.ndarray((max(m, 1 << 20), *base.shape[1:]), dtype=np.int64, buffer=base,
+                          strides=(0, *base.strides[1:]))
+        view.flags.writeable = False
+        _HELD[key] = view
+    return view[:m]
+
+
+_HELD: dict[bytes, np.ndarray] = {}

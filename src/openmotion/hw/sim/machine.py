@@ -256,6 +256,9 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
 
     def _trace_row(self) -> np.ndarray:
         """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""
+        ks = self._ks
+        if ks is not None:
+            return ks.readback_row()
         return self.read_axes().reshape(1, -1, 3)
 
     def _next_action(self) -> float:
