@@ -247,7 +247,8 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     if not m:
         return held
     kern = _motion._kernel
-    if kern is not None and not movers and m > 1 and trace.strides[0] == 0:
+    if kern is not None and not movers and m > 1 and isinstance(trace, np.ndarray) \
+            and trace.strides[0] == 0:
         rec = ctl.recorder
         key = trace[0].tobytes()
         if held is not None and held[0] == key and held[1] == rec.total \
