@@ -68,10 +68,9 @@ def test_a_bad_row_is_refused_and_nothing_stored():
     def fill(rt, rf, rstate, rio, head, slots):
         try:
             _kernel.record_rows(rt, rf, rstate, rio, head, slots, 0.0, 0.001, 0, tr,
-                                np.zeros(2), np.zeros(2), np.array([0]), ends, np.zeros(1),
-                                np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64),
-                                np.zeros(2, dtype=np.int64), np.zeros(512, dtype=np.int64),
-                                False, np.zeros(2, dtype=np.int32))
+                                [0.0] * 4, np.array([0]), ends, np.zeros(1), [0] * 6,
+                                np.zeros(2, dtype=np.int64),
+                                np.zeros(512, dtype=np.int64), False)
         except ValueError as exc:
             raise MotionError(str(exc)) from None
 
@@ -126,3 +125,36 @@ def test_the_compiled_landing_row_is_the_python_row(jumping, monkeypatch):
     for k in want:
         assert got[k].tobytes() == want[k].tobytes(), k
     assert len(want["t"]) > 100
+
+
+def idle(jumping: bool, capacity: int, spill, held: list) -> dict:  # noqa: ANN001
+    x = default_machine().axes[0]
+    axes = (replace(x, name="x", logic={"org": "nc"}), replace(x, name="y"))
+    c = Controller(MachineConfig(name="idle", axes=axes))
+    c.virtual_jumps = jumping
+    c.enable_all()
+    c.start_recording(capacity=capacity, spill_path=spill)
+    c.axes[1].counters.set_feedback_source("internal")
+    c.advance(2.5)  # idle: virtual time jumps, the recorder holds the readback
+    held.append(len(c.recorder._held))
+    c.axes[0].move_relative(3_000, max_vel=60_000, tacc=0.02)
+    c.wait_motion_done()
+    c.advance(1.7)
+    c.hardware.scenario.press_estop(at=c.time + 0.0105)
+    c.advance(0.9)  # idle again, E-stop bit set in every row
+    held.append(len(c.recorder._held))
+    return c.recorder.all_arrays()
+
+
+@pytest.mark.parametrize("capacity,spill", [(10_000, False), (700, False), (1200, True)])
+def test_an_idle_stretch_recorded_jumping_is_the_per_cycle_recording(capacity, spill,
+                                                                     tmp_path):
+    held: list = []
+    want = idle(False, capacity, tmp_path / "a.bin" if spill else None, [])
+    got = idle(True, capacity, tmp_path / "b.bin" if spill else None, held)
+    assert got.keys() == want.keys()
+    for k in want:
+        assert got[k].tobytes() == want[k].tobytes(), k
+    cycles = round(want["t"][-1] / 1e-3)  # every cycle from 1 on, spilled or kept
+    assert cycles > 5000 and len(want["t"]) == (cycles if spill else min(capacity, cycles))
+    assert (max(held) > 0) != spill  # held runs were used (a spilling recorder takes rows)

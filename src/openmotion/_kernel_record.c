@@ -21,46 +21,81 @@ static inline int64_t wrap28(int64_t x)
 }
 
 const char record_rows_doc[] =
-"record_rows(rt, rf, rstate, rio, head, slots, origin, period, n0, trace, pos, vel, idx,\n"
-"            ends, cmd_off, internal, fb_off, nc, table, estop, state) -> None\n\n"
+"record_rows(rt, rf, rstate, rio, head, slots, origin, period, n0, trace, pv, idx, ends,\n"
+"            cmd_off, ax, nc, table, estop) -> None\n\n"
 "Write the rows of cycles n0+1 .. n0+m (m = len(trace)) into the ring rt[R], rf[R, F, n],\n"
 "int32 rstate[R, n], int64 rio[R, n] (empty: channel off) from row `head` on (mod R; only\n"
 "the last min(m, R - 1) rows). slots: int64[3], the float slot of cmd_pos, fb_pos, cmd_vel\n"
-"(-1: off). trace int64[m, n, 3]; pos, vel float64[n]; idx int64[k] the movers; ends a\n"
-"tuple of k float64[>= m, 2]; cmd_off float64[k]; internal, fb_off, nc int64[n]; table\n"
-"int64[T] (io word of each logical level word); state int32[n].";
+"(-1: off). trace int64[m, n, 3]; pv a list of 2n floats (each axis's position,\n"
+"velocity); idx int64[k] the movers; ends a tuple of k float64[>= m, 2]; cmd_off\n"
+"float64[k]; ax a list of 3n ints (each axis's feedback from the output pulses?, feedback\n"
+"offset, state code); nc int64[n]; table int64[T] (io word of each logical level word).";
+
+/* The 2n floats of pv and 3n ints of ax (Python lists: no array to build per call) into
+ * one buffer; NULL with an exception set on a bad list. */
+static double *axis_values(PyObject *opv, PyObject *oax, Py_ssize_t *n_out)
+{
+    if (!PyList_Check(opv) || !PyList_Check(oax)) {
+        PyErr_SetString(PyExc_TypeError, "record_rows: pv and ax must be lists");
+        return NULL;
+    }
+    Py_ssize_t n = PyList_GET_SIZE(opv) / 2;
+    if (n < 1 || PyList_GET_SIZE(opv) != 2 * n || PyList_GET_SIZE(oax) != 3 * n) {
+        PyErr_SetString(PyExc_ValueError, "record_rows: arrays disagree in size");
+        return NULL;
+    }
+    double *v = PyMem_Malloc(sizeof(double) * 2 * n + sizeof(int64_t) * 3 * n);
+    if (v == NULL) { PyErr_NoMemory(); return NULL; }
+    int64_t *a = (int64_t *)(v + 2 * n);
+    for (Py_ssize_t i = 0; i < 2 * n; i++) {
+        v[i] = PyFloat_AsDouble(PyList_GET_ITEM(opv, i));
+        if (v[i] == -1.0 && PyErr_Occurred()) { PyMem_Free(v); return NULL; }
+    }
+    for (Py_ssize_t i = 0; i < 3 * n; i++) {
+        a[i] = PyLong_AsLongLong(PyList_GET_ITEM(oax, i));
+        if (a[i] == -1 && PyErr_Occurred()) { PyMem_Free(v); return NULL; }
+    }
+    *n_out = n;
+    return v;
+}
 
 PyObject *record_rows(PyObject *self, PyObject *args)
 {
-    PyObject *o[4], *oslots, *otr, *opos, *ovel, *oidx, *ends, *ooff, *oint, *ofb, *onc, *otab,
-        *ost;
+    PyObject *o[4], *oslots, *otr, *opv, *oidx, *ends, *ooff, *oax, *onc, *otab;
     long long head, n0;
     double origin, period;
     int estop;
-    if (!PyArg_ParseTuple(args, "OOOOLOddLOOOOO!OOOOOpO", &o[0], &o[1], &o[2], &o[3], &head,
-                          &oslots, &origin, &period, &n0, &otr, &opos, &ovel, &oidx,
-                          &PyTuple_Type, &ends, &ooff, &oint, &ofb, &onc, &otab, &estop, &ost))
+    if (!PyArg_ParseTuple(args, "OOOOLOddLOOOO!OOOOp", &o[0], &o[1], &o[2], &o[3], &head,
+                          &oslots, &origin, &period, &n0, &otr, &opv, &oidx, &PyTuple_Type,
+                          &ends, &ooff, &oax, &onc, &otab, &estop))
         return NULL;
-    PyObject *objs[17] = {o[0], o[1], o[2], o[3], oslots, otr, opos, ovel, oidx, ooff, oint,
-                          ofb, onc, otab, ost, NULL, NULL};
-    static const Py_ssize_t sizes[15] = {8, 8, 4, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 4};
-    static const char *names[15] = {"rt", "rf", "rstate", "rio", "slots", "trace", "pos", "vel",
-                                    "idx", "cmd_off", "internal", "fb_off", "nc", "table",
-                                    "state"};
-    Buf bufs[15];
+    Py_ssize_t n = 0;
+    double *pv = axis_values(opv, oax, &n);
+    if (pv == NULL) return NULL;
+    const int64_t *ax = (const int64_t *)(pv + 2 * n);
+    /* slot 6 and 9 (pv, ax) are the lists, parsed above */
+    PyObject *objs[12] = {o[0], o[1], o[2], o[3], oslots, otr, NULL, oidx, ooff, NULL, onc,
+                          otab};
+    static const Py_ssize_t sizes[12] = {8, 8, 4, 8, 8, 8, 0, 8, 8, 0, 8, 8};
+    static const char *names[12] = {"rt", "rf", "rstate", "rio", "slots", "trace", "", "idx",
+                                    "cmd_off", "", "nc", "table"};
+    Buf bufs[12];
     memset(bufs, 0, sizeof bufs);
-    for (int k = 0; k < 15; k++)
-        if (get_buf(objs[k], &bufs[k], sizes[k], names[k]) < 0) { release(bufs, 15); return NULL; }
-    Py_ssize_t R = bufs[0].b.len / 8, n = bufs[6].b.len / 8, nk = bufs[8].b.len / 8;
+    for (int k = 0; k < 12; k++)
+        if (objs[k] && get_buf(objs[k], &bufs[k], sizes[k], names[k]) < 0) {
+            release(bufs, 12);
+            PyMem_Free(pv);
+            return NULL;
+        }
+    Py_ssize_t R = bufs[0].b.len / 8, nk = bufs[7].b.len / 8;
     Py_ssize_t m = n ? bufs[5].b.len / (8 * 3 * n) : 0;
     Py_ssize_t F = (R && n) ? bufs[1].b.len / (8 * R * n) : 0;
-    const int64_t *slots = bufs[4].b.buf, *idx = bufs[8].b.buf, *table = bufs[13].b.buf;
-    Py_ssize_t T = bufs[13].b.len / 8;
+    const int64_t *slots = bufs[4].b.buf, *idx = bufs[7].b.buf, *table = bufs[11].b.buf;
+    Py_ssize_t T = bufs[11].b.len / 8;
     const char *bad = NULL;
-    if (R < 2 || n < 1 || bufs[4].b.len != 3 * 8 || bufs[7].b.len != n * 8
+    if (R < 2 || bufs[4].b.len != 3 * 8
             || bufs[5].b.len != m * n * 3 * 8 || bufs[1].b.len != R * F * n * 8
-            || bufs[9].b.len != nk * 8 || bufs[10].b.len != n * 8 || bufs[11].b.len != n * 8
-            || bufs[12].b.len != n * 8 || bufs[14].b.len != n * 4
+            || bufs[8].b.len != nk * 8 || bufs[10].b.len != n * 8
             || (bufs[2].b.len && bufs[2].b.len != R * n * 4)
             || (bufs[3].b.len && bufs[3].b.len != R * n * 8)
             || PyTuple_GET_SIZE(ends) != nk || head < 0 || head >= R)
@@ -70,12 +105,13 @@ PyObject *record_rows(PyObject *self, PyObject *args)
     for (Py_ssize_t k = 0; k < nk && !bad; k++)
         if (idx[k] < 0 || idx[k] >= n) bad = "record_rows: bad mover index";
     if (bad) {
-        release(bufs, 15);
+        release(bufs, 12);
+        PyMem_Free(pv);
         PyErr_SetString(PyExc_ValueError, bad);
         return NULL;
     }
     Buf *eb = PyMem_Calloc(nk + 1, sizeof(Buf));
-    if (eb == NULL) { release(bufs, 15); return PyErr_NoMemory(); }
+    if (eb == NULL) { release(bufs, 12); PyMem_Free(pv); return PyErr_NoMemory(); }
     int fail = 0;
     for (Py_ssize_t k = 0; k < nk && !fail; k++) {
         if (PyObject_GetBuffer(PyTuple_GET_ITEM(ends, k), &eb[k].b, PyBUF_C_CONTIGUOUS) < 0) {
@@ -91,21 +127,21 @@ PyObject *record_rows(PyObject *self, PyObject *args)
     if (fail) {
         release(eb, (int)nk);
         PyMem_Free(eb);
-        release(bufs, 15);
+        release(bufs, 12);
+        PyMem_Free(pv);
         return NULL;
     }
     double *rt = bufs[0].b.buf, *rf = bufs[1].b.buf;
     int32_t *rstate = bufs[2].b.len ? bufs[2].b.buf : NULL;
     int64_t *rio = bufs[3].b.len ? bufs[3].b.buf : NULL;
-    const int64_t *tr = bufs[5].b.buf, *internal = bufs[10].b.buf, *fboff = bufs[11].b.buf,
-                  *nc = bufs[12].b.buf;
-    const double *pos = bufs[6].b.buf, *vel = bufs[7].b.buf, *off = bufs[9].b.buf;
-    const int32_t *state = bufs[14].b.buf;
+    const int64_t *tr = bufs[5].b.buf, *nc = bufs[10].b.buf;
+    const double *off = bufs[8].b.buf;
     int64_t *mover = PyMem_Malloc(sizeof(int64_t) * (n + 1));
     if (mover == NULL) {
         release(eb, (int)nk);
         PyMem_Free(eb);
-        release(bufs, 15);
+        release(bufs, 12);
+        PyMem_Free(pv);
         return PyErr_NoMemory();
     }
     for (Py_ssize_t x = 0; x < n; x++) mover[x] = -1;
@@ -114,7 +150,7 @@ PyObject *record_rows(PyObject *self, PyObject *args)
     int64_t sp = slots[0], sf = slots[1], sv = slots[2];
     int finite = 1; /* Recorder.record_block's check, before any row is written */
     for (Py_ssize_t x = 0; x < n; x++)
-        if (mover[x] < 0 && !(isfinite(pos[x]) && isfinite(vel[x]))) finite = 0;
+        if (mover[x] < 0 && !(isfinite(pv[x * 2]) && isfinite(pv[x * 2 + 1]))) finite = 0;
     for (Py_ssize_t k = 0; k < nk && finite; k++) {
         const double *e = eb[k].b.buf;
         for (Py_ssize_t r = m - keep; r < m; r++)
@@ -124,7 +160,8 @@ PyObject *record_rows(PyObject *self, PyObject *args)
         PyMem_Free(mover);
         release(eb, (int)nk);
         PyMem_Free(eb);
-        release(bufs, 15);
+        release(bufs, 12);
+        PyMem_Free(pv);
         PyErr_SetString(PyExc_ValueError, "recorded positions/velocities must be finite");
         return NULL;
     }
@@ -136,11 +173,12 @@ PyObject *record_rows(PyObject *self, PyObject *args)
         for (Py_ssize_t x = 0; x < n; x++) {
             int64_t k = mover[x];
             const double *e = k >= 0 ? (const double *)eb[k].b.buf + r * 2 : NULL;
-            if (sp >= 0) f[sp * n + x] = e ? e[0] + off[k] : pos[x];
-            if (sv >= 0) f[sv * n + x] = e ? e[1] : vel[x];
-            if (sf >= 0) f[sf * n + x] = (double)wrap28((internal[x] ? trr[x * 3]
-                                                                    : trr[x * 3 + 1]) + fboff[x]);
-            if (rstate) rstate[row * n + x] = state[x];
+            const int64_t *a = ax + x * 3;
+            if (sp >= 0) f[sp * n + x] = e ? e[0] + off[k] : pv[x * 2];
+            if (sv >= 0) f[sv * n + x] = e ? e[1] : pv[x * 2 + 1];
+            if (sf >= 0) f[sf * n + x] = (double)wrap28((a[0] ? trr[x * 3] : trr[x * 3 + 1])
+                                                        + a[1]);
+            if (rstate) rstate[row * n + x] = (int32_t)a[2];
             if (rio) {
                 int64_t w = trr[x * 3 + 2] ^ nc[x];
                 int64_t v = (w >= 0 && w < T) ? table[w] : 0;
@@ -151,6 +189,7 @@ PyObject *record_rows(PyObject *self, PyObject *args)
     PyMem_Free(mover);
     release(eb, (int)nk);
     PyMem_Free(eb);
-    release(bufs, 15);
+    release(bufs, 12);
+    PyMem_Free(pv);
     Py_RETURN_NONE;
 }

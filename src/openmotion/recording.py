@@ -7,6 +7,12 @@ bounded"). `arrays()` returns them in time order for plots (plot.plot_trace) and
 first appended to a raw file, so a 10-hour recording runs in flat memory and nothing is lost
 (`load_spill` reads it back).
 
+A stretch of rows in which every channel holds its value (an idle virtual-time jump,
+`hold`) is kept as one run (the values once, the times by their grid formula) and written
+into the ring only when something reads the rows or a later row would overwrite them, so
+recording an idle hour costs next to nothing until the trace is read; the rows are the
+same either way.
+
 Channels, per axis:
   cmd_pos  command position (pulses, float64: counts are exact up to 2**53)
   fb_pos   feedback (encoder) position
@@ -33,6 +39,7 @@ CHANNELS = FLOAT_CHANNELS + INT_CHANNELS
 _INT_DTYPES = {"state": np.int32, "io": np.int64}
 _NO_STATE = np.zeros(0, dtype=np.int32)
 _NO_IO = np.zeros(0, dtype=np.int64)
+_MAX_HELD = 64  # held runs kept unwritten at most (then they are written into the ring)
 
 
 class Recorder:
@@ -70,6 +77,12 @@ class Recorder:
         self._count = 0  # live rows (<= capacity)
         self.total = 0   # rows ever recorded since the last clear
         self._last_t = -math.inf
+        # held runs not yet in the ring, oldest first: [abs start, m, origin, period, n0,
+        # float values (F, n), {int channel: values (n,)}]; abs row j lives at ring row
+        # j % (capacity + 1) (head == total mod rows); _floor: the oldest run's first kept
+        # abs row (a write reaching its ring row, abs floor + capacity + 1, settles first)
+        self._held: list[list[Any]] = []
+        self._floor = math.inf
         self._spill: Path | None = None
         self.spilled = 0
         if spill_path is not None:
@@ -94,6 +107,8 @@ class Recorder:
             raise MotionError(
                 f"t must be finite and >= the previous time {self._last_t!r}, got {t!r}"
             )
+        if self.total + 1 > self._floor + self.capacity + 1:
+            self._settle()
         i = self._head
         vals = {"cmd_pos": cmd_pos, "fb_pos": fb_pos, "cmd_vel": cmd_vel, "state": state,
                 "io": io}
@@ -153,6 +168,8 @@ class Recorder:
             for r in range(m):
                 self.record(tt[r], **{c: v[r] for c, v in vals.items()})
             return
+        if self.total + m > self._floor + self.capacity + 1:
+            self._settle()
         rows = self.capacity + 1
         keep = min(m, self.capacity)  # older rows of the block would be overwritten anyway
         idx = (self._head + (m - keep) + np.arange(keep)) % rows
@@ -183,6 +200,8 @@ class Recorder:
                               f"{self._last_t!r}")
         if not m:
             return True
+        if self.total + m > self._floor + self.capacity + 1:
+            self._settle()
         slots = self._slots
         if slots is None:
             slots = self._slots = np.array([self._fslot.get(c, -1) for c in FLOAT_CHANNELS],
@@ -194,6 +213,70 @@ class Recorder:
         self._head = (self._head + m) % (self.capacity + 1)
         self.total += m
         return True
+
+    def hold(self, m: int, origin: float, period: float, n0: int) -> bool:
+        """Store m rows that repeat the newest row's channel values at the times
+        origin + (n0 + 1 + r) * period, r = 0 .. m-1 (an idle jump's crossed cycles, whose
+        first row was recorded). Kept as one run until read (`arrays`) or about to be
+        overwritten; the rows are those m `record` calls would store. Returns False and
+        stores nothing for a spilling recorder (the caller records the rows). MotionError
+        (nothing stored) without a newest row or on times out of order."""
+        if type(m) is not int or m < 0:
+            check_int("m", m, 0)
+        if not self._count:
+            raise MotionError("hold needs a recorded row to repeat")
+        if self._spill is not None:
+            return False
+        if not m:
+            return True
+        t1 = origin + (n0 + 1) * period
+        t2 = origin + (n0 + m) * period
+        if not (math.isfinite(t1) and math.isfinite(t2) and t1 >= self._last_t
+                and t2 >= t1):
+            raise MotionError(f"t must be finite and non-decreasing from the previous time "
+                              f"{self._last_t!r}")
+        total = self.total
+        held = self._held
+        if len(held) >= _MAX_HELD:  # (overlaps need nothing: runs settle oldest first)
+            self._settle()
+            held = self._held
+        last = held[-1] if held else None
+        if last is not None and last[0] + last[1] == total:  # the newest row is this run's
+            if last[2] == origin and last[3] == period and last[4] + last[1] == n0:
+                last[1] += m
+            else:
+                held.append([total, m, origin, period, n0, last[5], last[6]])
+        else:
+            r = (self._head - 1) % (self.capacity + 1)
+            held.append([total, m, origin, period, n0, self._f[r].copy(),
+                         {c: a[r].copy() for c, a in self._i.items()}])
+        first = held[0]
+        self._floor = first[0] + first[1] - min(first[1], self.capacity)
+        self._last_t = float(t2)
+        self._count = min(self.capacity, self._count + m)
+        self._head = (self._head + m) % (self.capacity + 1)
+        self.total = total + m
+        return True
+
+    def _settle(self) -> None:
+        """Write the held runs into the ring (oldest first; only the rows still kept)."""
+        rows = self.capacity + 1
+        for start, m, origin, period, n0, fv, iv in self._held:
+            keep = min(m, self.capacity)
+            r0 = m - keep  # the first row of the run still kept
+            at = (start + r0) % rows
+            while keep:
+                k = min(keep, rows - at)
+                self._t[at:at + k] = origin + np.arange(n0 + 1 + r0, n0 + 1 + r0 + k,
+                                                        dtype=np.int64) * period
+                self._f[at:at + k] = fv
+                for c, a in self._i.items():
+                    a[at:at + k] = iv[c]
+                keep -= k
+                r0 += k
+                at = 0
+        self._held = []
+        self._floor = math.inf
 
     # ------------------------------------------------------------------ reading
     def __len__(self) -> int:
@@ -211,6 +294,8 @@ class Recorder:
 
     def arrays(self) -> dict[str, NDArray[Any]]:
         """Copies of the retained rows in time order: 't' (n,) and each channel (n, n_axes)."""
+        if self._held:
+            self._settle()
         idx = self._order()
         out: dict[str, NDArray[Any]] = {"t": self._t[idx]}
         for c in self.channels:
@@ -224,6 +309,8 @@ class Recorder:
         self.total = 0
         self.spilled = 0
         self._last_t = -math.inf
+        self._held = []
+        self._floor = math.inf
         if self._spill is not None:
             self._spill.write_bytes(b"")
 

@@ -162,6 +162,7 @@ def jump(ctl: Controller, land: int) -> None:
     t0 = ctl._time
     chunk = FIRST_CHUNK if _motion._kernel is None else FIRST_CHUNK_COMPILED
     ends: list[np.ndarray] = []
+    held: tuple | None = None  # record_trace's token of the last chunk's held readback
     while True:
         stop = min(land, n + chunk)
         ends = []
@@ -185,7 +186,8 @@ def jump(ctl: Controller, land: int) -> None:
             return
         last = run.cycle < stop or run.edges or stop >= land
         if rec is not None:  # the landing cycle is recorded by _finish_cycle
-            record_trace(ctl, movers, ends, n, run.trace[:run.cycle - n - (1 if last else 0)])
+            held = record_trace(ctl, movers, ends, n,
+                                run.trace[:run.cycle - n - (1 if last else 0)], held)
         if ctl._jump_observers:
             _observe(ctl, n, run.cycle - 1 if last else stop, movers, ends, run.trace)
         if last:
@@ -231,23 +233,40 @@ def _ahead(ctl: Controller, m: _motion.ActiveMotion, t0: float, n: int, stop: in
 
 
 def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
-                 trace: np.ndarray) -> None:
+                 trace: np.ndarray, held: tuple | None = None) -> tuple | None:
     """Record cycles n+1 .. n+len(trace) that a jump crossed: the rows `Controller._record`
     writes cycle by cycle, from the back end's readback at each cycle end (`trace`) and the
-    end states of the movers' pieces (`ends`); nothing else changes in those cycles."""
-    from .controller import STATE_CODES  # the controller imports this module
+    end states of the movers' pieces (`ends`); nothing else changes in those cycles.
 
+    A readback that held through the chunk (`trace` one row broadcast, strides[0] == 0, as
+    SimMachine.run_cycles reports an idle stretch) with no mover gives rows that differ
+    only in time: the first is written, the rest held (`Recorder.hold`). Returns the token
+    `held` of the next chunk of the same jump: the same readback again (nothing else
+    changes between a jump's chunks) is held on from the recorder's newest row."""
     m = len(trace)
     if not m:
-        return
-    axes = ctl.axes
+        return held
     kern = _motion._kernel
+    if kern is not None and not movers and m > 1 and isinstance(trace, np.ndarray) \
+            and trace.strides[0] == 0:
+        rec = ctl.recorder
+        key = trace[0].tobytes()
+        if held is not None and held[0] == key and held[1] == rec.total \
+                and rec.hold(m, ctl._t_origin, ctl.period, n):
+            return key, rec.total
+        if _record_rows(ctl, kern, n, np.array(trace[:1], dtype=np.int64), _NO_MOVERS, (),
+                        _NO_OFFSETS, "record_block"):
+            rec.hold(m - 1, ctl._t_origin, ctl.period, n + 1)  # it took the row: it holds
+            return key, rec.total
+    from .controller import STATE_CODES  # the controller imports this module
+
+    axes = ctl.axes
     if kern is not None and _record_rows(  # the rows straight into the recorder's ring, in C
-            ctl, kern, n, np.ascontiguousarray(trace, dtype=np.int64),
+            ctl, kern, n, _writable(trace),
             np.array([ax.index for ax in movers], dtype=np.int64),
             tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
             np.array([ax.counters._cmd_off for ax in movers], dtype=float), "record_block"):
-        return
+        return None
     t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
     pos = np.empty((m, len(axes)))
     vel = np.empty((m, len(axes)))
@@ -266,6 +285,13 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
     state = np.broadcast_to(np.array([STATE_CODES[ax.state] for ax in axes], dtype=np.int64),
                             (m, len(axes)))
     ctl.recorder.record_block(t, cmd_pos=pos, fb_pos=fb, cmd_vel=vel, state=state, io=io)
+    return None
+
+
+def _writable(trace: np.ndarray) -> np.ndarray:
+    """`trace` as a C-contiguous, writable int64 array (the kernel's buffers are)."""
+    t = np.ascontiguousarray(trace, dtype=np.int64)
+    return t if t.flags.writeable else t.copy()
 
 
 _BULK: dict[type, bool] = {}
@@ -288,10 +314,11 @@ def _level_word(inputs: dict[str, bool]) -> int:
 
 
 def _state_codes() -> dict:
-    """Controller.STATE_CODES (imported late: the controller imports this module)."""
+    """Controller.STATE_CODES keyed by id() of the state (an Enum member hashes slowly;
+    imported late: the controller imports this module)."""
     if not _STATE_CODES:
         from .controller import STATE_CODES
-        _STATE_CODES.update(STATE_CODES)
+        _STATE_CODES.update({id(st): code for st, code in STATE_CODES.items()})
     return _STATE_CODES
 
 
@@ -311,12 +338,15 @@ def record_now(ctl: Controller, n: int) -> bool:
         bulk = _BULK[t] = isinstance(hw, BulkReadback)
     if kern is None or not bulk:
         return False
-    axes = ctl.axes
-    rows = np.array(hw.read_axes(), dtype=np.int64)
-    for i, c in enumerate(ctl._rb_cycle):
-        if c == ctl._n:  # read in this cycle: the values the controller holds
-            cnt = axes[i].counters
-            rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
+    rows = _writable(hw.read_axes())
+    now = ctl._n
+    if now in ctl._rb_cycle:
+        rows = rows.copy()  # not the back end's own array
+        axes = ctl.axes
+        for i, c in enumerate(ctl._rb_cycle):
+            if c == now:  # read in this cycle: the values the controller holds
+                cnt = axes[i].counters
+                rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
     return _record_rows(ctl, kern, n - 1, rows.reshape(1, -1, 3), _NO_MOVERS, (),
                         _NO_OFFSETS, "record")
 
@@ -326,17 +356,18 @@ def _record_rows(ctl: Controller, kern: Any, n: int, trace: np.ndarray,
     """Write the recorder rows of cycles n+1 .. n+len(trace) in one compiled call
     (`_kernel.record_rows`) from the back end's readback `trace` and the movers' piece ends;
     the axes' held values fill the rest. False when the recorder cannot take them so."""
-    axes = ctl.axes
-    cnt = [ax.counters for ax in axes]
     codes = _STATE_CODES or _state_codes()
     origin, period = ctl._t_origin, ctl.period
-    args = (origin, period, n, trace,
-            np.array([ax.position for ax in axes]), np.array([ax.velocity for ax in axes]),
-            movers, ends, offsets,
-            np.array([c._fb_internal for c in cnt], dtype=np.int64),
-            np.array([c._fb_off for c in cnt], dtype=np.int64), _nc_words(ctl),
-            _io_table(), bool(ctl._estop),
-            np.array([codes[ax.state] for ax in axes], dtype=np.int32))
+    # per axis Axis.position, Axis.velocity and the feedback source (internal?), feedback
+    # offset, state code, read from the fields those properties return, as flat lists
+    pv: list[float] = []
+    ia: list[int] = []
+    for ax in ctl.axes:
+        c = ax.counters
+        pv += (ax._pos + c._cmd_off, ax._vel)
+        ia += (c._fb_internal, c._fb_off, codes[id(ax._state)])
+    args = (origin, period, n, trace, pv, movers, ends, offsets, ia, _nc_words(ctl),
+            _io_table(), bool(ctl._estop))
 
     def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
         try:

@@ -224,6 +224,12 @@ class KernelState:
             rb = self._readback = self.readback_rows().tolist()
         return tuple(rb[x])  # type: ignore[return-value]
 
+    def readback_row(self) -> np.ndarray:
+        """int64 [1, n, 3]: `readback_rows` as one trace row."""
+        out = np.empty((1, len(self.ai), 3), dtype=np.int64)
+        _k.readback(self.ai, self.si, out)
+        return out
+
     def readback_rows(self) -> np.ndarray:
         """int64 [n, 3]: (pulse count, decoded count, input level bits) of every axis now."""
         out = np.empty((len(self.ai), 3), dtype=np.int64)
@@ -382,3 +388,60 @@ def _record_stretches(axes: list[SimAxis], rows: np.ndarray) -> None:
         if g.record is not None:
             cub = Cubic(p0, v0, a0, j) if kind else None
             g.record.add(Stretch(t0, t1, cub, tc, int(dr), int(c0), int(c1)), g.half)
+
+
+def joined_trace(rows: list[np.ndarray | tuple[np.ndarray, int]], n: int) -> np.ndarray:
+    """The trace parts of a run ([cycles, n, 3] arrays, or (row [1, n, 3], cycles) for a
+    readback held over cycles) as one array; a readback that held through the whole run
+    (an idle stretch) comes back as its row over the cycles with strides[0] == 0 (a
+    read-only view), so its rows cost nothing to make or to record."""
+    if not rows:
+        return np.zeros((0, n, 3), dtype=np.int64)
+    if len(rows) == 1 and type(rows[0]) is not tuple:
+        return rows[0]
+    if len(rows) == 2:  # the usual idle chunk: one cycle run, then the held stretch
+        a, b = rows
+        if type(b) is tuple and type(a) is not tuple and len(a) == 1 \
+                and a.tobytes() == b[0].tobytes():
+            return _held_rows(a, 1 + b[1])
+    key = None
+    total = 0
+    for r in rows:
+        if type(r) is tuple:
+            row, c = r
+        elif len(r) == 1:
+            row, c = r, 1
+        else:
+            break
+        b = row.tobytes()
+        if key is None:
+            key = b
+        elif b != key:
+            break
+        total += c
+    else:
+        first = rows[0]
+        first = first[0] if type(first) is tuple else first
+        return first if total == 1 else _held_rows(first, total)
+    return np.concatenate([np.broadcast_to(r[0], (r[1], n, 3)) if type(r) is tuple else r
+                           for r in rows])
+
+
+def _held_rows(row: np.ndarray, m: int) -> np.ndarray:
+    """The row [1, n, 3] seen m times: a read-only view with strides[0] == 0, cut from one
+    long view kept per distinct row (an idle machine shows the same row chunk after
+    chunk, and a view costs microseconds to build; the kept copy is never written)."""
+    key = row.tobytes()
+    view = _HELD.get(key)
+    if view is None or len(view) < m:
+        if len(_HELD) >= 64:
+            _HELD.clear()
+        base = np.array(row, dtype=np.int64)
+        view = np.ndarray((max(m, 1 << 20), *base.shape[1:]), dtype=np.int64, buffer=base,
+                          strides=(0, *base.strides[1:]))
+        view.flags.writeable = False
+        _HELD[key] = view
+    return view[:m]
+
+
+_HELD: dict[bytes, np.ndarray] = {}

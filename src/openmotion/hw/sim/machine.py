@@ -194,7 +194,7 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         had = [len(q) > 0 for q in queues]
         k = start
         edges: list[InputEdge] = []
-        rows: list[np.ndarray] = []
+        rows: list[np.ndarray | tuple[np.ndarray, int]] = []
         first = True
         paced = kernel.pacing()  # real time: every cycle at its wall-clock slot
         while k < stop:
@@ -202,8 +202,8 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
             if not first and hold and not paced:
                 k0 = k
                 k, edges = self._skip_idle(origin, period, k, stop)
-                if trace and k > k0:
-                    rows.append(np.repeat(self._trace_row(), k - k0, axis=0))
+                if trace and k > k0:  # a held readback: one row, seen k - k0 times
+                    rows.append((self._trace_row(), k - k0))
                 if edges or k >= stop:
                     break
             first = False
@@ -237,10 +237,7 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
                 break
             edges = []
         drained = tuple(i for i, q in enumerate(queues) if had[i] and not q)
-        tr = None
-        if trace:
-            tr = np.concatenate(rows) if rows else np.zeros((0, len(self._ax), 3),
-                                                            dtype=np.int64)
+        tr = kernel.joined_trace(rows, len(self._ax)) if trace else None
         return QueueRun(k, edges, drained, tr)
 
     def _kernel_state(self) -> kernel.KernelState | None:
@@ -259,6 +256,9 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
 
     def _trace_row(self) -> np.ndarray:
         """[1, axis, 3]: pulse count, decoded count and input level bits of every axis."""
+        ks = self._ks
+        if ks is not None:
+            return ks.readback_row()
         return self.read_axes().reshape(1, -1, 3)
 
     def _next_action(self) -> float:
@@ -744,3 +744,4 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         plant.lost += pulses
         if pulses:
             ax.scan([JumpPiece(self._t, m0, m0 - pulses)], raw)
+
