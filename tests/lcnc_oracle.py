@@ -209,14 +209,20 @@ def parse_listing(listing: str) -> list[Motion]:
 def inch_tool_table(path: Path = TOOLS) -> str:
     """A mm tool table as rs274 reads it: the standalone interpreter takes tool table
     lengths and diameters in inches whatever the machine units."""
+    return scale_tool_table(path.read_text(), 1.0 / 25.4)
+
+
+def scale_tool_table(text: str, factor: float) -> str:
+    """A LinuxCNC tool table with its lengths and diameters (X Y Z U V W D) times `factor`
+    (1/25.4: mm to rs274's inches; 25.4: a LinuxCNC test's table to mm)."""
     out = []
-    for raw in path.read_text().splitlines():
+    for raw in text.splitlines():
         body, sep, comment = raw.partition(";")
         words = []
         for w in body.split():
             letter, v = w[0].upper(), w[1:]
             if letter in "XYZUVWD":
-                v = f"{float(v) / 25.4:.9f}"
+                v = f"{float(v) * factor:.9f}"
             words.append(letter + v)
         out.append(" ".join(words) + f" {sep}{comment}")
     return "\n".join(out) + "\n"

@@ -36,7 +36,13 @@ from pathlib import Path, PurePosixPath
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from lcnc_oracle import OPTIONS, compare, openmotion_motions, run_rs274  # noqa: E402
+from lcnc_oracle import (  # noqa: E402
+    OPTIONS,
+    compare,
+    openmotion_motions,
+    run_rs274,
+    scale_tool_table,
+)
 from openmotion.program import GCodeError  # noqa: E402
 
 
@@ -81,21 +87,6 @@ def _test_sh_runs(repo: str, rev: str, folder: str, files: list[str]
     return runs
 
 
-def mm_tool_table(text: str) -> str:
-    """A LinuxCNC test's tool table (rs274 reads its lengths in inches) in mm for openmotion."""
-    out = []
-    for raw in text.splitlines():
-        body, sep, comment = raw.partition(";")
-        words = []
-        for w in body.split():
-            letter, v = w[0].upper(), w[1:]
-            if letter in "XYZUVWD":
-                v = f"{float(v) * 25.4:.9f}"
-            words.append(letter + v)
-        out.append(" ".join(words) + f" {sep}{comment}")
-    return "\n".join(out) + "\n"
-
-
 def _ini_value(ini: str, section: str, key: str) -> str | None:
     parser = configparser.ConfigParser(strict=False, interpolation=None,
                                        inline_comment_prefixes=("#", ";"))
@@ -133,7 +124,7 @@ def _one(job: tuple[str, str, str, list[str], tuple | None]) -> tuple[str, str, 
             subs = [str((d / p).resolve()) for p in sub_path.split(":")]
         options = replace(OPTIONS, subroutine_path=tuple(subs), require_end=True)
         if tbl is not None:
-            (d / "mm.tbl").write_text(mm_tool_table(tbl))
+            (d / "mm.tbl").write_text(scale_tool_table(tbl, 25.4))
             options = replace(options, tool_table=d / "mm.tbl")
         ours: list = []
         try:
