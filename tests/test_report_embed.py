@@ -108,3 +108,21 @@ def test_a_long_programs_page_is_one_file_under_2_mb(tmp_path, n, notes):
     assert page.stat().st_size < 2_000_000, page.stat().st_size
     assert_self_contained(page.read_text())
     assert sorted(p.name for p in tmp_path.iterdir()) == ["spiral.html", "spiral.ngc"]
+
+
+def test_step_lanes_keep_exactly_their_changes():
+    import numpy as np
+
+    from openmotion.program.report_html import SCREEN_POINTS, step_indices
+
+    level = np.zeros(100_000)
+    level[30_000:30_010] = 1.0
+    level[70_000:] = 2.0
+    keep = step_indices(level)
+    assert keep.tolist() == [0, 30_000, 30_010, 70_000, 99_999]
+    # held from each kept sample to the next (shape "hv"), the kept samples give every value
+    held = level[keep][np.searchsorted(keep, np.arange(len(level)), side="right") - 1]
+    assert np.array_equal(held, level)
+    busy = np.arange(10 * SCREEN_POINTS) % 2.0  # more changes than pixels: decimated
+    assert len(step_indices(busy)) < len(busy)
+    assert step_indices(np.zeros(0)).tolist() == [] and step_indices(np.ones(1)).tolist() == [0]

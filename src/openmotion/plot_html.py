@@ -69,7 +69,7 @@ def trace_page(t: NDArray[Any], velocity: Mapping[str, NDArray[Any]],
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
 
-    from .program.report_html import screen_indices
+    from .program.report_html import screen_indices, step_indices
 
     n_rows = 2 + bool(lanes)
     lane_px = max(160, 26 * len(lanes))  # one readable label per lane
@@ -89,7 +89,7 @@ def trace_page(t: NDArray[Any], velocity: Mapping[str, NDArray[Any]],
     ticks: list[float] = []
     text: list[str] = []
     for lane, (label, level, names) in enumerate(lanes):
-        keep = screen_indices(np.asarray(level, dtype=float))
+        keep = step_indices(np.asarray(level, dtype=float))  # exact for a step line
         top = max(len(names) - 1, 1)
         y = lane * 1.5 + np.asarray(level, dtype=float)[keep] / top
         hover = [f"{label}: {names[int(v)]}" for v in np.asarray(level)[keep]]

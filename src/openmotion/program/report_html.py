@@ -55,6 +55,17 @@ def screen_indices(y: np.ndarray, n: int = SCREEN_POINTS) -> np.ndarray:
     return np.unique(np.concatenate(keep))
 
 
+def step_indices(level: np.ndarray, n: int = SCREEN_POINTS) -> np.ndarray:
+    """Indices of a step signal (a lane drawn with shape "hv") that draw exactly like all of
+    it: the first and last sample and every sample where the level changes; a signal that
+    changes more often than 4 * n times falls back to `screen_indices`."""
+    m = len(level)
+    change = np.flatnonzero(np.diff(level) != 0) + 1
+    if len(change) > 4 * n:
+        return screen_indices(level, n)
+    return np.unique(np.concatenate([[0], change, [m - 1]])) if m else np.arange(0)
+
+
 #: At most this many extra samples (the first and last of every command) are kept on the
 #: path so a click on a listing line finds its stretch even when it is shorter than a pixel.
 MAX_BOUNDARY_POINTS = 20_000
