@@ -35,6 +35,8 @@ window.openmotionPlotly = (async () => {
   const s = document.createElement('script');
   s.textContent = js;
   document.head.append(s);  // runs now: window.Plotly
+  if (document.readyState === 'loading')  // the figures below are not all parsed yet
+    await new Promise(r => document.addEventListener('DOMContentLoaded', r, {once: true}));
   for (const el of document.querySelectorAll('script[type="application/vnd.plotly+json"]')) {
     const fig = JSON.parse(el.textContent);
     await Plotly.newPlot(document.getElementById(el.dataset.div), fig.data, fig.layout,
