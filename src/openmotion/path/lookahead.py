@@ -53,6 +53,21 @@ from .geometry import Array, Line, PathElement, vnorm
 
 #: Element types checked by a plain isinstance (the Protocol check is slow).
 _KNOWN = (Line, Arc, Arc3D)
+#: openmotion's own element types found to be path elements: typing's runtime Protocol
+#: check reads every member of the instance (properties included), ~18 us an element, so
+#: each of ours (pathexec.Trimmed ...) is checked in full once; a user's type, whose
+#: instances may differ, every time.
+_ELEMENT_TYPES: set[type] = set(_KNOWN)
+
+
+def _is_element(el: object) -> bool:
+    if type(el) in _ELEMENT_TYPES:
+        return True
+    if isinstance(el, PathElement):
+        if type(el).__module__.startswith("openmotion."):
+            _ELEMENT_TYPES.add(type(el))
+        return True
+    return False
 
 
 @dataclass(frozen=True)
@@ -351,7 +366,7 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
             or len(elements) == 0:
         raise MotionError("elements must be a non-empty sequence of path elements")
     for k, el in enumerate(elements):
-        if not isinstance(el, _KNOWN) and not isinstance(el, PathElement):
+        if not _is_element(el):
             raise MotionError(f"elements[{k}] must be a path element (Line, Arc, Arc3D), "
                               f"got {type(el).__name__}")
     dim = elements[0].dim
