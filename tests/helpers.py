@@ -74,3 +74,20 @@ def start_line(c: Controller, start: Sequence[float], end: Sequence[float],
                        ref.duration, State(p0), State(p0 + dk), ref.labels, ref.dt)
         c.axes[ax].run_profile(prof, stop_accel=a, stop_jerk=j)
     return True
+
+
+def segment_profile(segs: Sequence[tuple[float, float, float, bool]], v0: float,
+                    p0: float = 0.0) -> Profile:
+    """A profile from drawn (duration, jerk, start acceleration, dwell) segments: a dwell
+    stops on the spot (dwell and arrival semantics), the others are jerk segments."""
+    from openmotion.profile.segments import ProfileBuilder
+
+    b = ProfileBuilder(p0, v0, v_before=v0)
+    for dur, jerk, accel, dwell in segs:
+        if dwell:
+            b.set_velocity(0.0)
+            b.segment(dur, 0.0, accel=0.0)
+        else:
+            b.segment(dur, jerk, accel=accel)
+    return b.build()
+

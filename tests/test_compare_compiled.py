@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import compare_oracle as oracle
-from helpers import free_axes, start_line
+from helpers import free_axes, segment_profile, start_line
 from openmotion import _compare
 from openmotion.control.trigger import compare_math as cm
 from openmotion.control.trigger.compare import (
@@ -31,7 +31,6 @@ from openmotion.control.trigger.compare import (
 )
 from openmotion.control.trigger.compare_math import Track, VectorCycle
 from openmotion.history import MotionHistory
-from openmotion.profile.segments import ProfileBuilder
 
 oracle.set_gauss(cm._GL_X, cm._GL_W)
 
@@ -40,15 +39,8 @@ seg = st.tuples(st.floats(1e-4, 0.01), st.floats(-1e7, 1e7), st.floats(-1e4, 1e4
 
 
 def _track(segs, v0: float, p0: float) -> tuple[Track, float]:  # noqa: ANN001
-    b = ProfileBuilder(p0, v0, v_before=v0)
-    for dur, jerk, accel, dwell in segs:
-        if dwell:
-            b.set_velocity(0.0)
-            b.segment(dur, 0.0, accel=0.0)
-        else:
-            b.segment(dur, jerk, accel=accel)
+    prof = segment_profile(segs, v0, p0)
     h = MotionHistory(1)
-    prof = b.build()
     h.append(0, 0.0, prof)
     r = h.records(0)
     return Track(r["ts"], r["p0"], r["v0"], r["a0"], r["j"]), prof.duration

@@ -5,9 +5,9 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from helpers import segment_profile
 from openmotion.control.trigger.compare_math import Track, crossings_after, first_crossing
 from openmotion.history import MotionHistory
-from openmotion.profile.segments import ProfileBuilder
 
 seg = st.tuples(st.floats(1e-4, 0.01), st.floats(-1e7, 1e7), st.floats(-1e4, 1e4),
                 st.booleans())
@@ -18,14 +18,7 @@ seg = st.tuples(st.floats(1e-4, 0.01), st.floats(-1e7, 1e7), st.floats(-1e4, 1e4
        w0=st.floats(0, 1), w1=st.floats(0, 1), direction=st.sampled_from([-1, 0, 1]))
 @settings(max_examples=300, deadline=None)
 def test_same_events_as_history(segs, v0, pick, mode, w0, w1, direction):
-    b = ProfileBuilder(0.0, v0, v_before=v0)
-    for dur, jerk, accel, dwell in segs:
-        if dwell:  # a stop on the spot: tests dwell and arrival semantics
-            b.set_velocity(0.0)
-            b.segment(dur, 0.0, accel=0.0)
-        else:
-            b.segment(dur, jerk, accel=accel)
-    prof = b.build()
+    prof = segment_profile(segs, v0)
     h = MotionHistory(1)
     h.append(0, 0.0, prof)
     r = h.records(0)

@@ -12,11 +12,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import compare_oracle as oracle
+from helpers import segment_profile
 from openmotion import _compare
 from openmotion.control.trigger import compare_math as cm
 from openmotion.control.trigger.compare_math import Track, VectorCycle
 from openmotion.history import MotionHistory
-from openmotion.profile.segments import ProfileBuilder
 
 oracle.set_gauss(cm._GL_X, cm._GL_W)
 
@@ -90,14 +90,7 @@ def test_vector_cycle_is_the_numpy_construction(recs, v0, w, a, b, on_knot, s0):
        v0=st.floats(-5e3, 5e3), cut=st.floats(0, 1), width=st.sampled_from([1e-3, 1e-4]))
 @settings(max_examples=200, deadline=None)
 def test_history_spec_reads_the_rows_in_place(segs, v0, cut, width):
-    b = ProfileBuilder(0.0, v0, v_before=v0)
-    for dur, jerk, accel, dwell in segs:
-        if dwell:
-            b.set_velocity(0.0)
-            b.segment(dur, 0.0, accel=0.0)
-        else:
-            b.segment(dur, jerk, accel=accel)
-    prof = b.build()
+    prof = segment_profile(segs, v0)
     h = MotionHistory(2)
     h.append(0, 0.0, prof)
     h.append(1, 0.0, prof)
