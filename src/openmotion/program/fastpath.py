@@ -123,6 +123,7 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
     slots = [(gi, letters[L][0], letters[L][1], L not in ROTARY_LETTERS)
              for gi, L in enumerate(order, 1)]
     n_groups = len(order) + 2
+    no_words = (None,) * (n_groups - 2)
     xy_groups = [gi for gi, L in enumerate(order, 1) if L in "XY"]
     # Modal._rotary_only: (machine axis, rotary) of every mapped letter, in its order
     movers = [(ax, L in ROTARY_LETTERS) for L, (ax, _k) in letters.items()]
@@ -139,6 +140,10 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
     lscale, ldiv = modal.lscale, modal.ldiv
     unit = lscale == 1.0 == ldiv
     moves_ok, feeds_ok = _plain_modes(modal)
+    # written back to the modal state before a general line and at the end
+    feed, f_lin, f_ang = modal.feed, modal.feed_lin, modal.feed_ang
+    motion_prev = modal.motion_prev
+    cycle_set = True  # cycle.initial may be set: the next plain line clears it
     for k, text in enumerate(lines, 1):
         if not running:  # after M2/M30: later lines are still parsed (their errors count)
             if len(text) > max_len or canonical(text) is None:
@@ -159,52 +164,52 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
                 fv = float(f)
                 if fv < 0.0:
                     m = None  # the general path's error
-            moving = False
-            for gi in range(1, n_groups - 1):
-                if grp[gi] is not None:
-                    moving = True
-                    break
+            moving = grp[1:-1] != no_words
             if m is not None and moving and (mode == 0 or (mode == 10 and feeds_ok)):
                 steps += 1
                 seen_code = True
                 if steps > limit:
                     raise _Defer("max_blocks")
-                feed = modal.feed
                 if f is not None:
-                    feed = fv
-                    f_lin = fv * lscale / ldiv
-                    f_ang = fv
+                    n_feed, n_lin, n_ang = fv, fv * lscale / ldiv, fv
                 else:
-                    f_lin, f_ang = modal.feed_lin, modal.feed_ang
+                    n_feed, n_lin, n_ang = feed, f_lin, f_ang
                 target = pos[:]
-                for gi, ax, kk, linear in slots:
-                    sv = grp[gi]
-                    if sv is not None:
-                        v = float(sv)
-                        if linear and not unit:
-                            v = v * lscale / ldiv
-                        target[ax] = pos[ax] + v if incremental else v + off[kk]
+                if unit and not incremental:
+                    for gi, ax, kk, _linear in slots:
+                        sv = grp[gi]
+                        if sv is not None:
+                            target[ax] = float(sv) + off[kk]
+                else:
+                    for gi, ax, kk, linear in slots:
+                        sv = grp[gi]
+                        if sv is not None:
+                            v = float(sv)
+                            if linear and not unit:
+                                v = v * lscale / ldiv
+                            target[ax] = pos[ax] + v if incremental else v + off[kk]
                 per_s = 0.0
                 if mode == 10:
-                    if feed <= 0.0:
+                    if n_feed <= 0.0:
                         m = None  # "feed rate is zero or not set": the general path
                     else:
                         rotary_only = False
                         if any_rotary:
                             moved = [rot for ax, rot in movers if target[ax] != pos[ax]]
                             rotary_only = bool(moved) and all(moved)
-                        per_s = (f_ang if rotary_only else f_lin) / 60.0
+                        per_s = (n_ang if rotary_only else n_lin) / 60.0
                 if m is not None and soft:
                     try:
                         modal.check_limits(_FakeBlock, target, target, "", 0)
                     except _Reroute:
                         m = None
                 if m is not None:
-                    if f is not None:
-                        modal.feed, modal.feed_lin, modal.feed_ang = feed, f_lin, f_ang
-                    modal.motion_prev = motion
+                    feed, f_lin, f_ang = n_feed, n_lin, n_ang
+                    motion_prev = motion
                     motion = mode
-                    cycle.initial = None
+                    if cycle_set:
+                        cycle.initial = None
+                        cycle_set = False
                     if comp.arc_not_allowed:
                         for gi in xy_groups:
                             if grp[gi] is not None:
@@ -218,11 +223,13 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
                 steps -= 1  # the general path below counts the line again
             elif m is not None and not moving:
                 if f is not None:
-                    modal.feed, modal.feed_lin, modal.feed_ang = fv, fv * lscale / ldiv, fv
+                    feed, f_lin, f_ang = fv, fv * lscale / ldiv, fv
                 if g is not None:
-                    modal.motion_prev = motion
+                    motion_prev = motion
                     motion = mode
-                    cycle.initial = None
+                    if cycle_set:
+                        cycle.initial = None
+                        cycle_set = False
                 if text.strip():
                     seen_code = True
                     steps += 1
@@ -246,7 +253,8 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
             raise _Defer("max_blocks")
         if b.delete and skip_deleted:
             continue
-        modal.motion, modal.pos = motion, pos
+        modal.motion, modal.pos, modal.motion_prev = motion, pos, motion_prev
+        modal.feed, modal.feed_lin, modal.feed_ang = feed, f_lin, f_ang
         running = modal.execute(b, general)
         if modal.flow_request is not None:
             raise _Defer("M98/M99")
@@ -262,7 +270,11 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
         lscale, ldiv = modal.lscale, modal.ldiv
         unit = lscale == 1.0 == ldiv
         moves_ok, feeds_ok = _plain_modes(modal)
-    modal.motion, modal.pos = motion, pos
+        feed, f_lin, f_ang = modal.feed, modal.feed_lin, modal.feed_ang
+        motion_prev = modal.motion_prev
+        cycle_set = True
+    modal.motion, modal.pos, modal.motion_prev = motion, pos, motion_prev
+    modal.feed, modal.feed_lin, modal.feed_ang = feed, f_lin, f_ang
     yield from general
 
 
