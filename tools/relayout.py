@@ -78,9 +78,9 @@ MAPPING: dict[str, str] = {
     "network": "cards", "speed_range": "cards",
     # compare and PSO
     "compare": "trigger", "compare_due": "trigger", "compare_io": "trigger",
-    "compare_jobs": "trigger", "compare_math": "trigger",
-    "compare_scope": "trigger", "pso": "trigger", "hsl_trigger": "trigger",
-    "analog": "trigger",
+    "compare_jobs": "trigger", "compare_math": "trigger", "compare_replan": "trigger",
+    "compare_scope": "trigger", "compare_tracks": "trigger", "pso": "trigger",
+    "hsl_trigger": "trigger", "analog": "trigger",
     # homing and latch
     "homing": "home", "homing_modes": "home", "homing_sequence": "home", "latch": "home",
     "pulserule": "home", "homeconf": "home",
