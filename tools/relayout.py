@@ -66,7 +66,8 @@ PACKAGES: dict[str, tuple[str, tuple[str, ...]]] = {
 #: control module -> sub-package (every module of src/openmotion/control/ must be here)
 MAPPING: dict[str, str] = {
     # core
-    "axis": "core", "axisexec": "core", "clock": "core", "controller": "core",
+    "axis": "core", "axisexec": "core", "axisrunning": "core", "clock": "core",
+    "controller": "core",
     "counters": "core", "events": "core", "jump": "core", "motion": "core",
     "planning": "core", "realtime": "core", "states": "core",
     # safety reactions
