@@ -67,7 +67,7 @@ PACKAGES: dict[str, tuple[str, tuple[str, ...]]] = {
 MAPPING: dict[str, str] = {
     # core
     "axis": "core", "axisexec": "core", "axisrunning": "core", "clock": "core",
-    "controller": "core",
+    "controller": "core", "controller_hooks": "core", "controller_settings": "core",
     "counters": "core", "events": "core", "jump": "core", "motion": "core",
     "planning": "core", "realtime": "core", "states": "core",
     # safety reactions
