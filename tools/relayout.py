@@ -66,7 +66,8 @@ PACKAGES: dict[str, tuple[str, tuple[str, ...]]] = {
 #: control module -> sub-package (every module of src/openmotion/control/ must be here)
 MAPPING: dict[str, str] = {
     # core
-    "axis": "core", "axisexec": "core", "clock": "core", "controller": "core",
+    "axis": "core", "axisexec": "core", "axisrunning": "core", "clock": "core",
+    "controller": "core", "controller_hooks": "core", "controller_settings": "core",
     "counters": "core", "events": "core", "jump": "core", "motion": "core",
     "planning": "core", "realtime": "core", "states": "core",
     # safety reactions
@@ -78,9 +79,9 @@ MAPPING: dict[str, str] = {
     "network": "cards", "speed_range": "cards",
     # compare and PSO
     "compare": "trigger", "compare_due": "trigger", "compare_io": "trigger",
-    "compare_jobs": "trigger", "compare_math": "trigger",
-    "compare_scope": "trigger", "pso": "trigger", "hsl_trigger": "trigger",
-    "analog": "trigger",
+    "compare_jobs": "trigger", "compare_math": "trigger", "compare_replan": "trigger",
+    "compare_scope": "trigger", "compare_tracks": "trigger", "pso": "trigger",
+    "hsl_trigger": "trigger", "analog": "trigger",
     # homing and latch
     "homing": "home", "homing_modes": "home", "homing_sequence": "home", "latch": "home",
     "pulserule": "home", "homeconf": "home",

@@ -11,42 +11,41 @@ converts the program unit (G20/G21) to the machine unit for linear axes (1 for A
 work is the selected G54..G59.3 origin, g92 the G92 offset and tool the G43 length (Z only).
 Offsets live in LinuxCNC's parameters: G54 X..W = #5221..#5229 (+20 per system), G92 =
 #5211..#5219, G28 = #5161.., G30 = #5181..; all in machine units. The group-0 commands that
-rewrite them (G10, G28/G30, G92) are in coords.py; G2/G3 in arcmove.py.
+rewrite them (G10, G28/G30, G92) are in coords.py; G2/G3 in arcmove.py. Axis words ->
+machine targets and the soft-limit check are in modalcoords.py, the motion-mode dispatch
+and feed rates in modalmotion.py (mixins of Modal).
 """
 
 from __future__ import annotations
 
 import math
 
-from . import canon, frame
+from . import canon
 from .analogout import m67_m68
-from .arcmove import arc_move
 from .codes import G_GROUP, G_REFUSED, M_GROUP, M_REFUSED
-from .compmove import comp_motion
 from .coords import offset_command
-from .css import FeedMode, g96, nominal_rpm
+from .css import FeedMode, g96
 from .cuttercomp import CutterComp, comp_off, comp_on
-from .cycles import CYCLES, CycleState, canned_cycle
+from .cycles import CYCLES, CycleState
 from .expr import EvalError, Node
-from .latheprofile import LATHE_CYCLES, lathe_cycle
+from .latheprofile import LATHE_CYCLES
 from .messages import comment_commands
+from .modalcoords import COORD_SYSTEMS, ModalCoordinates
+from .modalmotion import ModalMotion
 from .modalstate import SavedState, state_word
 from .named import READ_ONLY, predefined
-from .options import AXIS_LETTERS, MM_PER_INCH, ROTARY_LETTERS, GCodeOptions
+from .options import AXIS_LETTERS, MM_PER_INCH, GCodeOptions
 from .orient import m19
 from .overrides import m48_m53
 from .params import Parameters
 from .parser import Block, Value
 from .polar import polar_words
-from .probing import PROBE_CODES, g38, m66
-from .rigidtap import g33_1
-from .splines import SPLINE_CODES, open_block_error, spline_move
-from .threading import g33, g76
+from .probing import m66
+from .splines import open_block_error
 from .tooloffsets import set_tool_parameters, tool_length
 from .usermcodes import m100_m199
-from .words import Word, feed_length, fmt
+from .words import Word, fmt
 
-COORD_SYSTEMS = {540: 1, 550: 2, 560: 3, 570: 4, 580: 5, 590: 6, 591: 7, 592: 8, 593: 9}
 AXIS_SET = frozenset(AXIS_LETTERS)
 
 #: Motion codes that may stand without axis words (LinuxCNC's enhance_block): G0-G3, the
@@ -55,7 +54,7 @@ AXIS_SET = frozenset(AXIS_LETTERS)
 AXES_OPTIONAL = frozenset({None, 0, 10, 20, 30, 52, 53, *LATHE_CYCLES})
 
 
-class Modal:
+class Modal(ModalCoordinates, ModalMotion):
     """Modal state + positions; `execute(block, out)` appends the line's commands to out.
 
     Returns False when the line ended the program (M2/M30).
@@ -132,10 +131,7 @@ class Modal:
         self.retract_old_z = False  # G98 (True) / G99; LinuxCNC's rs274 starts in G99
         self.diameter_mode = False  # G7
 
-    # -- coordinates -----------------------------------------------------------------
-    def update_offsets(self) -> None:
-        frame.update(self)
-
+    # -- state read by predefined parameters (named.py); coordinates: modalcoords.py --
     def ccomp_code(self) -> int:
         """Active cutter compensation as G-code * 10 (400 = off)."""
         return self.comp.code()
@@ -149,105 +145,6 @@ class Modal:
     def pocket_of(self, tool: int) -> int:
         """Pocket of a tool (a tool table without pockets: the tool number, 0 -> -1)."""
         return tool if tool > 0 else -1
-
-    def lin(self, v: float) -> float:
-        """A program length in machine units (exact when the units agree or 1 in = 25.4 mm)."""
-        return v * self.lscale / self.ldiv
-
-    def conv(self, v: float, letter: str) -> float:
-        """Program value of axis `letter` in machine units (rotary axes are degrees)."""
-        return v if letter in ROTARY_LETTERS else v * self.lscale / self.ldiv
-
-    def program_position(self, k: int) -> float:
-        """Current position of axis letter number k (X=0..W=8) in program coordinates."""
-        letter = AXIS_LETTERS[k]
-        info = self.letters.get(letter)
-        if info is None:
-            return 0.0
-        if self.rotated and k in (0, 1):
-            xy = frame.machine_to_xy(self, self.pos[self.letters["X"][0]],
-                                     self.pos[self.letters["Y"][0]])
-            return xy[k] * self.ldiv / self.lscale
-        d = self.pos[info[0]] - self.off[k]
-        return d if letter in ROTARY_LETTERS else d * self.ldiv / self.lscale
-
-    def axis_index(self, b: Block, letter: str, w: Word) -> int:
-        info = self.letters.get(letter)
-        if info is None:
-            raise b.error(f"axis letter {letter} has no machine axis (axes: "
-                          f"{', '.join(sorted(self.letters))})", w.pos, fmt(letter, w.value))
-        return info[0]
-
-    def target_position(self, b: Block, axes: dict[str, Word], machine: bool = False,
-                        incremental: bool | None = None, diameter: bool = True
-                        ) -> list[float]:
-        """Machine end point of axis words (program units; G90/G91, G7 on X, rotation)."""
-        inc = self.incremental if incremental is None else incremental
-        target = self.pos[:]
-        xy: list[float] | None = None
-        for letter, w in axes.items():
-            ax = self.axis_index(b, letter, w)
-            v = self.conv(w.value, letter)
-            if letter == "X" and self.diameter_mode and diameter and not machine:
-                v *= 0.5  # G7: X words are diameters
-            k = self.letters[letter][1]
-            if machine:
-                target[ax] = v
-            elif self.rotated and k < 2:
-                if xy is None:
-                    xy = list(frame.machine_to_xy(self, self.pos[self.letters["X"][0]],
-                                                  self.pos[self.letters["Y"][0]]))
-                xy[k] = xy[k] + v if inc else v
-            elif inc:
-                target[ax] = self.pos[ax] + v
-            else:
-                target[ax] = v + self.off[k]
-        if xy is not None:
-            mx, my = frame.xy_to_machine(self, xy[0], xy[1])
-            target[self.letters["X"][0]], target[self.letters["Y"][0]] = mx, my
-        return target
-
-    def check_limits(self, b: Block, lo: list[float], hi: list[float], word: str,
-                      pos: int) -> None:
-        limits = self.opt.soft_limits
-        if limits is None:
-            return
-        for ax, lim in enumerate(limits):
-            if lim is None:
-                continue
-            u = self._unit(ax)
-            if lo[ax] < lim[0] - 1e-9 * max(1.0, abs(lim[0])):
-                raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
-                              f"machine {lo[ax]:.6g} < min {lim[0]:g} {u}"
-                              f"{self._offset_note(ax)}", pos, word)
-            if hi[ax] > lim[1] + 1e-9 * max(1.0, abs(lim[1])):
-                raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
-                              f"machine {hi[ax]:.6g} > max {lim[1]:g} {u}"
-                              f"{self._offset_note(ax)}", pos, word)
-
-    def _unit(self, ax: int) -> str:
-        """The unit of machine axis `ax`'s positions: degrees on A/B/C, else the machine's."""
-        names = [L for L, (a, _) in self.letters.items() if a == ax]
-        return "deg" if names and names[0] in "ABC" else self.opt.machine_units
-
-    def _limit_axis(self, ax: int) -> str:
-        """The program's letter for machine axis `ax` (soft-limit messages)."""
-        names = [L for L, (a, _) in self.letters.items() if a == ax]
-        return names[0] if names else f"machine axis {ax}"
-
-    def _offset_note(self, ax: int) -> str:
-        """' (active offset G55 X-60, G92 X5)': where the program origin of axis `ax` is."""
-        names = [(L, k) for L, (a, k) in self.letters.items() if a == ax]
-        if not names:
-            return ""
-        letter, k = names[0]
-        system = {v: f"G{c // 10}" + (f".{c % 10}" if c % 10 else "")
-                  for c, v in COORD_SYSTEMS.items()}[self.coord]
-        work = self.params.numbers[5221 + 20 * (self.coord - 1) + k]
-        note = f" (active offset {system} {letter}{work:g}"
-        if self.g92[k]:
-            note += f", G92 {letter}{self.g92[k]:g}"
-        return note + ")"
 
     # -- evaluation ------------------------------------------------------------------
     def evaluate(self, b: Block, v: Value, word: str = "") -> float:
@@ -600,108 +497,3 @@ class Modal:
         """A Spindle record in the current direction and speed (cycles stop/restart)."""
         return canon.Spindle(on, self.spindle_cw, self.speed, self.opt.spindle_output,
                              b.line, b.file)
-
-    def feed_rate(self, b: Block, words: dict[str, Word], gword: str, gpos: int,
-                  rotary_only: bool = False) -> tuple[float, float | None]:
-        """(feed_per_s, duration) for a feed move; errors when F is missing. A move of
-        rotary axes only runs at the F number in degrees per minute (never unit-scaled)."""
-        if self.inverse_time:
-            f = words.get("F")
-            if f is None or f.value <= 0:
-                raise b.error("inverse time feed (G93) needs F > 0 on every G1/G2/G3 line",
-                              gpos, gword)
-            return 0.0, 60.0 / f.value
-        if self.feed <= 0.0:
-            raise b.error("feed rate is zero or not set: give F before or with "
-                          f"{gword}", gpos, gword)
-        return self.per_second(self.feed_ang if rotary_only else self.feed_lin, b, gword,
-                               gpos), None
-
-    def per_second(self, f: float, b: Block, gword: str, gpos: int) -> float:
-        """A feed F (per minute, or per revolution in G95) in units per second; G95 uses the
-        commanded spindle speed S (no spindle feedback on this path)."""
-        if not self.per_rev:
-            return f / 60.0
-        rpm = nominal_rpm(self)
-        if not self.spindle_on or self.speed <= 0.0 or not math.isfinite(rpm):
-            raise b.error(f"{gword} in G95 (feed per revolution) needs the spindle turning "
-                          "at S > 0" + (" (G96 at X0 without D: no rpm limit)"
-                                        if not math.isfinite(rpm) else ""), gpos, gword)
-        return f * rpm / 60.0
-
-    def _rotary_only(self, start: list[float], end: list[float]) -> bool:
-        """True when only rotary axes move (LinuxCNC then feeds at the angular rate)."""
-        moved = [L for L, (ax, _k) in self.letters.items() if end[ax] != start[ax]]
-        return bool(moved) and all(L in ROTARY_LETTERS for L in moved)
-
-    def _motion(self, b: Block, gs: dict[int, tuple[int, int]], axes: dict[str, Word],
-                words: dict[str, Word], used: set[str], out: list[canon.Command],
-                machine: bool) -> None:
-        mode = self.motion
-        gpos = gs[1][1] if 1 in gs else (axes[next(iter(axes))].pos if axes else 0)
-        if mode is None:
-            if 1 in gs:
-                raise b.error("axis words cannot be used with G80", gs[1][1], "G80")
-            w = next(iter(axes.values()))
-            raise b.error("axis words without a motion mode (G0, G1, G2 or G3)", w.pos,
-                          fmt(next(iter(axes)), w.value))
-        gword = f"G{mode / 10:g}"
-        if mode not in (52, 53):
-            open_block_error(self, b, gpos, gword)
-        if mode in SPLINE_CODES:
-            if machine:
-                raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
-            spline_move(self, b, mode, gpos, axes, words, used, out)
-            return
-        if machine:
-            if mode not in (0, 10):
-                raise b.error("G53 needs G0 or G1", gs[0][1], "G53")
-            if self.incremental:
-                raise b.error("G53 cannot be used in incremental mode (G91)", gs[0][1], "G53")
-        if mode in CYCLES:
-            if self.comp.side:
-                raise b.error("canned cycles cannot be used with cutter compensation on",
-                              gpos, gword)
-            canned_cycle(self, b, mode, gpos, axes, words, used, out)
-            return
-        if mode in LATHE_CYCLES:
-            lathe_cycle(self, b, mode, gpos, axes, words, used, out)
-            return
-        if mode == 331:
-            g33_1(self, b, gpos, axes, words, used, out)
-            return
-        if mode in (330, 760):
-            if self.comp.side:
-                raise b.error(f"{gword} cannot be used with cutter compensation on", gpos,
-                              gword)
-            if mode == 760:
-                g76(self, b, gpos, axes, words, used, out)
-            else:
-                g33(self, b, gpos, self.target_position(b, axes), words, used, out)
-            return
-        if mode in PROBE_CODES:
-            target = self.target_position(b, axes)
-            g38(self, b, mode, gpos, target, words, used, out)
-            return
-        if mode in (20, 30) and self.comp.arc_not_allowed:
-            raise b.error("the move just after cutter compensation ends (G40) must be a "
-                          "straight line", gpos, gword)
-        if self.comp.active:
-            comp_motion(self, b, mode, gpos, gword, axes, words, used, out, machine)
-            return
-        if mode in (0, 10) and any(L in axes for L in "XY"):
-            self.comp.arc_not_allowed = False
-        target = self.target_position(b, axes, machine=machine)
-        if mode == 0:
-            self.check_limits(b, target, target, gword, gpos)
-            out.append(canon.Rapid(tuple(target), b.line, b.file))
-        elif mode == 10:
-            feed, duration = self.feed_rate(b, words, gword, gpos,
-                                            self._rotary_only(self.pos, target))
-            if duration is not None:
-                feed = feed_length(self.pos, target, self.letters) / duration
-            self.check_limits(b, target, target, gword, gpos)
-            out.append(canon.Feed(tuple(target), feed, b.line, b.file, duration))
-        else:
-            out.append(arc_move(self, b, mode, gpos, target, words, used))
-        self.pos = target

@@ -7,32 +7,25 @@ pass `units=True` to give positions and speeds in the axis's user unit (AxisUnit
 
 Every command validates and plans completely before it changes anything: a refused command
 (MotionError) leaves the state, counters and running motion exactly as they were. Running
-the installed motion from the controller's cycle is axisexec.py (`AxisEngine`, the base).
+the installed motion from the controller's cycle is axisexec.py (`AxisEngine`, the base);
+the commands on a running motion (change_speed/position, stops) are axisrunning.py.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from functools import wraps
-from typing import TYPE_CHECKING, Any, Protocol, TypeVar
+from typing import TYPE_CHECKING, Protocol
 
-from ...errors import (
-    InfeasibleError,
-    MotionError,
-    check_finite,
-    check_flags,
-    check_nonnegative,
-    check_positive,
-)
+from ...errors import MotionError, check_finite, check_nonnegative, check_positive
 from ...hw.interface import AxisCommand
 from ...limits import check_quantity
-from ...profile.onthefly import final_decel_start
 from ...profile.pcl import MoveSpec
 from ...profile.segments import Profile
 from ...units import MAX_PULSE_RATE, AxisUnits
 from . import planning
 from .axisexec import AxisEngine
+from .axisrunning import AxisRunningCommands, _locked
 from .counters import COUNTER_MAX, COUNTER_MIN, Counters
 from .motion import ActiveMotion
 from .states import AxisState, MotionDone, transition
@@ -41,7 +34,6 @@ if TYPE_CHECKING:
     from ...config import AxisConfig
     from .controller import Controller
 
-F = TypeVar("F", bound=Callable[..., Any])
 S = AxisState
 
 
@@ -54,19 +46,7 @@ class SpeedGrid(Protocol):
     def change(self, new_vel: float, current_range: float) -> float: ...
 
 
-def _locked(fn: F) -> F:
-    """Serialise a public call with the cycle loop (real-time mode runs on a thread)."""
-
-    @wraps(fn)
-    def wrapper(self: Axis, *args: Any, **kwargs: Any) -> Any:
-        check_flags(kwargs)
-        with self._ctl._lock:
-            return fn(self, *args, **kwargs)
-
-    return wrapper  # type: ignore[return-value]
-
-
-class Axis(AxisEngine):
+class Axis(AxisRunningCommands, AxisEngine):
     """An axis of a `Controller`. Get it with `controller.axis(name_or_index)`."""
 
     def __init__(self, index: int, config: AxisConfig, controller: Controller) -> None:
@@ -504,99 +484,6 @@ class Axis(AxisEngine):
         """Homing -> Standstill (any homing move still running is cut at once)."""
         if self._state is S.HOMING:
             self._kill_motion()
-            self._state = transition(self._state, S.STANDSTILL, self.name)
-
-    @_locked
-    def change_speed(self, new_vel: float, tacc: float, *, units: bool = False) -> None:
-        """Change speed on the fly (HSL v_change), for velocity and positioning moves.
-
-        The new speed may not exceed the fixed speed range (`fix_speed_range`) or, when none
-        is fixed, the move's own MaxVel. Refused (InfeasibleError, motion unchanged) when a
-        positioning move has too few pulses left to reach the speed and still stop. A
-        change to the speed the move already runs or ramps to changes nothing (a legacy loop
-        re-issuing v_change while a sensor stays on keeps its first ramp).
-        """
-        v = abs(self.check_speed("new_vel", new_vel, units))
-        ta = check_positive("tacc", tacc)
-        m = self._check_running("change_speed")
-        if m.spec is None:
-            raise MotionError(f"axis {self.name}: change_speed applies to T/S and velocity "
-                              "moves, not jerk-limited ones")
-        limit = self._speed_range if self._speed_range is not None else m.v_range
-        if v > limit * (1.0 + 1e-12):
-            raise InfeasibleError(
-                f"new_vel must be <= the speed range {self.speed_text(limit, units)} "
-                f"(fix_speed_range to allow more), got {new_vel!r}")
-        if self.speed_model is not None:
-            v = self.speed_model.change(v, limit)
-        t = self._ctl.time
-        if v == m.spec.max_vel and t - m.t_start < final_decel_start(m.profile):
-            return  # already running (or ramping) to this speed: the registers stay as set
-        profile, spec = planning.change_speed(m, t, v, ta, limit)
-        self._replace(m, profile, spec, m.target)
-
-    @_locked
-    def change_position(self, new_position: float, *, units: bool = False) -> None:
-        """Change the target of a running absolute move on the fly (HSL p_change).
-
-        Refused (InfeasibleError, motion unchanged) during the final deceleration or when
-        the new target is too close to stop at; a target already passed makes the axis stop
-        and come back ("go back").
-        """
-        p = check_finite("new_position", new_position)
-        p = float(self.units.to_pulses(p)) if units else p
-        if not COUNTER_MIN <= p <= COUNTER_MAX:
-            lo, hi = (COUNTER_MIN, COUNTER_MAX) if not units else sorted(
-                float(self.units.to_units(c)) for c in (COUNTER_MIN, COUNTER_MAX))
-            raise MotionError(f"new_position must be in [{lo:.10g}, {hi:.10g}]"
-                              f"{' ' + self.units.unit if units else ''}, "
-                              f"got {new_position!r}")
-        m = self._check_running("change_position")
-        if m.kind != "absolute":
-            raise MotionError(f"axis {self.name}: change_position applies to absolute moves "
-                              "only (HSL 4.11)")
-        new_target = round(m.target + (p - m.abs_target))
-        profile, spec = planning.change_position(m, self._ctl.time, new_target)
-        self._replace(m, profile, spec, float(new_target), abs_target=p)
-        self.counters.add_target(p - self.counters.target)
-
-    @_locked
-    def stop(self, tdec: float | None = None) -> None:
-        """Decelerating stop (HSL sd_stop / PLCopen MC_Stop) from any motion.
-
-        `tdec` is the deceleration time of the move's parameters (MaxVel -> StrVel); by
-        default the running move's own Tdec. Stopping an axis at rest does nothing.
-        """
-        td = None if tdec is None else check_positive("tdec", tdec)
-        m = self._motion
-        if m is None and self._state is S.HOMING:  # homing between two moves: abort it
-            self.end_homing()
-            return
-        if m is None or self._state is S.STOPPING and td is None:
-            return
-        t = self._ctl.time
-        profile = planning.decel_stop(m, t, td)
-        self._replace(m, profile, m.spec, None, kind="stop")
-        self._state = transition(self._state, S.STOPPING, self.name)
-
-    def _stop_along(self, tail: Profile) -> None:
-        """Decelerating stop that follows `tail` (command-counter frame, time 0 = now, ends
-        at rest) instead of the axis's own deceleration: a group stopping along its path
-        when one of its axes is stopped. The axis is STOPPING (or stays in ErrorStop)."""
-        m = self._motion
-        if m is None:
-            return
-        shifted = tail.shifted(-self.counters._cmd_off)
-        self._replace(m, m.profile.splice(self._ctl.time - m.t_start, shifted), m.spec, None,
-                      kind="stop")
-        if self._state is not S.ERROR_STOP:
-            self._state = transition(self._state, S.STOPPING, self.name)
-
-    @_locked
-    def stop_immediately(self) -> None:
-        """Immediate stop (HSL emg_stop): the pulse output stops at once, at any state."""
-        self._kill_motion()
-        if self._state in (S.DISCRETE_MOTION, S.CONTINUOUS_MOTION, S.STOPPING, S.HOMING):
             self._state = transition(self._state, S.STANDSTILL, self.name)
 
     # ------------------------------------------------------------------ internals

@@ -15,24 +15,30 @@ One cycle (period T, from t0 to t1 = t0 + T):
 Virtual time: `step()`, `advance(dt)`, `run_until(condition, timeout)` - deterministic, as
 fast as Python goes. Real time: `start_realtime()` paces the same cycle to the wall clock on
 a thread; `stop_realtime()`; `with controller.start_realtime(): ...`; `cycle_stats()`.
+Registering hooks is controller_hooks.py, changing the period or an axis's settings on a
+running machine controller_settings.py (mixins of Controller).
 """
 
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import math
-from collections.abc import Callable, Collection, Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
-from ...config import ENCODER_MULTIPLIER, MachineConfig, default_machine
-from ...errors import MotionError, check_int, check_nonnegative
+from ...config import MachineConfig, default_machine
+from ...errors import MotionError, check_nonnegative
 from ...history import MotionHistory
 from ...hw.interface import Hardware, InputEdge
 from ...recording import Recorder
-from ...units import MAX_PULSE_RATE
 from .axis import Axis
 from .clock import CycleStats, RealtimePacer, check_period
+from .controller_hooks import ControllerHooks
+from .controller_settings import (  # noqa: F401 - re-exported (compat.mccl_motion)
+    DECODER_FIELDS,
+    RECONFIGURABLE,
+    ControllerSettings,
+)
 from .events import EventLog
 from .jump import jump, plan_jump, record_now
 from .motion import ActiveMotion
@@ -91,15 +97,10 @@ MotionCheck = Callable[[Axis, ActiveMotion], None]
 MotionHook = Callable[[Axis, "ActiveMotion | None"], None]
 PeriodHook = Callable[[float, bool], None]
 ConfigHook = Callable[[int, Any, bool], None]
-#: AxisConfig fields `Controller.reconfigure_axis` changes on a running machine.
-DECODER_FIELDS = ("encoder_mode", "swap_ab", "invert_a", "invert_b", "invert_z")
-RECONFIGURABLE = ("pulses_per_rev", "lead", "gear_ratio", "reverse", "max_speed", "logic",
-                  "pulse_mode", "pulse_width_us", "encoder_lines_per_rev", "move_ratio",
-                  *DECODER_FIELDS)
 JumpObserver = Callable[["Controller", int, int, "np.ndarray", "np.ndarray"], None]
 
 
-class Controller:
+class Controller(ControllerHooks, ControllerSettings):
     """Multi-axis controller over a `Hardware` back end (the simulator by default).
 
     config: the machine (default `default_machine()`); hardware: a back end implementing
@@ -243,269 +244,9 @@ class Controller:
     def _emg_level_active(self, level: bool) -> bool:
         return level != self._emg_nc
 
-    # ------------------------------------------------------------------ hooks
-    def add_edge_hook(self, hook: EdgeHook, *, signals: Collection[str] | None = None
-                      ) -> None:
-        """Call `hook(controller, edge)` for every input edge, after the built-in hooks.
-
-        `signals`, if given, promises the hook does nothing for edges on other signals:
-        virtual time then jumps over cycles whose only edges are on signals no hook acts
-        on (control/core/jump.py). Without it, every edge ends a jump.
-        """
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        if signals is not None and (isinstance(signals, str) or not all(
-                isinstance(x, str) for x in signals)):
-            raise MotionError(f"signals must be a collection of signal names, got "
-                                  f"{signals!r}")
-        with self._lock:
-            self._edge_hooks.append(hook)
-            if signals is not None:
-                self._edge_signals[hook] = frozenset(signals)
-
-    def remove_edge_hook(self, hook: EdgeHook) -> None:
-        with self._lock:
-            if hook in self._edge_hooks[2:]:
-                self._edge_hooks.remove(hook)
-                if hook not in self._edge_hooks:
-                    self._edge_signals.pop(hook, None)
-
-    def add_cycle_hook(self, hook: CycleHook, *, due: DueFn | None = None) -> None:
-        """Call `hook(controller, t)` at the end of every cycle (t = cycle end time).
-
-        `due(controller)`, if given, returns the earliest time at which the hook may act
-        (it must run in the first cycle ending at or after it; math.inf: not before the
-        next input edge or motion change; the current time or less: every cycle). Virtual
-        time jumps only over cycles in which every cycle hook is not due (control/core/jump.py);
-        a hook without `due` runs every cycle and keeps time from jumping.
-        """
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        if due is not None and not callable(due):
-            raise MotionError(f"due must be callable or None, got {due!r}")
-        with self._lock:
-            self._cycle_hooks.append(hook)
-            if due is not None:
-                self._cycle_dues[hook] = due
-
-    def remove_cycle_hook(self, hook: CycleHook) -> None:
-        with self._lock:
-            if hook in self._cycle_hooks:
-                self._cycle_hooks.remove(hook)
-                if hook not in self._cycle_hooks:
-                    self._cycle_dues.pop(hook, None)
-
-    def add_pre_advance_hook(self, hook: PreAdvanceHook, *, due: DueFn | None = None
-                             ) -> None:
-        """Call `hook(controller, t0, t1)` every cycle after every axis's command for
-        [t0, t1] is set and before `hardware.advance(t1)`: the commanded motion of the
-        coming cycle is known then (the history holds it), so a hook can schedule timed
-        outputs for it (hw.interface.TimedOutputHardware).
-
-        `due(controller)`, as for `add_cycle_hook`: the earliest time inside the first
-        cycle in which the hook may act; that cycle then runs on its own (a jump lands
-        before it). Without it, every cycle runs.
-        """
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        if due is not None and not callable(due):
-            raise MotionError(f"due must be callable or None, got {due!r}")
-        with self._lock:
-            self._pre_hooks.append(hook)
-            if due is not None:
-                self._pre_dues[hook] = due
-
-    def remove_pre_advance_hook(self, hook: PreAdvanceHook) -> None:
-        with self._lock:
-            if hook in self._pre_hooks:
-                self._pre_hooks.remove(hook)
-                if hook not in self._pre_hooks:
-                    self._pre_dues.pop(hook, None)
-
-    def add_jump_observer(self, observer: JumpObserver) -> None:
-        """Call `observer(controller, first, last, positions, actual)` when a jump
-        (control/core/jump.py) crosses cycles first..last without running their hooks:
-        `positions[i, a]` (float arrays, one row per crossed cycle, one column per axis)
-        is axis a's command position (pulses) at the end of cycle first + i, exactly as
-        those cycles would have left it, and `actual[i, a]` its `counters.actual()` (the
-        feedback position in the command frame) there; valid during the call only. A hook
-        that records something every cycle (a trace) fills the crossed cycles from it and
-        can declare a `due`."""
-        if not callable(observer):
-            raise MotionError(f"observer must be callable, got {observer!r}")
-        with self._lock:
-            self._jump_observers.append(observer)
-
-    def remove_jump_observer(self, observer: JumpObserver) -> None:
-        with self._lock:
-            if observer in self._jump_observers:
-                self._jump_observers.remove(observer)
-
-    def add_sample_hook(self, hook: SampleHook, per_cycle: int = 1) -> None:
-        """Call `hook(controller, t)` `per_cycle` times per cycle, at t = t0 + k*T/per_cycle
-        (k = 0..per_cycle-1), after the cycle's commands are sent and the hardware has been
-        advanced to t (sampled loops: read feedback, write an output held from t)."""
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        check_int("per_cycle", per_cycle, 1, 1000)
-        with self._lock:
-            self._sample_hooks.append((hook, per_cycle))
-            self._samples = math.lcm(*(n for _, n in self._sample_hooks))
-
-    def remove_sample_hook(self, hook: SampleHook) -> None:
-        with self._lock:
-            self._sample_hooks = [(h, n) for h, n in self._sample_hooks if h != hook]
-            self._samples = math.lcm(1, *(n for _, n in self._sample_hooks))
-
-    def add_fault_hook(self, hook: FaultHook) -> None:
-        """Call `hook(axis, reason)` whenever an axis goes to ErrorStop (`fault_stop`):
-        limits, alarms, E-stop, safety reactions. A group engine subscribes here."""
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        with self._lock:
-            self._fault_hooks.append(hook)
-
-    def remove_fault_hook(self, hook: FaultHook) -> None:
-        with self._lock:
-            if hook in self._fault_hooks:
-                self._fault_hooks.remove(hook)
-
-    def add_motion_check(self, check: MotionCheck) -> None:
-        """Call `check(axis, motion)` before a motion starts or is re-planned (not for
-        stops); it refuses by raising MotionError, which leaves the axis unchanged."""
-        if not callable(check):
-            raise MotionError(f"check must be callable, got {check!r}")
-        with self._lock:
-            self._motion_checks.append(check)
-
-    def remove_motion_check(self, check: MotionCheck) -> None:
-        with self._lock:
-            if check in self._motion_checks:
-                self._motion_checks.remove(check)
-
-    def add_motion_hook(self, hook: MotionHook) -> None:
-        """Call `hook(axis, motion)` whenever an axis starts, re-plans or kills its motion
-        (motion None: stopped at once, disabled, faulted). Not called when a motion ends by
-        itself. A group engine subscribes to react to its axes being stopped directly."""
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        with self._lock:
-            self._motion_hooks.append(hook)
-
-    def remove_motion_hook(self, hook: MotionHook) -> None:
-        with self._lock:
-            if hook in self._motion_hooks:
-                self._motion_hooks.remove(hook)
-
-    def add_period_hook(self, hook: PeriodHook) -> None:
-        """Call `hook(new_period, commit)` when the period changes (`set_period`): first
-        with commit False for every hook (raise MotionError to refuse the change), then
-        with commit True once it is made. Capabilities whose settings are per period (a
-        group's per-period pulse caps) subscribe here."""
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        with self._lock:
-            self._period_hooks.append(hook)
-
-    def remove_period_hook(self, hook: PeriodHook) -> None:
-        with self._lock:
-            if hook in self._period_hooks:
-                self._period_hooks.remove(hook)
-
-    def set_period(self, seconds: float) -> None:
-        """Change the interpolation period (MCC_SetInterpolationTime, 1 ms .. 1 s) between
-        two cycles: the cycle grid goes on from now in steps of the new period. Refused
-        (MotionError, nothing changed) in real-time mode, while an axis moves (its motion
-        was checked against the old period's per-period limits) or when a period hook
-        refuses (a group with commands queued or running)."""
-        p = check_period(seconds)
-        with self._lock:
-            if self.realtime:
-                raise MotionError("period: cannot change while the real-time pacer runs")
-            for a in self.axes:
-                if a.is_moving:
-                    raise MotionError(f"period: cannot change while axis {a.name} moves")
-            hooks = list(self._period_hooks)
-            for hook in hooks:
-                hook(p, False)
-            self.period = p
-            self._t_origin = self._time - self._n * p
-            self._pacer = RealtimePacer(self.step, p, self._overran)
-            for hook in hooks:
-                hook(p, True)
-
-    def set_encoder_mode(self, axis: int | str, mode: str) -> None:
-        """Change how an axis's A/B encoder input is decoded (x1, x2, x4: "ab_x1" ..
-        "ab_x4") on a running machine (MCC_SetENCInputRate): `reconfigure_axis` of
-        encoder_mode, limited to the A/B modes of an A/B input. The same encoder then
-        gives new/old multiplier counts per command pulse: the move ratio (feedback
-        counts per command pulse, the error counter's scale) follows."""
-        ax = self.axis(axis)
-        if not isinstance(mode, str) or mode not in ("ab_x1", "ab_x2", "ab_x4"):
-            raise MotionError(f"mode must be 'ab_x1', 'ab_x2' or 'ab_x4', got {mode!r}")
-        if not ax.config.encoder_mode.startswith("ab"):
-            raise MotionError(f"axis {ax.name}: encoder_mode {ax.config.encoder_mode!r} is "
-                              "not an A/B input")
-        k = ENCODER_MULTIPLIER[mode] / ENCODER_MULTIPLIER[ax.config.encoder_mode]
-        self.reconfigure_axis(ax.index, encoder_mode=mode,
-                              move_ratio=ax.config.move_ratio * k)
-
-    def add_config_hook(self, hook: ConfigHook) -> None:
-        """Call `hook(axis_index, new_config, commit)` when an axis is reconfigured
-        (`reconfigure_axis`): first with commit False (raise MotionError to refuse), then
-        with commit True once it is made. A group whose units follow the machine
-        subscribes here."""
-        if not callable(hook):
-            raise MotionError(f"hook must be callable, got {hook!r}")
-        with self._lock:
-            self._config_hooks.append(hook)
-
-    def remove_config_hook(self, hook: ConfigHook) -> None:
-        with self._lock:
-            if hook in self._config_hooks:
-                self._config_hooks.remove(hook)
-
-    def reconfigure_axis(self, axis: int | str, **changes: Any) -> None:
-        """Change an axis's settings on a running machine while it is at rest (MCCL
-        MCC_UpdateMachParam after MCC_SetMachParam): the mechanism ratio (pulses_per_rev,
-        lead, gear_ratio), reverse, max_speed, the signal logic (`logic`: how the board
-        reads its inputs; the switches themselves stay as wired), the pulse output format
-        and the encoder decoding (encoder_mode, swap_ab, invert_a/b/z: the hardware's
-        `configure_decoder`). Counters keep their pulse values; what they mean in user
-        units follows the new ratio. Refused (MotionError, nothing changed) for other
-        fields, an invalid value, a moving axis, a config hook's refusal (a group with
-        commands) or hardware that cannot change its decoder."""
-        ax = self.axis(axis)
-        bad = sorted(set(changes) - set(RECONFIGURABLE))
-        if bad:
-            raise MotionError(f"{', '.join(bad)}: not changeable on a running machine "
-                              f"(changeable: {', '.join(RECONFIGURABLE)})")
-        cfg = dataclasses.replace(ax.config, **changes)  # validated (__post_init__)
-        decode = any(getattr(cfg, k) != getattr(ax.config, k) for k in DECODER_FIELDS)
-        setter = getattr(self.hardware, "configure_decoder", None)
-        if decode and setter is None:
-            raise MotionError("this hardware cannot change its encoder decoding")
-        with self._lock:
-            if ax.is_moving:
-                raise MotionError(f"axis {ax.name}: cannot be reconfigured while it moves")
-            hooks = list(self._config_hooks)
-            for hook in hooks:
-                hook(ax.index, cfg, False)
-            if decode:
-                setter(ax.index, cfg)
-            if cfg.move_ratio != ax.config.move_ratio:
-                ax.counters.set_move_ratio(cfg.move_ratio)
-            ax.config = cfg
-            ax._max_speed = min(cfg.max_speed_pps, MAX_PULSE_RATE)
-            axes = list(self.config.axes)
-            axes[ax.index] = cfg
-            self.config = dataclasses.replace(self.config, axes=tuple(axes))
-            self._nc[ax.index] = {s for s in ("pel", "mel", "org", "sd", "ltc", "ez", "alm",
-                                              "inp", "rdy") if cfg.signal_logic(s) == "nc"}
-            self._emg_nc = any(a.signal_logic("emg") == "nc" for a in self.config.axes)
-            for hook in hooks:
-                hook(ax.index, cfg, True)
-
+    # ------------------------------------------------------------------ motion checks
+    # (add_*/remove_* of every hook: controller_hooks.py; set_period, set_encoder_mode,
+    # reconfigure_axis: controller_settings.py)
     def _vet_motion(self, axis: Axis, motion: ActiveMotion) -> None:
         for check in tuple(self._motion_checks):
             check(axis, motion)

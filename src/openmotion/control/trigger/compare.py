@@ -1,7 +1,8 @@
 """Compare engine: position-compare triggers located exactly on the analytic motion.
 
 (Jobs, sources and actions live in compare_jobs.py and are re-exported here; the solvers
-in compare_math.py, compiled in openmotion._compare; outputs and the event log in compare_io.py.)
+in compare_math.py, compiled in openmotion._compare; outputs and the event log in compare_io.py;
+the sources' per-cycle tracks in compare_tracks.py, the re-plan rollback in compare_replan.py.)
 
 Attached to a Controller through a cycle hook. At the end of each cycle [t0, t1] it takes
 the motion just executed from the MotionHistory and finds, for every active job, every
@@ -62,13 +63,9 @@ from .compare_jobs import (
     WindowJob,
     every_distance,
 )
-from .compare_math import (
-    Track,
-    VectorCycle,
-    affine_track,
-    history_track,
-    track_range,
-)
+from .compare_math import Track, VectorCycle
+from .compare_replan import CompareReplan
+from .compare_tracks import CompareTracks
 
 if TYPE_CHECKING:
     from ..core.controller import Controller
@@ -110,7 +107,7 @@ class SpeedPwm:
 
 
 # ---------------------------------------------------------------------------- engine
-class CompareEngine:
+class CompareEngine(CompareTracks, CompareReplan):
     """Runs compare jobs on a Controller every cycle (see module docstring).
 
     buffer_size: total points all jobs may hold; outputs: output numbers able to compare
@@ -325,103 +322,7 @@ class CompareEngine:
             self._pwms.remove(pwm)
             self.output(pwm.output).set(self.ctl.time, False)
 
-    # ------------------------------------------------------------------ per-cycle data
-    def _cmd_offset(self, axis: int) -> float:
-        return -self.ctl.axes[axis].counters.pulses_from_command(0.0)
-
-    def _mpos_error(self, axis: int) -> float:
-        """Following error in feedback counts at the current time."""
-        ctr = self.ctl.axes[axis].counters
-        h = self.ctl.history.position_at(axis, self.ctl.time)
-        return ctr.feedback_unwrapped() - ctr.move_ratio * (h + self._cmd_offset(axis))
-
-    def _start_mpos(self, axis: int) -> None:
-        if axis not in self._mpos_err:
-            self._mpos_err[axis] = self._mpos_error(axis)
-
-    def track(self, src: AxisSource) -> Track:
-        """The source's track over this cycle (cached per cycle)."""
-        tr = self._tracks.get(src)
-        if tr is None:
-            ta, t1 = self._win
-            h = history_track(self.ctl.history, src.axis, ta, t1)
-            off = self._cmd_offset(src.axis)
-            if src.kind == "dpos":
-                tr = affine_track(h, 1.0, off)
-            else:
-                r = self.ctl.axes[src.axis].counters.move_ratio
-                e0 = self._mpos_err[src.axis]
-                e1 = self._mpos_e1[src.axis]
-                tr = affine_track(h, r, r * off, e0, (e1 - e0) / (t1 - ta), ta)
-            self._tracks[src] = tr
-        return tr
-
-    def track_spec(self, src: AxisSource) -> tuple[Any, float, float, float, float, float]:
-        """The source's track over this cycle as the compiled driver cuts it from the
-        history itself: (the axis's record store, scale, offset, e0, slope, t_ref), the
-        arguments of `affine_track` (cached per cycle; `track` builds the same rows)."""
-        sp = self._specs.get(src)
-        if sp is None:
-            ta, t1 = self._win
-            h = self.ctl.history._tracks[src.axis]
-            off = self._cmd_offset(src.axis)
-            if src.kind == "dpos":
-                sp = (h, 1.0, off, 0.0, 0.0, 0.0)
-            else:
-                r = self.ctl.axes[src.axis].counters.move_ratio
-                e0 = self._mpos_err[src.axis]
-                e1 = self._mpos_e1[src.axis]
-                sp = (h, r, r * off, e0, (e1 - e0) / (t1 - ta), ta)
-            self._specs[src] = sp
-        return sp
-
-    def track_range(self, src: AxisSource) -> tuple[float, float]:
-        """(min, max) of the source over this cycle (cached per cycle)."""
-        r = self._ranges.get(src)
-        if r is None:
-            r = self._ranges[src] = track_range(self.track(src), *self._win)
-        return r
-
-    def window_inputs(self, axes: tuple[int, ...], kind: str
-                      ) -> tuple[list[Track], list[tuple[float, float]]]:
-        """The tracks and ranges of `axes` in frame `kind` over this cycle (cached per
-        cycle: jobs on the same axes share them)."""
-        key = (axes, kind)
-        hit = self._windows.get(key)
-        if hit is None:
-            srcs = [AxisSource(a, kind) for a in axes]
-            hit = self._windows[key] = ([self.track(s) for s in srcs],
-                                        [self.track_range(s) for s in srcs])
-        return hit
-
-    def reachable(self, src: AxisSource, level: float) -> bool:
-        """Can the source touch `level` in this cycle? (skips the exact solver if not)"""
-        lo, hi = self.track_range(src)
-        slack = 1e-9 * (abs(level) + 1.0)
-        return lo - slack <= level <= hi + slack
-
-    def vector_cycle(self, src: VectorSource) -> VectorCycle:
-        vc = self._vcycles.get(src)
-        if vc is None:
-            ta, t1 = self._win
-            w = self._weights.get(src)
-            if w is None:
-                w = self._weights[src] = src.weights
-            stores = self.ctl.history._tracks  # (the rows as stored: history.rows)
-            vc = VectorCycle([(stores[a],) for a in src.axes], w, ta, t1, self._vectors[src])
-            self._vcycles[src] = vc
-        return vc
-
     # ------------------------------------------------------------------ the cycle
-    def _begin(self, ta: float, t1: float) -> None:
-        self._win = (ta, t1)
-        self._tracks = {}
-        self._specs = {}
-        self._ranges: dict[AxisSource, tuple[float, float]] = {}
-        self._vcycles = {}
-        self._windows: dict[tuple[tuple[int, ...], str],
-                            tuple[list[Track], list[tuple[float, float]]]] = {}
-
     def _group(self, pre: bool | None) -> _Group:
         """The jobs of a scan group (pre True: command-position ones, False: MPOS ones,
         None: all), split into those the compiled driver runs and the rest; rebuilt only
@@ -537,68 +438,6 @@ class CompareEngine:
         for src in self._vectors:
             self._vectors[src] = self.vector_cycle(src).end
 
-    # A stop the hardware makes by itself at an input edge (hw.interface.EdgeStopHardware)
-    # or a re-plan from an edge time changes (t0, t1] after the pre-advance scan. The
-    # history record in force at the end of the cycle is kept; if it changed after the cycle,
-    # the scan's effects (job state, waveforms, vector lengths, PWM duties, log rows) are
-    # undone and the scan is run again on the motion as executed. Edges already handed to
-    # the hardware cannot be taken back: the line is corrected at the cycle end.
-    def _snapshot(self, ta: float, t1: float) -> None:
-        if not (self._jobs or self._pwms or self._vectors):
-            self._plan = None
-            return
-        # the compared axes and the pulse timers change only with the jobs and vectors
-        key = (self._next_id, len(self._jobs), len(self._vectors))
-        if key != self._plan_key:
-            axes: set[int] = set()
-            for j in self._jobs.values():
-                src = getattr(j, "source", None)
-                axes.update(j.axes if isinstance(j, WindowJob) else
-                            src.axes if isinstance(src, VectorSource) else (src.axis,))
-            for v in self._vectors:
-                axes.update(v.axes)
-            self._plan_axes = sorted(axes)
-            self._plan_hists = [self.ctl.history._tracks[a] for a in self._plan_axes]
-            self._timers = {id(x): x for x in (_timer_of(j.action)
-                                               for j in self._jobs.values()) if x is not None}
-            self._plan_key = key
-        # the history record in force just before t1 of every compared axis (a re-plan
-        # or cut inside the cycle starts a new one there; a motion starting exactly at t1
-        # does not count), read in place from the history's record stores
-        solvers = _cm._solvers()
-        self._plan = solvers.plan_records(self._plan_hists, t1)
-        timers = self._timers
-        lines = self._lines
-        self._snap = (
-            dict(self._jobs),
-            {k: (j.index, j.hits, j.active) for k, j in self._jobs.items()},
-            {k: (x.busy_until, x.overruns, x.ignored) for k, x in timers.items()}, timers,
-            dict(zip(lines, solvers.lines_snapshot(list(lines.values()), ta), strict=True)),
-            dict(self._vectors), [len(p.duties) for p in self._pwms])
-
-    def _moved_off_plan(self) -> bool:
-        if self._plan is None:
-            return False
-        return not _cm._solvers().plan_records(self._plan_hists, self._win[1], self._plan)
-
-    def _rollback(self, ta: float) -> None:
-        jobs, state, tstate, timers, lines, vectors, duties = self._snap
-        for k, (idx, hits, active) in state.items():
-            j = jobs[k]
-            if k in self._jobs or j.done:  # not removed by the user meanwhile
-                j.index, j.hits, j.active = idx, hits, active
-                if active:
-                    self._jobs[k] = j
-        self._jobs_ver += 1
-        for k, (busy, over, ign) in tstate.items():
-            timers[k].busy_until, timers[k].overruns, timers[k].ignored = busy, over, ign
-        for n_, snap in lines.items():
-            self._lines[n_].restore(ta, snap)
-        self._vectors.update(vectors)
-        for p, n_ in zip(self._pwms, duties, strict=False):
-            del p.duties[n_:]
-        self._pre_rows = []
-
     def _due(self, ctl: Controller) -> float:
         """When a hook of the engine may next act (control/trigger/compare_due.py)."""
         return engine_due(self)
@@ -701,12 +540,6 @@ def _native(job: CompareJob) -> bool:
     if type(job.action) not in _ACTIONS:
         return False
     return type(job) is WindowJob or type(job) is LevelJob
-
-
-def _timer_of(action: Action) -> Any:
-    """The pulse timer an action drives (itself, or a trigger's `timer`), or None."""
-    tm = getattr(action, "timer", action)
-    return tm if hasattr(tm, "busy_until") else None
 
 
 def _on_command(job: CompareJob) -> bool:
