@@ -1,7 +1,8 @@
 """Slow oracle: the chain planner's passes as Python computed them before they moved to C
 (src/openmotion/_chain.c, in openmotion._corner): the look-ahead's backward and forward
 passes and cruise speeds (path/lookahead.py), the trapezoids as v**2(s) knots and the
-constant-acceleration pieces of s(t) (control/groups/pathexec.py). The equivalence tests
+constant-acceleration pieces of s(t) (control/groups/pathexec.py), the times s(t) crosses
+the element boundaries (control/groups/pathaxes.py). The equivalence tests
 (tests/test_chain_planner.py) compare the compiled passes with these bit for bit."""
 
 from __future__ import annotations
@@ -133,3 +134,19 @@ def s_profile(curve_s: np.ndarray, curve_v2: np.ndarray, jump: bool, s_end: floa
                    a0=arr[:, 3].copy(), j=arr[:, 4].copy(), duration=t, start=start,
                    end=State(float(s_end), 0.0, 0.0), labels=tuple(labels),
                    dt=np.array(dts, dtype=np.float64))
+
+
+def crossings(sp: Profile, levels: np.ndarray) -> np.ndarray:
+    lv = levels[(levels > sp.start.p) & (levels < sp.end.p)]
+    n = sp.n_segments
+    if not len(lv) or not n:
+        return np.zeros(0)
+    k = np.clip(np.searchsorted(sp.p0, lv, side="right") - 1, 0, n - 1)
+    dts = sp.dt if sp.dt is not None else np.diff(np.append(sp.t0, sp.duration))
+    lo, hi = np.zeros(len(lv)), np.asarray(dts, dtype=float)[k].copy()
+    p0, v0, a0, j = sp.p0[k], sp.v0[k], sp.a0[k], sp.j[k]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        below = p0 + mid * (v0 + mid * (a0 / 2.0 + mid * j / 6.0)) < lv
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return np.unique(sp.t0[k] + hi)

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 import oracle_chain as oc
 from openmotion import _corner
+from openmotion.control.groups import pathaxes
 from openmotion.control.groups import pathexec as px
 from openmotion.errors import InfeasibleError
 from openmotion.path import Line, plan_speeds
@@ -183,3 +184,25 @@ def test_random_chains_bit_for_bit() -> None:
         for name in ("t0", "p0", "v0", "a0", "dt"):
             _same(getattr(got, name), getattr(want, name))
         assert got.duration == want.duration and got.labels == want.labels
+
+
+def test_crossings_bit_for_bit() -> None:
+    """The instants s(t) crosses element boundaries: a constant-acceleration s(t) and a
+    smoothed (jerk) one."""
+    from openmotion.path.smoothing import fir_smooth
+
+    rng = np.random.default_rng(3)
+    length = rng.uniform(1e-3, 0.2, 300)
+    s, v2 = oc.curve_from_speeds([ElementSpeeds(0.0, 0.0, 0.0, 1.0, 1.0, 0.0)] + [
+        ElementSpeeds(v, v, v, 500.0, 40.0, float(L)) for v, L in
+        zip(rng.uniform(1.0, 40.0, 300), length, strict=True)])
+    v2[0] = v2[-1] = 0.0
+    raw = px.s_profile(px.SpeedCurve(s, v2), float(s[-1]), [])
+    levels = np.cumsum(length)[:-1]
+    for sp in (raw, fir_smooth(raw, 0.01)):
+        got = pathaxes._crossings(sp, levels)
+        assert len(got) == 299
+        _same(got, oc.crossings(sp, levels))
+    with pytest.raises(ValueError):
+        _corner.crossings(np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(3),
+                          np.zeros(2))

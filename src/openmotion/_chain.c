@@ -19,7 +19,9 @@
  * - s_pieces(knots, v2, v, s_end, dwell, lead, out): the constant-acceleration pieces of
  *   s(t) along the knots (pathexec.s_profile's loop) written as the columns t0, p0, v0,
  *   a0, dt, kind (1: a dwell) of out[0..5, :m] -> (m, duration), m = -1 when the curve
- *   stalls at rest before its end.
+ *   stalls at rest before its end;
+ * - crossings(p0, v0, a0, j, hi, levels): the times a segment of s(t) reaches a level
+ *   (pathaxes._crossings' bisection, 60 halvings), written over hi.
  *
  * Every formula repeats the Python operation order it replaced (the oracle in
  * tests/oracle_chain.py), built with -ffp-contract=off: the results are bit for bit the
@@ -481,5 +483,50 @@ PyObject *chain_py_s_pieces(PyObject *self, PyObject *const *args, Py_ssize_t na
     result = Py_BuildValue("(nd)", m, t);
 done:
     for (int q = 0; q < held; q++) PyBuffer_Release(&in[q]);
+    return result;
+}
+
+/* pathaxes._crossings' bisection: for each level, 60 halvings of [0, hi] in the segment
+ * (p0, v0, a0, j) that holds it, hi kept where the cubic is >= the level (in place) */
+PyObject *chain_py_crossings(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "crossings(p0, v0, a0, j, hi, levels)");
+        return NULL;
+    }
+    Py_buffer b[6];
+    int held = 0;
+    PyObject *result = NULL;
+    for (; held < 6; held++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held == 4 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(args[held], &b[held], flags) < 0) goto done;
+        if (b[held].itemsize != 8 || b[held].format == NULL ||
+            strcmp(b[held].format, "d") != 0 || b[held].ndim != 1 ||
+            b[held].shape[0] != b[0].shape[0]) {
+            held++;
+            PyErr_SetString(PyExc_ValueError, "crossings: float64 vectors of one length");
+            goto done;
+        }
+    }
+    const double *p0 = b[0].buf, *v0 = b[1].buf, *a0 = b[2].buf, *j = b[3].buf;
+    const double *lv = b[5].buf;
+    double *hi = b[4].buf;
+    for (Py_ssize_t i = 0; i < b[0].shape[0]; i++) {
+        double lo = 0.0, h = hi[i];
+        for (int it = 0; it < 60; it++) {
+            double mid = 0.5 * (lo + h);
+            double p = p0[i] + mid * (v0[i] + mid * (a0[i] / 2.0 + mid * j[i] / 6.0));
+            if (p < lv[i])
+                lo = mid;
+            else
+                h = mid;
+        }
+        hi[i] = h;
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int q = 0; q < held; q++) PyBuffer_Release(&b[q]);
     return result;
 }

@@ -234,6 +234,9 @@ static PyMethodDef methods[] = {
     {"s_pieces", (PyCFunction)(void (*)(void))chain_py_s_pieces, METH_FASTCALL,
      "s_pieces(knots, v2, v, s_end, dwell, lead, out) -> (rows, duration); rows -1: "
      "stall."},
+    {"crossings", (PyCFunction)(void (*)(void))chain_py_crossings, METH_FASTCALL,
+     "crossings(p0, v0, a0, j, hi, levels): the bisection of pathaxes._crossings, hi in "
+     "place."},
     {NULL, NULL, 0, NULL},
 };
 
