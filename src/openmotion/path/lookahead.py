@@ -37,7 +37,6 @@ length L is linear: v1**2 = v0**2 + 2*a*L.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import weakref
 from collections.abc import Sequence
@@ -132,40 +131,11 @@ def _limit_along(limit: float, axis: Array | None, weight: Array) -> float:
     return limit if limit <= best else best
 
 
-class _Memo:
-    """A memo per element, by identity: as a WeakKeyDictionary (no element kept alive, an
-    entry dropped with its element) but cheaper to ask (a dict lookup by id() and one weak
-    reference call, no reference made per question), as the look-ahead asks for every
-    element of every re-plan."""
-
-    __slots__ = ("_d",)
-
-    def __init__(self) -> None:
-        self._d: dict[int, tuple[weakref.ref, Any]] = {}
-
-    def get(self, el: Any) -> Any:
-        hit = self._d.get(id(el))
-        if hit is not None and hit[0]() is el:
-            return hit[1]
-        return None
-
-    def put(self, el: Any, value: Any) -> None:
-        """Remember `value` for `el` (an element that takes no weak reference: nothing)."""
-        d, key = self._d, id(el)
-
-        def gone(ref: weakref.ref, d: dict = d, key: int = key) -> None:
-            entry = d.get(key)
-            if entry is not None and entry[0] is ref:  # (not a newer element's entry)
-                del d[key]
-
-        with contextlib.suppress(TypeError):
-            d[key] = (weakref.ref(el, gone), value)
-
-
 #: Memo of `_element_limits`: one entry per element, its last parameters and result. The
 #: elements are immutable and a streaming chain asks about the same ones at every re-plan
-#: (most of a long chain's planning time otherwise).
-_LIMITS = _Memo()
+#: (most of a long chain's planning time otherwise). Weak keys: no element is kept alive.
+_LIMITS: weakref.WeakKeyDictionary[Any, tuple[tuple, tuple[float, float]]] = \
+    weakref.WeakKeyDictionary()
 
 
 def _axes_key(vmax_ax: Array | None, amax_ax: Array | None) -> tuple:
@@ -181,16 +151,19 @@ def _element_limits(el: PathElement, feed: float, accel: float, vmax_ax: Array |
     caller's `_axes_key(vmax_ax, amax_ax)`, when it asks for many elements."""
     key = (feed, accel, ratio) + (_axes_key(vmax_ax, amax_ax) if axes_key is None
                                   else axes_key)
-    hit = _LIMITS.get(el)
+    try:
+        hit = _LIMITS.get(el)
+    except TypeError:  # an element that is not hashable or weak-referenceable
+        return _limits_of(el, feed, accel, vmax_ax, amax_ax, ratio)
     if hit is not None and hit[0] == key:
         return hit[1]
     out = _limits_of(el, feed, accel, vmax_ax, amax_ax, ratio)
-    _LIMITS.put(el, (key, out))
+    _LIMITS[el] = (key, out)
     return out
 
 
 #: Memo of `_tangential_decel` (as `_LIMITS`, for a deceleration set apart).
-_DEC_LIMITS = _Memo()
+_DEC_LIMITS: weakref.WeakKeyDictionary[Any, tuple[tuple, float]] = weakref.WeakKeyDictionary()
 
 
 def _tangential_decel(el: PathElement, decel: float, amax_ax: Array | None,
@@ -198,11 +171,14 @@ def _tangential_decel(el: PathElement, decel: float, amax_ax: Array | None,
     """Tangential deceleration of one element (`_element_limits`' first value with the
     deceleration; memoized separately so both stay cached)."""
     key = (decel, ratio, None if amax_ax is None else amax_ax.tobytes())
-    hit = _DEC_LIMITS.get(el)
+    try:
+        hit = _DEC_LIMITS.get(el)
+    except TypeError:
+        return _limits_of(el, math.inf, decel, None, amax_ax, ratio)[0]
     if hit is not None and hit[0] == key:
         return hit[1]
     out = _limits_of(el, math.inf, decel, None, amax_ax, ratio)[0]
-    _DEC_LIMITS.put(el, (key, out))
+    _DEC_LIMITS[el] = (key, out)
     return out
 
 
@@ -236,17 +212,21 @@ def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
 #: Memo of `_junction_cap` (as `_LIMITS`): per element, the element before it, the limits
 #: and the cap of their junction (a streaming chain asks about the same pairs at every
 #: re-plan). The element before is held while the element lives.
-_JUNCTIONS = _Memo()
+_JUNCTIONS: weakref.WeakKeyDictionary[Any, tuple[Any, tuple, float]] = \
+    weakref.WeakKeyDictionary()
 
 
 def _junction_memo(prev: PathElement, nxt: PathElement, accel: float, scv: float,
                    amax_ax: Array | None, vjump_ax: Array | None, key: tuple) -> float:
     """`_junction_cap` memoized; `key`: (scv, _axes_key(amax_ax, vjump_ax))."""
-    hit = _JUNCTIONS.get(nxt)
+    try:
+        hit = _JUNCTIONS.get(nxt)
+    except TypeError:  # an element that is not hashable or weak-referenceable
+        return _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
     if hit is not None and hit[0] is prev and hit[1] == (accel, key):
         return hit[2]
     out = _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
-    _JUNCTIONS.put(nxt, (prev, (accel, key), out))
+    _JUNCTIONS[nxt] = (prev, (accel, key), out)
     return out
 
 
