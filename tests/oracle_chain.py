@@ -2,7 +2,8 @@
 (src/openmotion/_chain.c, in openmotion._corner): the look-ahead's backward and forward
 passes and cruise speeds (path/lookahead.py), the trapezoids as v**2(s) knots and the
 constant-acceleration pieces of s(t) (control/groups/pathexec.py), the times s(t) crosses
-the element boundaries (control/groups/pathaxes.py). The equivalence tests
+the element boundaries (control/groups/pathaxes.py), a limit along per-axis caps
+(path/lookahead.py). The equivalence tests
 (tests/test_chain_planner.py) compare the compiled passes with these bit for bit."""
 
 from __future__ import annotations
@@ -150,3 +151,19 @@ def crossings(sp: Profile, levels: np.ndarray) -> np.ndarray:
         below = p0 + mid * (v0 + mid * (a0 / 2.0 + mid * j / 6.0)) < lv
         lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
     return np.unique(sp.t0[k] + hi)
+
+
+def limit_along(limit: float, axis: np.ndarray | None, weight: np.ndarray) -> float:
+    if axis is None:
+        return limit
+    best = math.inf
+    found = False
+    for a, w in zip(axis.tolist(), weight.tolist(), strict=True):
+        if w > 0.0:
+            found = True
+            q = a / w
+            if q < best:
+                best = q
+    if not found:
+        return limit
+    return limit if limit <= best else best

@@ -206,3 +206,20 @@ def test_crossings_bit_for_bit() -> None:
     with pytest.raises(ValueError):
         _corner.crossings(np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(3),
                           np.zeros(2))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(0.0, 1e6), st.lists(st.tuples(st.floats(1e-3, 1e9) | st.just(math.inf),
+                                               st.floats(0.0, 2.0) | st.just(5e-324)),
+                                     min_size=1, max_size=6))
+def test_limit_along_bit_for_bit(limit, pairs) -> None:
+    from openmotion.path.lookahead import _limit_along
+
+    axis = np.array([a for a, _ in pairs])
+    weight = np.array([w for _, w in pairs])
+    assert _limit_along(limit, axis, weight) == oc.limit_along(limit, axis, weight)
+    assert _limit_along(limit, None, weight) == limit
+    assert _limit_along(limit, axis, weight[::-1][::-1].tolist()) == \
+        oc.limit_along(limit, axis, weight)  # (any array-like weight)
+    with pytest.raises(ValueError):
+        _corner.limit_along(1.0, np.zeros(2), np.zeros(3))

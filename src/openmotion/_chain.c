@@ -21,7 +21,9 @@
  *   a0, dt, kind (1: a dwell) of out[0..5, :m] -> (m, duration), m = -1 when the curve
  *   stalls at rest before its end;
  * - crossings(p0, v0, a0, j, hi, levels): the times a segment of s(t) reaches a level
- *   (pathaxes._crossings' bisection, 60 halvings), written over hi.
+ *   (pathaxes._crossings' bisection, 60 halvings), written over hi;
+ * - limit_along(limit, axis, weight): a limit lowered by per-axis caps over per-axis
+ *   weights (lookahead._limit_along).
  *
  * Every formula repeats the Python operation order it replaced (the oracle in
  * tests/oracle_chain.py), built with -ffp-contract=off: the results are bit for bit the
@@ -528,5 +530,47 @@ PyObject *chain_py_crossings(PyObject *self, PyObject *const *args, Py_ssize_t n
     Py_INCREF(result);
 done:
     for (int q = 0; q < held; q++) PyBuffer_Release(&b[q]);
+    return result;
+}
+
+/* lookahead._limit_along: min(limit, axis_i / weight_i) over the axes with weight_i > 0
+ * (the first of equals, as Python's min) */
+PyObject *chain_py_limit_along(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "limit_along(limit, axis, weight)");
+        return NULL;
+    }
+    double limit = PyFloat_AsDouble(args[0]);
+    if (limit == -1.0 && PyErr_Occurred()) return NULL;
+    Py_buffer a, w;
+    if (PyObject_GetBuffer(args[1], &a, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) return NULL;
+    if (PyObject_GetBuffer(args[2], &w, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        PyBuffer_Release(&a);
+        return NULL;
+    }
+    PyObject *result = NULL;
+    if (a.itemsize != 8 || w.itemsize != 8 || a.format == NULL || w.format == NULL ||
+        strcmp(a.format, "d") != 0 || strcmp(w.format, "d") != 0 ||
+        a.len != w.len) {
+        PyErr_SetString(PyExc_ValueError, "limit_along: two float64 arrays of one size");
+        goto done;
+    }
+    const double *ax = a.buf, *wt = w.buf;
+    Py_ssize_t n = a.len / 8;
+    double best = INFINITY;
+    int found = 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (wt[i] > 0.0) {
+            found = 1;
+            double q = ax[i] / wt[i];
+            if (q < best) best = q;
+        }
+    }
+    result = PyFloat_FromDouble(!found || limit <= best ? limit : best);
+done:
+    PyBuffer_Release(&a);
+    PyBuffer_Release(&w);
     return result;
 }

@@ -8,6 +8,7 @@ PyObject *chain_py_speeds(PyObject *self, PyObject *const *args, Py_ssize_t narg
 PyObject *chain_py_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *chain_py_chain_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *chain_py_s_pieces(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *chain_py_limit_along(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *chain_py_crossings(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 
 #endif

@@ -237,6 +237,8 @@ static PyMethodDef methods[] = {
     {"crossings", (PyCFunction)(void (*)(void))chain_py_crossings, METH_FASTCALL,
      "crossings(p0, v0, a0, j, hi, levels): the bisection of pathaxes._crossings, hi in "
      "place."},
+    {"limit_along", (PyCFunction)(void (*)(void))chain_py_limit_along, METH_FASTCALL,
+     "limit_along(limit, axis, weight) -> min(limit, axis_i/weight_i over weight_i > 0)."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -113,22 +113,16 @@ def _axis_limits(name: str, value: ArrayLike | None, dim: int) -> Array | None:
 
 
 def _limit_along(limit: float, axis: Array | None, weight: Array) -> float:
-    """min(limit, axis_i / weight_i) over axes with weight_i > 0."""
+    """min(limit, axis_i / weight_i) over axes with weight_i > 0 (compiled: _chain.c; the
+    Python oracle is tests/oracle_chain.py). A denormal weight gives inf (no limit), as
+    numpy's quotient does."""
     if axis is None:
         return limit
-    # plain floats: the same IEEE quotients and minimum as the numpy form, without its
-    # per-call overhead (a few axes, asked for every element of every re-plan)
-    best = math.inf
-    found = False
-    for a, w in zip(axis.tolist(), weight.tolist(), strict=True):
-        if w > 0.0:
-            found = True
-            q = a / w  # a denormal weight: inf (no limit), as numpy gives it
-            if q < best:
-                best = q
-    if not found:
-        return limit
-    return limit if limit <= best else best
+    try:
+        return _corner.limit_along(limit, axis, weight)
+    except (ValueError, TypeError, BufferError):  # not two float64 arrays (a user's type)
+        return _corner.limit_along(limit, np.ascontiguousarray(axis, dtype=np.float64),
+                                   np.ascontiguousarray(weight, dtype=np.float64))
 
 
 #: Memo of `_element_limits`: one entry per element, its last parameters and result. The
