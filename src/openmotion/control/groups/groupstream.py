@@ -50,6 +50,7 @@ class ChainStream:
     _wait_inpos: bool
     _blend: bool
     _blend_tol: float
+    _corner_velocity: float
     sync_joins: int
 
     def _joins(self, tj: float, cmd: _Cmd, str_vel: float = 0.0) -> bool:
@@ -273,10 +274,13 @@ class ChainStream:
         if b is None:
             return None
         vmax, amax = self._caps()
-        accel = min(cmd.accel, cmd.dec, float(np.min(amax)))
+        memo = self.__dict__.get("_amin_memo")  # min(amax), kept while amax is the same
+        if memo is None or memo[0] is not amax:
+            memo = self._amin_memo = (amax, float(np.min(amax)))
+        accel = min(cmd.accel, cmd.dec, memo[1])
         v_corner = 0.0
-        corner = self._corner_limits()
-        if corner["square_corner_velocity"] > 0.0 and prev.length > 0.0 and el.length > 0.0:
+        if self._corner_velocity > 0.0 and prev.length > 0.0 and el.length > 0.0:
+            corner = self._corner_limits()
             v_corner = speed_caps([prev, el], cmd.feed, cmd.accel, axis_vmax=vmax,
                                   axis_amax=amax,
                                   square_corner_velocity=corner["square_corner_velocity"],
