@@ -223,3 +223,23 @@ def test_limit_along_bit_for_bit(limit, pairs) -> None:
         oc.limit_along(limit, axis, weight)  # (any array-like weight)
     with pytest.raises(ValueError):
         _corner.limit_along(1.0, np.zeros(2), np.zeros(3))
+
+
+def test_junction_memo_keeps_no_element_alive() -> None:
+    """The junction caps' memo refers to both elements weakly: a stream's earlier elements
+    go when the chain drops them (a strong reference to the element before made every
+    entry keep the whole history alive)."""
+    import gc
+    import weakref
+
+    from openmotion.path.lookahead import _JUNCTIONS
+
+    pts = [np.array([float(k), float(k % 2)]) for k in range(50)]
+    els = [Line(a, b) for a, b in zip(pts[:-1], pts[1:], strict=True)]
+    plan_speeds(els, 5.0, 50.0, square_corner_velocity=1.0)
+    first = weakref.ref(els[0])
+    before = len(_JUNCTIONS)
+    del els[:-1]  # only the last element lives on
+    gc.collect()
+    assert first() is None
+    assert len(_JUNCTIONS) <= before - 47

@@ -203,10 +203,11 @@ def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
     return _limit_along(v, vjump_ax, np.abs(diff))
 
 
-#: Memo of `_junction_cap` (as `_LIMITS`): per element, the element before it, the limits
-#: and the cap of their junction (a streaming chain asks about the same pairs at every
-#: re-plan). The element before is held while the element lives.
-_JUNCTIONS: weakref.WeakKeyDictionary[Any, tuple[Any, tuple, float]] = \
+#: Memo of `_junction_cap` (as `_LIMITS`): per element, a weak reference to the element
+#: before it, the limits and the cap of their junction (a streaming chain asks about the
+#: same pairs at every re-plan). Weak both ways: a strong one to the element before would
+#: keep every earlier element of a stream alive through the chain of entries.
+_JUNCTIONS: weakref.WeakKeyDictionary[Any, tuple[weakref.ref, tuple, float]] = \
     weakref.WeakKeyDictionary()
 
 
@@ -215,12 +216,12 @@ def _junction_memo(prev: PathElement, nxt: PathElement, accel: float, scv: float
     """`_junction_cap` memoized; `key`: (scv, _axes_key(amax_ax, vjump_ax))."""
     try:
         hit = _JUNCTIONS.get(nxt)
+        if hit is not None and hit[0]() is prev and hit[1] == (accel, key):
+            return hit[2]
+        out = _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
+        _JUNCTIONS[nxt] = (weakref.ref(prev), (accel, key), out)
     except TypeError:  # an element that is not hashable or weak-referenceable
         return _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
-    if hit is not None and hit[0] is prev and hit[1] == (accel, key):
-        return hit[2]
-    out = _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
-    _JUNCTIONS[nxt] = (prev, (accel, key), out)
     return out
 
 
