@@ -24,6 +24,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "_chain.h"
+
 #ifdef __clang__
 #pragma STDC FP_CONTRACT OFF
 #endif
@@ -219,12 +221,31 @@ done:
 static PyMethodDef methods[] = {
     {"line_blend", (PyCFunction)(void (*)(void))py_line_blend, METH_FASTCALL,
      line_blend_doc},
+    /* the chain planner's passes (_chain.c, its module doc) */
+    {"passes", (PyCFunction)(void (*)(void))chain_py_passes, METH_FASTCALL,
+     "passes(jcap2, acc, length, start2, dec) -> (back, fwd): the look-ahead's passes."},
+    {"speeds", (PyCFunction)(void (*)(void))chain_py_speeds, METH_FASTCALL,
+     "speeds(fwd, acc, dec, ccap, length) -> (entry, cruise, exit)."},
+    {"curve", (PyCFunction)(void (*)(void))chain_py_curve, METH_FASTCALL,
+     "curve(entry, cruise, exit, acc, dec, length, s0, v_first, out) -> knots written."},
+    {"chain_curve", (PyCFunction)(void (*)(void))chain_py_chain_curve, METH_FASTCALL,
+     "chain_curve(jcap2, acc, dec, ccap, length, start2, s0, out) -> knots "
+     "written, or -1 (start too fast)."},
+    {"s_pieces", (PyCFunction)(void (*)(void))chain_py_s_pieces, METH_FASTCALL,
+     "s_pieces(knots, v2, v, s_end, dwell, lead, out) -> (rows, duration); rows -1: "
+     "stall."},
+    {"crossings", (PyCFunction)(void (*)(void))chain_py_crossings, METH_FASTCALL,
+     "crossings(p0, v0, a0, j, hi, levels): the bisection of pathaxes._crossings, hi in "
+     "place."},
+    {"limit_along", (PyCFunction)(void (*)(void))chain_py_limit_along, METH_FASTCALL,
+     "limit_along(limit, axis, weight) -> min(limit, axis_i/weight_i over weight_i > 0)."},
     {NULL, NULL, 0, NULL},
 };
 
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_corner",
-    "Compiled line-line corner blend (the arc and trimmed lines of path/blend.py).", -1,
+    "Compiled line-line corner blend (path/blend.py) and chain planner passes (_chain.c).",
+    -1,
     methods,
 };
 

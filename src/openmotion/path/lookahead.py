@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import _corner
 from ..errors import InfeasibleError, MotionError, check_nonnegative, check_positive
 from .arcs import Arc, Arc3D
 from .blend import TANGENT_ANGLE, corner_speed
@@ -112,22 +113,16 @@ def _axis_limits(name: str, value: ArrayLike | None, dim: int) -> Array | None:
 
 
 def _limit_along(limit: float, axis: Array | None, weight: Array) -> float:
-    """min(limit, axis_i / weight_i) over axes with weight_i > 0."""
+    """min(limit, axis_i / weight_i) over axes with weight_i > 0 (compiled: _chain.c; the
+    Python oracle is tests/oracle_chain.py). A denormal weight gives inf (no limit), as
+    numpy's quotient does."""
     if axis is None:
         return limit
-    # plain floats: the same IEEE quotients and minimum as the numpy form, without its
-    # per-call overhead (a few axes, asked for every element of every re-plan)
-    best = math.inf
-    found = False
-    for a, w in zip(axis.tolist(), weight.tolist(), strict=True):
-        if w > 0.0:
-            found = True
-            q = a / w  # a denormal weight: inf (no limit), as numpy gives it
-            if q < best:
-                best = q
-    if not found:
-        return limit
-    return limit if limit <= best else best
+    try:
+        return _corner.limit_along(limit, axis, weight)
+    except (ValueError, TypeError, BufferError):  # not two float64 arrays (a user's type)
+        return _corner.limit_along(limit, np.ascontiguousarray(axis, dtype=np.float64),
+                                   np.ascontiguousarray(weight, dtype=np.float64))
 
 
 #: Memo of `_element_limits`: one entry per element, its last parameters and result. The
@@ -208,27 +203,35 @@ def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
     return _limit_along(v, vjump_ax, np.abs(diff))
 
 
+#: Memo of `_junction_cap` (as `_LIMITS`): per element, a weak reference to the element
+#: before it, the limits and the cap of their junction (a streaming chain asks about the
+#: same pairs at every re-plan). Weak both ways: a strong one to the element before would
+#: keep every earlier element of a stream alive through the chain of entries.
+_JUNCTIONS: weakref.WeakKeyDictionary[Any, tuple[weakref.ref, tuple, float]] = \
+    weakref.WeakKeyDictionary()
+
+
+def _junction_memo(prev: PathElement, nxt: PathElement, accel: float, scv: float,
+                   amax_ax: Array | None, vjump_ax: Array | None, key: tuple) -> float:
+    """`_junction_cap` memoized; `key`: (scv, _axes_key(amax_ax, vjump_ax))."""
+    try:
+        hit = _JUNCTIONS.get(nxt)
+        if hit is not None and hit[0]() is prev and hit[1] == (accel, key):
+            return hit[2]
+        out = _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
+        _JUNCTIONS[nxt] = (weakref.ref(prev), (accel, key), out)
+    except TypeError:  # an element that is not hashable or weak-referenceable
+        return _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
+    return out
+
+
 
 def _passes(jcap2: list[float], acc: list[float], length: list[float],
             start2: float, dec: list[float] | None = None) -> tuple[list[float], list[float]]:
     """Backward pass from the junction caps (v**2) at the decelerations `dec` (default
-    `acc`), then forward pass from start2 at the accelerations."""
-    n = len(length)
-    dv = [2.0 * a * L for a, L in zip(acc, length, strict=True)]
-    back = jcap2[:]
-    dvb = dv if dec is None else [2.0 * d * L for d, L in zip(dec, length, strict=True)]
-    nxt = back[n]
-    for k in range(n - 1, -1, -1):  # min() spelled out: this loop is the planner's hot spot
-        x = nxt + dvb[k]
-        c = jcap2[k]
-        nxt = back[k] = c if c <= x else x
-    fwd = [0.0] * (n + 1)
-    cur = fwd[0] = start2 if start2 <= back[0] else back[0]
-    for k in range(n):
-        x = cur + dv[k]
-        c = back[k + 1]
-        cur = fwd[k + 1] = c if c <= x else x
-    return back, fwd
+    `acc`), then forward pass from start2 at the accelerations (compiled: _chain.c; the
+    Python oracle is tests/oracle_chain.py)."""
+    return _corner.passes(jcap2, acc, length, start2, dec)
 
 
 def _cruise_caps(jcap2: list[float], cap2: list[float], acc: list[float],
@@ -362,6 +365,77 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
     junction they sit on. Raises InfeasibleError if `start_speed` is too high to obey the
     limits ahead.
     """
+    pr = _prepare(elements, feed, accel, square_corner_velocity, start_speed, end_speed,
+                  axis_vmax, axis_amax, axis_vjump, arc_tangential_ratio, min_cruise_ratio,
+                  decel)
+    feeds, accels, decels, live, acc, cap, length, dec, jcap2, v_start, mcr = pr
+    n = len(live)
+    if n == 0:
+        return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0, d)
+                     for f, a, d in zip(feeds, accels, decels, strict=True))
+    ccap = cap  # cruise caps (lowered by the minimum cruise ratio)
+    back, fwd = _passes(jcap2, acc, length, v_start * v_start, dec)
+    if v_start * v_start > back[0] * (1.0 + 1e-12):
+        raise InfeasibleError(f"start_speed {v_start:g} exceeds the highest speed the path "
+                              f"allows at its start, {math.sqrt(back[0]):.6g}")
+    if mcr > 0.0:
+        cap2, jcap2 = _cruise_caps(jcap2, [c * c for c in cap], acc, length, mcr,
+                                   v_start * v_start, dec)
+        ccap = [math.sqrt(c) for c in cap2]
+        back, fwd = _passes(jcap2, acc, length, v_start * v_start, dec)
+
+    entry, cruise, exit_ = _corner.speeds(fwd, acc, dec, ccap, length)  # step 4
+    planned = [ElementSpeeds(entry[k], cruise[k], exit_[k], acc[k], cap[k], length[k],
+                             dec[k]) for k in range(n)]
+
+    out: list[ElementSpeeds] = []
+    nxt = 0
+    for k in range(len(elements)):
+        if nxt < n and live[nxt] == k:
+            out.append(planned[nxt])
+            nxt += 1
+        else:  # zero length: sits on the junction before live element nxt
+            v = planned[nxt].entry if nxt < n else planned[-1].exit
+            out.append(ElementSpeeds(v, v, v, accels[k], feeds[k], 0.0, decels[k]))
+    return tuple(out)
+
+
+def _curve_knots(elements: Sequence[PathElement], feed: float | Sequence[float],
+                 accel: float | Sequence[float], s0: float, *,
+                 square_corner_velocity: float = 0.0, start_speed: float = 0.0,
+                 end_speed: float = 0.0, axis_vmax: ArrayLike | None = None,
+                 axis_amax: ArrayLike | None = None, axis_vjump: ArrayLike | None = None,
+                 arc_tangential_ratio: float = 0.5, min_cruise_ratio: float = 0.0,
+                 decel: float | Sequence[float] | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """`plan_speeds`' plan as the knots (s from s0, v**2) of its trapezoids
+    (pathexec.curve_from_speeds) and the smallest tangential deceleration, in one compiled
+    call and without an ElementSpeeds per element: the streaming join's re-plan. None
+    where `plan_speeds` does more than that (no element of length > 0, a minimum cruise
+    ratio) or raises (a start too fast): the caller plans the slow way."""
+    pr = _prepare(elements, feed, accel, square_corner_velocity, start_speed, end_speed,
+                  axis_vmax, axis_amax, axis_vjump, arc_tangential_ratio, min_cruise_ratio,
+                  decel)
+    _, _, _, live, acc, cap, length, dec, jcap2, v_start, mcr = pr
+    n = len(live)
+    if n == 0 or mcr > 0.0:
+        return None
+    out = np.empty((2, 3 * n + 1))
+    m = _corner.chain_curve(jcap2, acc, dec, cap, length, v_start * v_start, s0, out)
+    if m < 0:
+        return None
+    return out[0, :m].copy(), out[1, :m].copy(), min(dec)
+
+
+def _prepare(elements: Sequence[PathElement], feed: float | Sequence[float],
+             accel: float | Sequence[float], square_corner_velocity: float,
+             start_speed: float, end_speed: float, axis_vmax: ArrayLike | None,
+             axis_amax: ArrayLike | None, axis_vjump: ArrayLike | None,
+             arc_tangential_ratio: float, min_cruise_ratio: float,
+             decel: float | Sequence[float] | None) -> tuple:
+    """`plan_speeds`' arguments checked and its steps 1-2 (module doc) on the elements of
+    length > 0: (feeds, accels, decels, live, acc, cap, length, dec, jcap2, v_start, mcr)
+    (live: their indices; the rest per live element, jcap2 per junction)."""
     if isinstance(elements, (str, bytes)) or not isinstance(elements, Sequence) \
             or len(elements) == 0:
         raise MotionError("elements must be a non-empty sequence of path elements")
@@ -387,8 +461,7 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
         if v_start > 0.0:
             raise InfeasibleError(f"start_speed {v_start:g} cannot be stopped on a path of "
                                   "length 0")
-        return tuple(ElementSpeeds(0.0, 0.0, 0.0, a, f, 0.0, d)
-                     for f, a, d in zip(feeds, accels, decels, strict=True))
+        return feeds, accels, decels, live, [], [], [], [], [], v_start, mcr
     els = [elements[k] for k in live]
     axes_key = _axes_key(vmax_ax, amax_ax)
     lim = [_element_limits(el, feeds[k], accels[k], vmax_ax, amax_ax, ratio, axes_key)
@@ -404,42 +477,15 @@ def plan_speeds(elements: Sequence[PathElement], feed: float | Sequence[float],
 
     # jcap2[k]: v**2 cap at the entry of live element k (k = n: the end of the path).
     jcap2 = [0.0] * (n + 1)
+    jkey = (scv, _axes_key(amax_ax, vjump_ax))
     jcap2[0] = cap[0] ** 2
     jcap2[n] = min(v_end, cap[n - 1]) ** 2
     for k in range(1, n):
         a_j = min(accels[live[k - 1]], accels[live[k]])
-        vj = min(cap[k - 1], cap[k], _junction_cap(els[k - 1], els[k], a_j, scv, amax_ax,
-                                                   vjump_ax))
+        vj = min(cap[k - 1], cap[k], _junction_memo(els[k - 1], els[k], a_j, scv, amax_ax,
+                                                    vjump_ax, jkey))
         jcap2[k] = vj * vj
-
-    ccap = cap  # cruise caps (lowered by the minimum cruise ratio)
-    back, fwd = _passes(jcap2, acc, length, v_start * v_start, dec)
-    if v_start * v_start > back[0] * (1.0 + 1e-12):
-        raise InfeasibleError(f"start_speed {v_start:g} exceeds the highest speed the path "
-                              f"allows at its start, {math.sqrt(back[0]):.6g}")
-    if mcr > 0.0:
-        cap2, jcap2 = _cruise_caps(jcap2, [c * c for c in cap], acc, length, mcr,
-                                   v_start * v_start, dec)
-        ccap = [math.sqrt(c) for c in cap2]
-        back, fwd = _passes(jcap2, acc, length, v_start * v_start, dec)
-
-    planned: list[ElementSpeeds] = []
-    for k in range(n):
-        vin, vout = math.sqrt(fwd[k]), math.sqrt(fwd[k + 1])
-        peak2 = _peak2(fwd[k], fwd[k + 1], acc[k], dec[k], length[k])
-        cruise = max(vin, vout, min(ccap[k], math.sqrt(peak2)))
-        planned.append(ElementSpeeds(vin, cruise, vout, acc[k], cap[k], length[k], dec[k]))
-
-    out: list[ElementSpeeds] = []
-    nxt = 0
-    for k in range(len(elements)):
-        if nxt < n and live[nxt] == k:
-            out.append(planned[nxt])
-            nxt += 1
-        else:  # zero length: sits on the junction before live element nxt
-            v = planned[nxt].entry if nxt < n else planned[-1].exit
-            out.append(ElementSpeeds(v, v, v, accels[k], feeds[k], 0.0, decels[k]))
-    return tuple(out)
+    return feeds, accels, decels, live, acc, cap, length, dec, jcap2, v_start, mcr
 
 
 def acceleration_reversals(plan: Sequence[ElementSpeeds], rel: float = 1e-9) -> int:

@@ -99,7 +99,7 @@ def _faults_pending(g: Any, ctl: Controller) -> bool:
 
 
 def _preblend_pending(g: Any) -> bool:
-    """Whether `_preblend` would change anything this cycle (see groupexec)."""
+    """Whether `_preblend` would change anything this cycle (see groupstream.py)."""
     from .groupexec import PREBLEND_AHEAD, PREBLEND_PER_CYCLE, GroupState
 
     r, q, pre = g._run, g._queue, g._pre

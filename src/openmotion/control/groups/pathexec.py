@@ -35,11 +35,12 @@ from typing import Any
 
 import numpy as np
 
+from ... import _corner
 from ...errors import InfeasibleError
 from ...path import ElementSpeeds, Line, plan_speeds
 from ...path.contour import contour_error  # noqa: F401 - re-exported (was defined here)
 from ...path.geometry import PathElement
-from ...path.lookahead import speed_caps, tangential_accels
+from ...path.lookahead import _curve_knots, speed_caps, tangential_accels
 from ...profile.segments import Profile, State
 from .pathpoints import ElementTable
 
@@ -70,34 +71,14 @@ class SpeedCurve:
 
 
 def curve_from_speeds(speeds: Sequence[ElementSpeeds], s0: float = 0.0) -> SpeedCurve:
-    """The trapezoids of the look-ahead as one curve, starting at path position s0."""
-    ss: list[float] = [s0]
-    vv: list[float] = [speeds[0].entry ** 2 if speeds else 0.0]
-    pos = s0
-    for sp in speeds:
-        if sp.length == 0.0:
-            continue
-        a, vc2 = sp.accel, sp.cruise ** 2
-        d_acc = max(0.0, (vc2 - sp.entry ** 2) / (2.0 * a))
-        d_dec = max(0.0, (vc2 - sp.exit ** 2) / (2.0 * sp.decel))
-        if d_acc + d_dec > sp.length:  # rounding: no cruise
-            d_acc = max(0.0, min(sp.length, d_acc))
-            d_dec = sp.length - d_acc
-        for d, v2 in ((d_acc, vc2), (sp.length - d_acc - d_dec, vc2)):
-            if d > 0.0:
-                ss.append(ss[-1] + d)
-                vv.append(v2)
-        pos += sp.length
-        ss.append(pos)
-        vv.append(sp.exit ** 2)
-    s = np.array(ss)
-    v2 = np.maximum(np.array(vv), 0.0)
-    keep = np.concatenate([[True], np.diff(s) > 0.0])  # drop zero-length pieces
-    keep[-1] = True
-    s, v2 = s[keep], v2[keep]
-    if len(s) > 1 and s[-2] >= s[-1]:
-        s, v2 = np.delete(s, -2), np.delete(v2, -2)
-    return SpeedCurve(s, v2)
+    """The trapezoids of the look-ahead as one curve, starting at path position s0
+    (compiled: _chain.c `curve`; the Python oracle is tests/oracle_chain.py)."""
+    out = np.empty((2, 3 * len(speeds) + 1))
+    m = _corner.curve([sp.entry for sp in speeds], [sp.cruise for sp in speeds],
+                      [sp.exit for sp in speeds], [sp.accel for sp in speeds],
+                      [sp.decel for sp in speeds], [sp.length for sp in speeds], s0,
+                      speeds[0].entry if speeds else 0.0, out)
+    return SpeedCurve(out[0, :m].copy(), out[1, :m].copy())
 
 
 def _combine(a: SpeedCurve, b: SpeedCurve, fn) -> SpeedCurve:
@@ -156,66 +137,34 @@ def s_profile(curve: SpeedCurve, s_end: float, breaks: Sequence[float], *,
     knots = knots[(knots >= curve.s[0]) & (knots <= s_end)]
     v2 = np.maximum(np.interp(knots, curve.s, curve.v2), 0.0)
     v = np.sqrt(v2)
-    ds = np.diff(knots)
-    dv2 = np.diff(v2)
-    # ProfileBuilder's segments written out (direction +1, jerk 0): the same float
-    # operations in the same order, without a method call per piece (a chain of
-    # hundreds of elements is one such loop per re-plan)
-    p, vcur, acur, t = float(knots[0]), float(v[0]), 0.0, 0.0
-    start = State(p, 0.0 if curve.jump else vcur, 0.0)
-    rows: list[tuple[float, float, float, float, float]] = []
-    dts: list[float] = []
-    labels: list[str] = []
+    # the pieces (ProfileBuilder's segments written out: direction +1, jerk 0, the same
+    # float operations in the same order) in one compiled loop (_chain.c `s_pieces`; the
+    # Python oracle is tests/oracle_chain.py)
+    out = np.empty((6, 2 * len(knots) + 1))
+    m, t = _corner.s_pieces(knots, v2, v, float(s_end), float(dwell), float(lead), out)
+    if m < 0:
+        raise InfeasibleError("path speed curve stalls at rest before its end")
+    start = State(float(knots[0]), 0.0 if curve.jump else float(v[0]), 0.0)
+    kind = out[5, :m]
+    return Profile(t0=out[0, :m].copy(), p0=out[1, :m].copy(), v0=out[2, :m].copy(),
+                   a0=out[3, :m].copy(), j=np.zeros(m), duration=t, start=start,
+                   end=State(float(s_end), 0.0, 0.0), labels=_labels(kind),
+                   dt=out[4, :m].copy())
 
-    def piece(dt: float, label: str) -> None:
-        nonlocal p, vcur, acur, t
-        rows.append((t, p, vcur, acur, 0.0))
-        dts.append(dt)
-        labels.append(label or f"segment {len(labels)}")
-        p = p + dt * (vcur + dt * (acur / 2.0 + dt * 0.0 / 6.0))
-        vcur = vcur + dt * (acur + dt * 0.0 / 2.0)
-        acur = acur + dt * 0.0
-        t += dt
 
-    if lead > 0.0:
-        acur = 0.0
-        piece(lead, "dwell")
-    last = len(ds) - 1
-    # a stall is a piece crawling at a speed rounding left (> 1e6 s at under 1e-6 of the
-    # curve's peak); a long piece at a real speed is a long path (2^45 pulses at a low feed)
-    crawl = 2e-6 * float(v.max(initial=0.0))
-    # Python floats: the same double arithmetic as numpy scalars, without their overhead
-    dsl, dv2l, vl = ds.tolist(), dv2.tolist(), v.tolist()
-    for k in range(len(dsl)):
-        d = dsl[k]
-        if d <= 0.0:
-            continue
-        a = dv2l[k] / (2.0 * d)
-        vm = vl[k] + vl[k + 1]
-        if vm <= 0.0 or (2.0 * d / vm > 1e6 and vm < crawl):
-            if d <= 1e-9 * max(1.0, s_end):  # a sliver left by rounding: step over it
-                continue
-            raise InfeasibleError("path speed curve stalls at rest before its end")
-        dt = 2.0 * d / vm  # exact for constant acceleration, also when a = 0
-        vcur = vl[k]
-        acur = a
-        if dt > 0.0:
-            rows.append((t, p, vcur, acur, 0.0))
-            dts.append(dt)
-            labels.append(f"segment {len(labels)}")
-            p = p + dt * (vcur + dt * (acur / 2.0 + dt * 0.0 / 6.0))
-            vcur = vcur + dt * (acur + dt * 0.0 / 2.0)
-            acur = acur + dt * 0.0
-            t += dt
-        if dwell > 0.0 and vl[k + 1] == 0.0 and k < last:
-            vcur = 0.0
-            acur = 0.0
-            piece(dwell, "dwell")
-    arr = np.array(rows, dtype=np.float64).reshape(-1, 5)
-    return Profile(t0=arr[:, 0].copy(), p0=arr[:, 1].copy(), v0=arr[:, 2].copy(),
-                   a0=arr[:, 3].copy(), j=arr[:, 4].copy(), duration=t, start=start,
-                   end=State(float(s_end), 0.0, 0.0), labels=tuple(labels),
-                   dt=np.array(dts, dtype=np.float64))
+#: "segment k" for k = 0, 1, ... (s_profile's piece labels), grown as asked
+_SEGMENT_LABELS: list[str] = []
+
+
+def _labels(kind: np.ndarray) -> tuple[str, ...]:
+    """s_profile's labels: "dwell" where `kind` is 1, else "segment k" (k: the row)."""
+    m = len(kind)
+    while len(_SEGMENT_LABELS) < m:
+        _SEGMENT_LABELS.append(f"segment {len(_SEGMENT_LABELS)}")
+    labels = _SEGMENT_LABELS[:m]
+    for k in np.flatnonzero(kind).tolist():
+        labels[k] = "dwell"
+    return tuple(labels)
 
 
 # -------------------------------------------------------------------------- chains
@@ -421,6 +370,9 @@ def plan_curve(chain: Chain, s0: float, v0: float, lim: Limits,
     if decels is not None:
         kw["decel"] = decels
     try:
+        fast = _curve_knots(els, feeds, accels, s0, start_speed=v0, **kw)
+        if fast is not None:  # the plan's knots in one compiled pass (_chain.c)
+            return _pinned(SpeedCurve(*fast), chain.length, jump=jump and v0 > 0.0)
         sp = plan_speeds(els, feeds, accels, start_speed=v0, **kw)
         return _with_amin(_pinned(curve_from_speeds(sp, s0), chain.length,
                                   jump=jump and v0 > 0.0), sp)
