@@ -69,7 +69,7 @@ def show(name: str, mode: str, s: CycleStats, busy: np.ndarray | None = None,
 def compiled_noop(seconds: float) -> CycleStats:
     """The compiled executor's wait (rt_wait/rt_close) around no work at all."""
     st = np.zeros(realtime.RT_NFIELDS)
-    rings = [np.zeros(65536) for _ in range(4)]
+    rings = [np.zeros(65536) for _ in realtime.RINGS]
     st[realtime.RT_PENDING] = -1.0
     st[realtime.RT_PERIOD] = 0.001
     st[realtime.RT_WALL0] = _kernel.rt_now() - 0.001
