@@ -297,10 +297,10 @@ class RealtimeExecutor(PacedThread):
             max_work=float(work.max()),
             python_cycles=self.python_cycles,
             executor="compiled",
-            own_overruns=_own_overruns(rings, self._period, from_start=count <= _WINDOW),
+            own_overruns=_own_overruns(rings, self._period),
             p99_cpu=float(np.percentile(cpu, 99)),
             max_cpu=float(cpu.max()),
-            own_cpu_overruns=_own_overruns(rings, self._period, "cpu", count <= _WINDOW),
+            own_cpu_overruns=_own_overruns(rings, self._period, "cpu"),
         )
 
     def samples(self) -> dict[str, np.ndarray]:
@@ -315,14 +315,13 @@ class RealtimeExecutor(PacedThread):
                 "lead": self._lead[order].copy()}
 
 
-def _own_overruns(rings: dict[str, np.ndarray], period: float, by: str = "busy",
-                  from_start: bool = True) -> int:
+def _own_overruns(rings: dict[str, np.ndarray], period: float, by: str = "busy") -> int:
     """Cycles after which the controller alone started the next cycle after its slot: each
     cycle started when planned (its slot, or up to `lead` periods earlier: the last
     cycles before a landing), or when the controller's own work before it ended, if later
     - no OS lateness - and took its busy time plus the Python work before the next cycle
-    (by="cpu": the thread's CPU time for both). `from_start`: the rings begin with the
-    executor's first cycle (which starts at its planned time: nothing can start earlier)."""
+    (by="cpu": the thread's CPU time for both). The first cycle of the rings starts when
+    planned."""
     own = rings[by].copy()
     m = len(own)
     if not m:
@@ -331,8 +330,6 @@ def _own_overruns(rings: dict[str, np.ndarray], period: float, by: str = "busy",
         own[:-1] += rings["work"][1:]
     k = np.arange(m, dtype=float)
     due = (k - rings["lead"]) * period  # from the first cycle's slot
-    if from_start:  # the first cycle began the run: none of them could start before it
-        due = np.maximum(due, due[0])
     # start[k] = max(due[k], start[k-1] + own[k-1]), in closed form (max-plus prefix)
     spent = np.concatenate(([0.0], np.cumsum(own[:-1])))
     start = spent + np.maximum.accumulate(due - spent)
