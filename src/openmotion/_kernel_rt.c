@@ -1,8 +1,8 @@
 /* Real-time pacing of the compiled cycles (openmotion._kernel, control/core/realtime.py).
  *
  * The real-time executor (a Python thread) binds a pacing context to its own thread with
- * `rt_paced(st, busy, late, work, fn, args)` and calls fn(*args) - a virtual-time jump -
- * inside it. Every cycle the compiled stepper loop (_kernel_stepper.c) then runs on that
+ * `rt_paced(st, busy, late, work, cpu, lead, fn, args)` and calls fn(*args) - a
+ * virtual-time jump - inside it. Every cycle the compiled stepper loop (_kernel_stepper.c) then runs on that
  * thread calls `rt_before_cycle(k)`, which sleeps (GIL released, the kernel runs without
  * it) until cycle k's slot on the wall clock, and `rt_after_cycle(k)`, which records the
  * cycle's busy time. `rt_before_cycle` returns 1 instead of waiting when another thread
@@ -15,13 +15,19 @@
  * stays "pending" from its slot until `rt_close` (or the next cycle) ends it, so its
  * busy time includes the Python work. Cycle k's slot starts at st[RT_WALL0] + k * period
  * (CLOCK_MONOTONIC seconds); a late cycle is never skipped (catch-up, as RealtimePacer).
+ * The landing lead: the last st[RT_LEAD] cycles before st[RT_LAND], the cycle the compiled
+ * run in progress lands on (or a cycle the Python path steps), do not wait for their own
+ * slots but run back to back from the slot of cycle RT_LAND - RT_LEAD, so the landing's
+ * Python work has RT_LEAD + 1 periods before the next slot (`planned_slot`); a cycle
+ * never starts more than RT_LEAD periods before its slot.
  *
  * The context lives in float64 numpy arrays owned by the executor: st[RT_NFIELDS], the
- * rings busy/late/work/cpu (same length): per cycle the busy time, the start lateness, the
- * Python work done between the previous cycle's end and the wait for this one (landing
- * and feeding the piece queue ahead), and the executor thread's CPU time from the cycle's
- * start to the wait for the next one (the cycle and the work after it, without the time
- * the thread was preempted: the controller's own cost on a loaded machine).
+ * rings busy/late/work/cpu/lead (same length): per cycle the busy time, the start
+ * lateness against its planned start, the Python work done between the previous cycle's
+ * end and the wait for this one (landing and feeding the piece queue ahead), the executor
+ * thread's CPU time from the cycle's start to the wait for the next one (the cycle and the
+ * work after it, without the time the thread was preempted: the controller's own cost on
+ * a loaded machine), and the periods it was planned ahead of its slot (the lead).
  */
 #include "_kernel.h"
 #include <time.h>

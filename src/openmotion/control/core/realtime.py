@@ -16,12 +16,23 @@ closed in Python, a back end the compiled loop cannot serve: servo/DC plants, pi
 tables, armed stops) the cycle runs in Python (`Controller.step`) at its slot: the
 fallback, counted in `CycleStats.python_cycles`.
 
+The landing lead: a landing's Python work (its hooks: a path start, a join install; the
+trace of the crossed cycles; planning and feeding the next run) takes several periods
+where a path starts. So the last `LANDING_LEAD_S` of cycles before a planned landing (and
+a Python step, a landing of its own) do not wait for their own slots: they run back to
+back from the slot of the first of them, and the landing's work has the lead plus a period
+before the next cycle's slot. The machine is then at most the lead ahead of the wall
+clock; every cycle is the same cycle, only delivered early (as catch-up delivers late).
+A run is one chunk of jump.py's feed (`RUN_CYCLES`), so all its Python work is at its
+landing.
+
 Because a real-time run takes the same jumps as virtual time (same pieces, same landing
 cycles), it gives the same counters, events and histories as the virtual-time run of the
-same commands (tests/test_realtime.py).
+same commands (tests/test_realtime_executor.py, tests/test_realtime_lead.py).
 
-Statistics, per cycle (rings of 65536 cycles): `late` (start against the slot: the OS
-wake-up, or Python work that overran the gap), `busy` (the cycle itself: compiled, or the
+Statistics, per cycle (rings of 65536 cycles): `late` (start against the planned start:
+the OS wake-up, or Python work that overran the gap), `lead` (periods planned ahead of
+its slot), `busy` (the cycle itself: compiled, or the
 Python path, plus the reactions of a landing cycle), `work` (Python between the cycles:
 landing, planning and feeding the next pieces; it delays nothing unless it overflows the
 gap, which then shows as lateness). `clock.pacer_baseline` measures a no-op pacer the
