@@ -18,7 +18,10 @@ landing's reactions), start lateness p99 (jitter: OS wake-up plus any Python wor
 overflowed the gap), Python work between cycles p99/max (landing, feeding the pieces
 ahead; compiled executor only), overruns (cycles that ended after the next slot began;
 "own": those the controller's busy time plus its work before the next cycle caused alone,
-the OS's lateness left out - wall time, so CPU starvation inside a cycle still counts),
+the OS's lateness left out - wall time, so CPU starvation inside a cycle still counts;
+"own by cpu": the same from the thread's CPU time, the figure to trust on a shared
+machine; the compiled executor counts from each cycle's planned start, which the landing
+lead puts up to realtime.LANDING_LEAD_S before the slot for the cycles before a landing),
 cycles stepped in Python, compiled runs (each ends in a landing: Python's work). Compare
 the lateness with the no-op rows: what exceeds them is the controller's.
 
@@ -69,7 +72,7 @@ def show(name: str, mode: str, s: CycleStats, busy: np.ndarray | None = None,
 def compiled_noop(seconds: float) -> CycleStats:
     """The compiled executor's wait (rt_wait/rt_close) around no work at all."""
     st = np.zeros(realtime.RT_NFIELDS)
-    rings = [np.zeros(65536) for _ in range(4)]
+    rings = [np.zeros(65536) for _ in realtime.RINGS]
     st[realtime.RT_PENDING] = -1.0
     st[realtime.RT_PERIOD] = 0.001
     st[realtime.RT_WALL0] = _kernel.rt_now() - 0.001

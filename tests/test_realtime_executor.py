@@ -232,10 +232,12 @@ def test_a_failure_inside_a_compiled_run_faults_and_real_time_goes_on():
     assert hw.queued(2) == 0  # nothing half-queued stays behind
 
 
-def test_a_request_at_the_first_cycle_of_a_later_chunk_lands_on_a_cycle_run():
+def test_a_request_at_the_first_cycle_of_a_later_chunk_lands_on_a_cycle_run(monkeypatch):
     """A compiled run over the horizon is fed in chunks (jump.py); the C loop never returns
     at the first cycle of a kernel run, so a lock request arriving just as a later chunk
-    starts lands after that chunk's first cycle, with the virtual-time result."""
+    starts lands after that chunk's first cycle, with the virtual-time result. (Runs are
+    one chunk by default, `realtime.RUN_CYCLES`; here they span the whole horizon.)"""
+    monkeypatch.setattr(realtime, "RUN_CYCLES", None)
     def setup(ctl: Controller) -> None:
         ctl.hardware.record_pulses()
         ctl.enable_all()

@@ -1,8 +1,8 @@
 /* Real-time pacing of the compiled cycles (openmotion._kernel, control/core/realtime.py).
  *
  * The real-time executor (a Python thread) binds a pacing context to its own thread with
- * `rt_paced(st, busy, late, work, fn, args)` and calls fn(*args) - a virtual-time jump -
- * inside it. Every cycle the compiled stepper loop (_kernel_stepper.c) then runs on that
+ * `rt_paced(st, busy, late, work, cpu, lead, fn, args)` and calls fn(*args) - a
+ * virtual-time jump - inside it. Every cycle the compiled stepper loop (_kernel_stepper.c) then runs on that
  * thread calls `rt_before_cycle(k)`, which sleeps (GIL released, the kernel runs without
  * it) until cycle k's slot on the wall clock, and `rt_after_cycle(k)`, which records the
  * cycle's busy time. `rt_before_cycle` returns 1 instead of waiting when another thread
@@ -15,13 +15,19 @@
  * stays "pending" from its slot until `rt_close` (or the next cycle) ends it, so its
  * busy time includes the Python work. Cycle k's slot starts at st[RT_WALL0] + k * period
  * (CLOCK_MONOTONIC seconds); a late cycle is never skipped (catch-up, as RealtimePacer).
+ * The landing lead: the last st[RT_LEAD] cycles before st[RT_LAND], the cycle the compiled
+ * run in progress lands on (or a cycle the Python path steps), do not wait for their own
+ * slots but run back to back from the slot of cycle RT_LAND - RT_LEAD, so the landing's
+ * Python work has RT_LEAD + 1 periods before the next slot (`planned_slot`); a cycle
+ * never starts more than RT_LEAD periods before its slot.
  *
  * The context lives in float64 numpy arrays owned by the executor: st[RT_NFIELDS], the
- * rings busy/late/work/cpu (same length): per cycle the busy time, the start lateness, the
- * Python work done between the previous cycle's end and the wait for this one (landing
- * and feeding the piece queue ahead), and the executor thread's CPU time from the cycle's
- * start to the wait for the next one (the cycle and the work after it, without the time
- * the thread was preempted: the controller's own cost on a loaded machine).
+ * rings busy/late/work/cpu/lead (same length): per cycle the busy time, the start
+ * lateness against its planned start, the Python work done between the previous cycle's
+ * end and the wait for this one (landing and feeding the piece queue ahead), the executor
+ * thread's CPU time from the cycle's start to the wait for the next one (the cycle and the
+ * work after it, without the time the thread was preempted: the controller's own cost on
+ * a loaded machine), and the periods it was planned ahead of its slot (the lead).
  */
 #include "_kernel.h"
 #include <time.h>
@@ -29,10 +35,13 @@
 
 enum { RT_WALL0, RT_PERIOD, RT_COUNT, RT_WAITERS, RT_STOPPING, RT_PENDING, RT_START,
        RT_LASTEND, RT_OVERRUNS, RT_LATECYC, RT_BEHIND, RT_BURSTS, RT_INBURST,
-       RT_INTERRUPTED, RT_LASTK, RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_CPU0, RT_NFIELDS };
+       RT_INTERRUPTED, RT_LASTK, RT_LASTSTART, RT_LASTOVER, RT_EXTEND, RT_CPU0, RT_LAND,
+       RT_LEAD, RT_DUE, RT_NFIELDS };
+
+#define NRINGS 5
 
 typedef struct {
-    double *st, *busy, *late, *work, *cpu;
+    double *st, *busy, *late, *work, *cpu, *lead;
     Py_ssize_t cap;
 } RtCtx;
 
@@ -54,6 +63,18 @@ static double cpu_s(void)
 }
 
 static inline double vread(double *p) { return *(volatile double *)p; }
+
+/* The cycle whose slot cycle k waits for: k itself, or, for the last st[RT_LEAD] cycles
+ * before the landing st[RT_LAND] of the compiled run in progress, the cycle
+ * RT_LAND - RT_LEAD: those cycles run back to back from that slot on, so the Python work
+ * of the landing has RT_LEAD + 1 periods before the next cycle's slot (never earlier
+ * than RT_LEAD periods ahead of its own slot). */
+static double planned_slot(const double *st, double k)
+{
+    double land = st[RT_LAND], lead = st[RT_LEAD];
+    if (lead > 0.0 && land > 0.0 && k <= land && k > land - lead) return land - lead;
+    return k;
+}
 
 /* cycle k ends at t after `busy` seconds of work: an overrun when it ends after the next
  * slot began (counted once per cycle: `over` says it was counted already) */
@@ -84,11 +105,10 @@ static void close_pending(RtCtx *c, double t)
     double *st = c->st;
     if (st[RT_PENDING] < 0.0) return;
     double k = st[RT_PENDING], period = st[RT_PERIOD];
-    double due = st[RT_WALL0] + k * period;
     Py_ssize_t i = (Py_ssize_t)((long long)st[RT_COUNT] % (long long)c->cap);
     double start = st[RT_START];
-    c->late[i] = start - due;
-    if (start - due >= period) st[RT_LATECYC] += 1.0;
+    c->late[i] = start - st[RT_DUE];  /* against the instant it was planned for */
+    if (start - (st[RT_WALL0] + k * period) >= period) st[RT_LATECYC] += 1.0;
     st[RT_COUNT] += 1.0;
     st[RT_PENDING] = -1.0;
     st[RT_LASTK] = k;
@@ -144,7 +164,9 @@ static int begin(RtCtx *c, long long k, int mode)
     if (st[RT_COUNT] >= 1.0 && st[RT_CPU0] > 0.0)  /* the last cycle and the work after it */
         c->cpu[(Py_ssize_t)((long long)(st[RT_COUNT] - 1.0) % (long long)c->cap)] =
             cpu_s() - st[RT_CPU0];
-    if (wait_until(c, st[RT_WALL0] + (double)k * st[RT_PERIOD], mode)) {
+    double slot = planned_slot(st, (double)k);
+    double due = st[RT_WALL0] + slot * st[RT_PERIOD];
+    if (wait_until(c, due, mode)) {
         /* no cycle begins: the landing work that follows still belongs to the last
          * cycle, the time spent here (planning, the wait) does not */
         st[RT_INTERRUPTED] = 1.0;
@@ -155,7 +177,9 @@ static int begin(RtCtx *c, long long k, int mode)
     Py_ssize_t i = (Py_ssize_t)((long long)st[RT_COUNT] % (long long)c->cap);
     c->work[i] = work;
     c->cpu[i] = 0.0;
+    c->lead[i] = (double)k - slot;
     st[RT_PENDING] = (double)k;
+    st[RT_DUE] = due;
     st[RT_START] = now_s();
     st[RT_CPU0] = cpu_s();
     return 0;
@@ -176,94 +200,93 @@ void rt_after_cycle(long long k)
 
 static int get_ctx(PyObject *const *o, Buf *bufs, RtCtx *c)
 {
-    static const char *names[5] = {"st", "busy", "late", "work", "cpu"};
-    for (int k = 0; k < 5; k++)
+    static const char *names[NRINGS + 1] = {"st", "busy", "late", "work", "cpu", "lead"};
+    for (int k = 0; k <= NRINGS; k++)
         if (get_buf(o[k], &bufs[k], 8, names[k]) < 0) return -1;
-    if (bufs[0].b.len != 8 * RT_NFIELDS || bufs[1].b.len == 0
-            || bufs[2].b.len != bufs[1].b.len || bufs[3].b.len != bufs[1].b.len
-            || bufs[4].b.len != bufs[1].b.len) {
+    int ok = bufs[0].b.len == 8 * RT_NFIELDS && bufs[1].b.len > 0;
+    for (int k = 2; k <= NRINGS; k++) ok = ok && bufs[k].b.len == bufs[1].b.len;
+    if (!ok) {
         PyErr_SetString(PyExc_ValueError, "rt: context arrays have the wrong sizes");
         return -1;
     }
+    double **rings[NRINGS] = {&c->busy, &c->late, &c->work, &c->cpu, &c->lead};
     c->st = bufs[0].b.buf;
-    c->busy = bufs[1].b.buf;
-    c->late = bufs[2].b.buf;
-    c->work = bufs[3].b.buf;
-    c->cpu = bufs[4].b.buf;
+    for (int k = 0; k < NRINGS; k++) *rings[k] = bufs[k + 1].b.buf;
     c->cap = bufs[1].b.len / 8;
     return 0;
 }
 
-/* The five context arrays as a call's only arguments (st, busy, late, work, cpu); on
- * failure the buffers are released and a Python error is set. */
+/* The six context arrays as a call's only arguments (st, busy, late, work, cpu, lead);
+ * on failure the buffers are released and a Python error is set. */
 static int ctx_args(PyObject *args, Buf *bufs, RtCtx *c)
 {
-    PyObject *o[5];
-    memset(bufs, 0, 5 * sizeof *bufs);
-    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) return -1;
-    if (get_ctx(o, bufs, c) < 0) { release(bufs, 5); return -1; }
+    PyObject *o[NRINGS + 1];
+    memset(bufs, 0, (NRINGS + 1) * sizeof *bufs);
+    if (!PyArg_ParseTuple(args, "OOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5]))
+        return -1;
+    if (get_ctx(o, bufs, c) < 0) { release(bufs, NRINGS + 1); return -1; }
     return 0;
 }
 
 const char rt_paced_doc[] =
-"rt_paced(st, busy, late, work, cpu, fn, args) -> fn(*args)\n\n"
+"rt_paced(st, busy, late, work, cpu, lead, fn, args) -> fn(*args)\n\n"
 "Call fn(*args) with the pacing context bound to this thread: every compiled cycle run\n"
 "inside waits for its slot on the wall clock and records its busy time.";
 
 PyObject *rt_paced(PyObject *self, PyObject *args)
 {
-    PyObject *o[5], *fn, *fargs;
-    if (!PyArg_ParseTuple(args, "OOOOOOO!", &o[0], &o[1], &o[2], &o[3], &o[4], &fn,
+    PyObject *o[NRINGS + 1], *fn, *fargs;
+    if (!PyArg_ParseTuple(args, "OOOOOOOO!", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &fn,
                           &PyTuple_Type, &fargs))
         return NULL;
-    Buf bufs[5];
+    Buf bufs[NRINGS + 1];
     memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, NRINGS + 1); return NULL; }
     RtCtx *outer = rt_cur;
     rt_cur = &c;
     PyObject *res = PyObject_Call(fn, fargs, NULL);
     rt_cur = outer;
-    release(bufs, 5);
+    release(bufs, NRINGS + 1);
     return res;
 }
 
 const char rt_wait_doc[] =
-"rt_wait(st, busy, late, work, cpu, k) -> True when interrupted instead\n\n"
+"rt_wait(st, busy, late, work, cpu, lead, k) -> True when interrupted instead\n\n"
 "End the pending cycle, then sleep (GIL released) until cycle k's slot and make k the\n"
 "pending cycle (a cycle the Python path runs; `rt_close` ends it). Returns True without\n"
 "beginning k when the executor stops or another thread waits for the lock.";
 
 PyObject *rt_wait(PyObject *self, PyObject *args)
 {
-    PyObject *o[5];
+    PyObject *o[NRINGS + 1];
     long long k;
-    if (!PyArg_ParseTuple(args, "OOOOOL", &o[0], &o[1], &o[2], &o[3], &o[4], &k))
+    if (!PyArg_ParseTuple(args, "OOOOOOL", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &k))
         return NULL;
-    Buf bufs[5];
+    Buf bufs[NRINGS + 1];
     memset(bufs, 0, sizeof bufs);
     RtCtx c;
-    if (get_ctx(o, bufs, &c) < 0) { release(bufs, 5); return NULL; }
+    if (get_ctx(o, bufs, &c) < 0) { release(bufs, NRINGS + 1); return NULL; }
     int stopped;
     Py_BEGIN_ALLOW_THREADS
     stopped = begin(&c, k, WAIT_ANY);
     Py_END_ALLOW_THREADS
-    release(bufs, 5);
+    release(bufs, NRINGS + 1);
     return PyBool_FromLong(stopped);
 }
 
 const char rt_close_doc[] =
-"rt_close(st, busy, late, work, cpu)\n\nEnd the pending cycle now, or, with none pending,\n"
+"rt_close(st, busy, late, work, cpu, lead)\n\nEnd the pending cycle now, or, with none pending,\n"
 "extend the last ended cycle's busy time to now (the Python work that landed it).";
 
 PyObject *rt_close(PyObject *self, PyObject *args)
 {
-    Buf bufs[5];
+    Buf bufs[NRINGS + 1];
     RtCtx c;
     if (ctx_args(args, bufs, &c) < 0) return NULL;
     if (c.st[RT_PENDING] >= 0.0) close_pending(&c, now_s());
     else extend_last(&c, now_s());
-    release(bufs, 5);
+    release(bufs, NRINGS + 1);
     Py_RETURN_NONE;
 }
 
@@ -304,12 +327,12 @@ PyObject *rt_slot(PyObject *self, PyObject *args)
 }
 
 const char rt_yield_doc[] =
-"rt_yield(st, busy, late, work, cpu)\n\nSleep (GIL released) while another thread waits for\n"
+"rt_yield(st, busy, late, work, cpu, lead)\n\nSleep (GIL released) while another thread waits for\n"
 "the controller's lock (st[RT_WAITERS] > 0), so it gets the lock; at most 20 ms.";
 
 PyObject *rt_yield(PyObject *self, PyObject *args)
 {
-    Buf bufs[5];
+    Buf bufs[NRINGS + 1];
     RtCtx c;
     if (ctx_args(args, bufs, &c) < 0) return NULL;
     Py_BEGIN_ALLOW_THREADS
@@ -320,6 +343,6 @@ PyObject *rt_yield(PyObject *self, PyObject *args)
         nanosleep(&ts, NULL);
     }
     Py_END_ALLOW_THREADS
-    release(bufs, 5);
+    release(bufs, NRINGS + 1);
     Py_RETURN_NONE;
 }

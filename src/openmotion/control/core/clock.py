@@ -50,12 +50,15 @@ class CycleStats:
     With the compiled executor (control/core/realtime.py, executor "compiled"): work = the
     Python work between cycles (landing, feeding the pieces ahead), python_cycles = cycles
     stepped in Python because nothing could be jumped (the fallback). own_overruns = cycles
-    whose own busy time plus the Python work before the next one exceeded the period: the
-    overruns the controller causes by itself, with the OS's wake-up lateness left out (wall
-    time: a thread preempted inside counts). cpu = the real-time thread's CPU time for a
-    cycle and the work after it, up to the wait for the next one (what the controller
-    itself costs, preemption left out); own_cpu_overruns = cycles where that exceeded the
-    period: the overruns the controller would cause on a machine of its own.
+    whose own busy time plus the Python work before the next one exceeded the time to the
+    next cycle's slot: the overruns the controller causes by itself, with the OS's wake-up
+    lateness left out (wall time: a thread preempted inside counts). The compiled executor
+    counts from each cycle's planned start (its slot, or up to the landing lead earlier for
+    the last cycles before a landing, which run ahead: realtime.LANDING_LEAD_S), or the
+    end of the controller's own work before it if later. cpu = the real-time thread's CPU
+    time for a cycle and the work after it, up to the wait for the next one (what the
+    controller itself costs, preemption left out); own_cpu_overruns = the same count from
+    that CPU time: the overruns the controller would cause on a machine of its own.
     """
 
     cycles: int
