@@ -39,6 +39,9 @@ enum { S_ACTIVE, S_WAKE, S_LEVELBITS, S_BIT, S_ARM, S_ARMLEVEL, S_ARMDIR, NSI };
 /* S_ARM: 0 not armed, else 1 + the switch's rank in the order the stops were armed (ties
  * at one instant go to the first armed, as SimAxis._first_armed) */
 #define LTC_BIT 4 /* AXIS_INPUTS.index("ltc"): SD shares its pin while no LTC is placed */
+/* a hidden switch (a probe's interval bound, hw/sim/probe.py) has S_BIT = HIDDEN_BIT + its
+ * slot and flips no input level (S_LEVELBITS 0): its edges feed the machine's edge filters */
+#define HIDDEN_BIT 9
 #define TIME_TOL 1e-13
 /* edge row (int64): axis, signal bit, level, own decoded count */
 #define NEI 4
@@ -453,7 +456,8 @@ static int scan(Axis *a, double m1, int d, Report *r, PRec *p)
                     if (peek(a, p, (double)em, &own)) return BAIL;
                     int st = add_edge(r, et, bit, ((ai[I_LEVELS] >> bit) & 1) ^ act, own);
                     if (st) return st;
-                    if (si[S_LEVELBITS] != ((int64_t)1 << bit)) { /* SD is also LTC */
+                    if (si[S_LEVELBITS] && si[S_LEVELBITS] != ((int64_t)1 << bit)) {
+                        /* SD is also LTC */
                         st = add_edge(r, et, LTC_BIT, ((ai[I_LEVELS] >> LTC_BIT) & 1) ^ act,
                                       own);
                         if (st) return st;
@@ -666,7 +670,10 @@ static int finish_edges(Report *r, Py_ssize_t e0, double *AD, int64_t *AI, doubl
     for (Py_ssize_t k = e0; k < r->ne; k++) {
         int64_t *enc = r->enc + k * r->n, axis = r->ei[k * NEI];
         for (Py_ssize_t x = 0; x < r->n; x++) {
-            if (x == axis) { enc[x] = r->ei[k * NEI + 3]; continue; }
+            if (x == axis && r->ei[k * NEI + 1] < HIDDEN_BIT) {
+                enc[x] = r->ei[k * NEI + 3]; /* (a hidden switch's: encoder_at, as Python) */
+                continue;
+            }
             Axis a = axis_at(AD, AI, SD, SI, PZ, x);
             if (encoder_at(&a, r, x, r->et[k], enc + x)) return BAIL;
         }
