@@ -221,9 +221,12 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
                 if tr is not None and len(tr):
                     rows.append(tr)
                 found, edges = edges, self._filtered(edges)
-                if found and not (wake is None or any(e.signal in wake for e in edges)
+                if found and not (edges and (wake is None or any(e.signal in wake
+                                                                 for e in edges))
                                   or ks.stopped()):
-                    edges = []  # a cycle with edges on other signals only: run on
+                    # a cycle with edges on other signals only (or a probe's hidden
+                    # switches that left its input as it was): run on
+                    edges = []
                     continue
                 if edges or k >= stop or (paced and kernel.interrupted()):
                     break
