@@ -231,3 +231,31 @@ def test_an_estop_inside_a_recorded_cycle_stops_the_axes_where_the_python_path_d
     assert runs[0] == runs[1]
     estops = [e for e in runs[1][1] if e[1] == "estop"]
     assert estops and all(e[0] == 0.0210753 and e[3] == int(e[3]) for e in estops)
+
+
+def test_an_action_that_touches_no_axis_keeps_the_kernels_arrays():
+    """A board input (or an E-stop with no armed EMG stop) inside a cycle: the kernel runs
+    on on the same arrays (nothing written back or rebuilt), with the Python path's edges
+    and counts; an axis action drops them."""
+    from openmotion.config import default_machine
+
+    seen = []
+    for native in (False, True):
+        hw = SimMachine(replace(default_machine(), digital_inputs=2))
+        hw.native = native
+        for i in range(hw.n_axes):
+            hw.command(i, AxisCommand(0.0, 0.01, 0.0, 20_000.0 + 1000.0 * i))
+        hw.advance(0.001)
+        ks = hw._ks
+        hw.scenario.set_input("di1", True, at=0.0013)
+        hw.scenario.press_estop(at=0.0017)
+        edges = hw.advance(0.002)
+        assert hw._ks is ks and (ks is not None) == native
+        assert [(e.time, e.signal, e.level) for e in edges] == [(0.0013, "di1", True),
+                                                                (0.0017, "emg", True)]
+        hw.scenario.inject_step_loss(0, 3, at=0.0025)
+        hw.advance(0.003)
+        if native:
+            assert hw._ks is not ks
+        seen.append((edges_of(edges), state(hw), hw.steps_lost(0)))
+    assert seen[0] == seen[1]

@@ -361,25 +361,36 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
                 self._set_stops(stops)
                 self._timed_done()
                 return edges
-            edges += self._filtered(self._act(end))  # on the objects (the arrays dropped)
-            carry = [ax.stop_time if ax.stop_time is not None else s
-                     for ax, s in zip(self._ax, stops, strict=True)]
+            edges += self._filtered(self._act(end))
+            if self._ks is None:  # an action changed the axes (objects current)
+                carry = [ax.stop_time if ax.stop_time is not None else s
+                         for ax, s in zip(self._ax, stops, strict=True)]
+            else:
+                carry = stops
             if end >= t and not (heap and heap[0][0] <= t):  # (a zero stretch is a no-op)
                 self._set_stops(carry)
                 self._timed_done()
                 return edges
 
     def _act(self, tk: float) -> list[InputEdge]:
-        """The scenario actions due at time tk (now), on the axis objects; their edges
-        with every axis's decoded count now."""
+        """The scenario actions due at time tk (now); their edges with every axis's decoded
+        count now. An action that changes an axis reaches it through `_axes` (the kernel's
+        arrays written back and dropped: rebuilt from the objects for the next part); one
+        that touches no axis (a board input, an E-stop with no armed EMG stop, an analog
+        input) leaves the arrays as they are."""
         raw: list = []
-        axes = self._axes
         for _, action in self.scenario.pop_due(tk):
             action(raw)
-        n = len(axes)
+        if not raw:
+            return []
+        ks = self._ks
+        if ks is not None:  # no axis touched (an axis's own edge would have dropped ks)
+            counts = tuple(ks.readback_rows()[:, 1].tolist())
+            return [InputEdge(tm, axis, sig, lv, counts) for tm, axis, sig, lv, _ in raw]
+        now = [ax.decoder.count for ax in self._ax]  # (current: `_axes` wrote them back)
         return [InputEdge(tm, axis, sig, lv, tuple(
-            own if (j == axis and own is not None) else axes[j].decoder.count
-            for j in range(n))) for tm, axis, sig, lv, own in raw]
+            own if (j == axis and own is not None) else c for j, c in enumerate(now)))
+            for tm, axis, sig, lv, own in raw]
 
     def _filtered(self, edges: list[InputEdge]) -> list[InputEdge]:
         """The kernel's edges (time-ordered) through the machine's edge filters (probe.py:
