@@ -16,8 +16,11 @@ flags = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off", "-fno-fa
 
 setup(ext_modules=[Extension("openmotion._kernel",
                              ["src/openmotion/_kernel.c", "src/openmotion/_kernel_stepper.c",
+                              "src/openmotion/_stepper_axis.c", "src/openmotion/_stepper_scan.c",
+                              "src/openmotion/_stepper_solve.c",
                               "src/openmotion/_kernel_rt.c", "src/openmotion/_kernel_record.c"],
-                             depends=["src/openmotion/_kernel.h"],
+                             depends=["src/openmotion/_kernel.h",
+                                      "src/openmotion/_kernel_stepper.h"],
                              extra_compile_args=flags),
                    Extension("openmotion._compare",
                              ["src/openmotion/_kernel_compare.c"]

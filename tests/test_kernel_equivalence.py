@@ -258,7 +258,7 @@ def test_the_state_kept_in_the_kernels_arrays_reads_and_writes_back_as_python(se
     assert runs[0] == runs[1]
 
 
-def test_the_kernel_stops_before_a_scenario_action_and_the_python_path_runs_it():
+def test_the_cycle_of_a_scenario_action_runs_in_the_kernel_as_in_python():
     cfgm = default_machine()
     results = []
     for native in (False, True):

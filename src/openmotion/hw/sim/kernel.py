@@ -65,16 +65,12 @@ if _k is not None:
 
 
 def usable(axes: list[SimAxis]) -> bool:
-    """True when the kernel models every axis (steppers, at most 8 switches, only the axis's
-    own input switches: a probe's hidden switches feed a board input through the
-    machine's edge filters, which only the Python path applies)."""
+    """True when the kernel models every axis (steppers with at most 8 switches; a probe's
+    hidden switches count: their edges come back named and go through the machine's edge
+    filters)."""
     if _k is None:
         return False
-    for ax in axes:
-        if (type(ax.plant) is not StepperPlant
-                or len(ax.switches) > _MAXSW or not _BIT.keys() >= ax.switches.keys()):
-            return False
-    return True
+    return all(type(ax.plant) is StepperPlant and len(ax.switches) <= _MAXSW for ax in axes)
 
 
 def pacing() -> bool:
@@ -96,8 +92,12 @@ def wait_slot(k: int) -> None:
         _k.rt_slot(int(k))
 
 
+#: the signal bit of a hidden switch (a probe's interval bound) in slot s: _HIDDEN + s
+_HIDDEN = len(AXIS_INPUTS)
+
+
 def _wakes(name: str, switches: dict, wake: Collection[str] | None) -> bool:
-    if wake is None or name in wake:
+    if wake is None or name in wake or name not in _BIT:  # hidden: the probe's filter
         return True
     return name == "sd" and "ltc" not in switches and "ltc" in wake
 
@@ -178,7 +178,7 @@ class KernelState:
                     base ^= bits
                 arm = ax.armed.get(name) if name != "ez" else None
                 rank = list(ax.armed).index(name) + 1 if arm is not None else 0
-                si[x, s] = (sw.active, 0, bits, _BIT[name], rank,
+                si[x, s] = (sw.active, 0, bits, _BIT.get(name, _HIDDEN + s), rank,
                             arm[0] if arm else 0, arm[1] if arm else 0)
             ail.append([g.count, plant.lost, plant.ideal, plant.enabled, dec.q, dec.last_dir,
                         dec.count, dec.period, len(sws), dec.turn[1], dec.turn[-1],
@@ -364,7 +364,8 @@ def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin:
         for tm, (axis, bit, level, _), counts in zip(et[:nedges].tolist(),
                                                      ei[:nedges].tolist(),
                                                      enc[:nedges].tolist(), strict=True):
-            edges.append(InputEdge(tm, axis, names[bit], level == 1, tuple(counts)))
+            name = names[bit] if bit < _HIDDEN else ks.names[axis][bit - _HIDDEN]
+            edges.append(InputEdge(tm, axis, name, level == 1, tuple(counts)))
     return k, t, tr[:k - start] if trace else None, edges, bool(full)
 
 

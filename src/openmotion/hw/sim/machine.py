@@ -220,9 +220,13 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
                         self._stale = True
                 if tr is not None and len(tr):
                     rows.append(tr)
-                if edges and not (wake is None or any(e.signal in wake for e in edges)
+                found, edges = edges, self._filtered(edges)
+                if found and not (edges and (wake is None or any(e.signal in wake
+                                                                 for e in edges))
                                   or ks.stopped()):
-                    edges = []  # a cycle with edges on other signals only: run on
+                    # a cycle with edges on other signals only (or a probe's hidden
+                    # switches that left its input as it was): run on
+                    edges = []
                     continue
                 if edges or k >= stop or (paced and kernel.interrupted()):
                     break
@@ -310,19 +314,124 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         t = check_finite("t", t)
         if t < self._t:
             raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
-        queues = self._queues
-        ks = self._kernel_state() if self.native and not self._pending \
-            and not self._edge_filters else None
-        if ks is not None:  # one cycle [now, t] in the kernel, every edge reported
-            k, t1, _, edges = kernel.run_quiet(ks, self._ax, queues, t, 1.0, -1, 0, self._t,
-                                               self._next_action(), None, report=True,
-                                               paced=False)
-            if k == 0:  # else an action is due in it or a count left the exact range
-                self._t = t1
-                self._timed_done()
-                if not ks.recording:
-                    self._stale = True
+        ks = self._kernel_state() if self.native and not self._pending else None
+        if ks is not None:
+            edges = self._advance_native(t)
+            if edges is not None:
                 return edges
+        return self._advance_python(t)
+
+    def _advance_native(self, t: float) -> list[InputEdge] | None:
+        """`advance(t)` in the kernel: the stretch [now, t] as one cycle, every edge
+        reported. A scenario action due in it cuts it into parts: the kernel runs up to the
+        action's instant, the action applies to the axes as the kernel left them (written
+        back), and the kernel runs on from the state the action left (the arrays rebuilt:
+        a cut command, a moved switch, an enable). The stop times of one Python stretch
+        (since the last piece start, `_advance`) are carried across the parts. None when
+        the kernel ran nothing (a count beyond its exact range: the Python path runs the
+        stretch); a later part the kernel refuses runs in Python."""
+        heap = self.scenario._heap
+        queues = self._queues
+        n = len(self._ax)
+        edges: list[InputEdge] = []
+        carry: list[float | None] | None = None  # stop times of the parts before
+        first = True
+        while True:
+            ks = self._kernel_state()
+            if ks is None:  # (an action left a machine the kernel does not model)
+                return edges + self._advance_rest(t, carry)
+            ta = heap[0][0] if heap else math.inf
+            end = t if ta > t else max(ta, self._t)
+            left = sum(map(len, queues))
+            k, t1, _, part = kernel.run_quiet(ks, self._ax, queues, end, 1.0, -1, 0, self._t,
+                                              math.inf, None, report=True, paced=False)
+            if k != 0:  # a count left the exact range: Python from here
+                return None if first else edges + self._advance_rest(t, carry)
+            first = False
+            self._t = t1
+            if not ks.recording:
+                self._stale = True
+            edges += self._filtered(part)
+            stops = [ks.stop_time(x) for x in range(n)]
+            if carry is not None and sum(map(len, queues)) == left:
+                # no piece started in this part: one Python stretch with the parts before
+                # (their stop times stand where this part cut nothing)
+                stops = [c if s is None else s for s, c in zip(stops, carry, strict=True)]
+            if ta > t:
+                self._set_stops(stops)
+                self._timed_done()
+                return edges
+            edges += self._filtered(self._act(end))
+            if self._ks is None:  # an action changed the axes (objects current)
+                carry = [ax.stop_time if ax.stop_time is not None else s
+                         for ax, s in zip(self._ax, stops, strict=True)]
+            else:
+                carry = stops
+            if end >= t and not (heap and heap[0][0] <= t):  # (a zero stretch is a no-op)
+                self._set_stops(carry)
+                self._timed_done()
+                return edges
+
+    def _act(self, tk: float) -> list[InputEdge]:
+        """The scenario actions due at time tk (now); their edges with every axis's decoded
+        count now. An action that changes an axis reaches it through `_axes` (the kernel's
+        arrays written back and dropped: rebuilt from the objects for the next part); one
+        that touches no axis (a board input, an E-stop with no armed EMG stop, an analog
+        input) leaves the arrays as they are."""
+        raw: list = []
+        for _, action in self.scenario.pop_due(tk):
+            action(raw)
+        if not raw:
+            return []
+        ks = self._ks
+        if ks is not None:  # no axis touched (an axis's own edge would have dropped ks)
+            counts = tuple(ks.readback_rows()[:, 1].tolist())
+            return [InputEdge(tm, axis, sig, lv, counts) for tm, axis, sig, lv, _ in raw]
+        now = [ax.decoder.count for ax in self._ax]  # (current: `_axes` wrote them back)
+        return [InputEdge(tm, axis, sig, lv, tuple(
+            own if (j == axis and own is not None) else c for j, c in enumerate(now)))
+            for tm, axis, sig, lv, own in raw]
+
+    def _filtered(self, edges: list[InputEdge]) -> list[InputEdge]:
+        """The kernel's edges (time-ordered) through the machine's edge filters (probe.py:
+        hidden switch edges become edges of a board input, with every axis's count at
+        that instant), as `_advance` filters its raw edges."""
+        if not self._edge_filters or not edges:
+            return edges
+        out = []
+        for e in edges:
+            raw = [(e.time, e.axis, e.signal, e.level, None)]
+            for f in self._edge_filters:
+                raw = f(raw)
+            for tm, axis, sig, lv, _ in raw:
+                out.append(e if axis == e.axis and sig == e.signal
+                           else InputEdge(tm, axis, sig, lv, e.encoders))
+        return out
+
+    def _set_stops(self, stops: list[float | None]) -> None:
+        """The stop times of the last stretch: into the kernel's arrays when they are
+        kept, and into the axis objects unless those are older than the arrays (with a
+        pulse record the kernel writes its state back at once: both are current)."""
+        ks = self._ks
+        if ks is not None:
+            ks.ad[:, kernel.D_STOP] = [math.nan if s is None else s for s in stops]
+        if ks is None or not self._stale:
+            for ax, s in zip(self._ax, stops, strict=True):
+                ax.stop_time = s
+
+    def _advance_rest(self, t: float, carry: list[float | None] | None) -> list[InputEdge]:
+        """The rest of a stretch in the Python path, after parts run in the kernel."""
+        left = sum(map(len, self._queues))
+        edges = self._advance_python(t)
+        if carry is not None and sum(map(len, self._queues)) == left:
+            self._set_stops([ax.stop_time if ax.stop_time is not None else c
+                             for ax, c in zip(self._axes, carry, strict=True)])
+        return edges
+
+    def _advance_python(self, t: float) -> list[InputEdge]:
+        """`advance(t)` in the Python pipeline (the oracle; machines the kernel does not
+        model)."""
+        queues = self._queues
         if not any(len(q) for q in queues):
             return self._advance(t)
         edges: list[InputEdge] = []
