@@ -527,3 +527,17 @@ def test_subnormal_jerk_or_acceleration_does_not_overflow() -> None:
         assert not np.any(np.isinf(c1)) and not np.any(np.isinf(c2))
         np.testing.assert_array_equal(tv, tsc)
         np.testing.assert_array_equal(dv, dsc)
+
+
+def test_state_at_gives_the_position_at_bit_for_bit():
+    """compare_due reads the command position with the scalar state_at: the same float as
+    position_at's vectorized path at every time (before, on and between records)."""
+    h = MotionHistory(1, positions=[12.5], t_start=0.3)
+    h.append(0, 0.5, scurve(12.5, 7.0))
+    h.append(0, 1.7, velocity_ramp(0.0, -3.0, 0.4, 5.0))
+    rng = np.random.default_rng(3)
+    times = np.concatenate([rng.uniform(0.0, 4.0, 400), [0.0, 0.3, 0.5, 1.7, 2.1, 9.0]])
+    arr = h.position_at(0, times)
+    for t, p in zip(times.tolist(), arr.tolist(), strict=True):
+        assert h.state_at(0, t).p == p == h.position_at(0, t)
+        assert math.copysign(1.0, h.state_at(0, t).p) == math.copysign(1.0, p)
