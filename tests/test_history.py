@@ -9,6 +9,7 @@ import pytest
 from hypothesis import assume, event, given, settings
 from hypothesis import strategies as st
 
+from longrun import size
 from openmotion.errors import MotionError
 from openmotion.history import MotionHistory
 from openmotion.profile.segments import Profile, ProfileBuilder, State
@@ -197,10 +198,11 @@ def test_memory_bounded_with_window() -> None:
     pr = scurve(0.0, 2.0)  # 4 segments + tail
     caps = []
     t = 0.0
-    for i in range(100_000):
+    n = size(30_000, 100_000)  # 30 windows of appends (100 with --long)
+    for i in range(n):
         h.append(0, t, pr if i % 2 == 0 else pr.shifted(0.0))
         t += 0.001  # each append splices onto the previous one 1 ms later
-        if i % 10_000 == 0:
+        if i % (n // 10) == 0:
             caps.append(h.capacity(0))
     # About one record per append stays in the 1 s window: ~1000 live rows, capacity
     # at most twice that, and flat after the warm-up.
