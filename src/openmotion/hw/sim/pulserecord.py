@@ -3,9 +3,10 @@
 The generator already cuts its command into monotone `Stretch`es with the exact count at
 each end; the record keeps those (a few per cycle, not one entry per pulse) and expands
 them on demand: pulse k of a stretch left when its cubic reached k - d*half (d the
-direction, half 0.5 or 0), a root found by vectorized bisection. The expansion is kept: a later
-call expands only the stretches added since (a rewind below it starts again). It also keeps every
-command the generator was given, so the commanded position is known at any instant.
+direction, half 0.5 or 0), a root found by vectorized bisection. The expansion is kept: a
+later call expands only the stretches added since (a rewind below it starts again). It
+also keeps every command the generator was given, so the commanded position is known at
+any instant.
 Recording is opt-in (`SimMachine.record_pulses`) and stops at `capacity` entries.
 """
 
