@@ -50,10 +50,12 @@ def table_without_mel(*, safety: bool = True) -> Controller:
 
 
 def finish_group(ctl: Controller, g: Group, timeout: float = 30.0) -> float:
-    """Run until the group is idle with an empty queue and no axis moving; the end time."""
+    """Run until the group is idle with an empty queue and no axis moving; the end time.
+    The condition is an end state: virtual time jumps to it (the same end as stepping)."""
     ctl.step()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), timeout)
+                         and not any(a.is_moving for a in g.axes), timeout,
+                         event_driven=True)
     return ctl.time
 
 

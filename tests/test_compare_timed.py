@@ -222,7 +222,8 @@ def test_sub_cycle_speed_pwm_integrates_to_the_path_length():
     g = Group(c, [0, 1], feed=50 * MM, acc_time=0.05)
     g.line([30 * MM, 40 * MM])
     assert c.run_until(lambda: g.queue_length == 0 and all(a.motion_done == 0
-                                                            for a in c.axes), 30.0)
+                                                            for a in c.axes), 30.0,
+                       event_driven=True)
     c.advance(0.005)
     t = np.array([x for x, _ in pwm.duties])
     duty = np.array([d for _, d in pwm.duties])

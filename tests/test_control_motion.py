@@ -21,7 +21,7 @@ def ctl():
 
 def run_move(c, ax, timeout=30.0):
     t0 = c.time
-    assert c.run_until(lambda: ax.motion_done == 0, timeout)
+    assert c.run_until(lambda: ax.motion_done == 0, timeout, event_driven=True)
     return c.time - t0
 
 

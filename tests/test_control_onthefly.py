@@ -36,7 +36,7 @@ def refused_then_as_planned(c, ax, planned_end, change):
     with pytest.raises(InfeasibleError):
         change()
     assert ax.snapshot() == before
-    assert c.run_until(lambda: ax.motion_done == 0, 30.0)
+    assert c.run_until(lambda: ax.motion_done == 0, 30.0, event_driven=True)
     assert planned_end - 1e-9 <= c.time <= planned_end + c.period + 1e-9
 
 

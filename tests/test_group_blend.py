@@ -174,7 +174,7 @@ def test_contour_error_of_a_recorded_arc_run():
     t0 = ctl.time
     ctl.step()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
-        a.is_moving for a in g.axes), 10)
+        a.is_moving for a in g.axes), 10, event_driven=True)
     t = np.linspace(t0, ctl.time, 5001)
     xy = np.stack([ctl.history.sample(a.index, t).p for a in g.axes], axis=1)
     els = [Line([0, 0], [20_000, 10_000]),
@@ -285,7 +285,7 @@ def test_commands_queued_while_running_join_the_look_ahead():
     # commands wait in the queue until the running chain needs them (lazy look-ahead)
     assert g.queue_length > 0
     ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
-        a.is_moving for a in g.axes), 30)
+        a.is_moving for a in g.axes), 30, event_driven=True)
     assert g.position.tolist() == pts[-1].tolist()
     t = np.linspace(t0, ctl.time, 20001)
     sx, sy = (ctl.history.sample(a.index, t) for a in g.axes)
@@ -307,7 +307,7 @@ def test_command_queued_while_braking_stops_exactly_at_the_corner():
     assert g.state is GroupState.MOVING
     g.line([3000, 5000])  # too late to blend: the corner is an exact stop
     ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
-        a.is_moving for a in g.axes), 10)
+        a.is_moving for a in g.axes), 10, event_driven=True)
     assert g.position.tolist() == [3000.0, 5000.0]
 
 
@@ -327,10 +327,10 @@ def test_overrides_and_holds_at_random_times_keep_path_limits_and_end(events, wi
             g.set_override(pct)
         if with_hold and k == 0 and g.state is GroupState.MOVING:
             g.hold()
-            ctl.run_until(lambda: g.state is GroupState.HELD, 5)
+            ctl.run_until(lambda: g.state is GroupState.HELD, 5, event_driven=True)
             g.cont()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
-        a.is_moving for a in g.axes), 60)
+        a.is_moving for a in g.axes), 60, event_driven=True)
     assert g.position.tolist() == pts[-1].tolist()
     t = np.linspace(t0, ctl.time, 8001)
     sx, sy = (ctl.history.sample(a.index, t) for a in g.axes)

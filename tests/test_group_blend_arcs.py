@@ -60,7 +60,7 @@ def _run(prog, tol: float | None, *, stream: bool = False):
             ctl.advance(0.05)  # the rest joins the running chain (_extend_running)
     ctl.step()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), 30)
+                         and not any(a.is_moving for a in g.axes), 30, event_driven=True)
     t = np.linspace(t0, ctl.time, 30001)
     sx, sy = (ctl.history.sample(a.index, t) for a in g.axes)
     return ctl.time - t0, g.position, t, sx, sy

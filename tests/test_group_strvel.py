@@ -34,7 +34,7 @@ def make(axes=("x", "y"), str_vel: float = SV, **kw) -> tuple[Controller, Group]
 def finish(ctl: Controller, g: Group, timeout: float = 30.0) -> float:
     ctl.step()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), timeout)
+                         and not any(a.is_moving for a in g.axes), timeout, event_driven=True)
     return ctl.time
 
 
@@ -155,7 +155,7 @@ def test_hold_and_continue_restart_at_str_vel_and_end_exactly():
     finish(ref_ctl, ref)
     ctl.advance(0.5)
     g.hold()
-    ctl.run_until(lambda: g.state is GroupState.HELD, 5)
+    ctl.run_until(lambda: g.state is GroupState.HELD, 5, event_driven=True)
     held = g.position.copy()
     assert 0 < held[0] < 40_000
     ctl.advance(0.1)
@@ -323,7 +323,7 @@ def test_safety_stops_a_str_vel_path():
     ctl, g = make()
     g.line([20_000, 20_000])
     ctl.hardware.scenario.press_estop(at=0.3)
-    ctl.run_until(lambda: g.state is GroupState.ERROR, 5.0)
+    ctl.run_until(lambda: g.state is GroupState.ERROR, 5.0, event_driven=True)
     ctl.advance(0.05)
     x, y = (ctl.hardware.read_axis(i).pulses_out for i in (0, 1))
     assert 0 < x < 20_000 and abs(x - y) <= 1 and not any(a.is_moving for a in g.axes)

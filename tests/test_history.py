@@ -9,6 +9,7 @@ import pytest
 from hypothesis import assume, event, given, settings
 from hypothesis import strategies as st
 
+from longrun import size
 from openmotion.errors import MotionError
 from openmotion.history import MotionHistory
 from openmotion.profile.segments import Profile, ProfileBuilder, State
@@ -197,10 +198,11 @@ def test_memory_bounded_with_window() -> None:
     pr = scurve(0.0, 2.0)  # 4 segments + tail
     caps = []
     t = 0.0
-    for i in range(100_000):
+    n = size(30_000, 100_000)  # 30 windows of appends (100 with --long)
+    for i in range(n):
         h.append(0, t, pr if i % 2 == 0 else pr.shifted(0.0))
         t += 0.001  # each append splices onto the previous one 1 ms later
-        if i % 10_000 == 0:
+        if i % (n // 10) == 0:
             caps.append(h.capacity(0))
     # About one record per append stays in the 1 s window: ~1000 live rows, capacity
     # at most twice that, and flat after the warm-up.
@@ -527,3 +529,17 @@ def test_subnormal_jerk_or_acceleration_does_not_overflow() -> None:
         assert not np.any(np.isinf(c1)) and not np.any(np.isinf(c2))
         np.testing.assert_array_equal(tv, tsc)
         np.testing.assert_array_equal(dv, dsc)
+
+
+def test_state_at_gives_the_position_at_bit_for_bit():
+    """compare_due reads the command position with the scalar state_at: the same float as
+    position_at's vectorized path at every time (before, on and between records)."""
+    h = MotionHistory(1, positions=[12.5], t_start=0.3)
+    h.append(0, 0.5, scurve(12.5, 7.0))
+    h.append(0, 1.7, velocity_ramp(0.0, -3.0, 0.4, 5.0))
+    rng = np.random.default_rng(3)
+    times = np.concatenate([rng.uniform(0.0, 4.0, 400), [0.0, 0.3, 0.5, 1.7, 2.1, 9.0]])
+    arr = h.position_at(0, times)
+    for t, p in zip(times.tolist(), arr.tolist(), strict=True):
+        assert h.state_at(0, t).p == p == h.position_at(0, t)
+        assert math.copysign(1.0, h.state_at(0, t).p) == math.copysign(1.0, p)

@@ -53,7 +53,7 @@ def make(start=0, org=(2000.0, 3000.0, 50.0), config=None, safety=False):
 
 
 def run(ctl, h, timeout=120.0):
-    assert ctl.run_until(lambda: not h.running, timeout)
+    assert ctl.run_until(lambda: not h.running, timeout, event_driven=True)
     return h.status
 
 
@@ -212,7 +212,7 @@ def test_home_sequence_orders_axes():
     seq.start()
     assert seq.code == -1
     assert ctl.axis("y").state is S.HOMING and ctl.axis("x").state is S.STANDSTILL
-    assert ctl.run_until(lambda: seq.code != -1, 60)
+    assert ctl.run_until(lambda: seq.code != -1, 60, event_driven=True)
     assert seq.state == "done"
     hx, hy = seq.groups[1][0], seq.groups[0][0]
     assert hx.status.mark_time > hy.status.mark_time

@@ -80,5 +80,5 @@ def test_start_that_fails_midway_leaves_nothing_behind(monkeypatch):
     monkeypatch.undo()
     h.start()  # the same object starts cleanly afterwards
     assert h.running
-    assert ctl.run_until(lambda: not h.running, 120.0)
+    assert ctl.run_until(lambda: not h.running, 120.0, event_driven=True)
     assert h.done

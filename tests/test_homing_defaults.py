@@ -33,7 +33,7 @@ def test_without_a_config_homing_takes_the_machine_files_table(tmp_path):
     assert ctl.wait_motion_done(timeout=10)
     h = Homing(ctl, "x")
     h.start()
-    assert ctl.run_until(lambda: not h.running, 120.0)
+    assert ctl.run_until(lambda: not h.running, 120.0, event_driven=True)
     assert h.status.state == "done"        # mode 1: the end of ORG moving down
     assert ctl.axis("x").counters.command == 0
 

@@ -206,7 +206,7 @@ def test_3_an_axis_stopped_directly_stops_the_whole_group(how):
     assert g.state is GroupState.IDLE
     g.line([0, 0])
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not x.is_moving and not y.is_moving, 10.0)
+                         and not x.is_moving and not y.is_moving, 10.0, event_driven=True)
     assert list(g.position) == [0.0, 0.0]
 
 
@@ -239,7 +239,7 @@ def _reversing_arc_group():
 def test_4_blend_next_to_a_reversing_arc_does_not_raise():
     ctl, g = _reversing_arc_group()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), 10.0)
+                         and not any(a.is_moving for a in g.axes), 10.0, event_driven=True)
     assert g.error_code == 0
     assert list(g.position) == pytest.approx([18840.09393231954, -99.61457509738375],
                                              abs=1e-6)
@@ -276,7 +276,7 @@ def test_4_a_planner_failure_becomes_a_fault_of_that_group(monkeypatch):
         a.reset()
     g.line([0, 0])
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0
-                         and not any(a.is_moving for a in g.axes), 10.0)
+                         and not any(a.is_moving for a in g.axes), 10.0, event_driven=True)
 
 
 def test_4_an_exception_in_any_hook_never_escapes_the_cycle():

@@ -313,7 +313,7 @@ JOB_JUMPS = [0]
 def test_random_scenarios_jump_like_cycle_by_cycle(long_run):
     global JOB_JUMPS  # noqa: PLW0603
     JOB_JUMPS = [0]
-    n = 600 if long_run else 12  # 12 seeds in the normal run (~6 s CPU), 600 with --long
+    n = 600 if long_run else 12  # 12 seeds in the normal run (~4 s CPU), 600 with --long
     jumps = sum(_check(seed) for seed in range(n))
     assert jumps > 300 * n  # the fast runs did jump over many cycles
     assert JOB_JUMPS[0] > 10 * n  # ... also while groups, homings, programs, compares ran

@@ -33,7 +33,7 @@ def test_phases_and_their_speeds():
     assert lib.MCC_GetGoHomeStatus() == D.HOME_COMMAND_NOTCALLED_ERR
     assert lib.MCC_GoHome(20, 0, 0, 0, 0, 0, 0, -1, -1, -1) == 0
     assert lib.MCC_GetGoHomeStatus() == -1          # in process
-    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60)
+    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60, event_driven=True)
     assert lib.MCC_GetGoHomeStatus() == 1           # finished
     t, v = speeds(lib, 0, t0, lib.controller.time)
     # phase 0 at 20 mm/s in wPhase0Dir (negative); phases 1-3 at 2 mm/s (1/10)
@@ -55,7 +55,7 @@ def test_phases_and_their_speeds():
 def test_home_only_mode_skips_the_index():
     lib = setup(HOME_CONFIG(wType=D.HOME_ONLY_MODE, wPhase0Dir=1, wPhase1Dir=0))
     assert lib.MCC_GoHome(20, 0, 0, 0, 0, 0, 0, -1, -1, -1) == 0
-    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60)
+    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60, event_driven=True)
     assert lib.MCC_GetGoHomeStatus() == 1
     assert lib.controller.hardware.motor_position(0) == -7900   # the sensor's release edge
 
@@ -63,7 +63,7 @@ def test_home_only_mode_skips_the_index():
 def test_index_only_mode():
     lib = setup(HOME_CONFIG(wType=D.INDEX_ONLY_MODE, wPhase0Dir=1, wPhase1Dir=0))
     assert lib.MCC_GoHome(20, 0, 0, 0, 0, 0, 0, -1, -1, -1) == 0
-    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60)
+    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60, event_driven=True)
     assert lib.MCC_GetGoHomeStatus() == 1
     assert lib.controller.hardware.motor_position(0) == 500    # first index, upwards
 
@@ -79,7 +79,7 @@ def test_order_and_abort():
     assert lib.MCC_GetGoHomeStatus() == 0
     ctl.run_until(lambda: not any(a.is_moving for a in ctl.axes), 5)
     assert lib.MCC_GoHome(20, 20, 0, 0, 0, 0, 1, 0, -1, -1) == 0
-    assert ctl.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 120)
+    assert ctl.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 120, event_driven=True)
     assert lib.MCC_GetGoHomeStatus() == 1
     assert ctl.axes[0].position == 0.0 and ctl.axes[1].position == 0.0
 
@@ -106,7 +106,7 @@ def test_home_acc_and_dec_steps():
     assert lib.MCC_SetGoHomeDecStep(40) == 0     # 200 ms to stop from it
     t0 = lib.controller.time
     assert lib.MCC_GoHome(5, 0, 0, 0, 0, 0, 0, -1, -1, -1) == 0
-    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60)
+    assert lib.controller.run_until(lambda: lib.MCC_GetGoHomeStatus() != -1, 60, event_driven=True)
     t, v = speeds(lib, 0, t0, lib.controller.time)
     moving = v != 0.0
     stop0 = np.nonzero(moving[:-1] & ~moving[1:])[0][0]   # phase 0 ends at rest

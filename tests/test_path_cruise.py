@@ -226,13 +226,13 @@ def record(scv: float, ratio: float):
     g.ptp(pts[0])
     ctl.step()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and not any(
-        a.is_moving for a in g.axes), 30)
+        a.is_moving for a in g.axes), 30, event_driven=True)
     t0 = ctl.time
     for p in pts[1:]:
         g.line(p)
     ctl.step()
     assert ctl.run_until(lambda: g.state is GroupState.IDLE and g.queue_length == 0 and not any(
-        a.is_moving for a in g.axes), 60)
+        a.is_moving for a in g.axes), 60, event_driven=True)
     t = t0 + np.arange(int(round((ctl.time - t0) / ctl.period)) + 1) * ctl.period
     smp = [ctl.history.sample(a.index, t) for a in g.axes]
     return ctl, g, pts, smp, ctl.time - t0

@@ -78,13 +78,13 @@ def test_size_limit_and_missing_file(tmp_path):
 
 
 def test_memory_stays_flat(tmp_path, long_run):
-    """10k lines (200k with --long): the stream's traced peak stays a small fraction of
-    compile_file's (about 1.7 MB against 67 MB at 10k lines; tracemalloc makes each line
-    costly, so the normal run keeps to 10k)."""
+    """5k lines (200k with --long): the stream's traced peak stays a small fraction of
+    compile_file's (about 1.0 MB against 67 MB at 5k lines, 1.7 MB at 10k; tracemalloc
+    makes each line costly, so the normal run keeps to 5k)."""
     path = tmp_path / "big.ngc"
     with path.open("w") as fh:
         fh.write("G21 G90 G1 F1200\n")
-        for k in range(200_000 if long_run else 10_000):
+        for k in range(200_000 if long_run else 5_000):
             fh.write(f"N{k} G1 X{k % 100}.25 Y{k % 37}.5 Z-1.{k % 9}\n")
         fh.write("M2\n")
     opts = GCodeOptions(axes={"X": 0, "Y": 1, "Z": 2})

@@ -66,7 +66,7 @@ def test_spiral_tail_with_unbounded_blending_runs_and_ends_exactly():
     ctl.enable_all()
     run = ProgramRunner(ctl, SPIRAL_TAIL, gcode={"parameters": work_origin(ctl)})
     run.start()
-    ctl.run_until(lambda: run.state is not RunState.RUNNING, 60.0)
+    ctl.run_until(lambda: run.state is not RunState.RUNNING, 60.0, event_driven=True)
     assert run.state is RunState.DONE
     assert ctl.time < 20.0  # about 6 s of machine time: no crawl
     g = run.group

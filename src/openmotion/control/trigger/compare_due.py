@@ -100,7 +100,8 @@ def _reach(eng: CompareEngine, axis: int, centre: float, width: float, now: floa
     """A lower bound of the first time the axis's command position (DPOS frame) comes
     within `width` of `centre` (-inf: it may be there now)."""
     ctl = eng.ctl
-    x = float(ctl.history.position_at(axis, now)) + eng._cmd_offset(axis)
+    # the scalar state_at: the same p as position_at (one formula), without its array path
+    x = ctl.history.state_at(axis, now).p + eng._cmd_offset(axis)
     d = abs(x - centre) - width - 1e-6 * (abs(centre) + width + 1.0)
     if d <= 0.0:
         return -math.inf
