@@ -119,6 +119,15 @@ def browser() -> Iterator[object]:
     yield from chromium()
 
 
+@pytest.fixture(scope="session")
+def tab(browser: object) -> Iterator[object]:
+    """The tab every UI test's `page` loads the UI into (tests/ui_browser.py), one per
+    process."""
+    from ui_browser import tab as make_tab
+
+    yield from make_tab(browser)
+
+
 @pytest.fixture
 def fuzz_long(request: pytest.FixtureRequest) -> bool:
     """True when the suite was started with --fuzz-long."""
