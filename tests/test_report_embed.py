@@ -73,9 +73,9 @@ def test_every_page_is_one_file_and_uses_only_the_bundles_trace_types(pages):
     assert sorted(p.name for p in pages["move"].parent.glob("*.js")) == []
 
 
-def test_chromium_draws_every_figure_with_the_embedded_bundle(pages, browser):
+def test_chromium_draws_every_figure_with_the_embedded_bundle(pages, tab):
     for path in pages.values():
-        got = draw(path, browser)
+        got = draw(path, tab)
         assert got["version"] == plotly_embed.bundle_version().split()[1]
         figs = figures(path.read_text())
         assert set(got["figures"]) == set(figs)
