@@ -169,8 +169,7 @@ def test_home_then_move_changes_chart_and_lamps(page):
     goto(page, "homing")
     page.wait_for_selector("#home-start")
     field(page, "home-fields", "mode").select_option("0")
-    page.wait_for_timeout(300)
-    assert page.locator("#home-drawing line").count() > 3
+    page.wait_for_function("() => document.querySelectorAll('#home-drawing line').length > 3")
     page.click("#home-start")
     wait_status(page, "s.axes.x.homing.state === 'running' || s.axes.x.homing.state === 'done'", 5)
     # done, and the counters cleared at the home (after the settling time at rest)
@@ -211,8 +210,7 @@ def test_home_then_move_changes_chart_and_lamps(page):
     csv = page.evaluate("window.openmotion.scopeChart.toCsv()")
     assert csv.startswith("t_s,") and csv.count("\n") > 100
     field(page, "scope-view", "window").fill("20")     # the move in view for the screenshot
-    page.wait_for_timeout(300)
-    shot(page, "scope")
+    shot(page, "scope", settle_ms=300)
 
 
 PROGRAM = """(square, then a pause)
@@ -298,8 +296,7 @@ def test_estop_stops_the_machine(page):
 def test_screenshots_of_the_other_pages(page):
     for name in ("machine",):
         goto(page, name)
-        page.wait_for_timeout(800)
-        shot(page, name)
+        shot(page, name, settle_ms=800)
 
 
 def test_with_a_token_the_page_loads_everything_with_it(tab, server):

@@ -185,9 +185,11 @@ def wait_jogged(pg: object, axis: str, before: float, sign: int) -> None:
     wait_status(pg, f"s.axes.{axis}.position {op} {before!r}")
 
 
-def shot(pg: object, name: str) -> None:
-    """Save docs/img/creator-<name>.png when OPENMOTION_SHOTS=1 (the committed screenshots)."""
+def shot(pg: object, name: str, settle_ms: int = 0) -> None:
+    """Save docs/img/creator-<name>.png when OPENMOTION_SHOTS=1 (the committed screenshots),
+    `settle_ms` after the call (a chart's redraw): only then, the tests wait for states."""
     if os.environ.get("OPENMOTION_SHOTS") == "1":
+        pg.wait_for_timeout(settle_ms)   # type: ignore[attr-defined]
         SHOTS.mkdir(parents=True, exist_ok=True)
         pg.screenshot(path=str(SHOTS / f"creator-{name}.png"), full_page=True)   # type: ignore[attr-defined]
 
