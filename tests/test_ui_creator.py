@@ -37,6 +37,24 @@ def test_every_page_opens_and_shows_the_machine(page):
     axes = status(page, "Object.keys(s.axes)")
     for a in axes:
         assert page.locator("#machine-axes td b", has_text=a).count() == 1
+    # the operation page's curve is not drawn while another page is shown (an idle tab
+    # would redraw it at every status push), but keeps its samples and is drawn on return
+    n = page.evaluate("""() => {
+        const c = window.openmotion.opChart;
+        c.__draws = 0;
+        const redraw = c.redraw.bind(c);
+        c.redraw = () => { c.__draws += 1; redraw(); };
+        return c.t.length;
+    }""")
+    page.wait_for_function(f"() => window.openmotion.opChart.t.length > {n} + 5")
+    page.evaluate("() => new Promise((r) => requestAnimationFrame(() => setTimeout(r, 0)))")
+    assert page.evaluate("window.openmotion.opChart.__draws") == 0
+    goto(page, "operation")
+    drawn = page.evaluate("""() => {
+        const c = window.openmotion.opChart;
+        return [c.__draws, c.plot.scales.x.max, c.t[c.t.length - 1]];
+    }""")
+    assert drawn[0] >= 1 and drawn[1] >= drawn[2] - 0.5, drawn   # up to a push or so ago
 
 
 def test_lost_connection_shows_at_once_and_reconnects(page):
