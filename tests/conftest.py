@@ -128,6 +128,19 @@ def tab(browser: object) -> Iterator[object]:
     yield from make_tab(browser)
 
 
+@pytest.fixture(scope="session")
+def laser_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """examples/programs/laser_contour.ngc run once per process (`openmotion run`, default
+    options): the folder holding its report page laser_contour.html. The report tests
+    (test_report_html.py, test_report_embed.py) only read it."""
+    from openmotion.cli import main
+
+    out = tmp_path_factory.mktemp("laser")
+    prog = Path(__file__).resolve().parents[1] / "examples" / "programs" / "laser_contour.ngc"
+    assert main(["run", str(prog), "--out", str(out)]) == 0
+    return out
+
+
 @pytest.fixture
 def fuzz_long(request: pytest.FixtureRequest) -> bool:
     """True when the suite was started with --fuzz-long."""

@@ -66,11 +66,10 @@ LASER = Path(__file__).resolve().parents[1] / "examples" / "programs" / "laser_c
 
 
 @pytest.fixture(scope="module")
-def laser_page(tmp_path_factory):
-    """examples/programs/laser_contour.ngc run once, its report page (text) and folder."""
-    out = tmp_path_factory.mktemp("laser")
-    assert main(["run", str(LASER), "--out", str(out)]) == 0
-    return (out / "laser_contour.html").read_text(), out
+def laser_page(laser_report):
+    """examples/programs/laser_contour.ngc run once (conftest.laser_report), its report
+    page (text) and folder."""
+    return (laser_report / "laser_contour.html").read_text(), laser_report
 
 
 def _extents(page: str) -> dict[str, list[str]]:
