@@ -52,10 +52,15 @@ def draw(page: Path, tab) -> dict:
 
     tab.on("pageerror", on_error)
     try:
-        tab.goto(page.as_uri())
-        tab.wait_for_function("() => window.openmotionPlotly", timeout=30000)
+        tab.goto(page.as_uri())   # after "load": the head's loader has set openmotionPlotly
+        # awaited in the page, not polled: while plotly inflates and draws, the page's main
+        # thread is busy for seconds on a loaded machine (a 30 s poll timed out once, load 20);
+        # the race only keeps a page that never draws from hanging the test
         out = tab.evaluate("""async () => {
-          await window.openmotionPlotly;
+          if (!window.openmotionPlotly) return {version: null, figures: {}, loader: false};
+          const late = new Promise((_, no) => setTimeout(() => no(new Error(
+            'the figures were not drawn within 120 s')), 120000));
+          await Promise.race([window.openmotionPlotly, late]);
           const figs = {};
           for (const d of document.querySelectorAll('.plotly-graph-div'))
             figs[d.id] = {traces: (d.data || []).length,
