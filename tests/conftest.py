@@ -75,13 +75,13 @@ def _reduce_properties(items: list[pytest.Item]) -> None:
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Property tests reduced unless --long (see PROPERTY_SHARE). Browser modules first (a
-    module with a test that uses `page` or `browser`, whole, so that its module fixtures
+    module with a test that uses `page`, `tab` or `browser`, whole, so that its module fixtures
     are made once; a stable sort: module order kept). They are the longest and run one
     after another on a module's server, so under xdist (`--dist worksteal`, set in
     pyproject.toml) they start at once and the short tests fill the other worker around
     them, instead of the browser modules running alone at the end."""
     browser_modules = {item.nodeid.split("::")[0] for item in items
-                       if {"page", "browser"} & set(getattr(item, "fixturenames", ()))}
+                       if {"page", "tab", "browser"} & set(getattr(item, "fixturenames", ()))}
 
     def browser_first(item: pytest.Item) -> int:
         return 0 if item.nodeid.split("::")[0] in browser_modules else 1
@@ -117,6 +117,28 @@ def browser() -> Iterator[object]:
     from ui_browser import chromium
 
     yield from chromium()
+
+
+@pytest.fixture(scope="session")
+def tab(browser: object) -> Iterator[object]:
+    """The tab every UI test's `page` loads the UI into (tests/ui_browser.py), one per
+    process."""
+    from ui_browser import tab as make_tab
+
+    yield from make_tab(browser)
+
+
+@pytest.fixture(scope="session")
+def laser_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """examples/programs/laser_contour.ngc run once per process (`openmotion run`, default
+    options): the folder holding its report page laser_contour.html. The report tests
+    (test_report_html.py, test_report_embed.py) only read it."""
+    from openmotion.cli import main
+
+    out = tmp_path_factory.mktemp("laser")
+    prog = Path(__file__).resolve().parents[1] / "examples" / "programs" / "laser_contour.ngc"
+    assert main(["run", str(prog), "--out", str(out)]) == 0
+    return out
 
 
 @pytest.fixture

@@ -41,19 +41,26 @@ def trace_types(text: str) -> set[str]:
     return {t.get("type", "scatter") for f in figures(text).values() for t in f["data"]}
 
 
-def draw(page: Path, browser) -> dict:
-    """Open `page` in `browser` (conftest's session chromium) in a fresh context; once the
-    loader has drawn every figure: plotly's version, per figure div its trace count and
+def draw(page: Path, tab) -> dict:
+    """Open `page` in `tab` (conftest's session tab, left at about:blank afterwards); once
+    the loader has drawn every figure: plotly's version, per figure div its trace count and
     whether an svg was drawn, and the page's errors."""
-    ctx = browser.new_context(viewport={"width": 1300, "height": 900})
+    errors: list[str] = []
+
+    def on_error(e: object) -> None:
+        errors.append(str(e))
+
+    tab.on("pageerror", on_error)
     try:
-        pg = ctx.new_page()
-        errors: list[str] = []
-        pg.on("pageerror", lambda e: errors.append(str(e)))
-        pg.goto(page.as_uri())
-        pg.wait_for_function("() => window.openmotionPlotly", timeout=30000)
-        out = pg.evaluate("""async () => {
-          await window.openmotionPlotly;
+        tab.goto(page.as_uri())   # after "load": the head's loader has set openmotionPlotly
+        # awaited in the page, not polled: while plotly inflates and draws, the page's main
+        # thread is busy for seconds on a loaded machine (a 30 s poll timed out once, load 20);
+        # the race only keeps a page that never draws from hanging the test
+        out = tab.evaluate("""async () => {
+          if (!window.openmotionPlotly) return {version: null, figures: {}, loader: false};
+          const late = new Promise((_, no) => setTimeout(() => no(new Error(
+            'the figures were not drawn within 120 s')), 120000));
+          await Promise.race([window.openmotionPlotly, late]);
           const figs = {};
           for (const d of document.querySelectorAll('.plotly-graph-div'))
             figs[d.id] = {traces: (d.data || []).length,
@@ -63,7 +70,8 @@ def draw(page: Path, browser) -> dict:
         out["errors"] = errors
         return out
     finally:
-        ctx.close()
+        tab.remove_listener("pageerror", on_error)
+        tab.goto("about:blank")
 
 
 def array(v: object) -> list:

@@ -18,12 +18,12 @@ from openmotion.program import plotly_embed
 from pagecheck import assert_self_contained, draw, figures, trace_types
 
 ROOT = Path(__file__).resolve().parents[1]
-LASER = ROOT / "examples" / "programs" / "laser_contour.ngc"
 
 
 @pytest.fixture(scope="module")
-def pages(tmp_path_factory):
-    """A 2-D report (laser_contour), a 3-D one, a profile and a trace page (text, path)."""
+def pages(tmp_path_factory, laser_report):
+    """A 2-D report (laser_contour: conftest.laser_report), a 3-D one, a profile and a
+    trace page (paths)."""
     from openmotion.plot import plot_profile, plot_trace
     from test_plot import scurve, trace
 
@@ -31,11 +31,11 @@ def pages(tmp_path_factory):
     prog = out / "helix.ngc"
     prog.write_text("G21 G90 F1200\nG0 X0 Y0 Z0\nM62 P0\nG1 X5\nG2 X5 Y0 Z-2 I-5 J0\n"
                     "M63 P0\nG0 Z5\nM2\n")
-    assert main(["run", str(LASER), "--out", str(out)]) == 0
     assert main(["run", str(prog), "--out", str(out)]) == 0
     plot_profile(scurve(), out / "move.png", html=True)
     plot_trace(trace(), out / "trace.png", html=True)
-    return {name: out / f"{name}.html" for name in ("laser_contour", "helix", "move", "trace")}
+    paths = {name: out / f"{name}.html" for name in ("helix", "move", "trace")}
+    return {"laser_contour": laser_report / "laser_contour.html", **paths}
 
 
 def test_the_bundle_is_package_data_with_its_licence_and_version():
@@ -73,9 +73,9 @@ def test_every_page_is_one_file_and_uses_only_the_bundles_trace_types(pages):
     assert sorted(p.name for p in pages["move"].parent.glob("*.js")) == []
 
 
-def test_chromium_draws_every_figure_with_the_embedded_bundle(pages, browser):
+def test_chromium_draws_every_figure_with_the_embedded_bundle(pages, tab):
     for path in pages.values():
-        got = draw(path, browser)
+        got = draw(path, tab)
         assert got["version"] == plotly_embed.bundle_version().split()[1]
         figs = figures(path.read_text())
         assert set(got["figures"]) == set(figs)

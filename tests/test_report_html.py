@@ -66,11 +66,10 @@ LASER = Path(__file__).resolve().parents[1] / "examples" / "programs" / "laser_c
 
 
 @pytest.fixture(scope="module")
-def laser_page(tmp_path_factory):
-    """examples/programs/laser_contour.ngc run once, its report page (text) and folder."""
-    out = tmp_path_factory.mktemp("laser")
-    assert main(["run", str(LASER), "--out", str(out)]) == 0
-    return (out / "laser_contour.html").read_text(), out
+def laser_page(laser_report):
+    """examples/programs/laser_contour.ngc run once (conftest.laser_report), its report
+    page (text) and folder."""
+    return (laser_report / "laser_contour.html").read_text(), laser_report
 
 
 def _extents(page: str) -> dict[str, list[str]]:
@@ -154,12 +153,16 @@ def test_soft_limit_box_has_the_edges_of_the_travel():
                                                    round(lims[c][1] - off[c], 9)}
 
 
-def test_report_page_links_the_listing_and_the_path_in_the_browser(laser_page, browser):
+def test_report_page_links_the_listing_and_the_path_in_the_browser(laser_page, tab):
     _, out = laser_page
-    pg = browser.new_page(viewport={"width": 1300, "height": 900})
+    pg = tab
+    errors: list[str] = []
+
+    def on_error(e: object) -> None:
+        errors.append(str(e))
+
+    pg.on("pageerror", on_error)
     try:
-        errors: list[str] = []
-        pg.on("pageerror", lambda e: errors.append(str(e)))
         pg.goto((out / "laser_contour.html").as_uri())
         pg.wait_for_function("() => { const d = document.getElementById('om-path');"
                              " return d && d.data; }", timeout=30000)
@@ -173,7 +176,8 @@ def test_report_page_links_the_listing_and_the_path_in_the_browser(laser_page, b
         assert pg.evaluate("() => window.openmotionSelected.points") == 0
         assert not errors, errors
     finally:
-        pg.context.close()
+        pg.remove_listener("pageerror", on_error)
+        pg.goto("about:blank")
 
 
 def test_a_100k_line_listing_is_small_and_cut_at_the_limit():

@@ -108,8 +108,8 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server | Extern
 
 def chromium() -> Iterator[object]:
     """Chromium under Playwright, until the generator is closed: conftest.py's session
-    fixture `browser`, one per test process, shared by every module's pages (each test
-    gets a fresh context: `page`)."""
+    fixture `browser`, one per test process, shared by every module's pages (the UI
+    tests load a fresh document into one tab: `tab`, `page`)."""
     need_browser()
     from playwright.sync_api import sync_playwright
 
@@ -122,23 +122,40 @@ def chromium() -> Iterator[object]:
             b.close()
 
 
-@pytest.fixture
-def page(browser: object, server: Server | External) -> Iterator[object]:
-    """A fresh tab on the UI, connected (lamp green) and showing the operation page."""
+def tab(browser: object) -> Iterator[object]:
+    """One context and tab for every `page` of a test process (conftest.py's session
+    fixture `tab`): a new context costs a renderer process (~1.3 s of CPU more than a
+    navigation); each test still gets a fresh document (`page`), and the app keeps nothing
+    in the browser (no storage, no cookies) that a navigation would not clear."""
     ctx = browser.new_context(viewport={"width": 1400, "height": 1000})   # type: ignore[attr-defined]
     ctx.set_default_timeout(30_000)      # every Playwright wait, unless a test asks for more
     pg = ctx.new_page()
     errors: list[str] = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
-    pg.goto(server.url)
-    pg.wait_for_selector("#conn[data-state=open]", timeout=30_000)
-    pg.wait_for_function("() => window.openmotion && window.openmotion.status !== null",
-                         timeout=30_000)
     pg.page_errors = errors   # type: ignore[attr-defined]
     try:
         yield pg
     finally:
         ctx.close()
+
+
+@pytest.fixture
+def page(tab: object, server: Server | External) -> Iterator[object]:
+    """The UI freshly loaded in the process's tab (conftest.py's `tab`), connected (lamp
+    green) and showing the operation page. Left for about:blank afterwards: the tab's socket
+    closes (the server stops its jogs, as when a tab is closed) and nothing runs in it
+    until the next test."""
+    pg = tab
+    errors: list[str] = pg.page_errors   # type: ignore[attr-defined]
+    errors.clear()
+    pg.goto(server.url)   # type: ignore[attr-defined]
+    pg.wait_for_selector("#conn[data-state=open]", timeout=30_000)   # type: ignore[attr-defined]
+    pg.wait_for_function("() => window.openmotion && window.openmotion.status !== null",   # type: ignore[attr-defined]
+                         timeout=30_000)
+    try:
+        yield pg
+    finally:
+        pg.goto("about:blank")   # type: ignore[attr-defined]
     assert not errors, f"JavaScript errors on the page: {errors}"
 
 
@@ -168,9 +185,11 @@ def wait_jogged(pg: object, axis: str, before: float, sign: int) -> None:
     wait_status(pg, f"s.axes.{axis}.position {op} {before!r}")
 
 
-def shot(pg: object, name: str) -> None:
-    """Save docs/img/creator-<name>.png when OPENMOTION_SHOTS=1 (the committed screenshots)."""
+def shot(pg: object, name: str, settle_ms: int = 0) -> None:
+    """Save docs/img/creator-<name>.png when OPENMOTION_SHOTS=1 (the committed screenshots),
+    `settle_ms` after the call (a chart's redraw): only then, the tests wait for states."""
     if os.environ.get("OPENMOTION_SHOTS") == "1":
+        pg.wait_for_timeout(settle_ms)   # type: ignore[attr-defined]
         SHOTS.mkdir(parents=True, exist_ok=True)
         pg.screenshot(path=str(SHOTS / f"creator-{name}.png"), full_page=True)   # type: ignore[attr-defined]
 

@@ -93,8 +93,14 @@ class App extends EventTarget {
 
   async reloadConfig() {
     $("#reload-banner").hidden = true;
+    clearTimeout(this._staleTimer);   // a check armed before the reload is answered by it
+    this._staleTimer = 0;
     this.info = await this.call("machine.info");
     this.configVersion = this.info.config_version;
+    // a check armed while machine.info was on its way compared with the old version
+    clearTimeout(this._staleTimer);
+    this._staleTimer = 0;
+    $("#reload-banner").hidden = true;
     this._fillAxes();
     $("#machine-name").textContent = `${this.info.name}${this.info.file ? "  —  " + this.info.file : "  (not saved to a file)"}`;
     this.dispatchEvent(new CustomEvent("config"));

@@ -1,6 +1,7 @@
 // A live scope chart on the vendored uPlot: a ring of samples (time + N channels), a
 // window that follows the newest sample, pause, drag-to-zoom (double click: back to live),
-// a level/edge trigger, CSV export. Redraws at most once per animation frame.
+// a level/edge trigger, CSV export. Redraws at most once per animation frame, and not
+// while hidden (setHidden: its page is not shown; the samples still arrive).
 
 /* global uPlot */
 
@@ -20,6 +21,7 @@ export class LiveChart {
     this.t = [];
     this.cols = this.channels.map(() => []);
     this.paused = false;
+    this.hidden = false;
     this.zoomed = false;
     this.trigger = { mode: "off", channel: 0, level: 0, edge: "rising", pre: 0.2 };
     this.frozen = null;     // [t0, t1] while a trigger capture is shown
@@ -121,6 +123,12 @@ export class LiveChart {
 
   setWindow(s) { this.windowS = s; this._schedule(); }
 
+  /** Hidden (its page not shown): samples are kept, nothing is drawn until shown again. */
+  setHidden(h) {
+    this.hidden = Boolean(h);
+    if (!this.hidden) this._schedule();
+  }
+
   setVisible(i, show) { this.plot.setSeries(i + 1, { show }); }
 
   /** mode: "off" | "normal" (re-arms after each capture) | "single" (stays frozen). */
@@ -160,7 +168,7 @@ export class LiveChart {
   }
 
   _schedule() {
-    if (this._raf) return;
+    if (this._raf || this.hidden) return;
     this._raf = requestAnimationFrame(() => { this._raf = 0; this.redraw(); });
   }
 

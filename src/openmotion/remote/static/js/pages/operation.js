@@ -69,8 +69,11 @@ export function mount(a, node) {
   app.addEventListener("lost", () => jogger.release("connection lost"));
 }
 
-export function show() { if (chart) chart.redraw(); }
-export function hide() { if (jogger) jogger.release("page left"); }
+export function show() { if (chart) { chart.setHidden(false); chart.redraw(); } }
+export function hide() {
+  if (jogger) jogger.release("page left");
+  if (chart) chart.setHidden(true);   // the curve keeps its samples, drawn when shown again
+}
 
 function build() {
   if (!app.info) return;
@@ -153,6 +156,7 @@ function build() {
     { key: "velocity", label: "velocity", unit: `${info.unit}/s` },
     { key: "position", label: "position", unit: info.unit },
   ], windowS: 10, capacity: 20000, height: 220 });
+  chart.setHidden(app.page !== "operation");
   app.opChart = chart;
   if (keep && keepAxis === app.axis) {
     fsTarget.setAll(keep.t); fsMotion.setAll(keep.m); fsRepeat.setAll(keep.r); fsJog.setAll(keep.j);
