@@ -191,15 +191,14 @@ def push(run: ProgramRunner, g: Group, op: Op) -> int:
     at_rest = run._idle()
     if op.kind == "delay":
         idx = g.delay(op.seconds)
+    elif op.kind == "line":
+        assert op.end is not None  # set_feed + line, without re-checking the compiler's
+        idx = g._queue_line(op.end, op.feed)
     else:
         g.set_feed(op.feed)
-        assert op.end is not None
-        if op.kind == "line":
-            idx = g.line(op.end)
-        else:
-            assert op.centre is not None
-            idx = g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
-                        turns=op.turns)
+        assert op.end is not None and op.centre is not None
+        idx = g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
+                    turns=op.turns)
     override_pushed(run, idx, op, at_rest)  # M48-M53 waiting for this command
     return idx
 
