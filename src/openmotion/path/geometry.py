@@ -155,19 +155,18 @@ class Line:
         of the same size, finite (not checked again). The same line as Line(start, end)."""
         obj = object.__new__(cls)
         delta = end - start
-        big = float(np.abs(delta).max())  # (the method: np.max's dispatch costs more)
+        # the largest |component| (finite values: the same as np.abs(delta).max(), whose
+        # two array calls cost more than this on the few axes of a path)
+        big = max(map(abs, delta.tolist()))
         if big > 0.0:
             q = delta / big
-            length = big * vnorm(q)
+            length = big * math.sqrt(q.dot(q))  # (vnorm, inlined)
             u = delta / length
         else:
             length = 0.0
             u = np.zeros_like(delta)
         u.flags.writeable = False
-        object.__setattr__(obj, "start", start)
-        object.__setattr__(obj, "end", end)
-        object.__setattr__(obj, "length", length)
-        object.__setattr__(obj, "direction", u)
+        obj.__dict__.update(start=start, end=end, length=length, direction=u)
         return obj
 
     @classmethod

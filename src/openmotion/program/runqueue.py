@@ -57,11 +57,16 @@ def record_synced(run: ProgramRunner, t: float, op: Op, index: int, level: bool)
 
 
 def idle(run: ProgramRunner) -> bool:
-    from ..control.groups.group import GroupState
-
     g = run.group
     assert g is not None
-    return g.state is GroupState.IDLE and g.queue_length == 0
+    if not _IDLE:  # the groups are imported on first use (as the runner imports them)
+        from ..control.groups.group import GroupState
+
+        _IDLE.append(GroupState.IDLE)
+    return g.state is _IDLE[0] and g.queue_length == 0
+
+
+_IDLE: list[object] = []  # GroupState.IDLE
 
 
 def idle_past(run: ProgramRunner, index: int) -> bool:

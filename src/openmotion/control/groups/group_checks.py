@@ -11,7 +11,7 @@ they were. `unit_scales` resolves the group's `units=` argument.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -41,6 +41,7 @@ from .groupexec import (
 if TYPE_CHECKING:
     from ..core.axis import Axis
     from ..core.controller import Controller
+    from ..guard.safety import Safety
 
 
 class GroupChecks(GroupEngine):
@@ -184,13 +185,13 @@ class GroupChecks(GroupEngine):
 
     def _accepting(self) -> bool:
         """Whether `_check_accepting` passes (it raises the refusal)."""
-        if self._state is GroupState.ERROR or len(self._queue) >= self._queue_size:
+        if self._state is _G_ERROR or len(self._queue) >= self._queue_size:
             return False
-        free = self._run is None and not self._dry
+        dry = self._dry
+        free = self._run is None and not dry
         for a in self.axes:
             st = a.state
-            if st is AxisState.ERROR_STOP or (st is AxisState.DISABLED and not self._dry) \
-                    or (free and a.is_moving):
+            if st is _A_ESTOP or (st is _A_DISABLED and not dry) or (free and a.is_moving):
                 return False
         return True
 
@@ -198,9 +199,7 @@ class GroupChecks(GroupEngine):
                  indices: tuple[int, ...]) -> bool:
         """Whether `_check_soft_limits` passes for the line start -> end (plain floats; the
         same products and comparisons as `_check_soft_span`)."""
-        from ..guard.safety import Safety
-
-        safety = Safety.of(self._ctl)
+        safety = _safety_of(self._ctl)
         if safety is None:
             return True
         for i, pl, nl in safety.soft.enabled_of(indices):
@@ -372,6 +371,22 @@ def unit_names(controller: Controller, axes: Sequence[Axis],
     if units is True:
         return tuple(controller.config.axes[a.index].unit for a in axes)
     return tuple(u.unit for u in units)  # type: ignore[union-attr]
+
+
+_G_ERROR = GroupState.ERROR
+_A_ESTOP, _A_DISABLED = AxisState.ERROR_STOP, AxisState.DISABLED
+
+
+def _safety_of(ctl: Controller) -> Safety | None:
+    """Safety.of (the guard is built on the groups' core: imported on first use)."""
+    if not _SAFETY:
+        from ..guard.safety import Safety
+
+        _SAFETY.append(Safety.of)
+    return _SAFETY[0](ctl)
+
+
+_SAFETY: list[Callable[[Controller], Safety | None]] = []
 
 
 def _first_over(need: np.ndarray, cap: np.ndarray) -> int | None:
