@@ -170,3 +170,58 @@ def test_first_line_starts_where_the_axes_are() -> None:
         ctl.run_until(lambda ax=ax: not ax.is_moving, 5.0)
         outs.append(_apply(g, [([3.0, 4.0], 20.0), ([3.0, 5.0], 20.0)], fast))
     assert outs[0] == outs[1]
+
+
+def test_chain_of_equals_between_bit_for_bit() -> None:
+    from openmotion.path.geometry import Line
+
+    rng = np.random.default_rng(7)
+    for dim in (2, 3, 4, 6, 17):
+        for scale in (1e-9, 0.05, 1e3):
+            pts = rng.normal(size=(300, dim)) * scale + rng.normal(size=dim) * 100.0
+            pts[5] = pts[4]  # a zero-length line
+            pts[7, 0] = pts[6, 0]
+            lines = Line.chain_of(pts.copy())
+            for k, got in enumerate(lines):
+                a, b = pts[k].copy(), pts[k + 1].copy()
+                a.flags.writeable = b.flags.writeable = False
+                want = Line.between(a, b)
+                assert got.length == want.length
+                for x, y in ((got.start, a), (got.end, b), (got.direction, want.direction),
+                             (got.max_abs_tangent, want.max_abs_tangent)):
+                    assert x.tobytes() == y.tobytes() and not x.flags.writeable
+                assert got.end is lines[k + 1].start if k + 1 < len(lines) else True
+
+
+def test_runner_takes_the_prepared_lines(monkeypatch: pytest.MonkeyPatch) -> None:
+    """cam_rose's lines come from the stretches prepared ahead (one line of each made by
+    the group itself), and the queue holds the same commands as with the public calls."""
+    from openmotion.path.geometry import Line
+    from openmotion.program.runner import RunOptions
+
+    text = (ROOT / "examples" / "programs" / "cam_rose.ngc").read_text()
+    queues = []
+    for public in (False, True):
+        made = []
+        between = Line.between.__func__  # type: ignore[attr-defined]
+
+        def counted(cls: type, a: np.ndarray, b: np.ndarray,
+                    made: list = made, between=between) -> Line:  # noqa: ANN001
+            made.append(1)
+            return between(cls, a, b)
+
+        with monkeypatch.context() as m:
+            m.setattr(Line, "between", classmethod(counted))
+            if public:
+                m.setattr(Group, "_queue_line", _public)
+            ctl = Controller()
+            ctl.enable_all()
+            run = ProgramRunner(ctl, text, gcode={"parameters": work_origin(ctl)},
+                                options=RunOptions(window=5000))
+            run.start()
+            assert run.group is not None
+            run._feed(run.group)
+            queues.append(_state(run.group))
+            if not public:
+                assert len(made) <= 4000 // 256 + 2
+    assert queues[0] == queues[1]

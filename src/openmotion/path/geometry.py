@@ -170,6 +170,41 @@ class Line:
         return obj
 
     @classmethod
+    def chain_of(cls, points: Array) -> list[Line]:
+        """The lines between consecutive rows of `points` (an (m, N) float64 array of
+        finite values a planner made, m >= 2), each the same as `between(points[k],
+        points[k + 1])` bit for bit, made in one pass over the stretch (a program's run of
+        lines). `points` is made read only; the lines' start, end and direction are its
+        rows (shared: lines[k].end is lines[k + 1].start)."""
+        points.flags.writeable = False
+        delta = points[1:] - points[:-1]
+        big = np.abs(delta).max(axis=1)
+        flat = big == 0.0
+        if flat.any():  # zero-length lines: length 0 and a zero direction, as between
+            big[flat] = 1.0
+        q = delta / big[:, None]
+        lengths = [b * math.sqrt(r.dot(r)) for b, r in zip(big.tolist(), q, strict=True)]
+        if flat.any():
+            lengths = [0.0 if f else x for f, x in zip(flat.tolist(), lengths, strict=True)]
+        length_col = np.array(lengths)
+        if flat.any():
+            length_col[flat] = 1.0
+        u = delta / length_col[:, None]
+        if flat.any():
+            u[flat] = 0.0
+        au = np.abs(u)
+        u.flags.writeable = au.flags.writeable = False
+        rows = list(points)
+        out = []
+        new = object.__new__
+        for k, (length, d, a) in enumerate(zip(lengths, u, au, strict=True)):
+            obj = new(cls)
+            obj.__dict__.update(start=rows[k], end=rows[k + 1], length=length, direction=d,
+                                _abs_dir=a)
+            out.append(obj)
+        return out
+
+    @classmethod
     def _planned(cls, start: Array, end: Array, length: float, direction: Array,
                  abs_direction: Array) -> Line:
         """A line whose length and direction (and |direction|) a planner computed itself

@@ -32,6 +32,7 @@ from .source import GCodeError
 
 if TYPE_CHECKING:
     from ..control.groups.group import Group
+    from ..path.geometry import Line
     from .runner import ProgramRunner
 
 
@@ -124,7 +125,10 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
             if planned > 0.0:  # G95: planned at the highest speed, the override scales
                 ceiling = ceiling_rps(run, planned)
                 op = replace(op, feed=op.feed * ceiling / planned)
-            idx = run._push(g, op)
+            if op.kind == "line":
+                idx = push(run, g, op, run._ahead.take(p.ops, p.pc))
+            else:
+                idx = run._push(g, op)
             if planned > 0.0:
                 run._per_rev_ops[idx] = ceiling
             run._line_of[idx] = op.line
@@ -191,14 +195,19 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
         run._end_of_pass()
 
 
-def push(run: ProgramRunner, g: Group, op: Op) -> int:
+def push(run: ProgramRunner, g: Group, op: Op,
+         ahead: tuple[np.ndarray, Line | None] | None = None) -> int:
+    """Queue a line, arc or delay op; `ahead`: a line's prepared (end, line) (runahead)."""
     run._pushed += 1
     at_rest = run._idle()
     if op.kind == "delay":
         idx = g.delay(op.seconds)
     elif op.kind == "line":
         assert op.end is not None  # set_feed + line, without re-checking the compiler's
-        idx = g._queue_line(op.end, op.feed)
+        if ahead is None:
+            idx = g._queue_line(op.end, op.feed)
+        else:
+            idx = g._queue_line(ahead[0], op.feed, ahead[1])
     else:
         g.set_feed(op.feed)
         assert op.end is not None and op.centre is not None

@@ -129,20 +129,23 @@ class GroupChecks(GroupEngine):
                                            f"pulses, got {show(value)}")
         return out
 
-    def _queue_line(self, end: np.ndarray, feed: float) -> int:
+    def _queue_line(self, end: np.ndarray, feed: float, line: Line | None = None) -> int:
         """The program runner's push (its cycle hook: the controller's lock is held):
         `set_feed(feed)` then `line(end)` for an `end` the program's compiler made (a 1-D
-        float64 array of one value per axis, logical units). The same command, made by the
-        same checks at the same values (plain float comparisons, no re-validation of what
-        cannot fail) and leaving the same state; when one of them fails, or the group is
-        set up in a way this path does not cover, the public calls run instead and raise
-        their own errors (or accept)."""
+        float64 array of one value per axis, logical units; taken as it is when read
+        only). `line`: the line to `end` the runner prepared (program/runahead.py), used
+        when it starts at the queue's tail (that very array). The same command, made by
+        the same checks at the same values (plain float comparisons, no re-validation of
+        what cannot fail) and leaving the same state; when one of them fails, or the group
+        is set up in a way this path does not cover, the public calls run instead and
+        raise their own errors (or accept)."""
         f = float(feed)
         if not PPS_MIN <= f <= PPS_MAX or f > self._sys_max * (1 + 1e-12) or self._refuse \
                 or self._str_vel != 0.0 or not self._accepting():
             return self._queue_line_public(end, feed)
         n = len(self.axes)
-        b = np.array(end, dtype=np.float64)
+        b = end if not end.flags.writeable and end.dtype == np.float64 \
+            else np.array(end, dtype=np.float64)
         if b.shape != (n,) or n < 2:
             return self._queue_line_public(end, feed)
         e_l = b.tolist()
@@ -152,12 +155,17 @@ class GroupChecks(GroupEngine):
         tail = self._tail
         if tail is None or (self._run is None and not self._queue and self._held is None):
             a = np.array(self._rest_point(), dtype=np.float64)
-        elif tail.flags.writeable:  # (a tail the public _push copied)
-            a = tail.copy()
+            line = None
+        elif line is not None and line.start is tail and line.end is b:
+            a = tail
         else:
-            a = tail  # the previous line's end (read only)
-        a.flags.writeable = b.flags.writeable = False
-        el = Line.between(a, b)  # the same line as line(end) makes, bit for bit
+            line = None  # (a tail the public _push copied is writeable: copied again)
+            a = tail.copy() if tail.flags.writeable else tail
+        if line is None:
+            a.flags.writeable = b.flags.writeable = False
+            el = Line.between(a, b)  # the same line as line(end) makes, bit for bit
+        else:
+            el = line
         length = el.length
         memo = self.__dict__.get("_push_memo")
         if memo is None or memo[0] is not self._k or memo[1] is not self._ppu:
