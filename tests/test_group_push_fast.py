@@ -40,7 +40,7 @@ M2
 """
 
 
-def _public(self: Group, end: np.ndarray, feed: float) -> int:
+def _public(self: Group, end: np.ndarray, feed: float, line: object = None) -> int:
     return self._queue_line_public(end, feed)
 
 
