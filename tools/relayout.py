@@ -87,8 +87,9 @@ MAPPING: dict[str, str] = {
     "pulserule": "home", "homeconf": "home",
     # groups and path execution
     "group": "groups", "group_checks": "groups", "group_corners": "groups",
-    "group_settings": "groups", "groupdue": "groups", "groupexec": "groups",
-    "groupstream": "groups", "groupfaults": "groups", "grouptypes": "groups",
+    "group_settings": "groups", "group_status": "groups", "groupdue": "groups",
+    "groupexec": "groups", "groupstream": "groups", "groupfaults": "groups",
+    "grouptypes": "groups",
     "groupjoin": "groups", "joinhandoff": "groups", "pathaxes": "groups", "pathexec": "groups",
     "pathpoints": "groups", "pathrun": "groups", "accuracy": "groups", "ptpblend": "groups",
     "overlap": "groups", "pathmove": "groups",

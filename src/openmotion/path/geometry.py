@@ -155,20 +155,54 @@ class Line:
         of the same size, finite (not checked again). The same line as Line(start, end)."""
         obj = object.__new__(cls)
         delta = end - start
-        big = float(np.abs(delta).max())  # (the method: np.max's dispatch costs more)
+        # the largest |component| (finite values: the same as np.abs(delta).max(), whose
+        # two array calls cost more than this on the few axes of a path)
+        big = max(map(abs, delta.tolist()))
         if big > 0.0:
             q = delta / big
-            length = big * vnorm(q)
+            length = big * math.sqrt(q.dot(q))  # (vnorm, inlined)
             u = delta / length
         else:
             length = 0.0
             u = np.zeros_like(delta)
         u.flags.writeable = False
-        object.__setattr__(obj, "start", start)
-        object.__setattr__(obj, "end", end)
-        object.__setattr__(obj, "length", length)
-        object.__setattr__(obj, "direction", u)
+        obj.__dict__.update(start=start, end=end, length=length, direction=u)
         return obj
+
+    @classmethod
+    def chain_of(cls, points: Array) -> list[Line]:
+        """The lines between consecutive rows of `points` (an (m, N) float64 array of
+        finite values a planner made, m >= 2), each the same as `between(points[k],
+        points[k + 1])` bit for bit, made in one pass over the stretch (a program's run of
+        lines). `points` is made read only; the lines' start, end and direction are its
+        rows (shared: lines[k].end is lines[k + 1].start)."""
+        points.flags.writeable = False
+        delta = points[1:] - points[:-1]
+        big = np.abs(delta).max(axis=1)
+        flat = big == 0.0
+        if flat.any():  # zero-length lines: length 0 and a zero direction, as between
+            big[flat] = 1.0
+        q = delta / big[:, None]
+        lengths = [b * math.sqrt(r.dot(r)) for b, r in zip(big.tolist(), q, strict=True)]
+        if flat.any():
+            lengths = [0.0 if f else x for f, x in zip(flat.tolist(), lengths, strict=True)]
+        length_col = np.array(lengths)
+        if flat.any():
+            length_col[flat] = 1.0
+        u = delta / length_col[:, None]
+        if flat.any():
+            u[flat] = 0.0
+        au = np.abs(u)
+        u.flags.writeable = au.flags.writeable = False
+        rows = list(points)
+        out = []
+        new = object.__new__
+        for k, (length, d, a) in enumerate(zip(lengths, u, au, strict=True)):
+            obj = new(cls)
+            obj.__dict__.update(start=rows[k], end=rows[k + 1], length=length, direction=d,
+                                _abs_dir=a)
+            out.append(obj)
+        return out
 
     @classmethod
     def _planned(cls, start: Array, end: Array, length: float, direction: Array,

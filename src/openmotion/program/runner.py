@@ -59,6 +59,7 @@ from .orient import Orient
 from .probing import Probe, WaitInput
 from .progunits import ProgramUnits
 from .rigidtap import RigidTap
+from .runahead import LinesAhead
 from .runaxes import gcode_fields, machine_axes, travel_limits
 from .runcompile import RunPass
 from .runfeed import follow_per_rev
@@ -211,6 +212,7 @@ class ProgramRunner:
                                     self._record_synced)
         self.synced_analog = SyncedAnalog(self._write_analog)
         self._pushed = 0
+        self._ahead = LinesAhead()  # the coming lines' geometry (runahead.py)
         self._last_line = 0
         self._exec_line = 0   # line of the last command the trace saw executing
         self._step_line: int | None = None

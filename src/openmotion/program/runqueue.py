@@ -32,6 +32,7 @@ from .source import GCodeError
 
 if TYPE_CHECKING:
     from ..control.groups.group import Group
+    from ..path.geometry import Line
     from .runner import ProgramRunner
 
 
@@ -57,11 +58,16 @@ def record_synced(run: ProgramRunner, t: float, op: Op, index: int, level: bool)
 
 
 def idle(run: ProgramRunner) -> bool:
-    from ..control.groups.group import GroupState
-
     g = run.group
     assert g is not None
-    return g.state is GroupState.IDLE and g.queue_length == 0
+    if not _IDLE:  # the groups are imported on first use (as the runner imports them)
+        from ..control.groups.group import GroupState
+
+        _IDLE.append(GroupState.IDLE)
+    return g.state is _IDLE[0] and g.queue_length == 0
+
+
+_IDLE: list[object] = []  # GroupState.IDLE
 
 
 def idle_past(run: ProgramRunner, index: int) -> bool:
@@ -119,7 +125,10 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
             if planned > 0.0:  # G95: planned at the highest speed, the override scales
                 ceiling = ceiling_rps(run, planned)
                 op = replace(op, feed=op.feed * ceiling / planned)
-            idx = run._push(g, op)
+            if op.kind == "line":
+                idx = push(run, g, op, run._ahead.take(p.ops, p.pc))
+            else:
+                idx = run._push(g, op)
             if planned > 0.0:
                 run._per_rev_ops[idx] = ceiling
             run._line_of[idx] = op.line
@@ -186,20 +195,24 @@ def feed(run: ProgramRunner, g: Group) -> None:  # noqa: C901 - one dispatch ove
         run._end_of_pass()
 
 
-def push(run: ProgramRunner, g: Group, op: Op) -> int:
+def push(run: ProgramRunner, g: Group, op: Op,
+         ahead: tuple[np.ndarray, Line | None] | None = None) -> int:
+    """Queue a line, arc or delay op; `ahead`: a line's prepared (end, line) (runahead)."""
     run._pushed += 1
     at_rest = run._idle()
     if op.kind == "delay":
         idx = g.delay(op.seconds)
+    elif op.kind == "line":
+        assert op.end is not None  # set_feed + line, without re-checking the compiler's
+        if ahead is None:
+            idx = g._queue_line(op.end, op.feed)
+        else:
+            idx = g._queue_line(ahead[0], op.feed, ahead[1])
     else:
         g.set_feed(op.feed)
-        assert op.end is not None
-        if op.kind == "line":
-            idx = g.line(op.end)
-        else:
-            assert op.centre is not None
-            idx = g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
-                        turns=op.turns)
+        assert op.end is not None and op.centre is not None
+        idx = g.arc(op.centre, op.end, plane=op.plane, direction=op.direction,
+                    turns=op.turns)
     override_pushed(run, idx, op, at_rest)  # M48-M53 waiting for this command
     return idx
 

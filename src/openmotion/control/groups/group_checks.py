@@ -11,15 +11,15 @@ they were. `unit_scales` resolves the group's `units=` argument.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import MotionError, show
-from ...limits import PATH_LENGTH_MAX, PULSES_MAX, as_array
+from ...limits import PATH_LENGTH_MAX, PPS_MAX, PPS_MIN, PULSES_MAX, as_array
 from ...path.extent import element_extent
-from ...path.geometry import PathElement
+from ...path.geometry import Line, PathElement
 from ...profile.pcl import MoveSpec
 from ...units import AxisUnits
 from ..core.states import AxisState
@@ -41,6 +41,7 @@ from .groupexec import (
 if TYPE_CHECKING:
     from ..core.axis import Axis
     from ..core.controller import Controller
+    from ..guard.safety import Safety
 
 
 class GroupChecks(GroupEngine):
@@ -84,9 +85,14 @@ class GroupChecks(GroupEngine):
         self._check_accepting()
         if self._tail is None or (self._run is None and not self._queue
                                   and self._held is None):
-            return self._units_of(self._stop_point()) if self._aborting \
-                and self._run is not None else self.position
+            return self._rest_point()
         return self._tail.copy()
+
+    def _rest_point(self) -> np.ndarray:
+        """Where a command starts when nothing is queued: where the axes are (while abort()
+        is still stopping: where it stops)."""
+        return self._units_of(self._stop_point()) if self._aborting \
+            and self._run is not None else self.position  # type: ignore[attr-defined]
 
     def _point(self, name: str, value: Sequence[float], base: np.ndarray | None) -> np.ndarray:
         try:
@@ -122,6 +128,98 @@ class GroupChecks(GroupEngine):
             raise GroupError(ERR_ARGUMENT, f"{name} must lie within |x| <= {PULSES_MAX:g} "
                                            f"pulses, got {show(value)}")
         return out
+
+    def _queue_line(self, end: np.ndarray, feed: float, line: Line | None = None) -> int:
+        """The program runner's push (its cycle hook: the controller's lock is held):
+        `set_feed(feed)` then `line(end)` for an `end` the program's compiler made (a 1-D
+        float64 array of one value per axis, logical units; taken as it is when read
+        only). `line`: the line to `end` the runner prepared (program/runahead.py), used
+        when it starts at the queue's tail (that very array). The same command, made by
+        the same checks at the same values (plain float comparisons, no re-validation of
+        what cannot fail) and leaving the same state; when one of them fails, or the group
+        is set up in a way this path does not cover, the public calls run instead and
+        raise their own errors (or accept)."""
+        f = float(feed)
+        if not PPS_MIN <= f <= PPS_MAX or f > self._sys_max * (1 + 1e-12) or self._refuse \
+                or self._str_vel != 0.0 or not self._accepting():
+            return self._queue_line_public(end, feed)
+        n = len(self.axes)
+        b = end if not end.flags.writeable and end.dtype == np.float64 \
+            else np.array(end, dtype=np.float64)
+        if b.shape != (n,) or n < 2:
+            return self._queue_line_public(end, feed)
+        e_l = b.tolist()
+        for x in e_l:
+            if not -PULSES_MAX <= x <= PULSES_MAX:  # (NaN, inf: the public call refuses)
+                return self._queue_line_public(end, feed)
+        tail = self._tail
+        if tail is None or (self._run is None and not self._queue and self._held is None):
+            a = np.array(self._rest_point(), dtype=np.float64)
+            line = None
+        elif line is not None and line.start is tail and line.end is b:
+            a = tail
+        else:
+            line = None  # (a tail the public _push copied is writeable: copied again)
+            a = tail.copy() if tail.flags.writeable else tail
+        if line is None:
+            a.flags.writeable = b.flags.writeable = False
+            el = Line.between(a, b)  # the same line as line(end) makes, bit for bit
+        else:
+            el = line
+        length = el.length
+        memo = self.__dict__.get("_push_memo")
+        if memo is None or memo[0] is not self._k or memo[1] is not self._ppu:
+            memo = self._push_memo = (self._k, self._ppu, self._k.tolist(),
+                                      float(np.max(np.abs(self._ppu))),
+                                      tuple(ax.index for ax in self.axes))
+        if length == 0.0 or not length * memo[3] <= PATH_LENGTH_MAX:
+            return self._queue_line_public(end, feed)
+        if not self._dry and not self._soft_ok(a.tolist(), e_l, memo[2], memo[4]):
+            return self._queue_line_public(end, feed)
+        self._feed = f
+        accel, decel, jerk = self._path_ramps(f)
+        cmd = _Cmd(self._next_index, "path", elements=(el,), feed=f, accel=accel,
+                   decel=decel, jerk=jerk, str_vel=0.0, move=self._path_move(f, 0.0))
+        self._queue.append(cmd)
+        self._next_index += 1
+        if self._run is not None and self._run.plan is not None:
+            self._join_queued(self._ctl.time)  # joins now if the running chain needs it
+        self._tail = b
+        return cmd.index
+
+    def _queue_line_public(self, end: np.ndarray, feed: float) -> int:
+        self.set_feed(feed)  # type: ignore[attr-defined]
+        return self.line(end)  # type: ignore[attr-defined]
+
+    def _accepting(self) -> bool:
+        """Whether `_check_accepting` passes (it raises the refusal)."""
+        if self._state is _G_ERROR or len(self._queue) >= self._queue_size:
+            return False
+        dry = self._dry
+        free = self._run is None and not dry
+        for a in self.axes:
+            st = a.state
+            if st is _A_ESTOP or (st is _A_DISABLED and not dry) or (free and a.is_moving):
+                return False
+        return True
+
+    def _soft_ok(self, start: list[float], end: list[float], k: list[float],
+                 indices: tuple[int, ...]) -> bool:
+        """Whether `_check_soft_limits` passes for the line start -> end (plain floats; the
+        same products and comparisons as `_check_soft_span`)."""
+        safety = _safety_of(self._ctl)
+        if safety is None:
+            return True
+        for i, pl, nl in safety.soft.enabled_of(indices):
+            s, e, ki = start[i], end[i], k[i]
+            lo, hi = (e, s) if e < s else (s, e)
+            x, y = lo * ki, hi * ki
+            plo, phi = (y, x) if y < x else (x, y)
+            s *= ki
+            if phi > max(pl, s) + 1e-9 * max(1.0, abs(pl)) or \
+                    plo < min(nl, s) - 1e-9 * max(1.0, abs(nl)):
+                return False
+        return True
 
     def _check_soft_limits(self, el: PathElement) -> None:
         """Refuse (ERR_LIMIT) a path element that would take an axis past an enabled soft
@@ -281,6 +379,22 @@ def unit_names(controller: Controller, axes: Sequence[Axis],
     if units is True:
         return tuple(controller.config.axes[a.index].unit for a in axes)
     return tuple(u.unit for u in units)  # type: ignore[union-attr]
+
+
+_G_ERROR = GroupState.ERROR
+_A_ESTOP, _A_DISABLED = AxisState.ERROR_STOP, AxisState.DISABLED
+
+
+def _safety_of(ctl: Controller) -> Safety | None:
+    """Safety.of (the guard is built on the groups' core: imported on first use)."""
+    if not _SAFETY:
+        from ..guard.safety import Safety
+
+        _SAFETY.append(Safety.of)
+    return _SAFETY[0](ctl)
+
+
+_SAFETY: list[Callable[[Controller], Safety | None]] = []
 
 
 def _first_over(need: np.ndarray, cap: np.ndarray) -> int | None:

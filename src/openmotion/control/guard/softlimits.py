@@ -165,6 +165,18 @@ class SoftLimits:
         lim = self._lim[self.ctl.axis(axis).index]
         return SoftLimit(lim.plimit, lim.nlimit, lim.enabled, lim.decelerate)
 
+    def enabled_of(self, indices: tuple[int, ...]) -> list[tuple[int, float, float]]:
+        """(k, plimit, nlimit) of every enabled limit among the controller axes `indices`
+        (k: the position in `indices`), as `get` reports them now: a group's push path
+        compares each queued point against these (plain floats, no copies)."""
+        lims = self._lim
+        out = []
+        for k, i in enumerate(indices):
+            lim = lims[i]
+            if lim.enabled:
+                out.append((k, lim.plimit, lim.nlimit))
+        return out
+
     # ------------------------------------------------------------------ internals
     def _raw(self, ax: Axis) -> tuple[float, float] | None:
         """(nlimit, plimit) in the raw pulse frame, or None when not active."""
