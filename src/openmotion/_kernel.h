@@ -45,6 +45,7 @@ int kernel_layout(PyObject *module);
 /* _kernel_record.c: a jump's crossed cycles into the recorder's ring arrays */
 PyObject *record_rows(PyObject *self, PyObject *args);
 extern const char record_rows_doc[];
+int record_types(PyObject *module); /* the RowSink type: one cycle's row */
 
 /* _kernel_rt.c: real-time pacing of the compiled cycles (control/core/realtime.py) */
 int rt_before_cycle(long long k, int first);  /* wait for cycle k's slot; 1: return at this

@@ -193,3 +193,298 @@ PyObject *record_rows(PyObject *self, PyObject *args)
     PyMem_Free(pv);
     Py_RETURN_NONE;
 }
+
+/* ------------------------------------------------------------------ RowSink
+ * One recorder row per cycle (a cycle-by-cycle step's Controller._record, through
+ * Recorder.row_sink): the ring's arrays, the channel slots, the io table and the state
+ * codes are bound once, and the sink keeps the ring's head, the newest time and the rows
+ * put since the Recorder last took them (`take`), so a row costs one call with the
+ * cycle's values. The row is the one record_rows writes for m = 1 with no mover (the same
+ * operations). */
+typedef struct {
+    PyObject_HEAD
+    Buf b[6]; /* rt, rf, rstate, rio, slots, table */
+    PyObject *states, *codes; /* tuples: state objects and their codes */
+    Py_ssize_t R, F, n, T;
+    int64_t sp, sf, sv;
+    Py_ssize_t head;      /* the ring row the next put writes */
+    long long pending;    /* rows put since the last take */
+    long long room;       /* rows it may put before the recorder must settle held runs */
+    double last_t;        /* the newest row's time */
+    int armed;
+} RowSink;
+
+static void sink_dealloc(RowSink *s)
+{
+    release(s->b, 6);
+    Py_XDECREF(s->states);
+    Py_XDECREF(s->codes);
+    Py_TYPE(s)->tp_free((PyObject *)s);
+}
+
+static int sink_init(RowSink *s, PyObject *args, PyObject *kw)
+{
+    PyObject *o[6], *states, *codes;
+    Py_ssize_t n;
+    static char *kwlist[] = {"rt", "rf", "rstate", "rio", "slots", "table", "n_axes",
+                             "states", "codes", NULL};
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOnO!O!", kwlist, &o[0], &o[1], &o[2],
+                                     &o[3], &o[4], &o[5], &n, &PyTuple_Type, &states,
+                                     &PyTuple_Type, &codes))
+        return -1;
+    release(s->b, 6);
+    memset(s->b, 0, sizeof s->b);
+    s->R = 0;
+    s->armed = 0;
+    static const Py_ssize_t sizes[6] = {8, 8, 4, 8, 8, 8};
+    static const char *names[6] = {"rt", "rf", "rstate", "rio", "slots", "table"};
+    for (int k = 0; k < 6; k++)
+        if (get_buf(o[k], &s->b[k], sizes[k], names[k]) < 0) {
+            release(s->b, 6);
+            memset(s->b, 0, sizeof s->b);
+            return -1;
+        }
+    Py_ssize_t R = s->b[0].b.len / 8;
+    Py_ssize_t F = (R && n > 0) ? s->b[1].b.len / (8 * R * n) : 0;
+    const int64_t *slots = s->b[4].b.buf;
+    const char *bad = NULL;
+    if (n < 1 || R < 2 || s->b[1].b.len != R * F * n * 8 || s->b[4].b.len != 3 * 8
+            || (s->b[2].b.len && s->b[2].b.len != R * n * 4)
+            || (s->b[3].b.len && s->b[3].b.len != R * n * 8)
+            || PyTuple_GET_SIZE(states) != PyTuple_GET_SIZE(codes))
+        bad = "RowSink: arrays disagree in size";
+    for (int k = 0; k < 3 && !bad; k++)
+        if (slots[k] < -1 || slots[k] >= F) bad = "RowSink: bad slot";
+    for (Py_ssize_t k = 0; k < PyTuple_GET_SIZE(codes) && !bad; k++)
+        if (!PyLong_Check(PyTuple_GET_ITEM(codes, k))) bad = "RowSink: codes must be ints";
+    if (bad) {
+        release(s->b, 6);
+        memset(s->b, 0, sizeof s->b);
+        PyErr_SetString(PyExc_ValueError, bad);
+        return -1;
+    }
+    Py_INCREF(states);
+    Py_INCREF(codes);
+    Py_XSETREF(s->states, states);
+    Py_XSETREF(s->codes, codes);
+    s->R = R;
+    s->F = F;
+    s->n = n;
+    s->T = s->b[5].b.len / 8;
+    s->sp = slots[0];
+    s->sf = slots[1];
+    s->sv = slots[2];
+    return 0;
+}
+
+/* a read-only int64 C-contiguous buffer of `len` items */
+static int int64s(PyObject *o, Py_buffer *b, Py_ssize_t len, const char *name)
+{
+    if (PyObject_GetBuffer(o, b, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) return -1;
+    if (b->itemsize != 8 || b->len != len * 8
+            || (b->format && strcmp(b->format, "l") && strcmp(b->format, "q"))) {
+        PyBuffer_Release(b);
+        PyErr_Format(PyExc_ValueError, "RowSink.put: %s must hold %zd int64", name, len);
+        return -1;
+    }
+    return 0;
+}
+
+/* Axis.position: the raw position plus the command offset, as Python adds them */
+static int position(PyObject *p, PyObject *off, double *out)
+{
+    if (PyLong_CheckExact(p) && PyLong_CheckExact(off)) {
+        PyObject *sum = PyNumber_Add(p, off);
+        if (sum == NULL) return -1;
+        *out = PyFloat_AsDouble(sum);
+        Py_DECREF(sum);
+    } else {
+        double a = PyFloat_AsDouble(p);
+        if (a == -1.0 && PyErr_Occurred()) return -1;
+        double b = PyFloat_AsDouble(off);
+        if (b == -1.0 && PyErr_Occurred()) return -1;
+        *out = a + b;
+    }
+    return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
+}
+
+/* 0 written, 1 no room (nothing written), -1 error (nothing written) */
+static int sink_row(RowSink *s, double t, PyObject *ov, PyObject *orb, PyObject *onc,
+                    int estop)
+{
+    Py_ssize_t n = s->n;
+    if (!(isfinite(t) && t >= s->last_t)) {
+        PyObject *a = PyFloat_FromDouble(s->last_t), *b = PyFloat_FromDouble(t);
+        if (a && b)
+            PyErr_Format(PyExc_ValueError, "t must be finite and >= the previous time %R, "
+                         "got %R", a, b);
+        Py_XDECREF(a);
+        Py_XDECREF(b);
+        return -1;
+    }
+    if (s->room <= 0) return 1;
+    if (!PyList_Check(ov) || PyList_GET_SIZE(ov) != 6 * n) {
+        PyErr_SetString(PyExc_ValueError, "RowSink.put: values disagree in size");
+        return -1;
+    }
+    double pvs[2 * 64], *pv = pvs;
+    int64_t ias[3 * 64], *ia = ias;
+    if (n > 64) {
+        pv = PyMem_Malloc(sizeof(double) * 2 * n + sizeof(int64_t) * 3 * n);
+        if (pv == NULL) { PyErr_NoMemory(); return -1; }
+        ia = (int64_t *)(pv + 2 * n);
+    }
+    PyObject **v = &PyList_GET_ITEM(ov, 0);
+    PyObject *const *st = &PyTuple_GET_ITEM(s->states, 0);
+    Py_ssize_t ns = PyTuple_GET_SIZE(s->states);
+    int fail = 0;
+    for (Py_ssize_t x = 0; x < n && !fail; x++, v += 6) {
+        /* (raw position, command offset, velocity, feedback internal?, feedback offset,
+         * state) */
+        if (position(v[0], v[1], &pv[x * 2]) < 0) { fail = 1; break; }
+        pv[x * 2 + 1] = PyFloat_AsDouble(v[2]);
+        if (pv[x * 2 + 1] == -1.0 && PyErr_Occurred()) { fail = 1; break; }
+        int internal = PyObject_IsTrue(v[3]);
+        if (internal < 0) { fail = 1; break; }
+        ia[x * 3] = internal;
+        ia[x * 3 + 1] = PyLong_AsLongLong(v[4]);
+        if (ia[x * 3 + 1] == -1 && PyErr_Occurred()) { fail = 1; break; }
+        Py_ssize_t j = 0;
+        while (j < ns && st[j] != v[5]) j++;
+        if (j == ns) {
+            PyErr_SetString(PyExc_ValueError, "RowSink.put: unknown axis state");
+            fail = 1;
+            break;
+        }
+        ia[x * 3 + 2] = PyLong_AsLongLong(PyTuple_GET_ITEM(s->codes, j));
+        if (!(isfinite(pv[x * 2]) && isfinite(pv[x * 2 + 1]))) {
+            PyErr_SetString(PyExc_ValueError, "recorded positions/velocities must be finite");
+            fail = 1;
+        }
+    }
+    Py_buffer rb, ncb;
+    if (!fail && int64s(orb, &rb, 3 * n, "readback") < 0) fail = 1;
+    if (!fail && int64s(onc, &ncb, n, "nc") < 0) {
+        PyBuffer_Release(&rb);
+        fail = 1;
+    }
+    if (fail) {
+        if (pv != pvs) PyMem_Free(pv);
+        return -1;
+    }
+    Py_ssize_t row = s->head;
+    double *rt = s->b[0].b.buf, *f = (double *)s->b[1].b.buf + row * s->F * n;
+    int32_t *rstate = s->b[2].b.len ? (int32_t *)s->b[2].b.buf + row * n : NULL;
+    int64_t *rio = s->b[3].b.len ? (int64_t *)s->b[3].b.buf + row * n : NULL;
+    const int64_t *tr = rb.buf, *nc = ncb.buf, *table = s->b[5].b.buf;
+    int64_t sp = s->sp, sf = s->sf, sv = s->sv, T = s->T;
+    rt[row] = t;
+    for (Py_ssize_t x = 0; x < n; x++) {
+        const int64_t *a = ia + x * 3;
+        if (sp >= 0) f[sp * n + x] = pv[x * 2];
+        if (sv >= 0) f[sv * n + x] = pv[x * 2 + 1];
+        if (sf >= 0) f[sf * n + x] = (double)wrap28((a[0] ? tr[x * 3] : tr[x * 3 + 1]) + a[1]);
+        if (rstate) rstate[x] = (int32_t)a[2];
+        if (rio) {
+            int64_t w = tr[x * 3 + 2] ^ nc[x];
+            int64_t val = (w >= 0 && w < T) ? table[w] : 0;
+            rio[x] = estop ? val | (1 << 6) : val;
+        }
+    }
+    PyBuffer_Release(&rb);
+    PyBuffer_Release(&ncb);
+    if (pv != pvs) PyMem_Free(pv);
+    s->head = row + 1 == s->R ? 0 : row + 1;
+    s->pending++;
+    s->room--;
+    s->last_t = t;
+    return 0;
+}
+
+static PyObject *sink_put(RowSink *s, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "RowSink.put takes (t, values, readback, nc, estop)");
+        return NULL;
+    }
+    if (!s->armed) {
+        PyErr_SetString(PyExc_ValueError, "RowSink: not armed");
+        return NULL;
+    }
+    double t = PyFloat_AsDouble(args[0]);
+    if (t == -1.0 && PyErr_Occurred()) return NULL;
+    int estop = PyObject_IsTrue(args[4]);
+    if (estop < 0) return NULL;
+    int r = sink_row(s, t, args[1], args[2], args[3], estop);
+    if (r < 0) return NULL;
+    return PyBool_FromLong(r == 0);
+}
+
+static PyObject *sink_arm(RowSink *s, PyObject *args)
+{
+    Py_ssize_t head;
+    long long room;
+    double last_t;
+    if (!PyArg_ParseTuple(args, "ndL", &head, &last_t, &room)) return NULL;
+    if (s->R == 0 || head < 0 || head >= s->R) {
+        PyErr_SetString(PyExc_ValueError, "RowSink.arm: bad head");
+        return NULL;
+    }
+    s->head = head;
+    s->last_t = last_t;
+    s->room = room;
+    s->pending = 0;
+    s->armed = 1;
+    Py_RETURN_NONE;
+}
+
+static PyObject *sink_take(RowSink *s, PyObject *noargs)
+{
+    PyObject *r = Py_BuildValue("(Ld)", s->pending, s->last_t);
+    if (r == NULL) return NULL;
+    s->pending = 0;
+    s->armed = 0;
+    return r;
+}
+
+static PyMethodDef sink_methods[] = {
+    {"put", (PyCFunction)(void (*)(void))sink_put, METH_FASTCALL,
+     "put(t, values, readback, nc, estop) -> bool\n\n"
+     "Write the row of time t at the head: per axis, from values (a list of 6n: raw "
+     "position, command offset, velocity, feedback from the output pulses?, feedback "
+     "offset, state object), readback int64[n, 3] (pulses out, decoded count, electrical "
+     "level word) and nc int64[n] (the normally-closed level bits), the command position "
+     "and velocity, the feedback counter (wrapped to 28 bits), the state code and the io "
+     "word (+ bit 6 on estop). False, nothing written, when the room given to arm is used "
+     "up; ValueError, nothing written, on a bad value."},
+    {"arm", (PyCFunction)sink_arm, METH_VARARGS,
+     "arm(head, last_t, room) -> None: put rows from ring row head on, times >= last_t, at "
+     "most room of them; forgets rows not taken."},
+    {"take", (PyCFunction)sink_take, METH_NOARGS,
+     "take() -> (rows, last_t): the rows put since arm (and their newest time); disarms."},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyTypeObject RowSinkType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "openmotion._kernel.RowSink",
+    .tp_basicsize = sizeof(RowSink),
+    .tp_dealloc = (destructor)sink_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "RowSink(rt, rf, rstate, rio, slots, table, n_axes, states, codes): a "
+              "recorder ring's arrays bound for one row per call (put).",
+    .tp_methods = sink_methods,
+    .tp_init = (initproc)sink_init,
+    .tp_new = PyType_GenericNew,
+};
+
+int record_types(PyObject *module)
+{
+    if (PyType_Ready(&RowSinkType) < 0) return -1;
+    Py_INCREF(&RowSinkType);
+    if (PyModule_AddObject(module, "RowSink", (PyObject *)&RowSinkType) < 0) {
+        Py_DECREF(&RowSinkType);
+        return -1;
+    }
+    return 0;
+}

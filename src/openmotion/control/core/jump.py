@@ -327,28 +327,60 @@ _STATE_CODES: dict = {}
 
 def record_now(ctl: Controller, n: int) -> bool:
     """Record the row of cycle n (its end, now) as `Controller._record` does, in one
-    compiled call: the back end's readback of every axis in one call (BulkReadback), the
-    cached one of an axis already read in this cycle (what its counters and inputs show).
-    False (nothing done) without the compiled kernel or a bulk readback."""
-    kern = _motion._kernel
+    compiled call (`Recorder.row_sink`): the back end's readback of every axis in one call
+    (BulkReadback), the cached one of an axis already read in this cycle (what its counters
+    and inputs show). False (nothing done) without the compiled kernel or a bulk readback,
+    or when the recorder takes rows one by one (spilling)."""
     hw = ctl.hardware
     t = type(hw)
     bulk = _BULK.get(t)
     if bulk is None:
         bulk = _BULK[t] = isinstance(hw, BulkReadback)
-    if kern is None or not bulk:
+    if _motion._kernel is None or not bulk:
         return False
-    rows = _writable(hw.read_axes())
+    rows = hw.read_axes()
+    if type(rows) is not np.ndarray or rows.dtype is not _INT64:
+        rows = _writable(rows)
     now = ctl._n
+    axes = ctl.axes
     if now in ctl._rb_cycle:
         rows = rows.copy()  # not the back end's own array
-        axes = ctl.axes
         for i, c in enumerate(ctl._rb_cycle):
             if c == now:  # read in this cycle: the values the controller holds
                 cnt = axes[i].counters
                 rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
-    return _record_rows(ctl, kern, n - 1, rows.reshape(1, -1, 3), _NO_MOVERS, (),
-                        _NO_OFFSETS, "record")
+    # per axis the fields Axis.position (raw + command offset), Axis.velocity, the
+    # feedback source (internal?) and offset and the state return, as one flat list
+    vals: list = []
+    for ax in axes:
+        c = ax.counters
+        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
+    t = ctl._t_origin + n * ctl.period
+    rec = ctl.recorder
+    table = _IO_TABLE[0] if _IO_TABLE else _io_table()
+    try:
+        sink = rec.sink or rec.row_sink(table, *_state_table())
+        if sink is None:  # a spilling recorder: row by row
+            return False
+        if not sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop)):
+            # no room: a held run's rows come first (row_sink settles them)
+            rec.row_sink(table, *_state_table()).put(t, vals, rows, _nc_words(ctl),
+                                                     bool(ctl._estop))
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record: {exc}") from None
+    return True
+
+
+def _state_table() -> tuple[tuple, tuple[int, ...]]:
+    """Controller.STATE_CODES as (states, codes) tuples (the recorder's row sink)."""
+    if not _STATE_TABLE:
+        from .controller import STATE_CODES  # the controller imports this module
+        _STATE_TABLE.append((tuple(STATE_CODES), tuple(STATE_CODES.values())))
+    return _STATE_TABLE[0]
+
+
+_STATE_TABLE: list[tuple[tuple, tuple[int, ...]]] = []
+_INT64 = np.dtype(np.int64)
 
 
 def _record_rows(ctl: Controller, kern: Any, n: int, trace: np.ndarray,
