@@ -407,10 +407,7 @@ static PyObject *sink_put(RowSink *s, PyObject *const *args, Py_ssize_t nargs)
         PyErr_SetString(PyExc_TypeError, "RowSink.put takes (t, values, readback, nc, estop)");
         return NULL;
     }
-    if (!s->armed) {
-        PyErr_SetString(PyExc_ValueError, "RowSink: not armed");
-        return NULL;
-    }
+    if (!s->armed) Py_RETURN_FALSE; /* the recorder took the rows back: arm it again */
     double t = PyFloat_AsDouble(args[0]);
     if (t == -1.0 && PyErr_Occurred()) return NULL;
     int estop = PyObject_IsTrue(args[4]);
@@ -455,8 +452,9 @@ static PyMethodDef sink_methods[] = {
      "offset, state object), readback int64[n, 3] (pulses out, decoded count, electrical "
      "level word) and nc int64[n] (the normally-closed level bits), the command position "
      "and velocity, the feedback counter (wrapped to 28 bits), the state code and the io "
-     "word (+ bit 6 on estop). False, nothing written, when the room given to arm is used "
-     "up; ValueError, nothing written, on a bad value."},
+     "word (+ bit 6 on estop). False, nothing written, when it is not armed (the recorder "
+     "took its rows back) or the room given to arm is used up; ValueError, nothing "
+     "written, on a bad value."},
     {"arm", (PyCFunction)sink_arm, METH_VARARGS,
      "arm(head, last_t, room) -> None: put rows from ring row head on, times >= last_t, at "
      "most room of them; forgets rows not taken."},

@@ -327,18 +327,18 @@ _STATE_CODES: dict = {}
 
 def record_now(ctl: Controller, n: int) -> bool:
     """Record the row of cycle n (its end, now) as `Controller._record` does, in one
-    compiled call (`Recorder.row_sink`): the back end's readback of every axis in one call
-    (BulkReadback), the cached one of an axis already read in this cycle (what its counters
-    and inputs show). False (nothing done) without the compiled kernel or a bulk readback,
-    or when the recorder takes rows one by one (spilling)."""
-    hw = ctl.hardware
-    t = type(hw)
-    bulk = _BULK.get(t)
-    if bulk is None:
-        bulk = _BULK[t] = isinstance(hw, BulkReadback)
-    if _motion._kernel is None or not bulk:
-        return False
-    rows = hw.read_axes()
+    compiled call (the recorder's armed row sink, `Recorder.row_sink`): the back end's
+    readback of every axis in one call (BulkReadback), the cached one of an axis already
+    read in this cycle (what its counters and inputs show). False (nothing done) without
+    the compiled kernel or a bulk readback, or when the recorder takes rows one by one
+    (spilling)."""
+    rec = ctl.recorder
+    sink = rec.sink  # armed by an earlier row, until anything else touches the recorder
+    if sink is None:
+        sink = _arm(ctl, rec)
+        if sink is None:
+            return False
+    rows = ctl.hardware.read_axes()
     if type(rows) is not np.ndarray or rows.dtype is not _INT64:
         rows = _writable(rows)
     now = ctl._n
@@ -356,19 +356,30 @@ def record_now(ctl: Controller, n: int) -> bool:
         c = ax.counters
         vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
     t = ctl._t_origin + n * ctl.period
-    rec = ctl.recorder
-    table = _IO_TABLE[0] if _IO_TABLE else _io_table()
     try:
-        sink = rec.sink or rec.row_sink(table, *_state_table())
-        if sink is None:  # a spilling recorder: row by row
-            return False
         if not sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop)):
-            # no room: a held run's rows come first (row_sink settles them)
-            rec.row_sink(table, *_state_table()).put(t, vals, rows, _nc_words(ctl),
-                                                     bool(ctl._estop))
+            # no room (a held run's rows come first: row_sink settles them) or disarmed
+            # (another thread read the recorder since): armed again
+            sink = _arm(ctl, rec)
+            if sink is None:
+                return False
+            sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop))
     except (TypeError, ValueError, OverflowError, BufferError) as exc:
         raise MotionError(f"record: {exc}") from None
     return True
+
+
+def _arm(ctl: Controller, rec: Any) -> Any:
+    """The recorder's row sink armed at its head (`Recorder.row_sink`), or None when the
+    row goes through `Recorder.record` (no compiled kernel, no bulk readback, spilling)."""
+    hw = ctl.hardware
+    t = type(hw)
+    bulk = _BULK.get(t)
+    if bulk is None:
+        bulk = _BULK[t] = isinstance(hw, BulkReadback)
+    if _motion._kernel is None or not bulk:
+        return None
+    return rec.row_sink(_IO_TABLE[0] if _IO_TABLE else _io_table(), *_state_table())
 
 
 def _state_table() -> tuple[tuple, tuple[int, ...]]:
