@@ -254,8 +254,7 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
         if held is not None and held[0] == key and held[1] == rec.total \
                 and rec.hold(m, ctl._t_origin, ctl.period, n):
             return key, rec.total
-        if _record_rows(ctl, kern, n, np.array(trace[:1], dtype=np.int64), _NO_MOVERS, (),
-                        _NO_OFFSETS, "record_block"):
+        if _first_row(ctl, rec, n + 1, trace[0]):
             rec.hold(m - 1, ctl._t_origin, ctl.period, n + 1)  # it took the row: it holds
             return key, rec.total
     from .controller import STATE_CODES  # the controller imports this module
@@ -366,6 +365,29 @@ def record_now(ctl: Controller, n: int) -> bool:
             sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop))
     except (TypeError, ValueError, OverflowError, BufferError) as exc:
         raise MotionError(f"record: {exc}") from None
+    return True
+
+
+def _first_row(ctl: Controller, rec: Any, n: int, readback: np.ndarray) -> bool:
+    """The row of cycle n from the readback row `readback` (int64 [n_axes, 3]) with no
+    mover (the first of an idle stretch), through the recorder's row sink; False (nothing
+    done) when the recorder takes rows one by one."""
+    sink = rec.sink or _arm(ctl, rec)
+    if sink is None:
+        return False
+    vals: list = []
+    for ax in ctl.axes:
+        c = ax.counters
+        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
+    t = ctl._t_origin + n * ctl.period
+    try:
+        if not sink.put(t, vals, readback, _nc_words(ctl), bool(ctl._estop)):
+            sink = _arm(ctl, rec)  # no room or disarmed (see record_now)
+            if sink is None:
+                return False
+            sink.put(t, vals, readback, _nc_words(ctl), bool(ctl._estop))
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record_block: {exc}") from None
     return True
 
 
