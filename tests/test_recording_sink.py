@@ -1,5 +1,6 @@
-"""The compiled row writer of a cycle-by-cycle step (`Recorder.row_sink`, `_kernel.RowSink`,
-used by control/core/jump.record_now) stores the very rows `Recorder.record` stores:
+"""The compiled row writer (`Recorder.row_sink`, `_kernel.RowSink`: a cycle-by-cycle step's
+row, control/core/jump.record_now, and a jump's crossed cycles, `put_block`) stores the very
+rows `Recorder.record` / `record_block` store:
 stepped against the Python row (`record_now` off) with several channel sets, a ring shorter
 than the run, feedback from either source with offsets, normally-closed contacts, E-stop,
 and steps mixed with jumps whose held idle runs the stepped rows later overwrite (the sink
@@ -24,8 +25,10 @@ def scripted(compiled: bool, capacity: int, channels, mixed: bool, monkeypatch) 
     from openmotion.control.core import controller as ctlmod
 
     with monkeypatch.context() as mp:
-        if not compiled:
+        if not compiled:  # every row through Recorder.record / record_block
             mp.setattr(ctlmod, "record_now", lambda *a: False)
+            mp.setattr(Recorder, "row_sink", lambda *a: None)
+            mp.setattr(Recorder, "record_into", lambda *a: False)
         x = default_machine().axes[0]
         axes = (replace(x, name="x", pel=SwitchConfig(position=30_000.0, width=400.0),
                         logic={"org": "nc"}),
@@ -149,3 +152,35 @@ def _tables() -> tuple:
     from openmotion.control.core import jump
 
     return (jump._io_table(), *jump._state_table())
+
+
+def test_a_bad_block_is_refused_and_nothing_stored():
+    from openmotion.control.core.axis import AxisState
+
+    r, sink = armed()
+    st = next(iter(AxisState))
+    vals = [1.0, 0, 2.0, False, 0, st] * 2
+    tr = np.zeros((3, 2, 3), dtype=np.int64)
+    nc = np.zeros(2, dtype=np.int64)
+    good_end = np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0]])
+    before = {k: v.copy() for k, v in r.arrays().items()}
+    sink = r.row_sink(*_tables(), 3)
+    bad = [
+        (0, tr, [0], (np.array([[1.0, 0.0], [np.nan, 0.0], [3.0, 0.0]]),), [0.0]),
+        (0, tr, [0], (good_end[:2],), [0.0]),  # ends too short
+        (0, tr, [2], (good_end,), [0.0]),  # not an axis
+        (0, tr, [0], (good_end,), []),  # an offset missing
+        (0, tr.astype(np.float64), [0], (good_end,), [0.0]),
+        (-5, tr, [0], (good_end,), [0.0]),  # earlier than the newest row
+    ]
+    for n0, trace, movers, ends, offs in bad:
+        with pytest.raises((ValueError, TypeError)):
+            sink.put_block(n0, 0.0, 0.001, trace, vals, movers, ends, offs, nc, False)
+    after = r.arrays()
+    assert all(after[k].tobytes() == before[k].tobytes() for k in before)
+    assert r.total == 1
+    sink = r.row_sink(*_tables(), 3)
+    assert sink.put_block(0, 0.0, 0.001, tr, vals, [1], (good_end,), [5.0], nc, False)
+    got = r.arrays()
+    assert got["t"].tolist() == [0.0, 0.001, 0.002, 0.003]
+    assert got["cmd_pos"][1:].tolist() == [[1.0, 6.0], [1.0, 7.0], [1.0, 8.0]]

@@ -308,6 +308,35 @@ static int position(PyObject *p, PyObject *off, double *out)
     return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
 }
 
+/* The axes' fields of a put (a list of 6n: raw position, command offset, velocity,
+ * feedback internal?, feedback offset, state object) into pv (position, velocity) and ia
+ * (internal?, feedback offset, state code); -1 with an exception set on a bad value. */
+static int fields(RowSink *s, PyObject *ov, double *pv, int64_t *ia)
+{
+    Py_ssize_t n = s->n;
+    PyObject **v = &PyList_GET_ITEM(ov, 0);
+    PyObject *const *st = &PyTuple_GET_ITEM(s->states, 0);
+    Py_ssize_t ns = PyTuple_GET_SIZE(s->states);
+    for (Py_ssize_t x = 0; x < n; x++, v += 6) {
+        if (position(v[0], v[1], &pv[x * 2]) < 0) return -1;
+        pv[x * 2 + 1] = PyFloat_AsDouble(v[2]);
+        if (pv[x * 2 + 1] == -1.0 && PyErr_Occurred()) return -1;
+        int internal = PyObject_IsTrue(v[3]);
+        if (internal < 0) return -1;
+        ia[x * 3] = internal;
+        ia[x * 3 + 1] = PyLong_AsLongLong(v[4]);
+        if (ia[x * 3 + 1] == -1 && PyErr_Occurred()) return -1;
+        Py_ssize_t j = 0;
+        while (j < ns && st[j] != v[5]) j++;
+        if (j == ns) {
+            PyErr_SetString(PyExc_ValueError, "RowSink.put: unknown axis state");
+            return -1;
+        }
+        ia[x * 3 + 2] = PyLong_AsLongLong(PyTuple_GET_ITEM(s->codes, j));
+    }
+    return 0;
+}
+
 /* 0 written, 1 no room (nothing written), -1 error (nothing written) */
 static int sink_row(RowSink *s, double t, PyObject *ov, PyObject *orb, PyObject *onc,
                     int estop)
@@ -334,34 +363,12 @@ static int sink_row(RowSink *s, double t, PyObject *ov, PyObject *orb, PyObject 
         if (pv == NULL) { PyErr_NoMemory(); return -1; }
         ia = (int64_t *)(pv + 2 * n);
     }
-    PyObject **v = &PyList_GET_ITEM(ov, 0);
-    PyObject *const *st = &PyTuple_GET_ITEM(s->states, 0);
-    Py_ssize_t ns = PyTuple_GET_SIZE(s->states);
-    int fail = 0;
-    for (Py_ssize_t x = 0; x < n && !fail; x++, v += 6) {
-        /* (raw position, command offset, velocity, feedback internal?, feedback offset,
-         * state) */
-        if (position(v[0], v[1], &pv[x * 2]) < 0) { fail = 1; break; }
-        pv[x * 2 + 1] = PyFloat_AsDouble(v[2]);
-        if (pv[x * 2 + 1] == -1.0 && PyErr_Occurred()) { fail = 1; break; }
-        int internal = PyObject_IsTrue(v[3]);
-        if (internal < 0) { fail = 1; break; }
-        ia[x * 3] = internal;
-        ia[x * 3 + 1] = PyLong_AsLongLong(v[4]);
-        if (ia[x * 3 + 1] == -1 && PyErr_Occurred()) { fail = 1; break; }
-        Py_ssize_t j = 0;
-        while (j < ns && st[j] != v[5]) j++;
-        if (j == ns) {
-            PyErr_SetString(PyExc_ValueError, "RowSink.put: unknown axis state");
-            fail = 1;
-            break;
-        }
-        ia[x * 3 + 2] = PyLong_AsLongLong(PyTuple_GET_ITEM(s->codes, j));
+    int fail = fields(s, ov, pv, ia) < 0;
+    for (Py_ssize_t x = 0; x < n && !fail; x++)
         if (!(isfinite(pv[x * 2]) && isfinite(pv[x * 2 + 1]))) {
             PyErr_SetString(PyExc_ValueError, "recorded positions/velocities must be finite");
             fail = 1;
         }
-    }
     Py_buffer rb, ncb;
     if (!fail && int64s(orb, &rb, 3 * n, "readback") < 0) fail = 1;
     if (!fail && int64s(onc, &ncb, n, "nc") < 0) {
@@ -417,6 +424,153 @@ static PyObject *sink_put(RowSink *s, PyObject *const *args, Py_ssize_t nargs)
     return PyBool_FromLong(r == 0);
 }
 
+
+/* The m rows of cycles n0+1 .. n0+m a jump crossed (record_rows' rows, through the bound
+ * ring): 0 written, 1 no room or not armed (nothing written), -1 error (nothing written). */
+static int sink_block(RowSink *s, PyObject *const *a)
+{
+    long long n0 = PyLong_AsLongLong(a[0]);
+    if (n0 == -1 && PyErr_Occurred()) return -1;
+    double origin = PyFloat_AsDouble(a[1]);
+    if (origin == -1.0 && PyErr_Occurred()) return -1;
+    double period = PyFloat_AsDouble(a[2]);
+    if (period == -1.0 && PyErr_Occurred()) return -1;
+    PyObject *ov = a[4], *omov = a[5], *ends = a[6], *ooff = a[7];
+    int estop = PyObject_IsTrue(a[9]);
+    if (estop < 0) return -1;
+    Py_ssize_t n = s->n, R = s->R;
+    if (!PyList_Check(ov) || PyList_GET_SIZE(ov) != 6 * n || !PyList_Check(omov)
+            || !PyTuple_Check(ends) || !PyList_Check(ooff)
+            || PyTuple_GET_SIZE(ends) != PyList_GET_SIZE(omov)
+            || PyList_GET_SIZE(ooff) != PyList_GET_SIZE(omov)) {
+        PyErr_SetString(PyExc_ValueError, "RowSink.put_block: arrays disagree in size");
+        return -1;
+    }
+    Py_buffer tb;
+    if (PyObject_GetBuffer(a[3], &tb, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) return -1;
+    Py_ssize_t m = tb.itemsize == 8 ? tb.len / (8 * 3 * n) : -1;
+    if (m < 0 || tb.len != m * n * 3 * 8
+            || (tb.format && strcmp(tb.format, "l") && strcmp(tb.format, "q"))) {
+        PyBuffer_Release(&tb);
+        PyErr_SetString(PyExc_ValueError, "RowSink.put_block: trace must be int64 [m, n, 3]");
+        return -1;
+    }
+    double t1 = origin + (double)(n0 + 1) * period, t2 = origin + (double)(n0 + m) * period;
+    if (m && !(isfinite(t1) && isfinite(t2) && t1 >= s->last_t && t2 >= t1)) {
+        PyBuffer_Release(&tb);
+        PyObject *x = PyFloat_FromDouble(s->last_t);
+        if (x)
+            PyErr_Format(PyExc_ValueError, "t must be finite and non-decreasing from the "
+                         "previous time %R", x);
+        Py_XDECREF(x);
+        return -1;
+    }
+    if (!s->armed || m > s->room) {
+        PyBuffer_Release(&tb);
+        return 1;
+    }
+    Py_ssize_t nk = PyList_GET_SIZE(omov);
+    double *pv = PyMem_Malloc(sizeof(double) * (2 * n + nk) + sizeof(int64_t) * (4 * n + 1)
+                              + sizeof(Buf) * (nk + 1));
+    if (pv == NULL) {
+        PyBuffer_Release(&tb);
+        PyErr_NoMemory();
+        return -1;
+    }
+    double *off = pv + 2 * n;
+    int64_t *ia = (int64_t *)(off + nk), *mover = ia + 3 * n;
+    Buf *eb = (Buf *)(mover + n + 1);
+    memset(eb, 0, sizeof(Buf) * (nk + 1));
+    Py_buffer ncb;
+    int fail = fields(s, ov, pv, ia) < 0, ncheld = 0;
+    if (!fail && int64s(a[8], &ncb, n, "nc") < 0) fail = 1;
+    else if (!fail) ncheld = 1;
+    for (Py_ssize_t x = 0; x < n; x++) mover[x] = -1;
+    for (Py_ssize_t k = 0; k < nk && !fail; k++) {
+        Py_ssize_t i = PyLong_AsSsize_t(PyList_GET_ITEM(omov, k));
+        if (i == -1 && PyErr_Occurred()) { fail = 1; break; }
+        if (i < 0 || i >= n) {
+            PyErr_SetString(PyExc_ValueError, "RowSink.put_block: bad mover index");
+            fail = 1;
+            break;
+        }
+        mover[i] = k;
+        off[k] = PyFloat_AsDouble(PyList_GET_ITEM(ooff, k));
+        if (off[k] == -1.0 && PyErr_Occurred()) { fail = 1; break; }
+        if (PyObject_GetBuffer(PyTuple_GET_ITEM(ends, k), &eb[k].b, PyBUF_C_CONTIGUOUS) < 0) {
+            fail = 1;
+            break;
+        }
+        eb[k].held = 1;
+        if (eb[k].b.itemsize != 8 || eb[k].b.len < m * 2 * 8) {
+            PyErr_SetString(PyExc_ValueError, "RowSink.put_block: ends too short");
+            fail = 1;
+        }
+    }
+    Py_ssize_t keep = m < R - 1 ? m : R - 1;
+    for (Py_ssize_t x = 0; x < n && !fail; x++)  /* record_rows' finiteness check */
+        if (mover[x] < 0 && !(isfinite(pv[x * 2]) && isfinite(pv[x * 2 + 1]))) fail = 2;
+    for (Py_ssize_t k = 0; k < nk && !fail; k++) {
+        const double *e = eb[k].b.buf;
+        for (Py_ssize_t r = m - keep; r < m; r++)
+            if (!(isfinite(e[r * 2] + off[k]) && isfinite(e[r * 2 + 1]))) { fail = 2; break; }
+    }
+    if (fail == 2)
+        PyErr_SetString(PyExc_ValueError, "recorded positions/velocities must be finite");
+    if (!fail) {
+        double *rt = s->b[0].b.buf, *rf = s->b[1].b.buf;
+        int32_t *rstate = s->b[2].b.len ? (int32_t *)s->b[2].b.buf : NULL;
+        int64_t *rio = s->b[3].b.len ? (int64_t *)s->b[3].b.buf : NULL;
+        const int64_t *tr = tb.buf, *nc = ncb.buf, *table = s->b[5].b.buf;
+        int64_t sp = s->sp, sf = s->sf, sv = s->sv, T = s->T;
+        Py_ssize_t F = s->F;
+        Py_ssize_t row = (Py_ssize_t)((s->head + (m - keep)) % R);
+        for (Py_ssize_t r = m - keep; r < m; r++, row = row + 1 == R ? 0 : row + 1) {
+            rt[row] = origin + (double)(n0 + 1 + r) * period;
+            double *f = rf + row * F * n;
+            const int64_t *trr = tr + r * n * 3;
+            for (Py_ssize_t x = 0; x < n; x++) {
+                int64_t k = mover[x];
+                const double *e = k >= 0 ? (const double *)eb[k].b.buf + r * 2 : NULL;
+                const int64_t *ax = ia + x * 3;
+                if (sp >= 0) f[sp * n + x] = e ? e[0] + off[k] : pv[x * 2];
+                if (sv >= 0) f[sv * n + x] = e ? e[1] : pv[x * 2 + 1];
+                if (sf >= 0) f[sf * n + x] = (double)wrap28((ax[0] ? trr[x * 3]
+                                                             : trr[x * 3 + 1]) + ax[1]);
+                if (rstate) rstate[row * n + x] = (int32_t)ax[2];
+                if (rio) {
+                    int64_t w = trr[x * 3 + 2] ^ nc[x];
+                    int64_t v = (w >= 0 && w < T) ? table[w] : 0;
+                    rio[row * n + x] = estop ? v | (1 << 6) : v;
+                }
+            }
+        }
+        if (m) {
+            s->head = (Py_ssize_t)((s->head + m) % R);
+            s->pending += m;
+            s->room -= m;
+            s->last_t = t2;
+        }
+    }
+    release(eb, (int)nk);
+    if (ncheld) PyBuffer_Release(&ncb);
+    PyMem_Free(pv);
+    PyBuffer_Release(&tb);
+    return fail ? -1 : 0;
+}
+
+static PyObject *sink_put_block(RowSink *s, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 10) {
+        PyErr_SetString(PyExc_TypeError, "RowSink.put_block takes (n0, origin, period, trace, "
+                                         "values, movers, ends, offsets, nc, estop)");
+        return NULL;
+    }
+    int r = sink_block(s, args);
+    if (r < 0) return NULL;
+    return PyBool_FromLong(r == 0);
+}
+
 static PyObject *sink_arm(RowSink *s, PyObject *args)
 {
     Py_ssize_t head;
@@ -454,6 +608,14 @@ static PyMethodDef sink_methods[] = {
      "and velocity, the feedback counter (wrapped to 28 bits), the state code and the io "
      "word (+ bit 6 on estop). False, nothing written, when it is not armed (the recorder "
      "took its rows back) or the room given to arm is used up; ValueError, nothing "
+     "written, on a bad value."},
+    {"put_block", (PyCFunction)(void (*)(void))sink_put_block, METH_FASTCALL,
+     "put_block(n0, origin, period, trace, values, movers, ends, offsets, nc, estop) -> bool"
+     "\n\nWrite the rows of cycles n0+1 .. n0+m (m = len(trace), int64 [m, n, 3] readback "
+     "at each cycle end; times origin + k * period; only the last min(m, R - 1) rows): "
+     "record_rows' rows, the values as put's, movers a list of axis indices whose "
+     "position and velocity come from ends[k] (float64 [>= m, 2], + offsets[k]). False, "
+     "nothing written, when not armed or the room is too small; ValueError, nothing "
      "written, on a bad value."},
     {"arm", (PyCFunction)sink_arm, METH_VARARGS,
      "arm(head, last_t, room) -> None: put rows from ring row head on, times >= last_t, at "

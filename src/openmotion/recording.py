@@ -227,11 +227,14 @@ class Recorder:
         return True
 
     def row_sink(self, table: NDArray[np.int64], states: tuple[Any, ...],
-                 codes: tuple[int, ...]) -> Any:
+                 codes: tuple[int, ...], rows: int = 1) -> Any:
         """The compiled row writer (`_kernel.RowSink`) bound to the ring and armed at its
         head, for the rows of a cycle-by-cycle step (control/core/jump.record_now): each
         `put(t, values, readback, nc, estop)` writes one row, the one `record` stores for
-        it (the io word `table[levels ^ nc]`, the state code `codes[k]` of `states[k]`).
+        it (the io word `table[levels ^ nc]`, the state code `codes[k]` of `states[k]`);
+        `put_block(...)` the rows of a jump's crossed cycles, those `record_into` of
+        `_kernel.record_rows` stores (`rows`: the held runs the next `rows` rows would
+        overwrite are settled first).
         Also `self.sink` until anything else reads or writes the recorder, which first
         takes the rows put back (`_sync`). None when the rows must go through `record` (a
         spilling recorder, no compiled kernel)."""
@@ -253,8 +256,8 @@ class Recorder:
                     self._i.get("io", _NO_IO), slots, table, self.n_axes, states, codes))
             except (TypeError, ValueError, BufferError) as exc:
                 raise MotionError(f"record: {exc}") from None
-        if self._total > self._floor + self.capacity:  # a row would overwrite a held one
-            self._settle()
+        if self._total + rows > self._floor + self.capacity + 1:  # they would overwrite
+            self._settle()  # a held row
         # rows it may put before one would overwrite a held run's row (then it settles)
         room = int(self._floor + self.capacity + 1 - self._total) if self._held else 1 << 62
         sink = bound[1]

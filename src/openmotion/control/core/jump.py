@@ -257,15 +257,11 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
         if _first_row(ctl, rec, n + 1, trace[0]):
             rec.hold(m - 1, ctl._t_origin, ctl.period, n + 1)  # it took the row: it holds
             return key, rec.total
+    if kern is not None and _block_rows(ctl, ctl.recorder, movers, ends, n, trace):
+        return None  # the rows straight into the recorder's ring, in C
     from .controller import STATE_CODES  # the controller imports this module
 
     axes = ctl.axes
-    if kern is not None and _record_rows(  # the rows straight into the recorder's ring, in C
-            ctl, kern, n, _writable(trace),
-            np.array([ax.index for ax in movers], dtype=np.int64),
-            tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
-            np.array([ax.counters._cmd_off for ax in movers], dtype=float), "record_block"):
-        return None
     t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
     pos = np.empty((m, len(axes)))
     vel = np.empty((m, len(axes)))
@@ -391,7 +387,36 @@ def _first_row(ctl: Controller, rec: Any, n: int, readback: np.ndarray) -> bool:
     return True
 
 
-def _arm(ctl: Controller, rec: Any) -> Any:
+def _block_rows(ctl: Controller, rec: Any, movers: list, ends: list[np.ndarray], n: int,
+                trace: np.ndarray) -> bool:
+    """The rows of cycles n+1 .. n+len(trace) a jump crossed through the recorder's row
+    sink (`put_block`: `_kernel.record_rows`' rows): the movers' positions and velocities
+    from their piece ends, every other axis's held values. False (nothing done) when the
+    recorder takes rows one by one."""
+    m = len(trace)
+    sink = rec.sink or _arm(ctl, rec, m)
+    if sink is None:
+        return False
+    vals: list = []
+    for ax in ctl.axes:
+        c = ax.counters
+        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
+    args = (n, ctl._t_origin, ctl.period, _writable(trace), vals,
+            [ax.index for ax in movers],
+            tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
+            [float(ax.counters._cmd_off) for ax in movers], _nc_words(ctl), bool(ctl._estop))
+    try:
+        if not sink.put_block(*args):
+            sink = _arm(ctl, rec, m)  # no room or disarmed (see record_now)
+            if sink is None:
+                return False
+            sink.put_block(*args)
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record_block: {exc}") from None
+    return True
+
+
+def _arm(ctl: Controller, rec: Any, rows: int = 1) -> Any:
     """The recorder's row sink armed at its head (`Recorder.row_sink`), or None when the
     row goes through `Recorder.record` (no compiled kernel, no bulk readback, spilling)."""
     hw = ctl.hardware
@@ -401,7 +426,7 @@ def _arm(ctl: Controller, rec: Any) -> Any:
         bulk = _BULK[t] = isinstance(hw, BulkReadback)
     if _motion._kernel is None or not bulk:
         return None
-    return rec.row_sink(_IO_TABLE[0] if _IO_TABLE else _io_table(), *_state_table())
+    return rec.row_sink(_IO_TABLE[0] if _IO_TABLE else _io_table(), *_state_table(), rows)
 
 
 def _state_table() -> tuple[tuple, tuple[int, ...]]:
