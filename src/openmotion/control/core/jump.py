@@ -308,18 +308,6 @@ def _level_word(inputs: dict[str, bool]) -> int:
     return w
 
 
-def _state_codes() -> dict:
-    """Controller.STATE_CODES keyed by id() of the state (an Enum member hashes slowly;
-    imported late: the controller imports this module)."""
-    if not _STATE_CODES:
-        from .controller import STATE_CODES
-        _STATE_CODES.update({id(st): code for st, code in STATE_CODES.items()})
-    return _STATE_CODES
-
-
-_STATE_CODES: dict = {}
-
-
 def record_now(ctl: Controller, n: int) -> bool:
     """Record the row of cycle n (its end, now) as `Controller._record` does, in one
     compiled call (the recorder's armed row sink, `Recorder.row_sink`): the back end's
@@ -390,7 +378,7 @@ def _first_row(ctl: Controller, rec: Any, n: int, readback: np.ndarray) -> bool:
 def _block_rows(ctl: Controller, rec: Any, movers: list, ends: list[np.ndarray], n: int,
                 trace: np.ndarray) -> bool:
     """The rows of cycles n+1 .. n+len(trace) a jump crossed through the recorder's row
-    sink (`put_block`: `_kernel.record_rows`' rows): the movers' positions and velocities
+    sink (`put_block`: the rows `_kernel.record_rows` writes): the movers' positions and velocities
     from their piece ends, every other axis's held values. False (nothing done) when the
     recorder takes rows one by one."""
     m = len(trace)
@@ -439,35 +427,6 @@ def _state_table() -> tuple[tuple, tuple[int, ...]]:
 
 _STATE_TABLE: list[tuple[tuple, tuple[int, ...]]] = []
 _INT64 = np.dtype(np.int64)
-
-
-def _record_rows(ctl: Controller, kern: Any, n: int, trace: np.ndarray,
-                 movers: np.ndarray, ends: tuple, offsets: np.ndarray, what: str) -> bool:
-    """Write the recorder rows of cycles n+1 .. n+len(trace) in one compiled call
-    (`_kernel.record_rows`) from the back end's readback `trace` and the movers' piece ends;
-    the axes' held values fill the rest. False when the recorder cannot take them so."""
-    codes = _STATE_CODES or _state_codes()
-    origin, period = ctl._t_origin, ctl.period
-    # per axis Axis.position, Axis.velocity and the feedback source (internal?), feedback
-    # offset, state code, read from the fields those properties return, as flat lists
-    pv: list[float] = []
-    ia: list[int] = []
-    for ax in ctl.axes:
-        c = ax.counters
-        pv += (ax._pos + c._cmd_off, ax._vel)
-        ia += (c._fb_internal, c._fb_off, codes[id(ax._state)])
-    args = (origin, period, n, trace, pv, movers, ends, offsets, ia, _nc_words(ctl),
-            _io_table(), bool(ctl._estop))
-
-    def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
-        try:
-            kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
-        except ValueError as exc:
-            raise MotionError(f"{what}: {exc}") from None
-
-    m = len(trace)
-    return ctl.recorder.record_into(m, origin + (n + 1) * period, origin + (n + m) * period,
-                                    fill)
 
 
 _IO_TABLE: list[np.ndarray] = []
