@@ -184,3 +184,28 @@ def test_a_bad_block_is_refused_and_nothing_stored():
     got = r.arrays()
     assert got["t"].tolist() == [0.0, 0.001, 0.002, 0.003]
     assert got["cmd_pos"][1:].tolist() == [[1.0, 6.0], [1.0, 7.0], [1.0, 8.0]]
+
+
+@pytest.mark.parametrize("jumping", [False, True])
+def test_a_contact_logic_changed_on_the_way_shows_in_the_io_words(jumping, monkeypatch):
+    from openmotion.control.core import controller as ctlmod
+
+    def io(compiled: bool) -> list:
+        with monkeypatch.context() as mp:
+            if not compiled:
+                mp.setattr(ctlmod, "record_now", lambda *a: False)
+                mp.setattr(Recorder, "row_sink", lambda *a: None)
+                mp.setattr(Recorder, "record_into", lambda *a: False)
+            c = Controller(MachineConfig(name="nc", axes=(default_machine().axes[0],)))
+            c.virtual_jumps = jumping
+            c.enable_all()
+            c.start_recording(capacity=500)
+            c.advance(0.05)
+            c.reconfigure_axis(0, logic={"org": "nc", "pel": "nc"})
+            c.advance(0.05)
+            c.reconfigure_axis(0, logic={})
+            c.advance(0.05)
+            return c.recorder.arrays()["io"][:, 0].tolist()
+
+    got, want = io(True), io(False)
+    assert got == want and len(set(want)) >= 2  # the rows change with the logic

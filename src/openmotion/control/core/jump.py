@@ -447,12 +447,15 @@ def _io_table() -> np.ndarray:
 
 def _nc_words(ctl: Controller) -> np.ndarray:
     """Per axis, the input-level bits (bit k = AXIS_INPUTS[k]) whose contact is normally
-    closed (the controller's contact table never changes after construction)."""
+    closed. `Controller.reconfigure_axis` (logic) puts a new set in the axis's place of the
+    contact table, so the words are kept with the sets they came from (held, so compared
+    by identity first, by value otherwise) and made again when one differs."""
     cached = getattr(ctl, "_jump_nc_words", None)
-    if cached is None or cached[0] is not ctl._nc:
+    sets = tuple(ctl._nc)
+    if cached is None or cached[0] != sets:
         words = np.array([sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if sig in nc)
-                          for nc in ctl._nc], dtype=np.int64)
-        cached = ctl._jump_nc_words = (ctl._nc, words)
+                          for nc in sets], dtype=np.int64)
+        cached = ctl._jump_nc_words = (sets, words)
     return cached[1]
 
 
