@@ -15,7 +15,8 @@ flags = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off", "-fno-fa
 
 setup(ext_modules=[Extension("openmotion._kernel",
                              ["src/openmotion/_kernel.c", "src/openmotion/_kernel_stepper.c",
-                              "src/openmotion/_kernel_rt.c", "src/openmotion/_kernel_record.c"],
+                              "src/openmotion/_kernel_rt.c", "src/openmotion/_kernel_record.c",
+                              "src/openmotion/_kernel_rowsink.c"],
                              depends=["src/openmotion/_kernel.h"],
                              extra_compile_args=flags),
                    Extension("openmotion._compare",
