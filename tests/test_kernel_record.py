@@ -21,6 +21,7 @@ def run(compiled: bool, capacity: int, channels, monkeypatch) -> dict:
     with monkeypatch.context() as mp:
         if not compiled:
             mp.setattr(Recorder, "record_into", lambda *a: False)
+            mp.setattr(Recorder, "row_sink", lambda *a: None)
         x = default_machine().axes[0]
         axes = (replace(x, name="x", pel=SwitchConfig(position=30_000.0, width=400.0),
                         logic={"org": "nc"}),

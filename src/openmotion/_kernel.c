@@ -166,7 +166,7 @@ PyMODINIT_FUNC PyInit__kernel(void)
 {
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) return NULL;
-    if (kernel_layout(m) < 0) {
+    if (kernel_layout(m) < 0 || record_types(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

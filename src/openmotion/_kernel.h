@@ -34,6 +34,18 @@ static inline void release(Buf *bufs, int n)
         if (bufs[k].held) PyBuffer_Release(&bufs[k].b);
 }
 
+/* a feedback counter wrapped to 28 bits (Counters.feedback_of), for the recorder's rows */
+#define HALF28 ((int64_t)1 << 27)
+#define FULL28 ((int64_t)1 << 28)
+
+static inline int64_t wrap28(int64_t x)
+{
+    if (x >= -HALF28 && x < HALF28) return x; /* the usual case: no division */
+    int64_t r = (x + HALF28) % FULL28;
+    if (r < 0) r += FULL28;
+    return r - HALF28;
+}
+
 /* _kernel_stepper.c: the simulator's stepper pipeline over a chunk of cycles */
 PyObject *kernel_run(PyObject *self, PyObject *args);
 extern const char kernel_run_doc[];
@@ -45,6 +57,8 @@ int kernel_layout(PyObject *module);
 /* _kernel_record.c: a jump's crossed cycles into the recorder's ring arrays */
 PyObject *record_rows(PyObject *self, PyObject *args);
 extern const char record_rows_doc[];
+/* _kernel_rowsink.c: the RowSink type (a recorder ring bound once, a row per call) */
+int record_types(PyObject *module);
 
 /* _kernel_rt.c: real-time pacing of the compiled cycles (control/core/realtime.py) */
 int rt_before_cycle(long long k, int first);  /* wait for cycle k's slot; 1: return at this

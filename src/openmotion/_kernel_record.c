@@ -9,16 +9,6 @@
  */
 #include "_kernel.h"
 
-#define HALF28 ((int64_t)1 << 27)
-#define FULL28 ((int64_t)1 << 28)
-
-static inline int64_t wrap28(int64_t x)
-{
-    if (x >= -HALF28 && x < HALF28) return x; /* the usual case: no division */
-    int64_t r = (x + HALF28) % FULL28;
-    if (r < 0) r += FULL28;
-    return r - HALF28;
-}
 
 const char record_rows_doc[] =
 "record_rows(rt, rf, rstate, rio, head, slots, origin, period, n0, trace, pv, idx, ends,\n"

@@ -33,6 +33,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import MotionError, check_int
 
+try:  # the compiled row writer of a cycle-by-cycle step (put_row); absent: record
+    from ._kernel import RowSink as _RowSink
+except ImportError:  # pragma: no cover - depends on the build
+    _RowSink = None
+
 FLOAT_CHANNELS = ("cmd_pos", "fb_pos", "cmd_vel")
 INT_CHANNELS = ("state", "io")
 CHANNELS = FLOAT_CHANNELS + INT_CHANNELS
@@ -73,9 +78,13 @@ class Recorder:
             a.fill(0)
         self._fslot = {c: k for k, c in enumerate(self._fchans)}
         self._slots: np.ndarray | None = None  # record_into's float slots
+        self._bound: tuple[Any, Any] | None = None  # row_sink's (table, RowSink)
+        #: the compiled row writer armed at the ring's head (`row_sink`), or None; the rows
+        #: it put are taken back (`_sync`) before anything else reads or writes the ring
+        self.sink: Any = None
         self._head = 0   # next row to write
         self._count = 0  # live rows (<= capacity)
-        self.total = 0   # rows ever recorded since the last clear
+        self._total = 0   # rows ever recorded since the last clear (`total`)
         self._last_t = -math.inf
         # held runs not yet in the ring, oldest first: [abs start, m, origin, period, n0,
         # float values (F, n), {int channel: values (n,)}]; abs row j lives at ring row
@@ -99,6 +108,7 @@ class Recorder:
         `t` must be finite and not earlier than the previous record. On a bad argument a
         MotionError is raised and the recording is unchanged.
         """
+        self._sync()
         try:
             t = float(t)
         except (TypeError, ValueError):
@@ -107,7 +117,7 @@ class Recorder:
             raise MotionError(
                 f"t must be finite and >= the previous time {self._last_t!r}, got {t!r}"
             )
-        if self.total + 1 > self._floor + self.capacity + 1:
+        if self._total + 1 > self._floor + self.capacity + 1:
             self._settle()
         i = self._head
         vals = {"cmd_pos": cmd_pos, "fb_pos": fb_pos, "cmd_vel": cmd_vel, "state": state,
@@ -139,12 +149,13 @@ class Recorder:
         else:
             self._count += 1
         self._head = i + 1 if i + 1 <= self.capacity else 0
-        self.total += 1
+        self._total += 1
 
     def record_block(self, t: ArrayLike, **channels: ArrayLike) -> None:
         """Store m cycles at once: `t` (m,) and each enabled channel (m, n_axes), as m
         `record` calls would (the same rows, the same checks; MotionError and nothing
         stored on a bad argument). Virtual-time jumps record the cycles they cross so."""
+        self._sync()
         try:
             tt = np.asarray(t, dtype=float)
             vals = {c: np.asarray(channels[c]) for c in self.channels}
@@ -168,7 +179,7 @@ class Recorder:
             for r in range(m):
                 self.record(tt[r], **{c: v[r] for c, v in vals.items()})
             return
-        if self.total + m > self._floor + self.capacity + 1:
+        if self._total + m > self._floor + self.capacity + 1:
             self._settle()
         rows = self.capacity + 1
         keep = min(m, self.capacity)  # older rows of the block would be overwritten anyway
@@ -181,7 +192,7 @@ class Recorder:
         self._last_t = float(tt[-1])
         self._count = min(self.capacity, self._count + m)
         self._head = (self._head + m) % rows
-        self.total += m
+        self._total += m
 
     def record_into(self, m: int, t_first: float, t_last: float,
                     fill: Callable[..., None]) -> bool:
@@ -193,6 +204,7 @@ class Recorder:
         `slots` the float slot of cmd_pos, fb_pos, cmd_vel (-1: off). Returns False and
         stores nothing when the rows must go through `record_block` (a spilling recorder).
         `fill` raises MotionError before writing anything if a value is bad."""
+        self._sync()
         if self._spill is not None:
             return False
         if not (math.isfinite(t_first) and t_first >= self._last_t and t_last >= t_first):
@@ -200,7 +212,7 @@ class Recorder:
                               f"{self._last_t!r}")
         if not m:
             return True
-        if self.total + m > self._floor + self.capacity + 1:
+        if self._total + m > self._floor + self.capacity + 1:
             self._settle()
         slots = self._slots
         if slots is None:
@@ -211,8 +223,59 @@ class Recorder:
         self._last_t = float(t_last)
         self._count = min(self.capacity, self._count + m)
         self._head = (self._head + m) % (self.capacity + 1)
-        self.total += m
+        self._total += m
         return True
+
+    def row_sink(self, table: NDArray[np.int64], states: tuple[Any, ...],
+                 codes: tuple[int, ...], rows: int = 1) -> Any:
+        """The compiled row writer (`_kernel.RowSink`) bound to the ring and armed at its
+        head, for the rows of a cycle-by-cycle step (control/core/jump.record_now): each
+        `put(t, values, readback, nc, estop)` writes one row, the one `record` stores for
+        it (the io word `table[levels ^ nc]`, the state code `codes[k]` of `states[k]`);
+        `put_block(...)` the rows of a jump's crossed cycles, those `record_into` of
+        `_kernel.record_rows` stores (`rows`: the held runs the next `rows` rows would
+        overwrite are settled first).
+        Also `self.sink` until anything else reads or writes the recorder, which first
+        takes the rows put back (`_sync`). None when the rows must go through `record` (a
+        spilling recorder, no compiled kernel)."""
+        self._sync()
+        if self._spill is not None or _RowSink is None:
+            return None
+        bound = self._bound
+        if bound is None or bound[0] is not table:
+            if not (isinstance(table, np.ndarray) and table.dtype == np.int64
+                    and table.ndim == 1):
+                raise MotionError(f"record: table must be a 1-D int64 array, got {table!r}")
+            slots = self._slots
+            if slots is None:
+                slots = self._slots = np.array([self._fslot.get(c, -1)
+                                                for c in FLOAT_CHANNELS], dtype=np.int64)
+            try:
+                bound = self._bound = (table, _RowSink(
+                    self._t, self._f, self._i.get("state", _NO_STATE),
+                    self._i.get("io", _NO_IO), slots, table, self.n_axes, states, codes))
+            except (TypeError, ValueError, BufferError) as exc:
+                raise MotionError(f"record: {exc}") from None
+        if self._total + rows > self._floor + self.capacity + 1:  # they would overwrite
+            self._settle()  # a held row
+        # rows it may put before one would overwrite a held run's row (then it settles)
+        room = int(self._floor + self.capacity + 1 - self._total) if self._held else 1 << 62
+        sink = bound[1]
+        sink.arm(self._head, self._last_t, room)
+        self.sink = sink
+        return sink
+
+    def _sync(self) -> None:
+        """Take back the rows the armed sink put (head, count, total, newest time)."""
+        s = self.sink
+        if s is not None:
+            self.sink = None
+            k, last = s.take()
+            if k:
+                self._head = (self._head + k) % (self.capacity + 1)
+                self._count = min(self.capacity, self._count + k)
+                self._total += k
+                self._last_t = last
 
     def hold(self, m: int, origin: float, period: float, n0: int) -> bool:
         """Store m rows that repeat the newest row's channel values at the times
@@ -221,6 +284,7 @@ class Recorder:
         overwritten; the rows are those m `record` calls would store. Returns False and
         stores nothing for a spilling recorder (the caller records the rows). MotionError
         (nothing stored) without a newest row or on times out of order."""
+        self._sync()
         if type(m) is not int or m < 0:
             check_int("m", m, 0)
         if not self._count:
@@ -235,7 +299,7 @@ class Recorder:
                 and t2 >= t1):
             raise MotionError(f"t must be finite and non-decreasing from the previous time "
                               f"{self._last_t!r}")
-        total = self.total
+        total = self._total
         held = self._held
         if len(held) >= _MAX_HELD:  # (overlaps need nothing: runs settle oldest first)
             self._settle()
@@ -255,7 +319,7 @@ class Recorder:
         self._last_t = float(t2)
         self._count = min(self.capacity, self._count + m)
         self._head = (self._head + m) % (self.capacity + 1)
-        self.total = total + m
+        self._total = total + m
         return True
 
     def _settle(self) -> None:
@@ -280,12 +344,20 @@ class Recorder:
 
     # ------------------------------------------------------------------ reading
     def __len__(self) -> int:
+        self._sync()
         return self._count
+
+    @property
+    def total(self) -> int:
+        """Rows ever recorded since the last clear."""
+        self._sync()
+        return self._total
 
     @property
     def dropped(self) -> int:
         """Rows that left the window without being spilled to a file."""
-        return self.total - self._count - self.spilled
+        self._sync()
+        return self._total - self._count - self.spilled
 
     def _order(self) -> NDArray[np.intp]:
         rows = self.capacity + 1
@@ -294,6 +366,7 @@ class Recorder:
 
     def arrays(self) -> dict[str, NDArray[Any]]:
         """Copies of the retained rows in time order: 't' (n,) and each channel (n, n_axes)."""
+        self._sync()
         if self._held:
             self._settle()
         idx = self._order()
@@ -304,9 +377,10 @@ class Recorder:
 
     def clear(self) -> None:
         """Forget every row (the spill file, if any, is restarted empty)."""
+        self._sync()
         self._head = 0
         self._count = 0
-        self.total = 0
+        self._total = 0
         self.spilled = 0
         self._last_t = -math.inf
         self._held = []

@@ -254,19 +254,14 @@ def record_trace(ctl: Controller, movers: list, ends: list[np.ndarray], n: int,
         if held is not None and held[0] == key and held[1] == rec.total \
                 and rec.hold(m, ctl._t_origin, ctl.period, n):
             return key, rec.total
-        if _record_rows(ctl, kern, n, np.array(trace[:1], dtype=np.int64), _NO_MOVERS, (),
-                        _NO_OFFSETS, "record_block"):
+        if _first_row(ctl, rec, n + 1, trace[0]):
             rec.hold(m - 1, ctl._t_origin, ctl.period, n + 1)  # it took the row: it holds
             return key, rec.total
+    if kern is not None and _block_rows(ctl, ctl.recorder, movers, ends, n, trace):
+        return None  # the rows straight into the recorder's ring, in C
     from .controller import STATE_CODES  # the controller imports this module
 
     axes = ctl.axes
-    if kern is not None and _record_rows(  # the rows straight into the recorder's ring, in C
-            ctl, kern, n, _writable(trace),
-            np.array([ax.index for ax in movers], dtype=np.int64),
-            tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
-            np.array([ax.counters._cmd_off for ax in movers], dtype=float), "record_block"):
-        return None
     t = ctl._t_origin + np.arange(n + 1, n + m + 1) * ctl.period
     pos = np.empty((m, len(axes)))
     vel = np.empty((m, len(axes)))
@@ -313,71 +308,125 @@ def _level_word(inputs: dict[str, bool]) -> int:
     return w
 
 
-def _state_codes() -> dict:
-    """Controller.STATE_CODES keyed by id() of the state (an Enum member hashes slowly;
-    imported late: the controller imports this module)."""
-    if not _STATE_CODES:
-        from .controller import STATE_CODES
-        _STATE_CODES.update({id(st): code for st, code in STATE_CODES.items()})
-    return _STATE_CODES
-
-
-_STATE_CODES: dict = {}
-
-
 def record_now(ctl: Controller, n: int) -> bool:
     """Record the row of cycle n (its end, now) as `Controller._record` does, in one
-    compiled call: the back end's readback of every axis in one call (BulkReadback), the
-    cached one of an axis already read in this cycle (what its counters and inputs show).
-    False (nothing done) without the compiled kernel or a bulk readback."""
-    kern = _motion._kernel
+    compiled call (the recorder's armed row sink, `Recorder.row_sink`): the back end's
+    readback of every axis in one call (BulkReadback), the cached one of an axis already
+    read in this cycle (what its counters and inputs show). False (nothing done) without
+    the compiled kernel or a bulk readback, or when the recorder takes rows one by one
+    (spilling)."""
+    rec = ctl.recorder
+    sink = rec.sink  # armed by an earlier row, until anything else touches the recorder
+    if sink is None:
+        sink = _arm(ctl, rec)
+        if sink is None:
+            return False
+    rows = ctl.hardware.read_axes()
+    if type(rows) is not np.ndarray or rows.dtype is not _INT64:
+        rows = _writable(rows)
+    now = ctl._n
+    axes = ctl.axes
+    if now in ctl._rb_cycle:
+        rows = rows.copy()  # not the back end's own array
+        for i, c in enumerate(ctl._rb_cycle):
+            if c == now:  # read in this cycle: the values the controller holds
+                cnt = axes[i].counters
+                rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
+    # per axis the fields Axis.position (raw + command offset), Axis.velocity, the
+    # feedback source (internal?) and offset and the state return, as one flat list
+    vals: list = []
+    for ax in axes:
+        c = ax.counters
+        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
+    t = ctl._t_origin + n * ctl.period
+    try:
+        if not sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop)):
+            # no room (a held run's rows come first: row_sink settles them) or disarmed
+            # (another thread read the recorder since): armed again
+            sink = _arm(ctl, rec)
+            if sink is None:
+                return False
+            sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop))
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record: {exc}") from None
+    return True
+
+
+def _first_row(ctl: Controller, rec: Any, n: int, readback: np.ndarray) -> bool:
+    """The row of cycle n from the readback row `readback` (int64 [n_axes, 3]) with no
+    mover (the first of an idle stretch), through the recorder's row sink; False (nothing
+    done) when the recorder takes rows one by one."""
+    sink = rec.sink or _arm(ctl, rec)
+    if sink is None:
+        return False
+    vals: list = []
+    for ax in ctl.axes:
+        c = ax.counters
+        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
+    t = ctl._t_origin + n * ctl.period
+    try:
+        if not sink.put(t, vals, readback, _nc_words(ctl), bool(ctl._estop)):
+            sink = _arm(ctl, rec)  # no room or disarmed (see record_now)
+            if sink is None:
+                return False
+            sink.put(t, vals, readback, _nc_words(ctl), bool(ctl._estop))
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record_block: {exc}") from None
+    return True
+
+
+def _block_rows(ctl: Controller, rec: Any, movers: list, ends: list[np.ndarray], n: int,
+                trace: np.ndarray) -> bool:
+    """The rows of cycles n+1 .. n+len(trace) a jump crossed through the recorder's row
+    sink (`put_block`: the rows `_kernel.record_rows` writes): the movers' positions and velocities
+    from their piece ends, every other axis's held values. False (nothing done) when the
+    recorder takes rows one by one."""
+    m = len(trace)
+    sink = rec.sink or _arm(ctl, rec, m)
+    if sink is None:
+        return False
+    vals: list = []
+    for ax in ctl.axes:
+        c = ax.counters
+        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
+    args = (n, ctl._t_origin, ctl.period, _writable(trace), vals,
+            [ax.index for ax in movers],
+            tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
+            [float(ax.counters._cmd_off) for ax in movers], _nc_words(ctl), bool(ctl._estop))
+    try:
+        if not sink.put_block(*args):
+            sink = _arm(ctl, rec, m)  # no room or disarmed (see record_now)
+            if sink is None:
+                return False
+            sink.put_block(*args)
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record_block: {exc}") from None
+    return True
+
+
+def _arm(ctl: Controller, rec: Any, rows: int = 1) -> Any:
+    """The recorder's row sink armed at its head (`Recorder.row_sink`), or None when the
+    row goes through `Recorder.record` (no compiled kernel, no bulk readback, spilling)."""
     hw = ctl.hardware
     t = type(hw)
     bulk = _BULK.get(t)
     if bulk is None:
         bulk = _BULK[t] = isinstance(hw, BulkReadback)
-    if kern is None or not bulk:
-        return False
-    rows = _writable(hw.read_axes())
-    now = ctl._n
-    if now in ctl._rb_cycle:
-        rows = rows.copy()  # not the back end's own array
-        axes = ctl.axes
-        for i, c in enumerate(ctl._rb_cycle):
-            if c == now:  # read in this cycle: the values the controller holds
-                cnt = axes[i].counters
-                rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
-    return _record_rows(ctl, kern, n - 1, rows.reshape(1, -1, 3), _NO_MOVERS, (),
-                        _NO_OFFSETS, "record")
+    if _motion._kernel is None or not bulk:
+        return None
+    return rec.row_sink(_IO_TABLE[0] if _IO_TABLE else _io_table(), *_state_table(), rows)
 
 
-def _record_rows(ctl: Controller, kern: Any, n: int, trace: np.ndarray,
-                 movers: np.ndarray, ends: tuple, offsets: np.ndarray, what: str) -> bool:
-    """Write the recorder rows of cycles n+1 .. n+len(trace) in one compiled call
-    (`_kernel.record_rows`) from the back end's readback `trace` and the movers' piece ends;
-    the axes' held values fill the rest. False when the recorder cannot take them so."""
-    codes = _STATE_CODES or _state_codes()
-    origin, period = ctl._t_origin, ctl.period
-    # per axis Axis.position, Axis.velocity and the feedback source (internal?), feedback
-    # offset, state code, read from the fields those properties return, as flat lists
-    pv: list[float] = []
-    ia: list[int] = []
-    for ax in ctl.axes:
-        c = ax.counters
-        pv += (ax._pos + c._cmd_off, ax._vel)
-        ia += (c._fb_internal, c._fb_off, codes[id(ax._state)])
-    args = (origin, period, n, trace, pv, movers, ends, offsets, ia, _nc_words(ctl),
-            _io_table(), bool(ctl._estop))
+def _state_table() -> tuple[tuple, tuple[int, ...]]:
+    """Controller.STATE_CODES as (states, codes) tuples (the recorder's row sink)."""
+    if not _STATE_TABLE:
+        from .controller import STATE_CODES  # the controller imports this module
+        _STATE_TABLE.append((tuple(STATE_CODES), tuple(STATE_CODES.values())))
+    return _STATE_TABLE[0]
 
-    def fill(rt, rf, rstate, rio, head, slots):  # noqa: ANN001, ANN202
-        try:
-            kern.record_rows(rt, rf, rstate, rio, head, slots, *args)
-        except ValueError as exc:
-            raise MotionError(f"{what}: {exc}") from None
 
-    m = len(trace)
-    return ctl.recorder.record_into(m, origin + (n + 1) * period, origin + (n + m) * period,
-                                    fill)
+_STATE_TABLE: list[tuple[tuple, tuple[int, ...]]] = []
+_INT64 = np.dtype(np.int64)
 
 
 _IO_TABLE: list[np.ndarray] = []
@@ -398,12 +447,15 @@ def _io_table() -> np.ndarray:
 
 def _nc_words(ctl: Controller) -> np.ndarray:
     """Per axis, the input-level bits (bit k = AXIS_INPUTS[k]) whose contact is normally
-    closed (the controller's contact table never changes after construction)."""
+    closed. `Controller.reconfigure_axis` (logic) puts a new set in the axis's place of the
+    contact table, so the words are kept with the sets they came from (held, so compared
+    by identity first, by value otherwise) and made again when one differs."""
     cached = getattr(ctl, "_jump_nc_words", None)
-    if cached is None or cached[0] is not ctl._nc:
+    sets = tuple(ctl._nc)
+    if cached is None or cached[0] != sets:
         words = np.array([sum(1 << k for k, sig in enumerate(AXIS_INPUTS) if sig in nc)
-                          for nc in ctl._nc], dtype=np.int64)
-        cached = ctl._jump_nc_words = (ctl._nc, words)
+                          for nc in sets], dtype=np.int64)
+        cached = ctl._jump_nc_words = (sets, words)
     return cached[1]
 
 

@@ -5,8 +5,10 @@ plant, the transmission (backlash, pitch error), switches at mechanical position
 encoder as decoded by the board. `advance(t)` cuts [now, t] at scenario action times, lets
 every axis run (its plant's monotone motor pieces, every switch/index edge on them at the
 exact crossing time) and gives each edge every axis's decoded encoder count at its instant.
-The machine itself is the board: the Hardware protocol, outputs, digital I/O, E-stop, the
-scenario's actions, and the extras tests and tools read.
+The machine itself is the board: the Hardware protocol, E-stop and the scenario's actions
+here; outputs and digital I/O in boardio.py (`SimBoardIO`), the per-axis extras tests and
+tools read (effort, edge stops, readouts, pulse rule and record, decoder) in axisextras.py
+(`SimAxisExtras`), analog I/O in analog.py / analog_in.py: mixins of `SimMachine`.
 
 Signal levels are electrical: a switch's level is (active XOR contact is NC), where the
 contact type is AxisConfig.logic[signal] ("no" default). The SD/LTC pin is one input: with
@@ -15,17 +17,15 @@ no separate LTC switch placed, every SD edge is also reported as an LTC edge.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Callable, Collection, Sequence
 
 import numpy as np
 
-from openmotion.config import AxisConfig, MachineConfig
+from openmotion.config import MachineConfig
 from openmotion.errors import MotionError, check_finite, check_nonnegative
 from openmotion.hw.interface import (
     AXIS_INPUTS,
-    AXIS_OUTPUTS,
     AxisCommand,
     AxisReadback,
     InputEdge,
@@ -36,13 +36,13 @@ from openmotion.hw.interface import (
 from . import kernel
 from .analog import SimAnalogOutputs
 from .analog_in import SimAnalogInputs
+from .axisextras import SimAxisExtras
+from .boardio import SimBoardIO
 from .cubic import Cubic
-from .encoder import Decoder, EncoderWiring
+from .encoder import EncoderWiring
 from .outputs import OutputRecord, TimedOutputs
 from .piecequeue import PieceQueue
 from .pieces import JumpPiece
-from .plant import StepperPlant
-from .pulserecord import PulseRecord, check_capacity
 from .scenario import Scenario
 from .simaxis import SimAxis
 from .switches import Switch
@@ -50,7 +50,7 @@ from .switches import Switch
 SWITCH_SIGNALS = ("pel", "mel", "org", "sd", "ltc")
 
 
-class SimMachine(SimAnalogOutputs, SimAnalogInputs):
+class SimMachine(SimBoardIO, SimAxisExtras, SimAnalogOutputs, SimAnalogInputs):
     """A simulated multi-axis machine implementing `openmotion.hw.interface.Hardware`.
 
     `wiring` optionally overrides the physical encoder of some axes (axis -> EncoderWiring)
@@ -492,279 +492,7 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
         return np.array([(ax.gen.count, ax.decoder.count, kernel.level_bits(ax))
                          for ax in self._objects()], dtype=np.int64).reshape(-1, 3)
 
-    def write_output(self, axis: int | None, signal: str, level: bool) -> None:
-        if not isinstance(level, bool):
-            raise MotionError(f"level must be a bool, got {level!r}")
-        if axis is None:
-            self._set_do(self._t, signal, level)
-            return
-        ax = self._axis(axis)
-        if signal not in AXIS_OUTPUTS:
-            raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, got {signal!r}")
-        if ax.outputs[signal] == level:
-            return
-        self.output_record.add(self._t, axis, signal, level)
-        before = {s: ax.level(s) for s in ("rdy", "inp")}
-        ax.outputs[signal] = level
-        if ax.is_servo:
-            ax.plant.set_outputs(self._t, ax.gen, ax.outputs["svon"], ax.alarm,
-                                 erc=(signal == "erc" and level))
-        if ax.is_dc:
-            ax.plant.svon = ax.outputs["svon"]
-        for s, lv in before.items():
-            if ax.level(s) != lv:
-                self._pending.append((self._t, axis, s, not lv, ax.decoder.count))
-
-    def write_output_at(self, t: float, axis: int | None, signal: str, level: bool) -> None:
-        """Drive an output at time t >= now (hw.interface.TimedOutputHardware): executed
-        inside `advance` at t exactly (an axis output cuts the run there, as a scenario
-        action does, so the drive sees it at t); `output_record` shows the edge at t."""
-        t = check_finite("t", t)
-        if t < self._t:
-            raise MotionError(f"t must be >= the current time {self._t!r}, got {t!r}")
-        if not isinstance(level, bool):
-            raise MotionError(f"level must be a bool, got {level!r}")
-        if axis is None:
-            self._board_index(signal, "do", len(self._do))
-        else:
-            self._index(axis)
-            if signal not in AXIS_OUTPUTS:
-                raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, "
-                                  f"got {signal!r}")
-        if t == self._t:
-            self.write_output(axis, signal, level)
-        elif axis is None:
-            self._timed.push(t, None, signal, level)
-        else:
-            self.scenario._push(t, lambda raw: self._timed_axis_output(axis, signal, level, raw))
-
-    def write_outputs_at(self, times: Sequence[float], axis: int | None, signal: str,
-                         levels: Sequence[bool]) -> None:
-        """`write_output_at(times[k], axis, signal, levels[k])` for every k in order, in one
-        call (the compare engine hands a cycle's edges of one line this way). Everything is
-        checked first: on refusal nothing is scheduled."""
-        if len(times) != len(levels):
-            raise MotionError(f"times and levels must have one entry each, got {len(times)} "
-                              f"times and {len(levels)} levels")
-        if not all(map(math.isfinite, times)):
-            raise MotionError(f"times must be finite, got {list(times)!r}")
-        if not times:
-            return
-        first = min(times)
-        if first < self._t:
-            raise MotionError(f"t must be >= the current time {self._t!r}, got {first!r}")
-        if not set(map(type, levels)) <= {bool}:
-            raise MotionError(f"levels must be bools, got {list(levels)!r}")
-        if axis is None:
-            self._board_index(signal, "do", len(self._do))
-            now = self._t
-            if first != now:
-                self._timed.push_many(list(times), None, signal, list(levels))
-                return
-            for t, lv in zip(times, levels, strict=True):  # those at `now` go out at once
-                if t == now:
-                    self.write_output(None, signal, lv)
-            later = [k for k, t in enumerate(times) if t != now]
-            self._timed.push_many([times[k] for k in later], None, signal,
-                                  [levels[k] for k in later])
-            return
-        for t, lv in zip(times, levels, strict=True):
-            self.write_output_at(t, axis, signal, lv)
-
-    def write_outputs_many(self, times: Sequence[float], signals: Sequence[str],
-                           levels: Sequence[bool]) -> None:
-        """`write_output_at(times[k], None, signals[k], levels[k])` for every k in order, in
-        one call (the compare engine's edges of a cycle, every line at once). Everything is
-        checked first: on refusal nothing is scheduled."""
-        n = len(times)
-        if len(signals) != n or len(levels) != n:
-            raise MotionError(f"times, signals and levels must have one entry each, got "
-                              f"{n} times, {len(signals)} signals and {len(levels)} levels")
-        if not n:
-            return
-        if not all(map(math.isfinite, times)):
-            raise MotionError(f"times must be finite, got {list(times)!r}")
-        now = self._t
-        first = min(times)
-        if first < now:
-            raise MotionError(f"t must be >= the current time {now!r}, got {first!r}")
-        if not set(map(type, levels)) <= {bool}:
-            raise MotionError(f"levels must be bools, got {list(levels)!r}")
-        slots = self.__dict__.setdefault("_do_slots", {})  # (as _set_do)
-        for signal in set(signals).difference(slots):
-            slots[signal] = self._board_index(signal, "do", len(self._do))
-        if first == now:  # (a write at the present instant goes out at once)
-            for t, signal, lv in zip(times, signals, levels, strict=True):
-                self.write_output_at(t, None, signal, lv)
-            return
-        self._timed.push_flat(list(times), list(signals), list(levels))
-
-    def _timed_axis_output(self, axis: int, signal: str, level: bool, raw: list) -> None:
-        self.write_output(axis, signal, level)
-        raw.extend(self._pending)  # RDY/INP edges it caused belong to this advance
-        self._pending.clear()
-
-    def _do_due(self, t: float) -> None:
-        """The timed board writes due by t (`_set_do` of each, in their order)."""
-        slots = self.__dict__.setdefault("_do_slots", {})
-        do, add = self._do, self.output_record._edges.append
-        for tk, sig, lv in self._timed.pop_due(t):
-            k = slots.get(sig)
-            if k is None:
-                k = slots[sig] = self._board_index(sig, "do", len(do))
-            if do[k] != lv:
-                do[k] = lv
-                add((tk, None, sig, lv))
-
-    def _set_do(self, t: float, signal: str, level: bool) -> None:
-        slots = self.__dict__.setdefault("_do_slots", {})  # signal -> index, parsed once
-        k = slots.get(signal)
-        if k is None:
-            k = slots[signal] = self._board_index(signal, "do", len(self._do))
-        if self._do[k] != level:
-            self._do[k] = level
-            self.output_record.add(t, None, signal, level)
-
-    def read_input(self, signal: str) -> bool:
-        if signal == "emg":
-            return self._emg_active != self._emg_nc
-        return self._di[self._board_index(signal, "di", len(self._di))]
-
-    def command_effort(self, axis: int, t0: float, value: float) -> None:
-        """Motor effort (PWM duty in [-1, 1], clamped) of a dc_servo axis, held from t0 (>=
-        the current time) until the next call (hw.interface.EffortHardware)."""
-        ax = self._axis(axis)
-        if not ax.is_dc:
-            raise MotionError(f"axis {axis} has no effort output (drive type "
-                              f"{ax.cfg.drive.type!r}, needs 'dc_servo')")
-        ax.plant.set_effort(self._t, t0, value)
-
-    def arm_stop(self, axis: int | None, signal: str, level: bool | None,
-                 direction: int = 0) -> None:
-        """Cut the pulse output at the exact time `signal` goes to electrical `level`
-        (hw.interface.EdgeStopHardware); `level` None disarms."""
-        if level is not None and not isinstance(level, bool):
-            raise MotionError(f"level must be a bool or None, got {level!r}")
-        if direction not in (-1, 0, 1) or isinstance(direction, bool):
-            raise MotionError(f"direction must be -1, 0 or 1, got {direction!r}")
-        if axis is None:
-            if signal != "emg":
-                raise MotionError(f"signal must be 'emg' for axis None, got {signal!r}")
-            self._emg_armed = level
-            return
-        ax = self._axis(axis)
-        if signal not in AXIS_INPUTS:
-            raise MotionError(f"signal must be one of {AXIS_INPUTS}, got {signal!r}")
-        if level is None:
-            ax.armed.pop(signal, None)
-        else:
-            ax.armed[signal] = (level, direction)
-
-    def stop_time(self, axis: int) -> float | None:
-        """When an armed stop cut the pulses of `axis` in the last advance, else None."""
-        if self._stale:  # the kernel ran last: its arrays hold the stop times
-            assert self._ks is not None
-            return self._ks.stop_time(self._index(axis))
-        return self._view(axis).stop_time
-
-    # -- extras for tests and tools ---------------------------------------------------------
-    def read_output(self, axis: int | None, signal: str) -> bool:
-        """Level last written to an output (`svon`/`erc` of an axis, or `do<n>`)."""
-        if axis is None:
-            return self._do[self._board_index(signal, "do", len(self._do))]
-        ax = self._axis(axis)
-        if signal not in AXIS_OUTPUTS:
-            raise MotionError(f"signal must be one of {AXIS_OUTPUTS} for an axis, got {signal!r}")
-        return ax.outputs[signal]
-
-    def steps_lost(self, axis: int) -> int:
-        """Pulses the stepper of `axis` has lost (stalls + injected losses); 0 for a servo."""
-        p = self._view(axis).plant
-        return p.lost if isinstance(p, StepperPlant) else 0
-
-    def motor_position(self, axis: int) -> float:
-        """Motor position (command pulses) at the current time."""
-        ax = self._view(axis)
-        return ax.plant.motor(ax.gen)
-
-    def load_position(self, axis: int) -> float:
-        """Position seen by encoder and switches (after backlash and pitch error)."""
-        return self._view(axis).y
-
-    def command_position(self, axis: int) -> float:
-        """Commanded (float) position at the current time."""
-        return self._view(axis).gen.pos(self._t)
-
-    @property
-    def half_pulse(self) -> bool:
-        """True (the default) when the generators count by the half-pulse rule (see
-        `set_half_pulse`); the control layer reads it (control.home.pulserule) to rebuild counts
-        at edge times the same way."""
-        return self._ax[0].gen.half == 0.5 if self._ax else True
-
-    def set_half_pulse(self, on: bool = True) -> None:
-        """Pulse rule of every axis's generator from now on.
-
-        On (the default): pulse k leaves when the command reaches k - 1/2 going up (k + 1/2
-        going down, Klipper's step_dist/2), so the count is the command rounded to nearest,
-        within half a pulse of the ideal path (issue 4's quantization bound); a switch
-        crossed by pulse k trips when the command is at k -/+ 1/2.
-        Off: pulse k leaves when the command reaches k itself (floor going up, ceil going
-        down), so a count lags the command by up to one pulse. Use it to model a generator
-        that truncates (a DDA that only carries whole pulses, or a card compared against
-        one), or to reproduce results recorded with the earlier default.
-        Set it at standstill; counts already emitted are not changed.
-        """
-        if not isinstance(on, bool):
-            raise MotionError(f"on must be a bool, got {on!r}")
-        for ax in self._axes:
-            ax.gen.half = 0.5 if on else 0.0
-
-    def record_pulses(self, on: bool = True, capacity: int = 1_000_000) -> None:
-        """Start recording every pulse and command of every axis from now on (a fresh
-        record), or stop (on=False, the record is dropped). `capacity` bounds each axis's
-        record (monotone stretches and commands, a few per cycle); a full record stops."""
-        if not isinstance(on, bool):
-            raise MotionError(f"on must be a bool, got {on!r}")
-        cap = check_capacity(capacity)
-        for ax in self._axes:
-            g = ax.gen
-            g.record = PulseRecord(g.count, cap, self._t, g.cubic, g.tc, g.te) if on else None
-
-    def pulse_record(self, axis: int) -> PulseRecord:
-        """What `axis` emitted since `record_pulses()`: `pulses()` gives every pulse's exact
-        time and the count after it, `command_at(times)` the commanded position.
-        MotionError if not recording or if the record filled its capacity."""
-        rec = self._view(axis).gen.record
-        if rec is None:
-            raise MotionError("pulse_record needs record_pulses() first")
-        if not rec.complete:
-            raise MotionError(f"axis {axis}: the pulse record filled its capacity "
-                              f"{rec.capacity}; record a shorter run or raise capacity")
-        return rec
-
     # -- internals ----------------------------------------------------------------------------
-    def configure_decoder(self, axis: int, cfg: AxisConfig) -> None:
-        """The board's decoding of an axis's encoder input from now on, as `cfg` sets it
-        (encoder_mode x1/x2/x4 or another signal mode, swap_ab, invert_a/b/z: HSL
-        pls_iptmode, MCCL MCC_SetENCInputRate / stEncoder): the encoder itself (its
-        wiring and resolution) stays, the count keeps its value and goes on as the new
-        settings decode it (a setting that differs from the wiring misreads it)."""
-        ax = self._axis(axis)
-        if not isinstance(cfg, AxisConfig):
-            raise MotionError(f"cfg must be an AxisConfig, got {type(cfg).__name__}")
-        old = ax.decoder
-        wiring = EncoderWiring(old.kind, old.upp, old.swap != ax.cfg.swap_ab,
-                               old.flip_a != ax.cfg.invert_a, old.flip_b != ax.cfg.invert_b,
-                               ax.z_flip != ax.cfg.invert_z)
-        new = Decoder(wiring, cfg, ax.y)
-        new.q, new.last_dir, new.count = old.q, old.last_dir, old.count
-        ax.decoder, ax.z_flip = new, wiring.invert_z != cfg.invert_z
-        ax.cfg = dataclasses.replace(ax.cfg, encoder_mode=cfg.encoder_mode,
-                                     swap_ab=cfg.swap_ab, invert_a=cfg.invert_a,
-                                     invert_b=cfg.invert_b, invert_z=cfg.invert_z)
-        ax.run_start = (ax.run_start[0], ax._dec_state())
-
     def _axis(self, axis: int) -> SimAxis:
         """Axis `axis` (checked), free to change (see `_axes`)."""
         return self._axes[self._index(axis)]
@@ -772,14 +500,6 @@ class SimMachine(SimAnalogOutputs, SimAnalogInputs):
     def _view(self, axis: int) -> SimAxis:
         """Axis `axis` (checked), current, for reading only."""
         return self._objects()[self._index(axis)]
-
-    @staticmethod
-    def _board_index(signal: str, prefix: str, n: int) -> int:
-        if isinstance(signal, str) and signal.startswith(prefix) and signal[len(prefix):].isdigit():
-            k = int(signal[len(prefix):])
-            if k < n:
-                return k
-        raise MotionError(f"signal must be {prefix}0..{prefix}{n - 1}, got {signal!r}")
 
     def _run(self, ta: float, tb: float, raw: list) -> None:
         """Move every axis over [ta, tb], appending raw edges."""
