@@ -218,6 +218,8 @@ def main() -> None:
         fn = case_group if sys.argv[2] == "group" else case_runner
         print(json.dumps(fn(int(sys.argv[3]))))
         return
+    if any(not a.isdigit() for a in sys.argv[1:]):  # --help, or a typo: the usage
+        raise SystemExit(__doc__)
     ns = [int(a) for a in sys.argv[1:]] or [1000, 10_000, 50_000]
     print(f"{'feeder':7} {'N':>6} {'us/cmd':>7} {'machine s':>9} {'fill ms':>7} "
           f"{'max cycle ms':>12} {'p99 ms':>7} {'mean ms':>7} {'chain':>5} {'rests':>5} "
