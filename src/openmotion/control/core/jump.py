@@ -332,23 +332,29 @@ def record_now(ctl: Controller, n: int) -> bool:
             if c == now:  # read in this cycle: the values the controller holds
                 cnt = axes[i].counters
                 rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
-    # per axis the fields Axis.position (raw + command offset), Axis.velocity, the
-    # feedback source (internal?) and offset and the state return, as one flat list
+    return _put_row(ctl, rec, sink, n, rows, "record")
+
+
+def _put_row(ctl: Controller, rec: Any, sink: Any, n: int, rows: np.ndarray,
+             what: str) -> bool:
+    """Cycle n's row through the armed `sink`, from the readback `rows` and per axis the
+    fields Axis.position (raw + command offset), Axis.velocity, the feedback source
+    (internal?) and offset and the state return, as one flat list. A sink with no room (a
+    held run's rows come first: row_sink settles them) or disarmed (another thread read
+    the recorder since) is armed again; False when the recorder takes rows one by one."""
     vals: list = []
-    for ax in axes:
+    for ax in ctl.axes:
         c = ax.counters
         vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
     t = ctl._t_origin + n * ctl.period
     try:
         if not sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop)):
-            # no room (a held run's rows come first: row_sink settles them) or disarmed
-            # (another thread read the recorder since): armed again
             sink = _arm(ctl, rec)
             if sink is None:
                 return False
             sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop))
     except (TypeError, ValueError, OverflowError, BufferError) as exc:
-        raise MotionError(f"record: {exc}") from None
+        raise MotionError(f"{what}: {exc}") from None
     return True
 
 
@@ -359,20 +365,7 @@ def _first_row(ctl: Controller, rec: Any, n: int, readback: np.ndarray) -> bool:
     sink = rec.sink or _arm(ctl, rec)
     if sink is None:
         return False
-    vals: list = []
-    for ax in ctl.axes:
-        c = ax.counters
-        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
-    t = ctl._t_origin + n * ctl.period
-    try:
-        if not sink.put(t, vals, readback, _nc_words(ctl), bool(ctl._estop)):
-            sink = _arm(ctl, rec)  # no room or disarmed (see record_now)
-            if sink is None:
-                return False
-            sink.put(t, vals, readback, _nc_words(ctl), bool(ctl._estop))
-    except (TypeError, ValueError, OverflowError, BufferError) as exc:
-        raise MotionError(f"record_block: {exc}") from None
-    return True
+    return _put_row(ctl, rec, sink, n, readback, "record_block")
 
 
 def _block_rows(ctl: Controller, rec: Any, movers: list, ends: list[np.ndarray], n: int,
