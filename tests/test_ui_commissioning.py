@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 import ui_browser
-from ui_browser import field, goto, ready_axis, shot, status, wait_jogged, wait_status
+from ui_browser import after_pushes, field, goto, ready_axis, shot, status, wait_jogged, wait_status
 
 server = ui_browser.server
 page = ui_browser.page
@@ -165,7 +165,12 @@ def test_simulation_trips_a_limit_and_an_alarm_and_runs_faster(page):
     page.wait_for_selector(f"#sim-di-lamp-3[data-on={str(not level).lower()}]")
     page.click("#sim-di-3")
     wait_status(page, f"s.board.di[3] === {str(level).lower()}", 5)
-    page.click("#sim-speed-5")
+    # a typed factor survives the pushes until Apply (they used to put the old one back)
+    field(page, "sim-speed", "factor").fill("5")
+    page.focus("#sim-reset")
+    after_pushes(page)
+    assert field(page, "sim-speed", "factor").input_value() == "5"
+    page.click("#sim-speed-apply")
     wait_status(page, "s.speed === 5", 5)
     # the factor reached the controller and its time goes on (how much faster than the
     # wall a loaded machine runs is a figure for bench/bench_ui.py, not a test)
@@ -189,6 +194,13 @@ def test_single_block_and_feed_override(page):
     page.click("#prog-load-text")
     page.wait_for_selector("#prog-loaded:has-text('7 lines')", timeout=30_000)
     page.check("#prog-single")
+    # the setting reaches the server at once and the box keeps it once the focus has left
+    # it (it used to follow the server's old value on the next push: a Run clicked then
+    # ran the whole program without a stop)
+    wait_status(page, "s.program.single_block")
+    page.focus("#prog-listing")
+    after_pushes(page)
+    assert page.is_checked("#prog-single")
     page.click("#prog-run-btn")
     wait_status(page, "s.program.state === 'paused' && s.program.line >= 2", 10)
     first = status(page, "s.program.line")

@@ -176,6 +176,16 @@ def wait_status(pg: object, cond: str, timeout_s: float = MIN_WAIT_S) -> None:
         timeout=max(timeout_s, MIN_WAIT_S) * 1000)
 
 
+def after_pushes(pg: object, n: int = 3) -> None:
+    """Wait until `n` more status pushes reached the page (each one redraws what follows
+    the live status): what a page keeps must survive them."""
+    pg.evaluate("""(n) => new Promise((done) => {
+        const a = window.openmotion;
+        const on = () => { if (--n <= 0) { a.removeEventListener('status', on); done(); } };
+        a.addEventListener('status', on);
+    })""", n)
+
+
 def wait_jogged(pg: object, axis: str, before: float, sign: int) -> None:
     """Wait until a deadman jog moved `axis` from `before` in the direction `sign`. The
     moved position lasts; the jog's speed does not: a browser stalled for longer than the

@@ -9,6 +9,9 @@ import { panel } from "./common.js";
 
 const ROW = 17, CHUNK = 1000;
 let app, root, view, listing, spacer, rows, fsPaste, fsRun, stateBox, loadInfo, loadErr, follow, sbox, ovr, ovrNum;
+// the server's single-block setting last seen: the box follows the server only when that
+// changes (another tab, a run), never back to a value the user has just changed it from
+let sbServer;
 let autoScroll = false, total = 0, chunks = new Map(), pendingChunks = new Set(), current = 0, lastUserScroll = 0, fileName = null;
 
 export function mount(a, node) {
@@ -27,7 +30,8 @@ export function mount(a, node) {
     { name: "optional_stop", label: "Optional stop (M1)", kind: "bool", value: false },
   ]);
   sbox = el("input", { type: "checkbox", id: "prog-single" });
-  sbox.addEventListener("change", () => { if (isRunning()) app.call("program.single_block", { on: sbox.checked }).catch(() => {}); });
+  // the setting lives on the server (kept for the next run, applied to a running one)
+  sbox.addEventListener("change", () => app.call("program.single_block", { on: sbox.checked }).catch(() => {}));
   ovr = el("input", { type: "range", min: 1, max: 200, value: 100, id: "prog-ovr", style: "width:200px" });
   ovrNum = el("span", { id: "prog-ovr-val" }, "100 %");
   let ovrTimer = 0;
@@ -209,7 +213,10 @@ function update() {
       ` · ${num(p.elapsed_s || 0, 1)} s · override ${p.feed_override ?? "-"} %${p.single_block ? " · single block" : ""}`),
     p.message ? el("div", { class: "small", id: "prog-message" }, p.message) : null,
     el("progress", { max: 1, value: p.progress || 0, style: "width:100%" }));
-  if (p.single_block !== undefined && document.activeElement !== sbox) sbox.checked = Boolean(p.single_block);
+  if (p.single_block !== undefined && p.single_block !== sbServer) {
+    sbServer = p.single_block;
+    sbox.checked = Boolean(p.single_block);
+  }
   const line = p.line || 0;
   if (line !== current) {
     current = line;

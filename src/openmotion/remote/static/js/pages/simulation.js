@@ -6,6 +6,7 @@ import { FieldSet } from "../fields.js";
 import { panel, Lamps } from "./common.js";
 
 let app, root, table, fsSpeed, estopBox, cycleBox, lampsByAxis = new Map();
+let speedSeen;   // the server's speed factor last seen (the field follows its changes only)
 const SIGNALS = [["pel", "+EL"], ["mel", "-EL"], ["org", "ORG"], ["sd", "SD"]];
 
 export function mount(a, node) {
@@ -122,8 +123,10 @@ function update() {
   estopBox.textContent = s.estop ? "E-stop ACTIVE" : "E-stop released";
   estopBox.style.color = s.estop ? "var(--bad)" : "var(--ok)";
   cycleBox.textContent = `speed ×${s.speed ?? 1} · cycle busy ${s.cycle ? num(s.cycle.busy_us, 0) : "-"} µs · overruns ${s.cycle ? s.cycle.overruns : "-"} · t = ${num(s.time, 2)} s`;
-  if (document.activeElement && document.activeElement.name !== "factor" && s.speed !== undefined && fsSpeed) {
-    const input = fsSpeed.inputs.get("factor");
-    if (input && document.activeElement !== input && Number(input.value) !== s.speed) fsSpeed.set("factor", s.speed);
+  // the field follows the server's factor only when that changes (another tab, a button):
+  // a push between typing a factor and clicking Apply must not put the old one back
+  if (s.speed !== undefined && s.speed !== speedSeen && fsSpeed) {
+    speedSeen = s.speed;
+    if (document.activeElement !== fsSpeed.inputs.get("factor")) fsSpeed.set("factor", s.speed);
   }
 }
