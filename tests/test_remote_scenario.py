@@ -9,6 +9,7 @@ import time
 import pytest
 
 from openmotion.remote import RemoteError
+from openmotion.remote.status import only_clock
 from remote_kit import at_rest, client, served
 
 WAIT = 20.0   # generous: the CI machine may be loaded; the checks are on states
@@ -261,3 +262,33 @@ def test_scope_records_on_the_server_with_trigger_and_csv(machine):
     assert csv[0] == "t," + ",".join(chans) and len(csv) > 10
     with pytest.raises(RemoteError, match="quantity"):
         m.call("scope.configure", channels=["x.nonsense"])
+
+
+def test_at_rest_the_pushes_slow_to_idle_hz_and_a_change_still_comes(machine):
+    svc, m = machine
+    with client(m.server) as c:
+        t0 = time.monotonic()
+        c.subscribe(rate_hz=50, idle_hz=1)
+        time.sleep(1.5)
+        with c._cond:
+            pushes = [n["params"][0] for n in c.notifications
+                      if n["method"] == "notify_status_update"]
+        # only the clock moved: one push a second at most (50 a second without idle_hz),
+        # each with nothing but the clock
+        assert len(pushes) <= (time.monotonic() - t0) / 0.99 + 1, len(pushes)
+        assert all(only_clock(d) for d in pushes), pushes
+        c.call("axis.servo", axis="z", on=True)
+        assert c.wait(lambda s: s["axes"]["z"]["servo"], WAIT)
+        # the merged diffs give the server's status (the skipped ones held only the clock)
+        assert c.wait(lambda s: s["axes"] == m.call("status.get")["axes"], WAIT)
+    with pytest.raises(RemoteError, match="idle_hz must be <= 20"):
+        m.call("status.subscribe", rate_hz=20, idle_hz=30)
+
+
+def test_only_clock_tells_a_diff_of_the_clock_from_a_change():
+    assert only_clock({"time": 1.0, "cycles": 1000, "scope": {"next": 1000},
+                       "cycle": {"busy_us": 30.0}})
+    assert only_clock({})
+    assert not only_clock({"time": 1.0, "axes": {"x": {"command": 1}}})
+    assert not only_clock({"time": 1.0, "scope": {"next": 5, "running": False}})
+    assert not only_clock({"program": {"line": 3}})

@@ -178,9 +178,13 @@ class RemoteClient:
             return self._pending.pop(key)[0]
 
     # ------------------------------------------------------------------ helpers
-    def subscribe(self, rate_hz: float = 20.0, fields: list[str] | None = None) -> str:
-        """Subscribe to status pushes; `status` is kept current from then on."""
+    def subscribe(self, rate_hz: float = 20.0, fields: list[str] | None = None,
+                  idle_hz: float | None = None) -> str:
+        """Subscribe to status pushes; `status` is kept current from then on. `idle_hz`:
+        while only the clock moves, pushes at most this often (default `rate_hz`)."""
         params: dict[str, Any] = {"rate_hz": rate_hz}
+        if idle_hz is not None:
+            params["idle_hz"] = idle_hz
         if fields is not None:
             params["fields"] = fields
         res = self.call("status.subscribe", **params)

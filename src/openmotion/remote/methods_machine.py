@@ -252,9 +252,12 @@ def _rate(p: Params) -> float:
 @method("status.subscribe", command=False)
 def status_subscribe(ctx: Context, p: Params) -> dict[str, Any]:
     rate = _rate(p)
+    idle = p.number("idle_hz", rate, lo=1.0, hi=rate)
+    if not math.isfinite(idle):
+        raise MotionError("idle_hz must be finite")
     fields = read_fields(p)
     p.done()
-    sub, snap = ctx.conn.subscribe_status(rate, fields)
+    sub, snap = ctx.conn.subscribe_status(rate, fields, idle)
     return {"subscription": sub, "status": snap}
 
 

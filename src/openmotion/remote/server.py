@@ -48,7 +48,7 @@ from .protocol import (
     response,
 )
 from .service import MachineService
-from .status import diff, snapshot
+from .status import diff, only_clock, snapshot
 
 log = logging.getLogger("openmotion.remote")
 
@@ -105,10 +105,13 @@ class Connection:
         self._subs[sid] = asyncio.run_coroutine_threadsafe(coro, self.loop)
         return sid
 
-    def subscribe_status(self, rate: float, fields: tuple[str, ...]
-                         ) -> tuple[str, dict[str, Any]]:
+    def subscribe_status(self, rate: float, fields: tuple[str, ...],
+                         idle_rate: float | None = None) -> tuple[str, dict[str, Any]]:
+        """Status diffs at `rate`; while only the clock moved (`only_clock`), at most at
+        `idle_rate` (default `rate`)."""
         snap = snapshot(self.server.svc, fields)
-        return self._add(self._status_loop(rate, fields, snap)), snap
+        idle = rate if idle_rate is None else min(idle_rate, rate)
+        return self._add(self._status_loop(rate, fields, snap, idle)), snap
 
     def subscribe_scope(self, rate: float) -> tuple[str, int]:
         nxt = self.server.svc.scope.info()["next"]
@@ -135,8 +138,10 @@ class Connection:
             yield
 
     async def _status_loop(self, rate: float, fields: tuple[str, ...],
-                           last: dict[str, Any]) -> None:
+                           last: dict[str, Any], idle_rate: float) -> None:
         svc = self.server.svc
+        idle_s = 1.0 / idle_rate - 0.5 / rate   # the tick nearest the idle period
+        pushed = self.loop.time()
         async for _ in self._ticks(rate):
             try:
                 snap = snapshot(svc, fields)
@@ -144,8 +149,11 @@ class Connection:
                 log.debug("status snapshot failed: %r", exc)
                 continue
             d = diff(last, snap)
+            if d and only_clock(d) and self.loop.time() - pushed < idle_s:
+                continue   # the next diff still holds this one's changes (from `last`)
             last = snap
             if d:
+                pushed = self.loop.time()
                 await self.send(notification("notify_status_update",
                                              [d, snap.get("time", svc.ctl.time)]))
 

@@ -101,6 +101,22 @@ def diff(old: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+#: what changes every cycle at rest: the clock, the cycle statistics, the scope's count
+CLOCK_FIELDS = frozenset(("time", "cycles", "cycle"))
+
+
+def only_clock(d: dict[str, Any]) -> bool:
+    """True when diff `d` holds nothing but the clock (CLOCK_FIELDS and the scope's sample
+    count `scope.next`): the machine is at rest as far as a page can show."""
+    for k, v in d.items():
+        if k == "scope":
+            if set(v) - {"next"}:
+                return False
+        elif k not in CLOCK_FIELDS:
+            return False
+    return True
+
+
 def merge(base: dict[str, Any], d: dict[str, Any]) -> dict[str, Any]:
     """Apply a diff to a snapshot in place (the client's side of `diff`)."""
     for k, v in d.items():

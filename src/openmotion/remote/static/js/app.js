@@ -141,7 +141,8 @@ class App extends EventTarget {
   async _onOpen() {
     try {
       await this.reloadConfig();
-      const sub = await this.call("status.subscribe", { rate_hz: 20 });
+      // 20 pushes a second while anything moves or changes, 4 while only the clock does
+      const sub = await this.call("status.subscribe", { rate_hz: 20, idle_hz: 4 });
       this.status = sub.status;
       this._statusChanged();
       this.dispatchEvent(new CustomEvent("connected"));
