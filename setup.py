@@ -2,8 +2,8 @@
 openmotion._compare, src/openmotion/_kernel_compare.c + _compare_*.c: the compare engine's
 solvers, and
 openmotion._profile, src/openmotion/_profile.c: the jerk-limited profile builder, and
-openmotion._corner, src/openmotion/_corner.c: the line-line corner blend, + _chain.c: the
-chain planner's passes); the rest
+openmotion._corner, src/openmotion/_corner.c: the module, + _blend.c: the line-line corner
+blends, + _chain.c: the chain planner's passes); the rest
 is declared in pyproject.toml. Plain C against the CPython API: no build tool beyond setuptools.
 -ffp-contract=off keeps the compiler from fusing a*b+c, so the kernel's floats are
 bit-identical to the Python path's."""
@@ -32,6 +32,7 @@ setup(ext_modules=[Extension("openmotion._kernel",
                    Extension("openmotion._profile", ["src/openmotion/_profile.c"],
                              extra_compile_args=flags),
                    Extension("openmotion._corner",
-                             ["src/openmotion/_corner.c", "src/openmotion/_chain.c"],
-                             depends=["src/openmotion/_chain.h"],
+                             ["src/openmotion/_corner.c", "src/openmotion/_chain.c",
+                              "src/openmotion/_blend.c"],
+                             depends=["src/openmotion/_chain.h", "src/openmotion/_blend.h"],
                              extra_compile_args=flags)])

@@ -32,3 +32,24 @@ def blend_lines(first: Line, second: Line, t: float, frac: float = 0.5):
     arc = Arc3D.from_frame(centre, e1, e2, radius, turn, start=a_start, end=a_end)
     dev = d * (1.0 - sin_t) / cos_t
     return Line(first.start, a_start), arc, Line(a_end, second.end), dev
+
+
+def blend_run(first, lines, tol: float, accel=None, feed=None):
+    """Slow oracle of path/blend.py `_line_run`: blend_corner corner after corner (each
+    corner's first line the previous corner's trimmed second), a blend kept only where
+    groupstream._blend_pays says it pays (no corner velocity) when accel and feed are
+    given; what the group's `_blend_new` did for every corner before the compiled run."""
+    from openmotion.control.groups.groupstream import _blend_pays
+    from openmotion.path import blend_corner
+
+    out = []
+    prev = first
+    for k, el in enumerate(lines):
+        b = blend_corner(prev, el, tol)
+        if b is not None and accel is not None:
+            trims = (float(prev.length - b.first.length), float(el.length - b.second.length))
+            if not _blend_pays(b, accel[k], feed[k], 0.0, trims):
+                b = None
+        out.append(None if b is None else (b.first, b.arc, b.second))
+        prev = el if b is None else b.second
+    return out

@@ -23,19 +23,19 @@ def _stream(n: int) -> tuple[Controller, Group, dict[str, int]]:
     g.enable_blend(0.005)
     pts = iter([(0.05 * k, 0.5 * math.sin(k / 15.0)) for k in range(1, n + 1)])
     count = {"new": 0, "join_new": 0}
-    new = g._blend_new
+    run = g._blend_run  # every corner the group blends goes through it
     join = g._join_queued
 
-    def blend_new(*a):  # noqa: ANN002, ANN202
-        count["new"] += 1
-        return new(*a)
+    def blend_run(prev, cmds):  # noqa: ANN001, ANN202
+        count["new"] += len(cmds)
+        return run(prev, cmds)
 
     def join_queued(t: float) -> None:
         before = count["new"]
         join(t)
         count["join_new"] += count["new"] - before
 
-    g._blend_new = blend_new  # type: ignore[method-assign]
+    g._blend_run = blend_run  # type: ignore[method-assign]
     g._join_queued = join_queued  # type: ignore[method-assign]
 
     def feed(c: Controller, t: float) -> None:

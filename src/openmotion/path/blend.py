@@ -25,6 +25,7 @@ Junction speed (grbl/Klipper, anchors b1), with Klipper's half-angle phi (cos(ph
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -118,25 +119,88 @@ def blend_corner(first: PathElement, second: PathElement, tolerance: float, *,
 def _line_line(first: Line, second: Line, t: float, frac: float) -> Blend | None:
     """The closed form of the module doc for two lines (None for a straight corner or a
     reversal), computed by the compiled helper
-    (`openmotion._corner`, one call per corner: a streaming job rounds every corner) and
-    wrapped in the elements. tests/oracle_blend.py keeps the numpy construction this
-    repeats (equal within rounding)."""
+    (`openmotion._corner`, one call per corner) and wrapped in the elements.
+    tests/oracle_blend.py keeps the numpy construction this repeats (equal within
+    rounding)."""
     dim = first.dim
     if dim > _corner_max_dim:
         return _line_line_numpy(first, second, t, frac)
-    out = np.empty((16, dim))
+    out = np.empty((_ROWS, dim))
     res = _corner.line_blend(out, first.start, first.end, second.end, first.direction,
                              second.direction, first.length, second.length, t, frac)
     if res is None:
         return None
     out.flags.writeable = False
-    (centre, e1, e2, a_start, a_end, via, lin, t_start, t_end, helix, mat, aaw, u1, au1,
-     u2, au2) = out
     len1, len2, radius, turn, length, kappa, dev = res
+    first_, arc, second_ = _pieces(list(out), first.start, second.end, len1, len2, radius,
+                                   turn, length, kappa)
+    return Blend(first_, arc, second_, dev)
+
+
+#: Rows per corner of the compiled blend (src/openmotion/_blend.c, its module doc).
+_ROWS = 15
+_zeros: dict[int, np.ndarray] = {}
+
+
+def _pieces(rows: list[np.ndarray], start: np.ndarray, end: np.ndarray, len1: float,
+            len2: float, radius: float, turn: float, length: float, kappa: float
+            ) -> tuple[Line, Arc3D, Line]:
+    """The trimmed first line (from `start`), the blend arc and the trimmed second line (to
+    `end`) around the rows of one compiled corner (read-only views)."""
+    (centre, e1, e2, a_start, a_end, via, lin, t_start, t_end, mat, aaw, u1, au1, u2,
+     au2) = rows
+    helix = _zeros.get(centre.size)
+    if helix is None:  # one read-only zero vector per axis count: no blend arc is a helix
+        helix = _zeros[centre.size] = np.zeros(centre.size)
+        helix.flags.writeable = False
     arc = Arc3D._blend_arc(centre, e1, e2, radius, turn, helix, a_start, a_end, via, length,
                            lin, t_start, t_end, kappa, mat, aaw)
-    return Blend(Line._planned(first.start, a_start, len1, u1, au1), arc,
-                 Line._planned(a_end, second.end, len2, u2, au2), dev)
+    return (Line._planned(start, a_start, len1, u1, au1), arc,
+            Line._planned(a_end, end, len2, u2, au2))
+
+
+def _line_run(first: Line, lines: Sequence[Line], tol: float,
+              frac: float = BLEND_DIST_FRACTION, accel: Sequence[float] | None = None,
+              feed: Sequence[float] | None = None
+              ) -> list[tuple[Line, Arc3D, Line] | None]:
+    """The corners first -> lines[0] -> lines[1] -> ... rounded one after the other, each
+    corner's first line the second of the one before (trimmed when that one was rounded):
+    per corner (trimmed first, arc, trimmed second) or None, what `blend_corner` gives
+    corner after corner, bit for bit. For lines a planner made itself (1 to 64 axes,
+    tol > 0, frac in (0, 0.5]: not checked again); the run stops before the first line
+    that does not start exactly where the line before it ends (the result is shorter: that
+    corner is `blend_corner`'s, with its gap check). With `accel` and `feed` (per corner)
+    a blend is kept only where it pays (groupstream._blend_pays without a corner
+    velocity). The whole run in one compiled call (openmotion._corner.line_run)."""
+    m = len(lines)
+    dim = first.start.size
+    starts = np.array([ln.start for ln in lines])
+    ends = np.array([first.end, *[ln.end for ln in lines]])
+    dirs = np.array([first.direction, *[ln.direction for ln in lines]])
+    lengths = np.array([first.length, *[ln.length for ln in lines]])
+    out = np.empty((m * _ROWS, dim))
+    scal = np.empty((m, 8))
+    acc = None if accel is None else np.array(accel, dtype=np.float64)
+    fd = None if feed is None else np.array(feed, dtype=np.float64)
+    done = _corner.line_run(out, scal, first.start, starts, ends, dirs, lengths, acc, fd,
+                            tol, frac)
+    out.flags.writeable = False
+    rows = list(out)
+    result: list[tuple[Line, Arc3D, Line] | None] = []
+    start = first.start
+    k = 0
+    for ln, (keep, len1, len2, radius, turn, length, kappa, _) in zip(
+            lines[:done], scal[:done].tolist(), strict=True):
+        if keep:
+            b = _pieces(rows[k:k + _ROWS], start, ln.end, len1, len2, radius, turn, length,
+                        kappa)
+            start = b[2].start
+        else:
+            b = None
+            start = ln.start
+        result.append(b)
+        k += _ROWS
+    return result
 
 
 def _line_line_numpy(first: Line, second: Line, t: float, frac: float) -> Blend | None:

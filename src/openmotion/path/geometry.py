@@ -210,11 +210,8 @@ class Line:
         """A line whose length and direction (and |direction|) a planner computed itself
         as `between` does (path/blend.py's compiled corner): read-only arrays, not checked."""
         obj = object.__new__(cls)
-        object.__setattr__(obj, "start", start)
-        object.__setattr__(obj, "end", end)
-        object.__setattr__(obj, "length", length)
-        object.__setattr__(obj, "direction", direction)
-        obj.__dict__["_abs_dir"] = abs_direction
+        obj.__dict__.update(start=start, end=end, length=length, direction=direction,
+                            _abs_dir=abs_direction)
         return obj
 
     @property

@@ -13,6 +13,7 @@ PREBLEND_PER_CYCLE, PREBLEND_AHEAD) live in groupexec.py and are read there at e
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections import deque
@@ -23,7 +24,8 @@ import numpy as np
 
 from ...errors import InfeasibleError, MotionError
 from ...path import blend_corner, speed_caps
-from ...path.geometry import PathElement
+from ...path.blend import _corner_max_dim, _line_run
+from ...path.geometry import Line, PathElement
 from ...path.lookahead import _element_limits as element_limits
 from ...path.smoothing import jerk_window
 from ...profile.segments import Profile
@@ -77,12 +79,11 @@ class ChainStream:
     def _take(self, tj: float, have: float, cmds: list[_Cmd]) -> list[_Cmd]:
         """Pop the queued commands that join a chain with `have` length ahead until it
         holds twice its reach (Klipper's lazy flush: the rest waits in the queue)."""
-        from .groupexec import MAX_JOIN  # (read at each use: see the module doc)
-
+        max_join = _groupexec().MAX_JOIN  # (read at each use: see the module doc)
         out: list[_Cmd] = []
         reach = max(self._reach(c, tj) for c in cmds[-1:]) if cmds else 0.0
         sv = cmds[0].str_vel if cmds else 0.0
-        while self._queue and len(out) < MAX_JOIN and self._joins(tj, self._queue[0], sv):
+        while self._queue and len(out) < max_join and self._joins(tj, self._queue[0], sv):
             reach = max(reach, self._reach(self._queue[0], tj))
             if have >= 2.0 * reach:
                 break
@@ -176,19 +177,34 @@ class ChainStream:
                   ) -> tuple[PathElement | None, list[PathElement], list[int]]:
         """The commands' elements (and owners), each corner blended where that pays; with
         `prev` (the last element before them) the first corner too: `prev` comes back
-        trimmed by that blend (or unchanged)."""
+        trimmed by that blend (or unchanged). A corner `_preblend` prepared goes through
+        `_blend_pair`, each stretch of the others through one `_blend_run`."""
+        cache = self._pre if pre is None else pre
         els: list[PathElement] = [prev] if prev is not None else []
         owners: list[int] = [-1] if prev is not None else []
-        for c in cmds:
-            el = c.elements[0]
-            b = self._blend_pair(els[-1], el, c, pre) if els else None
-            if b is not None:
-                els[-1] = b[0]
-                els.append(b[1])
-                owners.append(c.index)
-                el = b[2]
-            els.append(el)
-            owners.append(c.index)
+        i, n = 0, len(cmds)
+        if prev is None and cmds:
+            els.append(cmds[0].elements[0])
+            owners.append(cmds[0].index)
+            i = 1
+        while i < n:
+            if cmds[i].index in cache:
+                j = i + 1
+                got = [self._blend_pair(els[-1], cmds[i].elements[0], cmds[i], pre)]
+            else:  # (no prepared corner: what _blend_pair would compute, in one run)
+                j = i + 1
+                while j < n and cmds[j].index not in cache:
+                    j += 1
+                got = self._blend_run(els[-1], cmds[i:j])
+            for c, b in zip(cmds[i:j], got, strict=True):
+                if b is None:
+                    els.append(c.elements[0])
+                    owners.append(c.index)
+                else:
+                    els[-1] = b[0]
+                    els += b[1:]
+                    owners += (c.index, c.index)
+            i = j
         if prev is None:
             return None, els, owners
         return els[0], els[1:], owners[1:]
@@ -207,14 +223,46 @@ class ChainStream:
         hit = (self._pre if pre is None else pre).pop(cmd.index, None)
         if hit is not None and hit[0] is prev and hit[1] is el and hit[2] == self._blend_key():
             return hit[3]
-        return self._blend_new(prev, el, cmd)
+        return self._blend_run(prev, [cmd])[0]
+
+    def _blend_run(self, prev: PathElement, cmds: list[_Cmd]
+                   ) -> list[tuple[PathElement, PathElement, PathElement] | None]:
+        """`_blend_new` corner after corner: prev -> cmds[0]'s element -> cmds[1]'s ...,
+        each corner's first element the second of the corner before (trimmed when that one
+        was blended); bit for bit the same. Each stretch of lines (that follow one another,
+        no corner velocity) in one compiled call (path/blend.py `_line_run`)."""
+        if not (self._blend and self._blend_tol > 0.0):
+            return [None] * len(cmds)
+        out: list[tuple[PathElement, PathElement, PathElement] | None] = []
+        fast = self._corner_velocity == 0.0 and prev.start.size <= _corner_max_dim
+        single = False  # the next corner by _blend_new (its line starts off the corner)
+        i, n = 0, len(cmds)
+        while i < n:
+            j = i
+            if fast and not single and type(prev) is Line:  # the stretch of lines from i
+                while j < n and type(cmds[j].elements[0]) is Line:
+                    j += 1
+            if j > i:
+                run = cmds[i:j]
+                amin = self._amin(self._caps()[1])
+                got = _line_run(prev, [c.elements[0] for c in run], self._blend_tol,
+                                accel=[min(c.accel, c.dec, amin) for c in run],
+                                feed=[c.feed for c in run])
+                single = len(got) < len(run)
+            else:
+                got = [self._blend_new(prev, cmds[i].elements[0], cmds[i])]
+                single = False
+            if got:
+                out += got
+                i += len(got)
+                prev = cmds[i - 1].elements[0] if got[-1] is None else got[-1][2]
+        return out
 
     def _preblend(self) -> None:
         """A quiet cycle of a running chain: blend the next few queued corners ahead of the
         join that will take them, starting from the chain's last element, so the join's
         work (about 40 % of it was blending) is spread over the cycles before it."""
-        from .groupexec import PREBLEND_AHEAD, PREBLEND_PER_CYCLE
-
+        gx = _groupexec()
         r = self._run
         q = self._queue
         pre = self._pre
@@ -237,11 +285,13 @@ class ChainStream:
         if i == 0:
             pre.clear()  # nothing prepared, or stale: the chain's end changed
         key = self._blend_key()
-        for c in itertools.islice(q, i, min(len(q), i + PREBLEND_PER_CYCLE, PREBLEND_AHEAD)):
+        run: list[_Cmd] = []
+        for c in itertools.islice(q, i, min(len(q), i + gx.PREBLEND_PER_CYCLE, gx.PREBLEND_AHEAD)):
             if not self._joins(r.plan.tj, c, r.plan.limits.str_vel):
                 break
+            run.append(c)
+        for c, b in zip(run, self._blend_run(prev, run), strict=True):
             el = c.elements[0]
-            b = self._blend_new(prev, el, c)
             pre[c.index] = (prev, el, key, b)
             if b is not None and r.plan.tj == 0.0:
                 # the trimmed prev belongs to the command before c, the blend arc to c
@@ -274,10 +324,7 @@ class ChainStream:
         if b is None:
             return None
         vmax, amax = self._caps()
-        memo = self.__dict__.get("_amin_memo")  # min(amax), kept while amax is the same
-        if memo is None or memo[0] is not amax:
-            memo = self._amin_memo = (amax, float(np.min(amax)))
-        accel = min(cmd.accel, cmd.dec, memo[1])
+        accel = min(cmd.accel, cmd.dec, self._amin(amax))
         v_corner = 0.0
         if self._corner_velocity > 0.0 and prev.length > 0.0 and el.length > 0.0:
             corner = self._corner_limits()
@@ -289,6 +336,22 @@ class ChainStream:
         if not _blend_pays(b, accel, cmd.feed, v_corner, trims):
             return None
         return b.first, b.arc, b.second
+
+    def _amin(self, amax: np.ndarray) -> float:
+        """min(amax), kept while amax is the same object (settings replace it)."""
+        memo = self.__dict__.get("_amin_memo")
+        if memo is None or memo[0] is not amax:
+            memo = self._amin_memo = (amax, float(np.min(amax)))
+        return memo[1]
+
+
+@functools.cache
+def _groupexec() -> Any:
+    """The groupexec module (which imports this one), for its constants: imported once at
+    the first use (an import statement in a method costs microseconds at every call)."""
+    from . import groupexec
+
+    return groupexec
 
 
 def _peak_speed(p: Profile) -> float:
