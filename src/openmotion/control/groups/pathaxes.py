@@ -72,12 +72,12 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
     jj = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
     # on a line the axis motion is u*s(t) exactly: take a and j from s(t), not the fit
-    ss = sp.sample(t[:-1])
+    # (s(t) at the knots but the last: smp.a, smp.j are the samples of t[:-1] plus one)
     straight = table.curvature[km] == 0.0
     if np.any(straight):
         u = table.line_tangents(km[straight])
-        a0[straight] = ss.a[straight][:, None] * u
-        jj[straight] = ss.j[straight][:, None] * u
+        a0[straight] = smp.a[:-1][straight][:, None] * u
+        jj[straight] = smp.j[:-1][straight][:, None] * u
     out = []
     dts = np.diff(t)
     labels = ("path",) * len(dts)
