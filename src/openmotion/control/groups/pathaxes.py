@@ -65,8 +65,12 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
     # speed (junction deviation) the velocity jumps between two intervals, not inside one
     s_mid = sp.sample(0.5 * (t[:-1] + t[1:])).p
     km = np.clip(np.searchsorted(cum, s_mid, side="right") - 1, 0, n_el - 1)
-    v0 = table.tangent(km, np.clip(s[:-1] - cum[km], 0.0, lens[km])) * sd[:-1][:, None]
-    v1 = table.tangent(km, np.clip(s[1:] - cum[km], 0.0, lens[km])) * sd[1:][:, None]
+    # (the tangents at both ends of every interval in one evaluation: row by row the same)
+    m = len(km)
+    kk = np.concatenate((km, km))
+    tg = table.tangent(kk, np.clip(np.concatenate((s[:-1], s[1:])) - cum[kk], 0.0, lens[kk]))
+    v0 = tg[:m] * sd[:-1][:, None]
+    v1 = tg[m:] * sd[1:][:, None]
     h = np.diff(t)[:, None]
     dp = np.diff(pos, axis=0)
     a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
