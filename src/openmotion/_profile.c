@@ -551,6 +551,9 @@ done:
 /* _profile_sample.c */
 PyObject *om_profile_sample(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 extern const char om_profile_sample_doc[];
+/* _profile_knots.c */
+PyObject *om_axis_knots(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+extern const char om_axis_knots_doc[];
 
 static PyMethodDef methods[] = {
     {"phase_times", (PyCFunction)(void (*)(void))py_phase_times, METH_FASTCALL, phase_times_doc},
@@ -562,6 +565,8 @@ static PyMethodDef methods[] = {
      phases_many_doc},
     {"sample", (PyCFunction)(void (*)(void))om_profile_sample, METH_FASTCALL,
      om_profile_sample_doc},
+    {"axis_knots", (PyCFunction)(void (*)(void))om_axis_knots, METH_FASTCALL,
+     om_axis_knots_doc},
     {NULL, NULL, 0, NULL},
 };
 
