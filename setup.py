@@ -1,7 +1,8 @@
 """Build of the compiled inner loops (openmotion._kernel, src/openmotion/_kernel*.c, and
 openmotion._compare, src/openmotion/_kernel_compare.c + _compare_*.c: the compare engine's
 solvers, and
-openmotion._profile, src/openmotion/_profile.c: the jerk-limited profile builder, and
+openmotion._profile, src/openmotion/_profile.c: the jerk-limited profile builder (+
+_profile_sample.c: Profile.sample, _profile_knots.c: a chain's axis knots), and
 openmotion._corner, src/openmotion/_corner.c: the module, + _blend.c: the line-line corner
 blends, + _chain.c: the chain planner's passes); the rest
 is declared in pyproject.toml. Plain C against the CPython API: no build tool beyond setuptools.
@@ -29,7 +30,9 @@ setup(ext_modules=[Extension("openmotion._kernel",
                                 for job in ("track", "window", "vector", "lines", "scan")],
                              depends=["src/openmotion/_compare.h"],
                              extra_compile_args=flags),
-                   Extension("openmotion._profile", ["src/openmotion/_profile.c"],
+                   Extension("openmotion._profile", ["src/openmotion/_profile.c",
+                                                   "src/openmotion/_profile_sample.c",
+                                                   "src/openmotion/_profile_knots.c"],
                              extra_compile_args=flags),
                    Extension("openmotion._corner",
                              ["src/openmotion/_corner.c", "src/openmotion/_chain.c",

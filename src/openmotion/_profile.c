@@ -548,6 +548,13 @@ done:
     return result;
 }
 
+/* _profile_sample.c */
+PyObject *om_profile_sample(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+extern const char om_profile_sample_doc[];
+/* _profile_knots.c */
+PyObject *om_axis_knots(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+extern const char om_axis_knots_doc[];
+
 static PyMethodDef methods[] = {
     {"phase_times", (PyCFunction)(void (*)(void))py_phase_times, METH_FASTCALL, phase_times_doc},
     {"duration", (PyCFunction)(void (*)(void))py_duration, METH_FASTCALL, duration_doc},
@@ -556,6 +563,10 @@ static PyMethodDef methods[] = {
     {"synced", (PyCFunction)(void (*)(void))py_synced, METH_FASTCALL, synced_doc},
     {"phases_many", (PyCFunction)(void (*)(void))py_phases_many, METH_FASTCALL,
      phases_many_doc},
+    {"sample", (PyCFunction)(void (*)(void))om_profile_sample, METH_FASTCALL,
+     om_profile_sample_doc},
+    {"axis_knots", (PyCFunction)(void (*)(void))om_axis_knots, METH_FASTCALL,
+     om_axis_knots_doc},
     {NULL, NULL, 0, NULL},
 };
 

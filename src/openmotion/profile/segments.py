@@ -23,6 +23,11 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import check_finite
 from ..limits import as_array, check_pulses
 
+try:  # the compiled sampler (setup.py builds it; absent in an unbuilt source tree)
+    from .. import _profile as _c
+except ImportError:  # pragma: no cover - depends on the build
+    _c = None
+
 Array = NDArray[np.float64]
 
 
@@ -86,6 +91,25 @@ class Profile:
         """Position, velocity, acceleration and jerk at time(s) `t` (vectorized)."""
         fast = isinstance(t, np.ndarray) and t.dtype == np.float64
         ts = t if fast else as_array("t", t, None)
+        if _c is not None and self.t0.size:
+            # compiled: the same floats as `_sample_numpy` (_profile_sample.c)
+            shape = ts.shape
+            flat = np.ascontiguousarray(ts.reshape(-1))
+            m = flat.size
+            p, v, a, j = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+            st, en = self.start, self.end
+            try:
+                _c.sample(self.t0, self.p0, self.v0, self.a0, self.j, flat, p, v, a, j,
+                          st.p, st.v, en.p, en.v, self.duration)
+            except (TypeError, ValueError, BufferError):
+                pass  # columns that are not contiguous float64: the numpy version
+            else:
+                return Samples(p.reshape(shape), v.reshape(shape), a.reshape(shape),
+                               j.reshape(shape))
+        return self._sample_numpy(ts)
+
+    def _sample_numpy(self, ts: Array) -> Samples:
+        """`sample` with numpy (the oracle of the compiled version), ts float64."""
         shape = ts.shape
         ts = ts.reshape(-1)
         p = np.empty_like(ts)

@@ -418,6 +418,11 @@ class Axis(AxisRunningCommands, AxisEngine):
         """
         motion, start_p = self._prepare_profile(profile, stop_accel, stop_jerk,
                                                 replace_running, str_vel)
+        self._start_vetted(motion, start_p)
+
+    def _start_vetted(self, motion: ActiveMotion, start_p: float) -> None:
+        """Start a motion `_prepare_profile` vetted in this cycle (a group vets every axis
+        with `_vet_profile`, then starts them all without planning each twice)."""
         if self._motion is not None or self._state is S.HOMING:
             # homing moves keep the axis in Homing; a replaced motion keeps its state
             self._motion = motion
@@ -434,6 +439,13 @@ class Axis(AxisRunningCommands, AxisEngine):
         """Raise exactly as `run_profile` would, changing nothing (a group checks every
         axis's new motion before it starts any of them)."""
         self._prepare_profile(profile, stop_accel, stop_jerk, replace_running, str_vel)
+
+    def _vet_profile(self, profile: Profile, *, stop_accel: float, stop_jerk: float,
+                     replace_running: bool = False,
+                     str_vel: float = 0.0) -> tuple[ActiveMotion, float]:
+        """`check_profile` that returns the vetted motion and its start position, for
+        `_start_vetted` in the same cycle (lock held by the caller)."""
+        return self._prepare_profile(profile, stop_accel, stop_jerk, replace_running, str_vel)
 
     def _prepare_profile(self, profile: Profile, stop_accel: float, stop_jerk: float,
                          replace_running: bool,

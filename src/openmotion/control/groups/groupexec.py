@@ -371,17 +371,19 @@ class GroupEngine(ChainStream, GroupFaults, AsyncJoin, LookaheadSettings):
             args.append((a, p, {"stop_accel": acc, "stop_jerk": acc * 1000.0,
                                 "replace_running": a.motion is not None,
                                 "str_vel": str_vel * float(ppu)}))
-        for a, p, kw in args:
-            try:
-                a.check_profile(p, **kw)
-            except GroupError:
-                raise
-            except MotionError as exc:
-                raise GroupError(ERR_LIMIT if "SL" in str(exc) or "limit" in str(exc)
-                                 else ERR_AXIS_STATE, f"axis {a.name}: {exc}") from exc
-        with self._commanding():
+        vetted = []
+        with self._ctl._lock:  # the vetted motions start in the cycle they were vetted in
             for a, p, kw in args:
-                a.run_profile(p, **kw)
+                try:
+                    vetted.append((a, a._vet_profile(p, **kw)))
+                except GroupError:
+                    raise
+                except MotionError as exc:
+                    raise GroupError(ERR_LIMIT if "SL" in str(exc) or "limit" in str(exc)
+                                     else ERR_AXIS_STATE, f"axis {a.name}: {exc}") from exc
+            with self._commanding():
+                for a, (motion, start_p) in vetted:
+                    a._start_vetted(motion, start_p)
 
     def _replan(self, r: _Run, *, hold: bool) -> None:
         """Re-plan the running chain from now: a hold (to rest) or a new override."""

@@ -3,7 +3,9 @@
 Step 3 of pathexec.py (see its module doc): knots every interpolation period plus every
 break of s(t) and every element boundary s(t) crosses; positions from the elements, velocities
 tangent*ds/dt; on lines acceleration and jerk from s(t) exactly; the last knot is the chain's
-end point bit for bit.
+end point bit for bit. The knots' positions and coefficients of a chain of lines and arcs
+are one compiled call (`_profile.axis_knots`, src/openmotion/_profile_knots.c, the same
+floats as `_knots_numpy`, which is its test oracle and evaluates other element kinds).
 """
 
 from __future__ import annotations
@@ -15,10 +17,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ... import _corner
-from ...profile.segments import Profile, State
+from ...profile.segments import Profile, Samples, State
+
+try:  # the compiled knots (setup.py builds them; absent in an unbuilt source tree)
+    from ... import _profile
+except ImportError:  # pragma: no cover - depends on the build
+    _profile = None
 
 if TYPE_CHECKING:
     from .pathexec import Chain
+    from .pathpoints import ElementTable
 
 
 def axis_profiles(chain: Chain, sp: Profile, period: float,
@@ -51,9 +59,52 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
         return [Profile(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), 0.0,
                         State(float(x), 0.0, 0.0), State(float(x), 0.0, 0.0), (),
                         np.zeros(0)) for x in p0]
+    table = chain.table  # every element's parameters as arrays (pathpoints.py)
+    # s(t) at the interval midpoints: the element an interval lies on
+    s_mid = sp.sample(0.5 * (t[:-1] + t[1:])).p
+    out = _knots_compiled(chain, table, t, s, sd, s_mid, smp, starts)
+    if out is None:
+        out = _knots_numpy(chain, table, t, s, sd, s_mid, smp, starts)
+    pos, v0, a0, jj = out
+    profiles = []
+    dts = np.diff(t)
+    labels = ("path",) * len(dts)
+    for i in range(dim):
+        profiles.append(Profile(
+            t0=t[:-1].copy(), p0=pos[:-1, i].copy(), v0=v0[:, i].copy(), a0=a0[:, i].copy(),
+            j=jj[:, i].copy(), duration=float(dur),
+            start=State(float(pos[0, i]), float(v0[0, i]) if sp.start.v else 0.0, 0.0),
+            end=State(float(pos[-1, i]), 0.0, 0.0), labels=labels, dt=dts.copy()))
+    return profiles
+
+
+def _knots_compiled(chain: Chain, table: ElementTable, t: np.ndarray, s: np.ndarray,
+                    sd: np.ndarray, s_mid: np.ndarray, smp: Samples,
+                    starts: Sequence[float]) -> tuple[np.ndarray, ...] | None:
+    """`_knots_numpy` compiled (_profile_knots.c: the same floats); None when the chain
+    has an element the compiled version does not evaluate."""
+    packed = table.packed
+    if _profile is None or packed is None:
+        return None
+    n, dim = len(t), table.start.shape[1]
+    end = np.asarray(chain.elements[-1].end, dtype=float) if s[-1] >= chain.length \
+        else np.zeros(0)
+    pos = np.empty((n, dim))
+    v0, a0, jj = np.empty((n - 1, dim)), np.empty((n - 1, dim)), np.empty((n - 1, dim))
+    done = _profile.axis_knots(
+        packed, np.ascontiguousarray(chain.cum, dtype=float), t, s, sd, s_mid,
+        np.ascontiguousarray(smp.a[:-1]), np.ascontiguousarray(smp.j[:-1]),
+        np.ascontiguousarray(starts, dtype=float), end, pos, v0, a0, jj)
+    return (pos, v0, a0, jj) if done else None
+
+
+def _knots_numpy(chain: Chain, table: ElementTable, t: np.ndarray, s: np.ndarray,
+                 sd: np.ndarray, s_mid: np.ndarray, smp: Samples,
+                 starts: Sequence[float]) -> tuple[np.ndarray, ...]:
+    """Knot positions and each interval's v0, a0, j per axis (the oracle of the compiled
+    version, and what evaluates other element kinds)."""
     n_el = len(chain.elements)
     cum = chain.cum
-    table = chain.table  # every element's parameters as arrays (pathpoints.py)
     lens = table.lengths
     # positions per knot (continuous: consecutive elements join bit for bit)
     k = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, n_el - 1)
@@ -63,31 +114,25 @@ def axis_profiles(chain: Chain, sp: Profile, period: float,
         pos[-1] = chain.elements[-1].end
     # velocities per interval, from the element the interval lies on: at a corner taken at
     # speed (junction deviation) the velocity jumps between two intervals, not inside one
-    s_mid = sp.sample(0.5 * (t[:-1] + t[1:])).p
     km = np.clip(np.searchsorted(cum, s_mid, side="right") - 1, 0, n_el - 1)
-    v0 = table.tangent(km, np.clip(s[:-1] - cum[km], 0.0, lens[km])) * sd[:-1][:, None]
-    v1 = table.tangent(km, np.clip(s[1:] - cum[km], 0.0, lens[km])) * sd[1:][:, None]
+    # (the tangents at both ends of every interval in one evaluation: row by row the same)
+    m = len(km)
+    kk = np.concatenate((km, km))
+    tg = table.tangent(kk, np.clip(np.concatenate((s[:-1], s[1:])) - cum[kk], 0.0, lens[kk]))
+    v0 = tg[:m] * sd[:-1][:, None]
+    v1 = tg[m:] * sd[1:][:, None]
     h = np.diff(t)[:, None]
     dp = np.diff(pos, axis=0)
     a0 = (6.0 * dp - h * (4.0 * v0 + 2.0 * v1)) / (h * h)
     jj = (6.0 * h * (v0 + v1) - 12.0 * dp) / (h * h * h)
     # on a line the axis motion is u*s(t) exactly: take a and j from s(t), not the fit
-    ss = sp.sample(t[:-1])
+    # (s(t) at the knots but the last: smp.a, smp.j are the samples of t[:-1] plus one)
     straight = table.curvature[km] == 0.0
     if np.any(straight):
         u = table.line_tangents(km[straight])
-        a0[straight] = ss.a[straight][:, None] * u
-        jj[straight] = ss.j[straight][:, None] * u
-    out = []
-    dts = np.diff(t)
-    labels = ("path",) * len(dts)
-    for i in range(dim):
-        out.append(Profile(
-            t0=t[:-1].copy(), p0=pos[:-1, i].copy(), v0=v0[:, i].copy(), a0=a0[:, i].copy(),
-            j=jj[:, i].copy(), duration=float(dur),
-            start=State(float(pos[0, i]), float(v0[0, i]) if sp.start.v else 0.0, 0.0),
-            end=State(float(pos[-1, i]), 0.0, 0.0), labels=labels, dt=dts.copy()))
-    return out
+        a0[straight] = smp.a[:-1][straight][:, None] * u
+        jj[straight] = smp.j[:-1][straight][:, None] * u
+    return pos, v0, a0, jj
 
 
 def _crossings(sp: Profile, levels: np.ndarray) -> np.ndarray:

@@ -99,6 +99,26 @@ class ElementTable:
         self.lengths = np.array([el.length for el in elements], dtype=float)
         self.curvature = np.array([el.max_curvature for el in elements], dtype=float)
 
+    @property
+    def packed(self) -> Array | None:
+        """The rows as one float64 matrix for the compiled knots (`_profile.axis_knots`:
+        kind, trimmed, offset, stop, blen, radius, k, rs, length, curvature, then the
+        start, end, dirn, centre, e1, e2, lin and helix vectors); None when an element is
+        neither a line nor an arc (the numpy version evaluates it). Built once."""
+        memo = self.__dict__.get("_packed", False)
+        if memo is not False:
+            return memo
+        out = None
+        if not np.any(self.kind == _GENERIC):
+            out = np.ascontiguousarray(np.concatenate(
+                [np.stack([self.kind.astype(float), self.trimmed.astype(float), self.offset,
+                           self.stop, self.blen, self.radius, self.k, self.rs, self.lengths,
+                           self.curvature], axis=1),
+                 self.start, self.end, self.dirn, self.centre, self.e1, self.e2, self.lin,
+                 self.helix], axis=1), dtype=np.float64)
+        self._packed = out
+        return out
+
     def sliced(self, a: int, b: int | None = None) -> ElementTable:
         """The table of elements[a:b] (rows a..b-1)."""
         out = object.__new__(ElementTable)
