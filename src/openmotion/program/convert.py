@@ -29,7 +29,7 @@ group's Arc accepts (a LinuxCNC-tolerated spiral) is sent as chords within `chor
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -190,8 +190,33 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             raise _fail(cmd, f"feed {cmd.feed_per_s:g} units/s gives no usable speed")
         return min(f, sys_max)  # F above the machine maxima is clamped (as LinuxCNC)
 
+    ppu = scales.ppu
+    uniform = opts.feed_mode == "uniform"
     for cmd in cmds:
-        if isinstance(cmd, Probe):
+        kind = type(cmd)
+        if kind is _FEED or kind is _RAPID or isinstance(cmd, _FEED | _RAPID):
+            # G0/G1, the bulk of a program, first (no other command is one of these)
+            rapid = kind is _RAPID or (kind is not _FEED and isinstance(cmd, _RAPID))
+            end = np.asarray(cmd.end, dtype=float)
+            d = end - pos
+            # = float(np.linalg.norm(d)): a 1-D norm is sqrt(d.dot(d)), correctly rounded
+            length = math.sqrt(d.dot(d)) if d.ndim == 1 else float(np.linalg.norm(d))
+            if length == 0.0:
+                continue  # zero-length move: nothing to do
+            if rapid:
+                moving = np.abs(d) > 0.0
+                f = min(float(np.min(opts.rapid_ratio * vmax[moving] * length
+                                     / np.abs(d[moving]))), sys_max)
+            elif uniform and cmd.duration is None:  # feed_of's uniform F, inline
+                f = cmd.feed_per_s
+                if not f > 0.0 or not math.isfinite(f):
+                    raise _fail(cmd, f"feed {cmd.feed_per_s:g} units/s gives no usable speed")
+                f = min(f, sys_max)
+            else:
+                f = feed_of(cmd, d, length)
+            ops.append(_line_op(cmd.line, cmd.file, end * ppu, f, rapid, end, cmd))
+            pos = end
+        elif isinstance(cmd, Probe):
             end = np.asarray(cmd.end, dtype=float)
             f = min(cmd.feed_per_s, sys_max) if cmd.feed_per_s > 0 else sys_max
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end), f, end=end,
@@ -236,22 +261,6 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
             ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(start),
                           min(f * cmd.return_scale, sys_max), end=start, source=cmd))
             pos = start
-        elif isinstance(cmd, canon.Rapid | canon.Feed):
-            end = np.asarray(cmd.end, dtype=float)
-            d = end - pos
-            length = float(np.linalg.norm(d))
-            if length == 0.0:
-                continue  # zero-length move: nothing to do
-            if isinstance(cmd, canon.Rapid):
-                moving = np.abs(d) > 0.0
-                f = float(np.min(opts.rapid_ratio * vmax[moving] * length
-                                 / np.abs(d[moving])))
-                ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end),
-                              min(f, sys_max), True, end=end, source=cmd))
-            else:
-                ops.append(Op("line", cmd.line, cmd.file, scales.to_pulses(end),
-                              feed_of(cmd, d, length), end=end, source=cmd))
-            pos = end
         elif isinstance(cmd, canon.ArcMove):
             pos = _arc(cmd, scales, pos, opts, ops, feed_of)
         elif isinstance(cmd, SplineFeed):
@@ -298,6 +307,27 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
         else:  # pragma: no cover - canon is closed
             raise _fail(cmd, f"unsupported command {type(cmd).__name__}")
     return ops
+
+
+_FEED, _RAPID = canon.Feed, canon.Rapid
+#: An Op's fields as `Op(...)` sets them, for `_line_op` (kind "line", the defaults).
+_LINE_FIELDS = {f.name: f.default for f in fields(Op)} | {"kind": "line"}
+
+
+def _line_op(line: int, file: str, target: np.ndarray, feed: float, rapid: bool,
+             end: np.ndarray, source: canon.Command) -> Op:
+    """`Op("line", line, file, target, feed, rapid, end=end, source=source)`, the same
+    object (the same attributes in the same order) made without the frozen dataclass's
+    field-by-field `__init__` (a program has one per line)."""
+    op = _new(Op)
+    d = op.__dict__
+    d.update(_LINE_FIELDS)
+    d["line"], d["file"], d["target"], d["feed"] = line, file, target, feed
+    d["rapid"], d["end"], d["source"] = rapid, end, source
+    return op
+
+
+_new = object.__new__
 
 
 def _spline(cmd: SplineFeed, scales: Scales, pos: np.ndarray, opts: ConvertOptions,

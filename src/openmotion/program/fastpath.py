@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import gc
 import re
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 
 from . import canon
 from .cuttercomp import CutterComp
@@ -117,6 +117,8 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
     limit = options.max_blocks
     skip_deleted = options.block_delete
     soft = options.soft_limits is not None
+    # Modal.check_limits's bounds for a plain line (lo = hi = its target), the same floats
+    bounds = _soft_bounds(options.soft_limits, len(modal.pos)) if soft else None
     letters = modal.letters
     order = [L for L in "XYZABCUVW" if L in letters]
     # (group, machine axis, offset index, linear) per mapped letter, in regex order
@@ -199,10 +201,17 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
                             rotary_only = bool(moved) and all(moved)
                         per_s = (n_ang if rotary_only else n_lin) / 60.0
                 if m is not None and soft:
-                    try:
-                        modal.check_limits(_FakeBlock, target, target, "", 0)
-                    except _Reroute:
-                        m = None
+                    if bounds is None:
+                        try:
+                            modal.check_limits(_FakeBlock, target, target, "", 0)
+                        except _Reroute:
+                            m = None
+                    else:
+                        for ax, lo_b, hi_b in bounds:
+                            t = target[ax]
+                            if t < lo_b or t > hi_b:
+                                m = None  # the general path raises its error
+                                break
                 if m is not None:
                     feed, f_lin, f_ang = n_feed, n_lin, n_ang
                     motion_prev = motion
@@ -276,6 +285,17 @@ def plain_commands(lines: Iterable[str], options: GCodeOptions,  # noqa: C901
     modal.motion, modal.pos, modal.motion_prev = motion, pos, motion_prev
     modal.feed, modal.feed_lin, modal.feed_ang = feed, f_lin, f_ang
     yield from general
+
+
+def _soft_bounds(limits: Sequence[tuple[float, float] | None],
+                 n_axes: int) -> list[tuple[int, float, float]] | None:
+    """(machine axis, lowest, highest) position `Modal.check_limits` lets a point reach on
+    every limited axis (its own tolerance, computed the same way), or None when the limits
+    name more axes than the machine has (that call then runs as it is)."""
+    if len(limits) > n_axes:
+        return None
+    return [(ax, lim[0] - 1e-9 * max(1.0, abs(lim[0])), lim[1] + 1e-9 * max(1.0, abs(lim[1])))
+            for ax, lim in enumerate(limits) if lim is not None]
 
 
 class _FakeBlock:

@@ -104,14 +104,13 @@ class ModalCoordinates:
         for ax, lim in enumerate(limits):
             if lim is None:
                 continue
-            u = self._unit(ax)
             if lo[ax] < lim[0] - 1e-9 * max(1.0, abs(lim[0])):
                 raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
-                              f"machine {lo[ax]:.6g} < min {lim[0]:g} {u}"
+                              f"machine {lo[ax]:.6g} < min {lim[0]:g} {self._unit(ax)}"
                               f"{self._offset_note(ax)}", pos, word)
             if hi[ax] > lim[1] + 1e-9 * max(1.0, abs(lim[1])):
                 raise b.error(f"move beyond soft limit: {self._limit_axis(ax)} would reach "
-                              f"machine {hi[ax]:.6g} > max {lim[1]:g} {u}"
+                              f"machine {hi[ax]:.6g} > max {lim[1]:g} {self._unit(ax)}"
                               f"{self._offset_note(ax)}", pos, word)
 
     def _unit(self, ax: int) -> str:
