@@ -352,9 +352,18 @@ class Controller(ControllerHooks, ControllerSettings):
                 for h in tuple(hooks):
                     if h in hooks:
                         h(self, e)
-        for ax in self.axes:  # (an axis with nothing running or awaited: nothing to end)
-            if ax._motion is not None or ax._waiting_inp or ax._gated:
-                ax._cycle_end(t1)
+        origin, period = self._t_origin, self.period
+        for ax in self.axes:
+            m = ax._motion
+            if not (ax._waiting_inp or ax._gated):  # else Axis._cycle_end always runs
+                if m is None:
+                    continue  # nothing running or awaited: nothing to end
+                c = m._end_cycle  # (jump.end_cycle: the first cycle ending at or after
+                if c is not None and n < c[2] and c[0] == origin and c[1] == period:
+                    continue  # t_end; this cycle ends before it: the motion goes on)
+                if m.kind == "velocity":
+                    continue  # (never finishes by itself)
+            ax._cycle_end(t1)
         cycle_hooks = self._cycle_hooks
         for h in tuple(cycle_hooks):
             if h in cycle_hooks:

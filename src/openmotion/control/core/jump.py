@@ -117,14 +117,22 @@ def plan_jump(ctl: Controller, cycles: int) -> int:
             land = min(land, first_cycle_at(ctl, t) - 1)
             if land <= nxt:
                 return nxt
+    origin, period = ctl._t_origin, ctl.period
+    on_grid = ctl._time == origin + n0 * period  # (else end_cycle compares with the time)
     for ax in ctl.axes:
         if ax.command_transforms or ax._waiting_inp or ax._gated:
             return nxt
         m = ax._motion
         if m is not None and m.kind != "velocity":
-            land = min(land, end_cycle(ctl, m))
-            if land <= nxt:
-                return nxt
+            c = m._end_cycle  # end_cycle's kept grid cycle, when it is ahead of now
+            if on_grid and c is not None and c[2] > n0 and c[0] == origin and c[1] == period:
+                e = c[2]
+            else:
+                e = end_cycle(ctl, m)
+            if e < land:
+                land = e
+                if land <= nxt:
+                    return nxt
     dues = ctl._cycle_dues
     for hook in ctl._cycle_hooks:
         due = dues.get(hook)

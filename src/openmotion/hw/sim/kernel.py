@@ -337,12 +337,13 @@ def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin:
     if not recording:
         cur, vers = ks._cur, ks._vers
         after = ai[:, I_CURSOR].tolist()
-        for x, c in enumerate(after):
-            if c != cur[x]:
-                q = queues[x]
-                q.consume(c - cur[x])
-                vers[x] = q.version
-        ks._cur = after
+        if after != cur:
+            for x, c in enumerate(after):
+                if c != cur[x]:
+                    q = queues[x]
+                    q.consume(c - cur[x])
+                    vers[x] = q.version
+            ks._cur = after
     elif used:
         cursor = ai[used, I_CURSOR].tolist()
         for x, b, c in zip(used, begin, cursor, strict=True):

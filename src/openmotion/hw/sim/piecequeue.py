@@ -107,6 +107,10 @@ class PieceQueue:
         """Drop the next n pieces (they started)."""
         self.version += 1
         self._n -= n
+        blocks = self._blocks
+        if blocks and n < len(blocks[0]) - self._head:  # (the usual case: in the first block)
+            self._head += n
+            return
         while n:
             left = len(self._blocks[0]) - self._head
             if n < left:
