@@ -97,7 +97,8 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
      * caller asks for it (a buffer large enough for every cycle), else none */
     int64_t *TR = bufs[7].b.len >= (stop - start) * n * 3 * 8 ? bufs[7].b.buf : NULL;
     double *save_d = PyMem_Malloc(sizeof(double) * (n * ND + 1));
-    int64_t *save_i = PyMem_Malloc(sizeof(int64_t) * (n * NI + n * MAXSW * NSI + 1));
+    /* the rollback copy: AD, AI and the only field of SI a cycle writes (S_ACTIVE) */
+    int64_t *save_i = PyMem_Malloc(sizeof(int64_t) * (n * NI + n * MAXSW + 1));
     PRec *prec = PyMem_Malloc(sizeof(PRec) * (n * MAXPREC + 1));
     Py_ssize_t *rix = PyMem_Malloc(sizeof(Py_ssize_t) * (2 * n + 1));
     int64_t *rstart = PyMem_Malloc(sizeof(int64_t) * (n + 1));
@@ -120,7 +121,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
     redo:
         memcpy(save_d, AD, sizeof(double) * n * ND);
         memcpy(save_i, AI, sizeof(int64_t) * n * NI);
-        memcpy(save_i + n * NI, SI, sizeof(int64_t) * n * MAXSW * NSI);
+        for (Py_ssize_t q = 0; q < n * MAXSW; q++) save_i[n * NI + q] = SI[q * NSI + S_ACTIVE];
         Py_ssize_t rows0 = rec.n;
         double now0 = now;
         int status = OK;
@@ -163,7 +164,7 @@ PyObject *kernel_run(PyObject *self, PyObject *args)
         if (status != OK) { /* roll the cycle back */
             memcpy(AD, save_d, sizeof(double) * n * ND);
             memcpy(AI, save_i, sizeof(int64_t) * n * NI);
-            memcpy(SI, save_i + n * NI, sizeof(int64_t) * n * MAXSW * NSI);
+            for (Py_ssize_t q = 0; q < n * MAXSW; q++) SI[q * NSI + S_ACTIVE] = save_i[n * NI + q];
             rec.n = rows0;
             now = now0;
             rep.ne = 0;

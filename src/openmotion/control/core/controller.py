@@ -177,6 +177,9 @@ class Controller(ControllerHooks, ControllerSettings):
         self._pacer: RealtimePacer | RealtimeExecutor = RealtimePacer(
             self.step, self.period, self._overran)
         self._rb_cycle = [-1] * len(self.axes)
+        #: axis -> (motion, last cycle, origin, period, first cycle, ends): the pieces a
+        #: virtual-time jump left queued on the hardware for a motion (jump.py `_feed`)
+        self._fed: dict[int, tuple] = {}
         self._estop = self._emg_level_active(hardware.read_input("emg"))
         self.events = EventLog(self)  # faults, limits, latches, home completion, compare
         #: capabilities attached at construction (register_attachment): the closed servo
@@ -298,6 +301,8 @@ class Controller(ControllerHooks, ControllerSettings):
                         ax.fault_stop(reason)
             if self._n < n:  # the failure came before the hardware reached the cycle end
                 with contextlib.suppress(Exception):
+                    self._drop_fed()
+                with contextlib.suppress(Exception):
                     self.hardware.advance(t1)
                 self._n, self._time = n, t1
             self._committed = None
@@ -306,8 +311,18 @@ class Controller(ControllerHooks, ControllerSettings):
                 with contextlib.suppress(Exception):
                     events.record("cycle_error", None, self._time, None, reason)
 
+    def _drop_fed(self) -> None:
+        """Clear the pieces a jump left queued (jump.py `_feed`): the next cycle is
+        commanded otherwise."""
+        hw = self.hardware
+        for idx in self._fed:
+            hw.clear_queue(idx)
+        self._fed.clear()
+
     def _step(self) -> None:
         with self._lock:
+            if self._fed:
+                self._drop_fed()
             t0 = self._time
             n = self._n + 1
             t1 = self._t_origin + n * self.period
@@ -337,7 +352,17 @@ class Controller(ControllerHooks, ControllerSettings):
                 for h in tuple(hooks):
                     if h in hooks:
                         h(self, e)
+        origin, period = self._t_origin, self.period
         for ax in self.axes:
+            m = ax._motion
+            if not (ax._waiting_inp or ax._gated):  # else Axis._cycle_end always runs
+                if m is None:
+                    continue  # nothing running or awaited: nothing to end
+                c = m._end_cycle  # (jump.end_cycle: the first cycle ending at or after
+                if c is not None and n < c[2] and c[0] == origin and c[1] == period:
+                    continue  # t_end; this cycle ends before it: the motion goes on)
+                if m.kind == "velocity":
+                    continue  # (never finishes by itself)
             ax._cycle_end(t1)
         cycle_hooks = self._cycle_hooks
         for h in tuple(cycle_hooks):

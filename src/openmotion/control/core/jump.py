@@ -117,14 +117,22 @@ def plan_jump(ctl: Controller, cycles: int) -> int:
             land = min(land, first_cycle_at(ctl, t) - 1)
             if land <= nxt:
                 return nxt
+    origin, period = ctl._t_origin, ctl.period
+    on_grid = ctl._time == origin + n0 * period  # (else end_cycle compares with the time)
     for ax in ctl.axes:
         if ax.command_transforms or ax._waiting_inp or ax._gated:
             return nxt
         m = ax._motion
         if m is not None and m.kind != "velocity":
-            land = min(land, end_cycle(ctl, m))
-            if land <= nxt:
-                return nxt
+            c = m._end_cycle  # end_cycle's kept grid cycle, when it is ahead of now
+            if on_grid and c is not None and c[2] > n0 and c[0] == origin and c[1] == period:
+                e = c[2]
+            else:
+                e = end_cycle(ctl, m)
+            if e < land:
+                land = e
+                if land <= nxt:
+                    return nxt
     dues = ctl._cycle_dues
     for hook in ctl._cycle_hooks:
         due = dues.get(hook)
@@ -153,11 +161,24 @@ def wake_signals(ctl: Controller) -> frozenset[str] | None:
 def jump(ctl: Controller, land: int) -> None:
     """Run cycles up to `land` (> current + 1) through the back end's piece queue, fed
     ahead in chunks; finish the cycle it stops at (the first with an edge some hook acts
-    on, or `land`) as `step` does."""
+    on, or `land`) as `step` does.
+
+    A mover's pieces are queued up to the end of those computed ahead (`_ahead`), not only
+    to the chunk's end, and stay queued at the landing (`Controller._fed`): the next jump
+    of the same motion finds them there and queues nothing (`_feed`). Pieces left for a
+    motion that changed are dropped at the next jump, and `Controller.step` drops them
+    all before it commands a cycle itself."""
     hw = ctl.hardware
     origin, period = ctl._t_origin, ctl.period
-    movers = [ax for ax in ctl.axes if ax._motion is not None]
+    axes = ctl.axes
+    movers = [ax for ax in axes if ax._motion is not None]
+    fed = ctl._fed
+    if fed:  # pieces left at the last landing for a motion that is over or replaced
+        for idx in [i for i, e in fed.items() if axes[i]._motion is not e[0]]:
+            del fed[idx]
+            hw.clear_queue(idx)
     wake = wake_signals(ctl)
+    queued = hw.queued
     n = ctl._n
     t0 = ctl._time
     chunk = FIRST_CHUNK if _motion._kernel is None else FIRST_CHUNK_COMPILED
@@ -165,22 +186,25 @@ def jump(ctl: Controller, land: int) -> None:
     held: tuple | None = None  # record_trace's token of the last chunk's held readback
     while True:
         stop = min(land, n + chunk)
-        ends = []
-        for ax in movers:
-            m = ax._motion
-            assert m is not None
-            rows, p1v1 = _ahead(ctl, m, t0, n, stop)
-            try:
-                hw.queue_pieces(ax.index, PieceBlock(rows))
-            except BaseException:
-                for other in movers:  # nothing half-queued stays behind
-                    hw.clear_queue(other.index)
-                raise
-            ends.append(p1v1)
+        try:
+            ends = []
+            for ax in movers:  # (the pieces left queued for the motion serve: `_feed`)
+                e = fed.get(ax.index)
+                if (e is not None and e[0] is ax._motion and e[1] >= stop and e[2] == origin
+                        and e[3] == period and queued(ax.index) == e[1] - n):
+                    ends.append(e[5][n - e[4]:stop - e[4]])
+                else:
+                    ends.append(_feed(ctl, hw, ax, t0, n, stop))
+        except BaseException:
+            ctl._drop_fed()
+            for other in movers:  # nothing half-queued stays behind
+                hw.clear_queue(other.index)
+            raise
         rec = ctl.recorder
         run = hw.run_cycles(origin, period, n, stop, wake,
                             trace=rec is not None or bool(ctl._jump_observers))
         if run.cycle == ctl._n:  # real time: returned before its first cycle (realtime.py)
+            ctl._drop_fed()
             for ax in movers:
                 hw.clear_queue(ax.index)
             return
@@ -198,19 +222,34 @@ def jump(ctl: Controller, land: int) -> None:
     k = run.cycle
     for ax, p1v1 in zip(movers, ends, strict=True):
         ax._pos, ax._vel = p1v1[k - n - 1].tolist()
-        if k < stop:
-            hw.clear_queue(ax.index)
     ctl._finish_cycle(k, run.edges)
 
 
-def _ahead(ctl: Controller, m: _motion.ActiveMotion, t0: float, n: int, stop: int
-           ) -> tuple[np.ndarray, np.ndarray]:
+def _feed(ctl: Controller, hw: Any, ax: Any, t0: float, n: int, stop: int) -> np.ndarray:
+    """Queue `ax`'s motion afresh: the pieces of `_ahead` from cycle n+1 to the end of
+    those computed ahead (at least up to stop), after clearing what an earlier jump left
+    queued; returns the end states (p1, v1) of cycles n+1 .. stop. `jump` keeps the entry
+    (`Controller._fed`) and uses the queued pieces again while the queue holds exactly
+    those of cycles n+1 .. their end (one piece per cycle: a run started the ones before)
+    for the same motion on the same grid."""
+    idx = ax.index
+    if ctl._fed.pop(idx, None) is not None:
+        hw.clear_queue(idx)
+    rows, ends = _ahead(ctl, ax._motion, t0, n, stop, tail=True)
+    hw.queue_pieces(idx, PieceBlock(rows))
+    ctl._fed[idx] = (ax._motion, n + len(rows), ctl._t_origin, ctl.period, n, ends)
+    return ends[:stop - n]
+
+
+def _ahead(ctl: Controller, m: _motion.ActiveMotion, t0: float, n: int, stop: int,
+           tail: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """The pieces (rows) and end states (p1, v1) of `m` for cycles n+1 .. stop, the first
     starting at t0. With the compiled pieces they are computed ahead, up to the cycle the
     motion ends in (at most MAX_CHUNK cycles on), and kept on the motion, so the next
     jumps reuse them: a landing costs no new pieces for the axes still moving. A motion
     never changes once made, and every cycle's piece depends only on it and the cycle
-    grid, so the rows are the very ones computed at the landing."""
+    grid, so the rows are the very ones computed at the landing. `tail`: every row computed
+    ahead from cycle n+1 on (at least up to stop), not only those up to stop."""
     origin, period = ctl._t_origin, ctl.period
     cache = m._ahead
     if cache is not None:
@@ -218,7 +257,8 @@ def _ahead(ctl: Controller, m: _motion.ActiveMotion, t0: float, n: int, stop: in
         i = n - c_n
         if (c_origin == origin and c_period == period and 0 <= i < len(rows)
                 and stop - c_n <= len(rows) and rows[i, 0] == t0):
-            return rows[i:stop - c_n], ends[i:stop - c_n]
+            j = len(rows) if tail else stop - c_n
+            return rows[i:j], ends[i:j]
     upto = stop
     velocity = m.kind == "velocity"
     k_end = 0 if velocity else end_cycle(ctl, m)
@@ -229,6 +269,8 @@ def _ahead(ctl: Controller, m: _motion.ActiveMotion, t0: float, n: int, stop: in
         # after t_end on (the cycle ends rise with k, so that is a tail of the rows)
         ends[max(k_end, n + 1) - n - 1:, 1] = 0.0
     m._ahead = (origin, period, n, rows, ends)
+    if tail:
+        return rows, ends
     return rows[:stop - n], ends[:stop - n]
 
 

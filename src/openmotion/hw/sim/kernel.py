@@ -138,7 +138,7 @@ class KernelState:
     landing of a virtual-time jump costs no per-axis packing or copying."""
 
     __slots__ = ("ad", "ai", "sd", "si", "pitch", "names", "recording", "_wake", "_wake_key",
-                 "_readback", "_edges")
+                 "_readback", "_edges", "_arena", "_fill", "_vers", "_cur")
 
     def __init__(self, axes: list[SimAxis]) -> None:
         n = len(axes)
@@ -195,6 +195,13 @@ class KernelState:
         self._wake = np.zeros((n, _MAXSW), dtype=np.int64)
         self._readback: list[list[int]] | None = None
         self._edges = _edge_room(64, n)
+        # the queued pieces of every axis, kept between runs (`_sync_pieces`): rows
+        # [I_PBEGIN, I_PEND) of the arena are axis x's pieces as its queue held them at
+        # version _vers[x], the kernel's cursor (I_CURSOR) at _cur[x] its queue's head
+        self._arena = _NO_PIECES
+        self._fill = 0
+        self._vers = [-1] * n
+        self._cur = [0] * n
 
     def grow_edges(self) -> None:
         """Room for twice as many edges in one cycle (the kernel asked for more)."""
@@ -209,7 +216,7 @@ class KernelState:
                 for s, name in enumerate(nm):
                     self._wake[x, s] = _wakes(name, sws, key)
             self._wake_key = key
-        self.si[:, :, 1] = self._wake
+            self.si[:, :, 1] = self._wake  # (only set here: kept between runs)
 
     def set_command(self, x: int, p0: float, v0: float, a0: float, j: float, tc: float,
                     te: float) -> None:
@@ -313,6 +320,55 @@ def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin:
     if not report:  # in report mode every crossing is an edge anyway
         ks.set_wake(axes, wake)
     ai = ks.ai
+    recording = ks.recording
+    if recording:
+        used, begin, pieces, popt, rows = _gather_pieces(ks, queues, start, stop)
+    else:  # the arena kept between runs: only the queues changed since are copied in
+        pieces, popt, rows = _sync_pieces(ks, queues), _NONE, _NONE
+    tr = np.zeros((stop - start, n, 3), dtype=np.int64) if trace else _NO_TRACE
+    et, ei, enc = ks._edges
+    k, t, nrows, nedges, full = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, et,
+                                       ei, enc, ks.pitch, float(origin), float(period),
+                                       int(start), int(stop), float(now), float(limit),
+                                       report, paced)
+    if k == start:
+        return k, now, tr[:0] if trace else None, [], bool(full)
+    ks._readback = None
+    if not recording:
+        cur, vers = ks._cur, ks._vers
+        after = ai[:, I_CURSOR].tolist()
+        if after != cur:
+            for x, c in enumerate(after):
+                if c != cur[x]:
+                    q = queues[x]
+                    q.consume(c - cur[x])
+                    vers[x] = q.version
+            ks._cur = after
+    elif used:
+        cursor = ai[used, I_CURSOR].tolist()
+        for x, b, c in zip(used, begin, cursor, strict=True):
+            if c > b:
+                queues[x].consume(c - b)
+        _record_commands(axes, used, begin, cursor, pieces, popt)
+    if recording:
+        ks.write_back(axes)
+        _record_stretches(axes, rows[:nrows])
+    edges: list[InputEdge] = []
+    if nedges:
+        names = AXIS_INPUTS
+        for tm, (axis, bit, level, _), counts in zip(et[:nedges].tolist(),
+                                                     ei[:nedges].tolist(),
+                                                     enc[:nedges].tolist(), strict=True):
+            name = names[bit] if bit < _HIDDEN else ks.names[axis][bit - _HIDDEN]
+            edges.append(InputEdge(tm, axis, name, level == 1, tuple(counts)))
+    return k, t, tr[:k - start] if trace else None, edges, bool(full)
+
+
+def _gather_pieces(ks: KernelState, queues: list[PieceQueue], start: int, stop: int
+                   ) -> tuple[list[int], list[int], np.ndarray, np.ndarray, np.ndarray]:
+    """With pulse recording: every queue's pieces in one array made for this run (used
+    axes, their first rows, the pieces, their start times and the record rows to fill)."""
+    ai = ks.ai
     ai[:, I_PBEGIN:I_CURSOR + 1] = 0
     blocks: list[np.ndarray] = []
     used: list[int] = []
@@ -329,44 +385,46 @@ def _run(ks: KernelState, axes: list[SimAxis], queues: list[PieceQueue], origin:
         ai[used, I_PBEGIN] = begin
         ai[used, I_CURSOR] = begin
         ai[used, I_PEND] = [*begin[1:], total]
-    recording = ks.recording
     if not total:
         pieces = _NO_PIECES
     elif len(blocks) == 1 and blocks[0].flags.writeable:
         pieces = blocks[0]  # the queue's own block (the kernel only reads it)
     else:
         pieces = np.concatenate(blocks)
-    popt = np.zeros(len(pieces)) if recording else _NONE
-    cap = (stop - start) * n * 8 + 16 if recording else 0
-    rows = np.zeros((cap, _NREC)) if cap else _NONE
-    tr = np.zeros((stop - start, n, 3), dtype=np.int64) if trace else _NO_TRACE
-    et, ei, enc = ks._edges
-    k, t, nrows, nedges, full = _k.run(ks.ad, ai, ks.sd, ks.si, pieces, popt, rows, tr, et,
-                                       ei, enc, ks.pitch, float(origin), float(period),
-                                       int(start), int(stop), float(now), float(limit),
-                                       report, paced)
-    if k == start:
-        return k, now, tr[:0] if trace else None, [], bool(full)
-    ks._readback = None
-    if used:
-        cursor = ai[used, I_CURSOR].tolist()
-        for x, b, c in zip(used, begin, cursor, strict=True):
-            if c > b:
-                queues[x].consume(c - b)
-        if recording:
-            _record_commands(axes, used, begin, cursor, pieces, popt)
-    if recording:
-        ks.write_back(axes)
-        _record_stretches(axes, rows[:nrows])
-    edges: list[InputEdge] = []
-    if nedges:
-        names = AXIS_INPUTS
-        for tm, (axis, bit, level, _), counts in zip(et[:nedges].tolist(),
-                                                     ei[:nedges].tolist(),
-                                                     enc[:nedges].tolist(), strict=True):
-            name = names[bit] if bit < _HIDDEN else ks.names[axis][bit - _HIDDEN]
-            edges.append(InputEdge(tm, axis, name, level == 1, tuple(counts)))
-    return k, t, tr[:k - start] if trace else None, edges, bool(full)
+    popt = np.zeros(len(pieces))
+    cap = (stop - start) * len(queues) * 8 + 16
+    return used, begin, pieces, popt, np.zeros((cap, _NREC))
+
+
+def _sync_pieces(ks: KernelState, queues: list[PieceQueue]) -> np.ndarray:
+    """The arena of every axis's queued pieces (`KernelState._arena`), brought up to date:
+    the pieces of a queue that changed since the kernel last saw it (new pieces, cleared,
+    or started in Python) are copied in after the rows in use and the axis's [I_PBEGIN,
+    I_PEND) and cursor point at them; an axis whose queue did not change keeps its rows
+    and the cursor where the last run left it. A full arena is made again, larger."""
+    vers = ks._vers
+    changed = [x for x, q in enumerate(queues) if q.version != vers[x]]
+    if not changed:
+        return ks._arena
+    blocks = [queues[x].remaining() for x in changed]
+    need = sum(len(b) for b in blocks)
+    if ks._fill + need > len(ks._arena):  # compact: every axis's rows again, from row 0
+        changed = list(range(len(queues)))
+        blocks = [q.remaining() for q in queues]
+        need = sum(len(b) for b in blocks)
+        ks._arena = np.empty((max(2 * need, 4096), 6))
+        ks._fill = 0
+    arena, pos, cur, ai = ks._arena, ks._fill, ks._cur, ks.ai
+    for x, b in zip(changed, blocks, strict=True):
+        m = len(b)
+        if m:
+            arena[pos:pos + m] = b
+        ai[x, I_PBEGIN:I_CURSOR + 1] = (pos, pos + m, pos)  # begin, end, cursor
+        cur[x] = pos
+        pos += m
+        vers[x] = queues[x].version
+    ks._fill = pos
+    return arena
 
 
 def _record_commands(axes: list[SimAxis], used: list[int], begin: list[int],

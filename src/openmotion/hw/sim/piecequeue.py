@@ -33,13 +33,16 @@ TIME_SLACK = 1e-9
 class PieceQueue:
     """Pieces not started yet, in time order, and the end time of the last one queued."""
 
-    __slots__ = ("_blocks", "_head", "_n", "end")
+    __slots__ = ("_blocks", "_head", "_n", "end", "version")
 
     def __init__(self) -> None:
         self._blocks: list[np.ndarray] = []  # (m, 6) float arrays, oldest first
         self._head = 0  # rows of _blocks[0] already started
         self._n = 0
         self.end = -math.inf
+        #: changes with every change of the queue (the compiled kernel's copy of the rows,
+        #: hw/sim/kernel.py, is made again when it differs from the one it was made at)
+        self.version = 0
 
     def __len__(self) -> int:
         return self._n
@@ -55,6 +58,7 @@ class PieceQueue:
                     and len(rows) and _kernel.check_rows(rows, start, TIME_SLACK) < 0):
                 self._blocks.append(rows)
                 self._n += len(rows)
+                self.version += 1
                 last = rows[-1].tolist()
                 self.end = last[0] + last[1]
                 return
@@ -69,9 +73,11 @@ class PieceQueue:
             return
         self._blocks.append(rows)
         self._n += len(rows)
+        self.version += 1
         self.end = float(rows[-1, 0] + rows[-1, 1])
 
     def clear(self) -> None:
+        self.version += 1
         self._blocks.clear()
         self._head = 0
         self._n = 0
@@ -99,7 +105,12 @@ class PieceQueue:
 
     def consume(self, n: int) -> None:
         """Drop the next n pieces (they started)."""
+        self.version += 1
         self._n -= n
+        blocks = self._blocks
+        if blocks and n < len(blocks[0]) - self._head:  # (the usual case: in the first block)
+            self._head += n
+            return
         while n:
             left = len(self._blocks[0]) - self._head
             if n < left:
