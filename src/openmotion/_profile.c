@@ -18,8 +18,7 @@
  * dt[n]); a piece exists only for a phase that lasts (dt > 0); the mask's bit k says that
  * phase k (jerk.PHASE_LABELS order) has its piece.
  */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
+#include "_profile.h"
 #include <math.h>
 #include <string.h>
 
@@ -487,7 +486,7 @@ done:
     return result;
 }
 
-static int get_vec(PyObject *o, Py_buffer *b, int writable)
+int om_profile_vec(PyObject *o, Py_buffer *b, int writable, const char *who)
 {
     int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
     if (PyObject_GetBuffer(o, b, flags) < 0) return -1;
@@ -495,7 +494,7 @@ static int get_vec(PyObject *o, Py_buffer *b, int writable)
     size_t fl = strlen(f);
     if (b->itemsize != 8 || fl == 0 || f[fl - 1] != 'd') {
         PyBuffer_Release(b);
-        PyErr_SetString(PyExc_TypeError, "phases_many: float64 arrays expected");
+        PyErr_Format(PyExc_TypeError, "%s: float64 arrays expected", who);
         return -1;
     }
     return 0;
@@ -518,7 +517,7 @@ static PyObject *py_phases_many(PyObject *self, PyObject *const *args, Py_ssize_
     int held = 0;
     PyObject *result = NULL;
     for (; held < 6; held++)
-        if (get_vec(args[held], &b[held], held == 5) < 0) goto done;
+        if (om_profile_vec(args[held], &b[held], held == 5, "phases_many") < 0) goto done;
     Py_ssize_t n = b[0].len / 8;
     for (int k = 1; k < 5; k++)
         if (b[k].len / 8 != n) {
@@ -547,13 +546,6 @@ done:
     for (int k = 0; k < held; k++) PyBuffer_Release(&b[k]);
     return result;
 }
-
-/* _profile_sample.c */
-PyObject *om_profile_sample(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
-extern const char om_profile_sample_doc[];
-/* _profile_knots.c */
-PyObject *om_axis_knots(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
-extern const char om_axis_knots_doc[];
 
 static PyMethodDef methods[] = {
     {"phase_times", (PyCFunction)(void (*)(void))py_phase_times, METH_FASTCALL, phase_times_doc},

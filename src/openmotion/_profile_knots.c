@@ -12,8 +12,7 @@
  * last. A row of another element kind, or a straight element that is not a line, returns
  * False: the caller then runs the numpy version.
  */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
+#include "_profile.h"
 #include <math.h>
 #include <string.h>
 
@@ -109,20 +108,6 @@ static int eval_row(const double *r, int dim, double u, int tangent, double *out
     return 0;
 }
 
-static int vec(PyObject *o, Py_buffer *b, int writable)
-{
-    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
-    if (PyObject_GetBuffer(o, b, flags) < 0) return -1;
-    const char *f = b->format ? b->format : "B";
-    size_t fl = strlen(f);
-    if (b->itemsize != 8 || fl == 0 || f[fl - 1] != 'd') {
-        PyBuffer_Release(b);
-        PyErr_SetString(PyExc_TypeError, "axis_knots: float64 arrays expected");
-        return -1;
-    }
-    return 0;
-}
-
 const char om_axis_knots_doc[] =
     "axis_knots(table, cum, t, s, sd, s_mid, acc, jerk, starts, end, pos, v0, a0, j)\n"
     "fills pos (n x dim) and v0, a0, j ((n-1) x dim) for the knots t with path positions\n"
@@ -142,7 +127,7 @@ PyObject *om_axis_knots(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     PyObject *result = NULL;
     double *tmp = NULL;
     for (; held < 14; held++)
-        if (vec(args[held], &b[held], held >= 10) < 0) goto done;
+        if (om_profile_vec(args[held], &b[held], held >= 10, "axis_knots") < 0) goto done;
     {
         Py_ssize_t n_el = b[1].len / 8 - 1, n = b[2].len / 8;
         Py_ssize_t dim = b[8].len / 8, width = NSCAL + NVEC * dim;

@@ -11,27 +11,11 @@
  *   dt = t - t0[k], p = p0 + dt*(v0 + dt*(a0/2 + dt*j/6)), v = v0 + dt*(a0 + dt*j/2),
  *   a = a0 + dt*j.
  */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#include <string.h>
+#include "_profile.h"
 
 #ifdef __clang__
 #pragma STDC FP_CONTRACT OFF
 #endif
-
-static int vec(PyObject *o, Py_buffer *b, int writable)
-{
-    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
-    if (PyObject_GetBuffer(o, b, flags) < 0) return -1;
-    const char *f = b->format ? b->format : "B";
-    size_t fl = strlen(f);
-    if (b->itemsize != 8 || fl == 0 || f[fl - 1] != 'd') {
-        PyBuffer_Release(b);
-        PyErr_SetString(PyExc_TypeError, "sample: float64 arrays expected");
-        return -1;
-    }
-    return 0;
-}
 
 /* numpy's searchsorted(t0, t, side="right") - 1 on a sorted t0, clipped to [0, n-1] */
 static Py_ssize_t segment_of(const double *t0, Py_ssize_t n, double t)
@@ -71,7 +55,7 @@ PyObject *om_profile_sample(PyObject *self, PyObject *const *args, Py_ssize_t na
     int held = 0;
     PyObject *result = NULL;
     for (; held < 10; held++)
-        if (vec(args[held], &b[held], held >= 6) < 0) goto done;
+        if (om_profile_vec(args[held], &b[held], held >= 6, "sample") < 0) goto done;
     Py_ssize_t n = b[0].len / 8, m = b[5].len / 8;
     for (int k = 1; k < 5; k++)
         if (b[k].len / 8 != n) goto size;
