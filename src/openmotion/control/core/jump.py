@@ -332,6 +332,11 @@ def record_now(ctl: Controller, n: int) -> bool:
             if c == now:  # read in this cycle: the values the controller holds
                 cnt = axes[i].counters
                 rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
+    try:  # the usual case in one call; no room or disarmed: _put_row arms it again
+        if sink.put(ctl._t_origin + n * ctl.period, axes, rows, _nc_words(ctl), ctl._estop):
+            return True
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record: {exc}") from None
     return _put_row(ctl, rec, sink, n, rows, "record")
 
 
