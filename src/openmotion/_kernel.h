@@ -54,6 +54,30 @@ extern const char kernel_readback_doc[];
 /* field counts of its arrays, exported as module constants */
 int kernel_layout(PyObject *module);
 
+/* A recorder's ring (Recorder._t, _f, _i) as the row writer sees it: rt[R], rf[R, F, n],
+ * int32 rstate[R, n] and int64 rio[R, n] (NULL: channel off), the float slots of cmd_pos,
+ * fb_pos and cmd_vel (-1: off) and the io word of each logical level word (table[T]). */
+typedef struct {
+    double *rt, *rf;
+    int32_t *rstate;
+    int64_t *rio;
+    const int64_t *table;
+    Py_ssize_t R, F, n, T;
+    int64_t sp, sf, sv;
+} Ring;
+
+/* _kernel_rowsink.c: the one writer of recorder rows (a step's row, a jump's crossed
+ * cycles): rows of cycles n0+1 .. n0+m (times origin + k * period, or *t for m = 1) from
+ * ring row head on (mod R; the last min(m, R - 1) kept); per axis x: pv[2x] position and
+ * pv[2x+1] velocity, ia[3x] feedback from the output pulses?, ia[3x+1] feedback offset,
+ * ia[3x+2] state code; an axis with mover[x] = k >= 0 takes position and velocity from
+ * ends[k][2r], ends[k][2r+1] (+ off[k] on the position); tr int64 [m, n, 3] readback; nc
+ * int64[n]. 0, or -1 with ValueError set and nothing written (a value not finite). */
+int ring_rows(const Ring *g, Py_ssize_t head, const double *t, double origin, double period,
+              long long n0, Py_ssize_t m, const int64_t *tr, const double *pv,
+              const int64_t *ia, const int64_t *mover, const double *const *ends,
+              const double *off, const int64_t *nc, int estop);
+
 /* _kernel_record.c: a jump's crossed cycles into the recorder's ring arrays */
 PyObject *record_rows(PyObject *self, PyObject *args);
 extern const char record_rows_doc[];

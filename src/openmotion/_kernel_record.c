@@ -5,7 +5,8 @@
  * at the jump's start), the feedback counter (Counters.feedback_of: the output pulses or the
  * encoder, plus the offset, wrapped to 28 bits), the state code and the io word (the table
  * lookup of the logical input levels, + the E-stop bit). The same operations as the numpy
- * expressions they replace, so the rows are identical.
+ * expressions they replace, so the rows are identical. The rows are written by ring_rows
+ * (_kernel_rowsink.c), RowSink's writer: this only takes the arrays apart.
  */
 #include "_kernel.h"
 
@@ -100,8 +101,16 @@ PyObject *record_rows(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, bad);
         return NULL;
     }
-    Buf *eb = PyMem_Calloc(nk + 1, sizeof(Buf));
-    if (eb == NULL) { release(bufs, 12); PyMem_Free(pv); return PyErr_NoMemory(); }
+    Buf *eb = PyMem_Calloc(nk + 1, sizeof(Buf) + sizeof(double *));
+    int64_t *mover = PyMem_Malloc(sizeof(int64_t) * (n + 1));
+    if (eb == NULL || mover == NULL) {
+        PyMem_Free(eb);
+        PyMem_Free(mover);
+        release(bufs, 12);
+        PyMem_Free(pv);
+        return PyErr_NoMemory();
+    }
+    const double **ep = (const double **)(eb + nk + 1);
     int fail = 0;
     for (Py_ssize_t k = 0; k < nk && !fail; k++) {
         if (PyObject_GetBuffer(PyTuple_GET_ITEM(ends, k), &eb[k].b, PyBUF_C_CONTIGUOUS) < 0) {
@@ -109,77 +118,26 @@ PyObject *record_rows(PyObject *self, PyObject *args)
             break;
         }
         eb[k].held = 1;
+        ep[k] = eb[k].b.buf;
         if (eb[k].b.itemsize != 8 || eb[k].b.len < m * 2 * 8) {
             PyErr_SetString(PyExc_ValueError, "record_rows: ends too short");
             fail = 1;
         }
     }
-    if (fail) {
-        release(eb, (int)nk);
-        PyMem_Free(eb);
-        release(bufs, 12);
-        PyMem_Free(pv);
-        return NULL;
-    }
-    double *rt = bufs[0].b.buf, *rf = bufs[1].b.buf;
-    int32_t *rstate = bufs[2].b.len ? bufs[2].b.buf : NULL;
-    int64_t *rio = bufs[3].b.len ? bufs[3].b.buf : NULL;
-    const int64_t *tr = bufs[5].b.buf, *nc = bufs[10].b.buf;
-    const double *off = bufs[8].b.buf;
-    int64_t *mover = PyMem_Malloc(sizeof(int64_t) * (n + 1));
-    if (mover == NULL) {
-        release(eb, (int)nk);
-        PyMem_Free(eb);
-        release(bufs, 12);
-        PyMem_Free(pv);
-        return PyErr_NoMemory();
-    }
     for (Py_ssize_t x = 0; x < n; x++) mover[x] = -1;
     for (Py_ssize_t k = 0; k < nk; k++) mover[idx[k]] = k;
-    Py_ssize_t keep = m < R - 1 ? m : R - 1;
-    int64_t sp = slots[0], sf = slots[1], sv = slots[2];
-    int finite = 1; /* Recorder.record_block's check, before any row is written */
-    for (Py_ssize_t x = 0; x < n; x++)
-        if (mover[x] < 0 && !(isfinite(pv[x * 2]) && isfinite(pv[x * 2 + 1]))) finite = 0;
-    for (Py_ssize_t k = 0; k < nk && finite; k++) {
-        const double *e = eb[k].b.buf;
-        for (Py_ssize_t r = m - keep; r < m; r++)
-            if (!(isfinite(e[r * 2] + off[k]) && isfinite(e[r * 2 + 1]))) { finite = 0; break; }
-    }
-    if (!finite) {
-        PyMem_Free(mover);
-        release(eb, (int)nk);
-        PyMem_Free(eb);
-        release(bufs, 12);
-        PyMem_Free(pv);
-        PyErr_SetString(PyExc_ValueError, "recorded positions/velocities must be finite");
-        return NULL;
-    }
-    Py_ssize_t row = (Py_ssize_t)((head + (m - keep)) % R);
-    for (Py_ssize_t r = m - keep; r < m; r++, row = row + 1 == R ? 0 : row + 1) {
-        rt[row] = origin + (double)(n0 + 1 + r) * period;
-        double *f = rf + row * F * n;
-        const int64_t *trr = tr + r * n * 3;
-        for (Py_ssize_t x = 0; x < n; x++) {
-            int64_t k = mover[x];
-            const double *e = k >= 0 ? (const double *)eb[k].b.buf + r * 2 : NULL;
-            const int64_t *a = ax + x * 3;
-            if (sp >= 0) f[sp * n + x] = e ? e[0] + off[k] : pv[x * 2];
-            if (sv >= 0) f[sv * n + x] = e ? e[1] : pv[x * 2 + 1];
-            if (sf >= 0) f[sf * n + x] = (double)wrap28((a[0] ? trr[x * 3] : trr[x * 3 + 1])
-                                                        + a[1]);
-            if (rstate) rstate[row * n + x] = (int32_t)a[2];
-            if (rio) {
-                int64_t w = trr[x * 3 + 2] ^ nc[x];
-                int64_t v = (w >= 0 && w < T) ? table[w] : 0;
-                rio[row * n + x] = estop ? v | (1 << 6) : v;
-            }
-        }
+    if (!fail) { /* the rows through the one writer (RowSink's, _kernel_rowsink.c) */
+        Ring g = {bufs[0].b.buf, bufs[1].b.buf, bufs[2].b.len ? bufs[2].b.buf : NULL,
+                  bufs[3].b.len ? bufs[3].b.buf : NULL, table, R, F, n, T, slots[0],
+                  slots[1], slots[2]};
+        fail = ring_rows(&g, (Py_ssize_t)head, NULL, origin, period, n0, m, bufs[5].b.buf, pv,
+                         ax, mover, ep, bufs[8].b.buf, bufs[10].b.buf, estop) < 0;
     }
     PyMem_Free(mover);
     release(eb, (int)nk);
     PyMem_Free(eb);
     release(bufs, 12);
     PyMem_Free(pv);
+    if (fail) return NULL;
     Py_RETURN_NONE;
 }

@@ -374,27 +374,29 @@ def record_now(ctl: Controller, n: int) -> bool:
             if c == now:  # read in this cycle: the values the controller holds
                 cnt = axes[i].counters
                 rows[i] = (cnt._raw_out, cnt._raw_enc, _level_word(ctl._inputs[i]))
+    try:  # the usual case in one call; no room or disarmed: _put_row arms it again
+        if sink.put(ctl._t_origin + n * ctl.period, axes, rows, _nc_words(ctl), ctl._estop):
+            return True
+    except (TypeError, ValueError, OverflowError, BufferError) as exc:
+        raise MotionError(f"record: {exc}") from None
     return _put_row(ctl, rec, sink, n, rows, "record")
 
 
 def _put_row(ctl: Controller, rec: Any, sink: Any, n: int, rows: np.ndarray,
              what: str) -> bool:
-    """Cycle n's row through the armed `sink`, from the readback `rows` and per axis the
-    fields Axis.position (raw + command offset), Axis.velocity, the feedback source
-    (internal?) and offset and the state return, as one flat list. A sink with no room (a
+    """Cycle n's row through the armed `sink`, from the readback `rows` and the axes (the
+    sink reads each one's raw position and command offset, velocity, feedback source and
+    offset and state, as Axis.position etc. give them). A sink with no room (a
     held run's rows come first: row_sink settles them) or disarmed (another thread read
     the recorder since) is armed again; False when the recorder takes rows one by one."""
-    vals: list = []
-    for ax in ctl.axes:
-        c = ax.counters
-        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
+    axes = ctl.axes
     t = ctl._t_origin + n * ctl.period
     try:
-        if not sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop)):
+        if not sink.put(t, axes, rows, _nc_words(ctl), ctl._estop):
             sink = _arm(ctl, rec)
             if sink is None:
                 return False
-            sink.put(t, vals, rows, _nc_words(ctl), bool(ctl._estop))
+            sink.put(t, axes, rows, _nc_words(ctl), ctl._estop)
     except (TypeError, ValueError, OverflowError, BufferError) as exc:
         raise MotionError(f"{what}: {exc}") from None
     return True
@@ -420,14 +422,10 @@ def _block_rows(ctl: Controller, rec: Any, movers: list, ends: list[np.ndarray],
     sink = rec.sink or _arm(ctl, rec, m)
     if sink is None:
         return False
-    vals: list = []
-    for ax in ctl.axes:
-        c = ax.counters
-        vals += (ax._pos, c._cmd_off, ax._vel, c._fb_internal, c._fb_off, ax._state)
-    args = (n, ctl._t_origin, ctl.period, _writable(trace), vals,
+    args = (n, ctl._t_origin, ctl.period, _writable(trace), ctl.axes,
             [ax.index for ax in movers],
             tuple(e if e.flags.c_contiguous else np.ascontiguousarray(e) for e in ends),
-            [float(ax.counters._cmd_off) for ax in movers], _nc_words(ctl), bool(ctl._estop))
+            [float(ax.counters._cmd_off) for ax in movers], _nc_words(ctl), ctl._estop)
     try:
         if not sink.put_block(*args):
             sink = _arm(ctl, rec, m)  # no room or disarmed (see record_now)
