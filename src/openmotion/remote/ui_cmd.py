@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 
 from ..errors import MotionError
 
@@ -55,7 +56,9 @@ def cmd_ui(args: argparse.Namespace) -> int:
           f"API ws://{args.host}:{thread.port}/ws; Ctrl-C stops", file=sys.stderr)
     try:
         while thread._thread.is_alive():
-            thread._thread.join(0.5)
+            # not join(0.5): a Ctrl-C inside Thread.join leaves the thread marked ended, so
+            # thread.stop() below returned at once and uvicorn was still running at exit
+            time.sleep(0.5)
     except KeyboardInterrupt:
         print("openmotion ui: stopping the axes and the server", file=sys.stderr)
     finally:
