@@ -200,6 +200,45 @@ def test_runner_probes_the_simulated_surface_and_continues_with_it():
     assert ctl.axes[2].position == 0.0
 
 
+@pytest.mark.parametrize("text, surface_mm", [
+    (PROBE_PROG.replace("F60", "F600").replace("F120", "F900"), -2.0),  # (shorter)
+    ("G0 Z5\nG38.2 Z-1 F600\nG0 X5\nM2\n", -2.0),  # no contact: the run faults
+    ("G38.4 Z5 F200\n(DEBUG, #5063 #5070)\nG38.5 Z4 F100\n(DEBUG, #5063 #5070)\nM2\n", 1.0),
+], ids=["G38.2 G38.3", "no contact", "G38.4 G38.5"])
+def test_a_probe_move_jumps_to_its_edge_like_cycle_by_cycle(text, surface_mm):
+    """Before its trip a probe move waits on its edge hook (ProgramRunner._due): virtual
+    time jumps over it and lands in the edge's cycle; events, trace, ops and every axis
+    end as in the cycle-by-cycle run."""
+    from test_jump_equivalence import observe
+
+    out = []
+    for jumping in (False, True):
+        ctl, probe, run = _runner(text, surface_mm)
+        ctl.virtual_jumps = jumping
+        ctl.hardware.record_pulses(True)
+        steps = 0
+        real = ctl._finish_cycle
+
+        def counting(n, edges, real=real) -> None:  # noqa: ANN001
+            nonlocal steps
+            steps += 1
+            real(n, edges)
+
+        ctl._finish_cycle = counting  # type: ignore[method-assign]
+        run.start()
+        run.wait(60)
+        t, idx, p = run.trace()
+        events = [(e.t, e.kind, e.line, e.text) for e in run.events]
+        ops = [(o.line, None if o.end is None else tuple(o.end)) for o in run.ops]
+        out.append(((run.state, run.error, events, ops, t.tolist(), idx.tolist(), p.tolist(),
+                     run.actual_trace().tolist()), observe(ctl)))
+        if jumping:
+            assert steps < 0.2 * ctl.cycles  # most of the probe move jumped
+    assert out[0] == out[1]
+    state, _, events = out[0][0][:3]
+    assert (state is RunState.DONE) == any(e[1] == "probe_trip" for e in events)
+
+
 def test_runner_g38_2_without_contact_faults_with_linuxcncs_message():
     ctl, probe, run = _runner("G0 Z5\nG38.2 Z-1 F200\nG0 X5\nM2\n")
     run.start()

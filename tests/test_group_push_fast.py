@@ -71,7 +71,9 @@ def _run(text: str, stepping: bool) -> tuple[str, int, float]:
 @pytest.mark.parametrize("name", ["mixed", "laser_contour.ngc", "cam_rose.ngc"])
 def test_runs_equal_the_public_calls(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     text = MIXED if name == "mixed" else (ROOT / "examples" / "programs" / name).read_text()
-    stepping = name != "cam_rose.ngc"  # (the long one event-driven: its trace every cycle)
+    # the short mixed program cycle by cycle (every axis, every cycle); the long ones
+    # event-driven: the runner's trace still holds every cycle's command index and positions
+    stepping = name == "mixed"
     fast = _run(text, stepping)
     monkeypatch.setattr(Group, "_queue_line", _public)
     assert _run(text, stepping) == fast

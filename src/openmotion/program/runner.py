@@ -489,9 +489,12 @@ class ProgramRunner:
                          self.synced_analog.due(ctl, current, g.start_of))
             if synced == -math.inf:
                 return synced
-        if self._request is not None or self._stray_trip is not None \
-                or self.spindle is not None or self._fh_check:
-            # a probe move or M66 wait polls its input every cycle; the spindle is sampled
+        req = self._request
+        if (req is not None and not (isinstance(req, ProbeMove) and not req.tripped)) \
+                or self._stray_trip is not None or self.spindle is not None or self._fh_check:
+            # an M66 wait or a tripped probe move is polled every cycle; the spindle is
+            # sampled. A probe move before its trip waits on its edge hook, which lands a
+            # jump in the edge's cycle (where this hook then runs): it does not poll.
             return -math.inf
         t_sw = override_due(self)  # M48-M53 at their command's start, adaptive feed
         if self.state is not RunState.RUNNING:
