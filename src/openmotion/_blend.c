@@ -21,6 +21,10 @@
  * (the arc's end correction), arc start tangent, arc end tangent, the arc's max |tangent|
  * per axis, its axis acceleration weight, the first line's direction, its |direction|, the
  * second line's direction, its |direction| (the arc's helix is zero: not written).
+ * `line_run` reads three rows per line (start, end, direction) and its lengths; it writes
+ * each corner's rows and, per corner, 8 scalars (kept: 1 or 0, then line_blend's seven),
+ * and returns how many corners it did: it stops before a line whose start is not exactly
+ * the end of the line before (the caller takes that corner with blend_corner's checks).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -270,50 +274,52 @@ done:
 PyObject *blend_py_line_run(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
-    if (nargs != 11) {
-        PyErr_SetString(PyExc_TypeError, "line_run takes 11 arguments");
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError, "line_run takes 8 arguments");
         return NULL;
     }
-    double tol = PyFloat_AsDouble(args[9]), frac = PyFloat_AsDouble(args[10]);
+    double tol = PyFloat_AsDouble(args[6]), frac = PyFloat_AsDouble(args[7]);
     if (PyErr_Occurred()) return NULL;
-    int pays = args[7] != Py_None;
-    Py_buffer b[9];
+    int pays = args[4] != Py_None;
+    Py_buffer b[6];
     int held = 0;
     PyObject *result = NULL;
-    /* args: out, scal, start, starts, ends, dirs, lengths, accel, feed, tol, frac */
-    if (get(args[2], &b[0], -1, 0) < 0) return NULL;
+    /* args: out, scal, geo (per line: start, end, direction), lengths, accel, feed, tol,
+     * frac */
+    if (get(args[3], &b[0], -1, 0) < 0) return NULL;
     held = 1;
-    Py_ssize_t n = axes_of(&b[0]);
-    if (n < 0) goto done;
-    if (get(args[6], &b[1], -1, 0) < 0) goto done;
-    held = 2;
-    Py_ssize_t m = b[1].len / (Py_ssize_t)sizeof(double) - 1; /* corners */
+    Py_ssize_t m = b[0].len / (Py_ssize_t)sizeof(double) - 1; /* corners */
     if (m < 1) {
         PyErr_SetString(PyExc_ValueError, "line_run: at least two lines");
         goto done;
     }
+    if (get(args[2], &b[1], -1, 0) < 0) goto done;
+    held = 2;
+    Py_ssize_t n = b[1].len / (Py_ssize_t)sizeof(double) / (3 * (m + 1));
+    if (n < 1 || n > MAX_DIM || b[1].len != 3 * (m + 1) * n * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "line_run: 3 rows of 1 to 64 axes per line");
+        goto done;
+    }
     struct { int arg; Py_ssize_t size; int writable; } want[] = {
-        {3, m * n, 0}, {4, (m + 1) * n, 0}, {5, (m + 1) * n, 0}, {0, m * ROWS * n, 1},
-        {1, m * (SCALARS + 1), 1}, {7, m, 0}, {8, m, 0}};
-    for (int q = 0; q < (pays ? 7 : 5); q++) {
+        {0, m * ROWS * n, 1}, {1, m * (SCALARS + 1), 1}, {4, m, 0}, {5, m, 0}};
+    for (int q = 0; q < (pays ? 4 : 2); q++) {
         if (get(args[want[q].arg], &b[held], want[q].size, want[q].writable) < 0) goto done;
         held++;
     }
-    const double *start = b[0].buf, *lengths = b[1].buf, *starts = b[2].buf,
-                 *ends = b[3].buf, *dirs = b[4].buf;
-    double *out = b[5].buf, *scal = b[6].buf;
-    const double *accel = pays ? b[7].buf : NULL, *feed = pays ? b[8].buf : NULL;
+    const double *lengths = b[0].buf, *geo = b[1].buf;
+    double *out = b[2].buf, *scal = b[3].buf;
+    const double *accel = pays ? b[4].buf : NULL, *feed = pays ? b[5].buf : NULL;
     int dim = (int)n;
-    /* the current first line: its start, direction and length (its end is ends[k]) */
-    const double *cur_start = start, *cur_u = dirs;
+    /* the current first line: its start, direction and length (its end is line k's) */
+    const double *cur_start = geo, *cur_u = geo + 2 * n;
     double cur_len = lengths[0];
     Py_ssize_t k = 0;
     for (; k < m; k++) {
         double *rows = out + k * ROWS * n, *sc = scal + k * (SCALARS + 1);
-        const double *corner = ends + k * n, *end = ends + (k + 1) * n,
-                     *u = dirs + (k + 1) * n, *from_ = starts + k * n;
+        const double *corner = geo + (3 * k + 1) * n, *next = geo + 3 * (k + 1) * n;
+        const double *from = next, *end = next + n, *u = next + 2 * n;
         int same = 1;
-        for (int i = 0; i < dim; i++) same &= from_[i] == corner[i];
+        for (int i = 0; i < dim; i++) same &= from[i] == corner[i];
         if (!same) break; /* not where the line before ends: the caller's (a gap check) */
         double len = lengths[k + 1];
         int keep = 0;
@@ -329,7 +335,7 @@ PyObject *blend_py_line_run(PyObject *self, PyObject *const *args, Py_ssize_t na
             cur_u = rows + U2 * n;
             cur_len = sc[1 + L2];
         } else {
-            cur_start = corner; /* the second line as it was (its start is the corner) */
+            cur_start = from; /* the second line as it was */
             cur_u = u;
             cur_len = len;
         }

@@ -13,8 +13,8 @@ static PyMethodDef methods[] = {
     {"line_blend", (PyCFunction)(void (*)(void))blend_py_line_blend, METH_FASTCALL,
      "line_blend(out, start, corner, end, u1, u2, len1, len2, tol, frac): one corner."},
     {"line_run", (PyCFunction)(void (*)(void))blend_py_line_run, METH_FASTCALL,
-     "line_run(out, scal, start, ends, dirs, lengths, accel, feed, tol, frac): the corners "
-     "of a run of lines, one after the other."},
+     "line_run(out, scal, geo, lengths, accel, feed, tol, frac): the corners of a run of "
+     "lines, one after the other."},
     /* the chain planner's passes (_chain.c, its module doc) */
     {"passes", (PyCFunction)(void (*)(void))chain_py_passes, METH_FASTCALL,
      "passes(jcap2, acc, length, start2, dec) -> (back, fwd): the look-ahead's passes."},

@@ -142,6 +142,15 @@ _ROWS = 15
 _zeros: dict[int, np.ndarray] = {}
 
 
+def _helix(dim: int) -> np.ndarray:
+    """The helix of a blend arc (none: zeros), one read-only vector per axis count."""
+    out = _zeros.get(dim)
+    if out is None:
+        out = _zeros[dim] = np.zeros(dim)
+        out.flags.writeable = False
+    return out
+
+
 def _pieces(rows: list[np.ndarray], start: np.ndarray, end: np.ndarray, len1: float,
             len2: float, radius: float, turn: float, length: float, kappa: float
             ) -> tuple[Line, Arc3D, Line]:
@@ -149,12 +158,8 @@ def _pieces(rows: list[np.ndarray], start: np.ndarray, end: np.ndarray, len1: fl
     `end`) around the rows of one compiled corner (read-only views)."""
     (centre, e1, e2, a_start, a_end, via, lin, t_start, t_end, mat, aaw, u1, au1, u2,
      au2) = rows
-    helix = _zeros.get(centre.size)
-    if helix is None:  # one read-only zero vector per axis count: no blend arc is a helix
-        helix = _zeros[centre.size] = np.zeros(centre.size)
-        helix.flags.writeable = False
-    arc = Arc3D._blend_arc(centre, e1, e2, radius, turn, helix, a_start, a_end, via, length,
-                           lin, t_start, t_end, kappa, mat, aaw)
+    arc = Arc3D._blend_arc(centre, e1, e2, radius, turn, _helix(centre.size), a_start, a_end,
+                           via, length, lin, t_start, t_end, kappa, mat, aaw)
     return (Line._planned(start, a_start, len1, u1, au1), arc,
             Line._planned(a_end, end, len2, u2, au2))
 
@@ -174,31 +179,35 @@ def _line_run(first: Line, lines: Sequence[Line], tol: float,
     velocity). The whole run in one compiled call (openmotion._corner.line_run)."""
     m = len(lines)
     dim = first.start.size
-    starts = np.array([ln.start for ln in lines])
-    ends = np.array([first.end, *[ln.end for ln in lines]])
-    dirs = np.array([first.direction, *[ln.direction for ln in lines]])
+    # per line its start, end and direction, one row each (the layout line_run reads)
+    geo = np.array([first.start, first.end, first.direction,
+                    *[v for ln in lines for v in (ln.start, ln.end, ln.direction)]])
     lengths = np.array([first.length, *[ln.length for ln in lines]])
     out = np.empty((m * _ROWS, dim))
     scal = np.empty((m, 8))
     acc = None if accel is None else np.array(accel, dtype=np.float64)
     fd = None if feed is None else np.array(feed, dtype=np.float64)
-    done = _corner.line_run(out, scal, first.start, starts, ends, dirs, lengths, acc, fd,
-                            tol, frac)
+    done = _corner.line_run(out, scal, geo, lengths, acc, fd, tol, frac)
     out.flags.writeable = False
     rows = list(out)
+    helix = _helix(dim)
+    arc_of, line_of = Arc3D._blend_arc, Line._planned
     result: list[tuple[Line, Arc3D, Line] | None] = []
     start = first.start
     k = 0
     for ln, (keep, len1, len2, radius, turn, length, kappa, _) in zip(
             lines[:done], scal[:done].tolist(), strict=True):
-        if keep:
-            b = _pieces(rows[k:k + _ROWS], start, ln.end, len1, len2, radius, turn, length,
-                        kappa)
-            start = b[2].start
+        if keep:  # (_pieces, inlined: a join makes one per corner)
+            (centre, e1, e2, a_start, a_end, via, lin, t_start, t_end, mat, aaw, u1, au1, u2,
+             au2) = rows[k:k + _ROWS]
+            result.append((line_of(start, a_start, len1, u1, au1),
+                           arc_of(centre, e1, e2, radius, turn, helix, a_start, a_end, via,
+                                  length, lin, t_start, t_end, kappa, mat, aaw),
+                           line_of(a_end, ln.end, len2, u2, au2)))
+            start = a_end
         else:
-            b = None
+            result.append(None)
             start = ln.start
-        result.append(b)
         k += _ROWS
     return result
 

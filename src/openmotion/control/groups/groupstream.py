@@ -5,10 +5,12 @@ to brake from its feed (`_reach`, `_take`) and joins the next ones when it runs 
 (`_join_queued`): the running chain re-planned from now over itself and the new commands
 (pathrun.replan; the join's speed curve in one compiled pass, _chain.c), with the corner
 between them blended when the path has not reached the blend's start yet
-(`_join_options`). Every corner is rounded where that pays (`_blend_new`, `_blend_pays`);
-quiet cycles blend the queued corners ahead of the join (`_preblend`). In real-time mode
-the re-plan runs on the join worker (groupjoin.py). The constants (MAX_JOIN,
-PREBLEND_PER_CYCLE, PREBLEND_AHEAD) live in groupexec.py and are read there at each use.
+(`_join_options`). Every corner is rounded where that pays (`_blend_run`: each run of
+lines in one compiled call, path/blend.py `_line_run`; other corners `_blend_new`,
+`_blend_pays`); quiet cycles blend the queued corners ahead of the join (`_preblend`).
+In real-time mode the re-plan runs on the join worker (groupjoin.py). The constants
+(MAX_JOIN, PREBLEND_PER_CYCLE, PREBLEND_AHEAD) live in groupexec.py and are read there at
+each use.
 """
 
 from __future__ import annotations
