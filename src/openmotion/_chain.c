@@ -381,6 +381,32 @@ done:
     return result;
 }
 
+/* plan_speeds' steps 3-4 and curve_from_speeds in one pass (no minimum cruise ratio):
+ * the knots in s[0..m-1], v2[0..m-1] (room for 3n + 1 of each) -> m; -1 when start2
+ * exceeds what the path allows at its start (plan_speeds raises InfeasibleError), -2 out
+ * of memory (an exception set). Shared with _chain_prep.c. */
+Py_ssize_t chain_knots(const double *jcap2, const double *acc, const double *dec,
+                       const double *ccap, const double *length, Py_ssize_t n,
+                       double start2, double s0, double *s, double *v2)
+{
+    double *w = (double *)malloc(sizeof(double) * (size_t)(5 * n + 3));
+    if (w == NULL) {
+        PyErr_NoMemory();
+        return -2;
+    }
+    double *back = w, *fwd = w + n + 1, *cr = w + 2 * n + 2;
+    passes(jcap2, acc, length, start2, dec, n, back, fwd);
+    Py_ssize_t m = -1;
+    if (!(start2 > back[0] * (1.0 + 1e-12))) {
+        double *entry = back; /* back is no longer needed: entry over it */
+        /* fwd is read while entry (over back) is written: distinct ranges */
+        speeds(fwd, acc, dec, ccap, length, n, entry, cr, cr + n);
+        m = curve(entry, cr, cr + n, acc, dec, length, n, s0, entry[0], s, v2);
+    }
+    free(w);
+    return m;
+}
+
 PyObject *chain_py_chain_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
@@ -398,50 +424,26 @@ PyObject *chain_py_chain_curve(PyObject *self, PyObject *const *args, Py_ssize_t
     double start2 = PyFloat_AsDouble(args[5]), s0 = PyFloat_AsDouble(args[6]);
     if (PyErr_Occurred()) return NULL;
     PyObject *result = NULL;
-    double *jcap2 = NULL, *acc = NULL, *dec = NULL, *ccap = NULL, *length = NULL, *w = NULL;
+    double *jcap2 = NULL, *acc = NULL, *dec = NULL, *ccap = NULL, *length = NULL;
     jcap2 = to_doubles(args[0], n + 1, "jcap2");
     acc = jcap2 ? to_doubles(args[1], n, "acc") : NULL;
     dec = acc ? to_doubles(args[2], n, "dec") : NULL;
     ccap = dec ? to_doubles(args[3], n, "ccap") : NULL;
     length = ccap ? to_doubles(args[4], n, "length") : NULL;
     if (length == NULL) goto done;
-    w = (double *)malloc(sizeof(double) * (size_t)(5 * n + 2));
-    if (w == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    double *back = w, *fwd = w + n + 1;
-    passes(jcap2, acc, length, start2, dec, n, back, fwd);
-    if (start2 > back[0] * (1.0 + 1e-12)) { /* plan_speeds raises InfeasibleError */
-        result = PyLong_FromLong(-1);
-        goto done;
-    }
-    double *entry = back; /* back is no longer needed: entry, cruise, exit over w */
-    double *cr = (double *)malloc(sizeof(double) * (size_t)(2 * n + 1));
-    if (cr == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    /* fwd is read while entry (over back) is written: distinct ranges */
-    speeds(fwd, acc, dec, ccap, length, n, entry, cr, cr + n);
     Py_buffer b;
-    if (out_buffer(args[7], &b, 2, 3 * n + 1) < 0) {
-        free(cr);
-        goto done;
-    }
+    if (out_buffer(args[7], &b, 2, 3 * n + 1) < 0) goto done;
     double *s = (double *)b.buf;
-    Py_ssize_t m = curve(entry, cr, cr + n, acc, dec, length, n, s0, entry[0], s,
-                         s + b.shape[1]);
+    Py_ssize_t m = chain_knots(jcap2, acc, dec, ccap, length, n, start2, s0, s,
+                               s + b.shape[1]);
     PyBuffer_Release(&b);
-    free(cr);
-    result = PyLong_FromSsize_t(m);
+    if (m != -2) result = PyLong_FromSsize_t(m);
 done:
     free(jcap2);
     free(acc);
     free(dec);
     free(ccap);
     free(length);
-    free(w);
     return result;
 }
 
