@@ -182,7 +182,7 @@ static int axis_values(PyObject *obj, long dim, double *dst, int *has)
 
 enum { A_CTX, A_ELS, A_FEED, A_ACCEL, A_DECEL, A_SCV, A_VSTART, A_VEND, A_VMAX, A_AMAX,
        A_VJUMP, A_RATIO, A_MCR, NARGS };
-enum { C_TYPES, C_LINE, C_ARC, C_ARC3D, C_CHORD, C_JUNCTION, C_MEMO, NCTX };
+enum { C_TYPES, C_IS_ELEMENT, C_LINE, C_ARC, C_ARC3D, C_CHORD, C_JUNCTION, C_MEMO, NCTX };
 
 typedef struct {
     Py_ssize_t n, nl;     /* elements, those of length > 0 */
@@ -336,10 +336,24 @@ static int prep_inputs(PyObject *const *args, PyObject *const *ctx, Prep *p, Mem
     return 1;
 }
 
+/* el's type is in the set of known element types, or is_element(el) says it is one (and
+ * registers openmotion's own) */
+static int known(PyObject *const *ctx, PyObject *el)
+{
+    int c = PySet_Contains(ctx[C_TYPES], (PyObject *)Py_TYPE(el));
+    if (c == 0) {
+        PyObject *r = PyObject_CallOneArg(ctx[C_IS_ELEMENT], el);
+        c = r == Py_True;
+        Py_XDECREF(r);
+    }
+    PyErr_Clear();
+    return c == 1;
+}
+
 /* step 1 for element k: its length and limits into the record (and the live arrays);
  * 1 done, 0 only the Python path */
 static int prep_element(Prep *p, Py_ssize_t k, const Memo *old, Py_ssize_t j,
-                        PyObject *types, const ElemTypes *et, const Lim *lim)
+                        PyObject *const *ctx, const ElemTypes *et, const Lim *lim)
 {
     Memo *nm = p->memo;
     Py_ssize_t n = p->n;
@@ -356,8 +370,7 @@ static int prep_element(Prep *p, Py_ssize_t k, const Memo *old, Py_ssize_t j,
         Py_INCREF(old->refs[j]);
     } else {
         long d = 0;
-        if (PySet_Contains(types, (PyObject *)Py_TYPE(el)) != 1 || !elem_dim(&g, &d) ||
-            d != lim->dim || !elem_length(&g, &L))
+        if (!known(ctx, el) || !elem_dim(&g, &d) || d != lim->dim || !elem_length(&g, &L))
             goto out;
         if ((nm->refs[k] = PyWeakref_NewRef(el, NULL)) == NULL) PyErr_Clear();
     }
@@ -456,8 +469,8 @@ static int prepare_core(PyObject *const *args, Prep *p)
     if (!PyTuple_CheckExact(ctxo) || PyTuple_GET_SIZE(ctxo) != NCTX ||
         !PyAnySet_Check(PyTuple_GET_ITEM(ctxo, C_TYPES)) ||
         !PyList_CheckExact(PyTuple_GET_ITEM(ctxo, C_MEMO))) {
-        PyErr_SetString(PyExc_TypeError, "prepare: ctx must be (types, Line, Arc, Arc3D, "
-                                         "tangent_chord, junction, memo)");
+        PyErr_SetString(PyExc_TypeError, "prepare: ctx must be (types, is_element, Line, "
+                                         "Arc, Arc3D, tangent_chord, junction, memo)");
         return -1;
     }
     PyObject *const *ctx = &PyTuple_GET_ITEM(ctxo, 0);
@@ -490,7 +503,7 @@ static int prepare_core(PyObject *const *args, Prep *p)
         Py_ssize_t j = base + k;
         oj[k] = old != NULL && j >= 0 && j < old->n && ref_is(old->refs[j], p->items[k])
                     ? j : -1;
-        if (!prep_element(p, k, old, oj[k], ctx[C_TYPES], &et, &lim)) return 0;
+        if (!prep_element(p, k, old, oj[k], ctx, &et, &lim)) return 0;
     }
     if (p->nl == 0) return 0;
     if (!prep_junctions(args, p, old, oj, &et, ctx[C_JUNCTION], tchord)) return 0;

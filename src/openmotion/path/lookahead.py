@@ -212,7 +212,8 @@ _PREP_MEMO: list = []
 #: which two summation orders of c**2 can differ.
 _TANGENT_CHORD = TANGENT_ANGLE * (1.0 - 1e-9)
 #: What the compiled prepare needs besides the arguments (its ctx).
-_PREP_CTX = (_ELEMENT_TYPES, Line, Arc, Arc3D, _TANGENT_CHORD, _junction_cap, _PREP_MEMO)
+_PREP_CTX = (_ELEMENT_TYPES, _is_element, Line, Arc, Arc3D, _TANGENT_CHORD, _junction_cap,
+             _PREP_MEMO)
 
 
 def _passes(jcap2: list[float], acc: list[float], length: list[float],
