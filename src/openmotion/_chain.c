@@ -1,9 +1,9 @@
 /* The chain planner's arithmetic passes, compiled into openmotion._corner (issue 14: the
  * streaming join re-plans the running chain, a few hundred elements, at every join).
  *
- * One narrow interface on flat lists and float64 buffers; Python (path/lookahead.py,
- * control/groups/pathexec.py) computes the per-element limits and junction caps (memoized
- * per element), validates every argument and builds the objects around the numbers:
+ * One narrow interface on flat lists and float64 buffers; the per-element limits and
+ * junction caps come from _chain_prep.c (or lookahead.py's Python path), Python validates
+ * every argument and builds the objects around the numbers:
  *
  * - passes(jcap2, acc, length, start2, dec): the look-ahead's backward pass from the
  *   junction caps (v**2) at the decelerations (None: the accelerations), then its forward
@@ -15,7 +15,8 @@
  *   out[0, :m] (s) and out[1, :m] (v**2) -> m;
  * - chain_curve(jcap2, acc, dec, ccap, length, start2, s0, out): the three in one
  *   call (no minimum cruise ratio) -> m, or -1 when start2 exceeds what the path allows
- *   at its start (the caller re-plans the slow way and raises there);
+ *   at its start (the caller re-plans the slow way and raises there); its C core
+ *   chain_knots is _chain_prep.c's prepare_curve's second half;
  * - s_pieces(knots, v2, v, s_end, dwell, lead, out): the constant-acceleration pieces of
  *   s(t) along the knots (pathexec.s_profile's loop) written as the columns t0, p0, v0,
  *   a0, dt, kind (1: a dwell) of out[0..5, :m] -> (m, duration), m = -1 when the curve
