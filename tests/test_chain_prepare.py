@@ -66,6 +66,23 @@ def _arc_through(p: np.ndarray, q: np.ndarray, bulge: float) -> Arc3D | Line:
         return Line(p, q)
 
 
+def _blended(segs: list, tol: float) -> list:
+    """The elements with their line-line corners blended within tol (0: none), as a
+    stream joins them."""
+    els: list = []
+    cur = segs[0]
+    for nxt in segs[1:]:
+        b = blend_corner(cur, nxt, tol) if tol > 0.0 and isinstance(cur, Line) \
+            and isinstance(nxt, Line) else None
+        if b is None:
+            els.append(cur)
+            cur = nxt
+        else:
+            els += [b.first, b.arc]
+            cur = b.second
+    return els + [cur]
+
+
 @st.composite
 def chains(draw):
     """Elements laid end to end: lines (some of length 0, some straight on), blended
@@ -88,19 +105,7 @@ def chains(draw):
         shape = draw(st.sampled_from(["line", "line", "arc"]))
         segs.append(_arc_through(p, q, draw(st.floats(0.05, 0.6))) if shape == "arc"
                     else Line(p, q))
-    tol = draw(st.sampled_from([0.0, 0.01, 0.5]))
-    els: list = []
-    cur = segs[0]
-    for nxt in segs[1:]:
-        b = blend_corner(cur, nxt, tol) if tol > 0.0 and isinstance(cur, Line) \
-            and isinstance(nxt, Line) else None
-        if b is None:
-            els.append(cur)
-            cur = nxt
-        else:
-            els += [b.first, b.arc]
-            cur = b.second
-    els.append(cur)
+    els = _blended(segs, draw(st.sampled_from([0.0, 0.01, 0.5])))
     if draw(st.booleans()):  # a planar arc at the end (its own element type)
         e = els[-1].end
         centre = e.copy()
@@ -240,18 +245,7 @@ def test_curve_knots_compiled_equal_python() -> None:
     compiled passes (the way it went before), on a blended stream."""
     rng = np.random.default_rng(7)
     pts = np.cumsum(rng.normal(size=(60, 3)), axis=0)
-    els: list = []
-    cur = Line(pts[0], pts[1])
-    for p in pts[2:]:
-        nxt = Line(cur.end, p)
-        b = blend_corner(cur, nxt, 0.05)
-        if b is None:
-            els.append(cur)
-            cur = nxt
-        else:
-            els += [b.first, b.arc]
-            cur = b.second
-    els.append(cur)
+    els = _blended([Line(p, q) for p, q in zip(pts[:-1], pts[1:], strict=True)], 0.05)
     kw = {"square_corner_velocity": 0.5, "axis_vmax": np.full(3, 30.0),
           "axis_amax": np.full(3, 500.0)}
     la._PREP_MEMO.clear()

@@ -560,18 +560,7 @@ PyObject *chain_py_limit_along(PyObject *self, PyObject *const *args, Py_ssize_t
         PyErr_SetString(PyExc_ValueError, "limit_along: two float64 arrays of one size");
         goto done;
     }
-    const double *ax = a.buf, *wt = w.buf;
-    Py_ssize_t n = a.len / 8;
-    double best = INFINITY;
-    int found = 0;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        if (wt[i] > 0.0) {
-            found = 1;
-            double q = ax[i] / wt[i];
-            if (q < best) best = q;
-        }
-    }
-    result = PyFloat_FromDouble(!found || limit <= best ? limit : best);
+    result = PyFloat_FromDouble(chain_limit_along(limit, a.buf, w.buf, (long)(a.len / 8)));
 done:
     PyBuffer_Release(&a);
     PyBuffer_Release(&w);

@@ -44,6 +44,9 @@ int elem_dim(Elem *g, long *dim); /* el.dim (an int) */
 int elem_length(Elem *g, double *x);
 int elem_kappa(Elem *g);
 int elem_tangent(const ElemTypes *t, PyObject *el, int at_end, long dim, double *dst);
+/* lookahead._limit_along: min(limit, axis_i / w_i over w_i > 0), the first of equals
+ * (axis NULL: no per-axis limit) */
+double chain_limit_along(double limit, const double *axis, const double *w, long n);
 /* lookahead._limits_of: (tangential acceleration, speed cap); cap NULL: the first only */
 int elem_limits(Elem *g, const Lim *lim, double feed, double accel, double *acc,
                 double *cap);

@@ -201,8 +201,7 @@ int elem_tangent(const ElemTypes *t, PyObject *el, int at_end, long dim, double 
     return vec_of(o, dim, dst);
 }
 
-/* lookahead._limit_along (axis NULL: no per-axis limit) */
-static double limit_along(double limit, const double *axis, const double *w, long n)
+double chain_limit_along(double limit, const double *axis, const double *w, long n)
 {
     if (axis == NULL) return limit;
     double best = INFINITY;
@@ -222,11 +221,11 @@ int elem_limits(Elem *g, const Lim *lim, double feed, double accel, double *acc,
     if (!elem_kappa(g)) return 0;
     const double *w = NULL;
     if (lim->amax != NULL && (w = accel_weight(g, lim->dim)) == NULL) return 0;
-    double total = limit_along(accel, lim->amax, w, lim->dim);
+    double total = chain_limit_along(accel, lim->amax, w, lim->dim);
     double vmax = feed;
     if (cap != NULL && lim->vmax != NULL) {
         if (!elem_mat(g, lim->dim)) return 0;
-        vmax = limit_along(feed, lim->vmax, g->mat, lim->dim);
+        vmax = chain_limit_along(feed, lim->vmax, g->mat, lim->dim);
     }
     if (g->kappa == 0.0) {
         *acc = total;
