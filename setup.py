@@ -37,6 +37,7 @@ setup(ext_modules=[Extension("openmotion._kernel",
                              extra_compile_args=flags),
                    Extension("openmotion._corner",
                              ["src/openmotion/_corner.c", "src/openmotion/_chain.c",
-                              "src/openmotion/_blend.c"],
+                              "src/openmotion/_blend.c", "src/openmotion/_chain_prep.c",
+                              "src/openmotion/_chain_elem.c"],
                              depends=["src/openmotion/_chain.h", "src/openmotion/_blend.h"],
                              extra_compile_args=flags)])

@@ -226,20 +226,23 @@ def test_limit_along_bit_for_bit(limit, pairs) -> None:
 
 
 def test_junction_memo_keeps_no_element_alive() -> None:
-    """The junction caps' memo refers to both elements weakly: a stream's earlier elements
-    go when the chain drops them (a strong reference to the element before made every
-    entry keep the whole history alive)."""
+    """The look-ahead's memo (the compiled prepare's, _chain_prep.c: limits and junction
+    caps per element) refers to the elements weakly: a stream's earlier elements go when
+    the chain drops them (a strong reference to the element before made every entry keep
+    the whole history alive), and it keeps a few plans' records only."""
     import gc
     import weakref
 
-    from openmotion.path.lookahead import _JUNCTIONS
+    from openmotion.path.lookahead import _PREP_MEMO
 
     pts = [np.array([float(k), float(k % 2)]) for k in range(50)]
     els = [Line(a, b) for a, b in zip(pts[:-1], pts[1:], strict=True)]
     plan_speeds(els, 5.0, 50.0, square_corner_velocity=1.0)
+    assert _PREP_MEMO  # (the compiled path ran and kept a record)
     first = weakref.ref(els[0])
-    before = len(_JUNCTIONS)
     del els[:-1]  # only the last element lives on
     gc.collect()
     assert first() is None
-    assert len(_JUNCTIONS) <= before - 47
+    for k in range(10):  # more plans than records
+        plan_speeds([Line(np.zeros(2), np.array([1.0, float(k)]))], 5.0, 50.0)
+    assert len(_PREP_MEMO) <= 4

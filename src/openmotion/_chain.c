@@ -1,9 +1,9 @@
 /* The chain planner's arithmetic passes, compiled into openmotion._corner (issue 14: the
  * streaming join re-plans the running chain, a few hundred elements, at every join).
  *
- * One narrow interface on flat lists and float64 buffers; Python (path/lookahead.py,
- * control/groups/pathexec.py) computes the per-element limits and junction caps (memoized
- * per element), validates every argument and builds the objects around the numbers:
+ * One narrow interface on flat lists and float64 buffers; the per-element limits and
+ * junction caps come from _chain_prep.c (or lookahead.py's Python path), Python validates
+ * every argument and builds the objects around the numbers:
  *
  * - passes(jcap2, acc, length, start2, dec): the look-ahead's backward pass from the
  *   junction caps (v**2) at the decelerations (None: the accelerations), then its forward
@@ -15,7 +15,8 @@
  *   out[0, :m] (s) and out[1, :m] (v**2) -> m;
  * - chain_curve(jcap2, acc, dec, ccap, length, start2, s0, out): the three in one
  *   call (no minimum cruise ratio) -> m, or -1 when start2 exceeds what the path allows
- *   at its start (the caller re-plans the slow way and raises there);
+ *   at its start (the caller re-plans the slow way and raises there); its C core
+ *   chain_knots is _chain_prep.c's prepare_curve's second half;
  * - s_pieces(knots, v2, v, s_end, dwell, lead, out): the constant-acceleration pieces of
  *   s(t) along the knots (pathexec.s_profile's loop) written as the columns t0, p0, v0,
  *   a0, dt, kind (1: a dwell) of out[0..5, :m] -> (m, duration), m = -1 when the curve
@@ -381,6 +382,32 @@ done:
     return result;
 }
 
+/* plan_speeds' steps 3-4 and curve_from_speeds in one pass (no minimum cruise ratio):
+ * the knots in s[0..m-1], v2[0..m-1] (room for 3n + 1 of each) -> m; -1 when start2
+ * exceeds what the path allows at its start (plan_speeds raises InfeasibleError), -2 out
+ * of memory (an exception set). Shared with _chain_prep.c. */
+Py_ssize_t chain_knots(const double *jcap2, const double *acc, const double *dec,
+                       const double *ccap, const double *length, Py_ssize_t n,
+                       double start2, double s0, double *s, double *v2)
+{
+    double *w = (double *)malloc(sizeof(double) * (size_t)(5 * n + 3));
+    if (w == NULL) {
+        PyErr_NoMemory();
+        return -2;
+    }
+    double *back = w, *fwd = w + n + 1, *cr = w + 2 * n + 2;
+    passes(jcap2, acc, length, start2, dec, n, back, fwd);
+    Py_ssize_t m = -1;
+    if (!(start2 > back[0] * (1.0 + 1e-12))) {
+        double *entry = back; /* back is no longer needed: entry over it */
+        /* fwd is read while entry (over back) is written: distinct ranges */
+        speeds(fwd, acc, dec, ccap, length, n, entry, cr, cr + n);
+        m = curve(entry, cr, cr + n, acc, dec, length, n, s0, entry[0], s, v2);
+    }
+    free(w);
+    return m;
+}
+
 PyObject *chain_py_chain_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
@@ -398,50 +425,26 @@ PyObject *chain_py_chain_curve(PyObject *self, PyObject *const *args, Py_ssize_t
     double start2 = PyFloat_AsDouble(args[5]), s0 = PyFloat_AsDouble(args[6]);
     if (PyErr_Occurred()) return NULL;
     PyObject *result = NULL;
-    double *jcap2 = NULL, *acc = NULL, *dec = NULL, *ccap = NULL, *length = NULL, *w = NULL;
+    double *jcap2 = NULL, *acc = NULL, *dec = NULL, *ccap = NULL, *length = NULL;
     jcap2 = to_doubles(args[0], n + 1, "jcap2");
     acc = jcap2 ? to_doubles(args[1], n, "acc") : NULL;
     dec = acc ? to_doubles(args[2], n, "dec") : NULL;
     ccap = dec ? to_doubles(args[3], n, "ccap") : NULL;
     length = ccap ? to_doubles(args[4], n, "length") : NULL;
     if (length == NULL) goto done;
-    w = (double *)malloc(sizeof(double) * (size_t)(5 * n + 2));
-    if (w == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    double *back = w, *fwd = w + n + 1;
-    passes(jcap2, acc, length, start2, dec, n, back, fwd);
-    if (start2 > back[0] * (1.0 + 1e-12)) { /* plan_speeds raises InfeasibleError */
-        result = PyLong_FromLong(-1);
-        goto done;
-    }
-    double *entry = back; /* back is no longer needed: entry, cruise, exit over w */
-    double *cr = (double *)malloc(sizeof(double) * (size_t)(2 * n + 1));
-    if (cr == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    /* fwd is read while entry (over back) is written: distinct ranges */
-    speeds(fwd, acc, dec, ccap, length, n, entry, cr, cr + n);
     Py_buffer b;
-    if (out_buffer(args[7], &b, 2, 3 * n + 1) < 0) {
-        free(cr);
-        goto done;
-    }
+    if (out_buffer(args[7], &b, 2, 3 * n + 1) < 0) goto done;
     double *s = (double *)b.buf;
-    Py_ssize_t m = curve(entry, cr, cr + n, acc, dec, length, n, s0, entry[0], s,
-                         s + b.shape[1]);
+    Py_ssize_t m = chain_knots(jcap2, acc, dec, ccap, length, n, start2, s0, s,
+                               s + b.shape[1]);
     PyBuffer_Release(&b);
-    free(cr);
-    result = PyLong_FromSsize_t(m);
+    if (m != -2) result = PyLong_FromSsize_t(m);
 done:
     free(jcap2);
     free(acc);
     free(dec);
     free(ccap);
     free(length);
-    free(w);
     return result;
 }
 
@@ -557,18 +560,7 @@ PyObject *chain_py_limit_along(PyObject *self, PyObject *const *args, Py_ssize_t
         PyErr_SetString(PyExc_ValueError, "limit_along: two float64 arrays of one size");
         goto done;
     }
-    const double *ax = a.buf, *wt = w.buf;
-    Py_ssize_t n = a.len / 8;
-    double best = INFINITY;
-    int found = 0;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        if (wt[i] > 0.0) {
-            found = 1;
-            double q = ax[i] / wt[i];
-            if (q < best) best = q;
-        }
-    }
-    result = PyFloat_FromDouble(!found || limit <= best ? limit : best);
+    result = PyFloat_FromDouble(chain_limit_along(limit, a.buf, w.buf, (long)(a.len / 8)));
 done:
     PyBuffer_Release(&a);
     PyBuffer_Release(&w);

@@ -33,6 +33,12 @@ static PyMethodDef methods[] = {
      "place."},
     {"limit_along", (PyCFunction)(void (*)(void))chain_py_limit_along, METH_FASTCALL,
      "limit_along(limit, axis, weight) -> min(limit, axis_i/weight_i over weight_i > 0)."},
+    /* the look-ahead's per-element limits and junction caps (_chain_prep.c) */
+    {"prepare", (PyCFunction)(void (*)(void))chain_py_prepare, METH_FASTCALL,
+     "prepare(elements, types, feed, accel, decel, dim, vmax, amax, vjump, ratio, scv, "
+     "v_end, tangent_chord, junction, memo) -> (live, acc, cap, length, dec, jcap2) or None."},
+    {"prepare_curve", (PyCFunction)(void (*)(void))chain_py_prepare_curve, METH_FASTCALL,
+     "prepare_curve(<prepare's>, start2, s0, out) -> (knots written or -1, min dec) or None."},
     {NULL, NULL, 0, NULL},
 };
 

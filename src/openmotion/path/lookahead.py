@@ -203,27 +203,17 @@ def _junction_cap(prev: PathElement, nxt: PathElement, accel: float, scv: float,
     return _limit_along(v, vjump_ax, np.abs(diff))
 
 
-#: Memo of `_junction_cap` (as `_LIMITS`): per element, a weak reference to the element
-#: before it, the limits and the cap of their junction (a streaming chain asks about the
-#: same pairs at every re-plan). Weak both ways: a strong one to the element before would
-#: keep every earlier element of a stream alive through the chain of entries.
-_JUNCTIONS: weakref.WeakKeyDictionary[Any, tuple[weakref.ref, tuple, float]] = \
-    weakref.WeakKeyDictionary()
-
-
-def _junction_memo(prev: PathElement, nxt: PathElement, accel: float, scv: float,
-                   amax_ax: Array | None, vjump_ax: Array | None, key: tuple) -> float:
-    """`_junction_cap` memoized; `key`: (scv, _axes_key(amax_ax, vjump_ax))."""
-    try:
-        hit = _JUNCTIONS.get(nxt)
-        if hit is not None and hit[0]() is prev and hit[1] == (accel, key):
-            return hit[2]
-        out = _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
-        _JUNCTIONS[nxt] = (weakref.ref(prev), (accel, key), out)
-    except TypeError:  # an element that is not hashable or weak-referenceable
-        return _junction_cap(prev, nxt, accel, scv, amax_ax, vjump_ax)
-    return out
-
+#: The compiled `_prepare`'s memo (_chain_prep.c): the last calls' elements, held weakly,
+#: with their limits and junction caps; a streaming chain's re-plan recomputes only the
+#: elements and junctions that are new or whose feed or acceleration changed.
+_PREP_MEMO: list = []
+#: Chords |u2 - u1| below this are tangent junctions (`_junction_cap` returns inf) however
+#: numpy's dot product rounds: 2*asin(c/2) >= c, and the margin covers the few ulps by
+#: which two summation orders of c**2 can differ.
+_TANGENT_CHORD = TANGENT_ANGLE * (1.0 - 1e-9)
+#: What the compiled prepare needs besides the arguments (its ctx).
+_PREP_CTX = (_ELEMENT_TYPES, _is_element, Line, Arc, Arc3D, _TANGENT_CHORD, _junction_cap,
+             _PREP_MEMO)
 
 
 def _passes(jcap2: list[float], acc: list[float], length: list[float],
@@ -413,6 +403,15 @@ def _curve_knots(elements: Sequence[PathElement], feed: float | Sequence[float],
     call and without an ElementSpeeds per element: the streaming join's re-plan. None
     where `plan_speeds` does more than that (no element of length > 0, a minimum cruise
     ratio) or raises (a start too fast): the caller plans the slow way."""
+    if type(elements) in (list, tuple):  # compiled (_chain_prep.c) where it can
+        out = np.empty((2, 3 * len(elements) + 1))
+        got = _corner.prepare_curve(_PREP_CTX, elements, feed, accel, decel,
+                                    square_corner_velocity, start_speed, end_speed,
+                                    axis_vmax, axis_amax, axis_vjump, arc_tangential_ratio,
+                                    min_cruise_ratio, s0, out)
+        if got is not None:
+            m, dmin = got
+            return None if m < 0 else (out[0, :m].copy(), out[1, :m].copy(), dmin)
     pr = _prepare(elements, feed, accel, square_corner_velocity, start_speed, end_speed,
                   axis_vmax, axis_amax, axis_vjump, arc_tangential_ratio, min_cruise_ratio,
                   decel)
@@ -432,10 +431,21 @@ def _prepare(elements: Sequence[PathElement], feed: float | Sequence[float],
              start_speed: float, end_speed: float, axis_vmax: ArrayLike | None,
              axis_amax: ArrayLike | None, axis_vjump: ArrayLike | None,
              arc_tangential_ratio: float, min_cruise_ratio: float,
-             decel: float | Sequence[float] | None) -> tuple:
+             decel: float | Sequence[float] | None, compiled: bool = True) -> tuple:
     """`plan_speeds`' arguments checked and its steps 1-2 (module doc) on the elements of
     length > 0: (feeds, accels, decels, live, acc, cap, length, dec, jcap2, v_start, mcr)
-    (live: their indices; the rest per live element, jcap2 per junction)."""
+    (live: their indices; the rest per live element, jcap2 per junction). Compiled
+    (_chain_prep.c, memoized) where it can; `compiled=False`: the Python path alone."""
+    got = _corner.prepare(_PREP_CTX, elements, feed, accel, decel, square_corner_velocity,
+                          start_speed, end_speed, axis_vmax, axis_amax, axis_vjump,
+                          arc_tangential_ratio, min_cruise_ratio) if compiled else None
+    if got is not None:
+        live, acc, cap, length, dec, jcap2, v_start, mcr = got
+        n = len(elements)
+        feeds = _per_element("feed", feed, n)
+        accels = _per_element("accel", accel, n)
+        decels = accels if decel is None else _per_element("decel", decel, n)
+        return feeds, accels, decels, live, acc, cap, length, dec, jcap2, v_start, mcr
     if isinstance(elements, (str, bytes)) or not isinstance(elements, Sequence) \
             or len(elements) == 0:
         raise MotionError("elements must be a non-empty sequence of path elements")
@@ -477,13 +487,12 @@ def _prepare(elements: Sequence[PathElement], feed: float | Sequence[float],
 
     # jcap2[k]: v**2 cap at the entry of live element k (k = n: the end of the path).
     jcap2 = [0.0] * (n + 1)
-    jkey = (scv, _axes_key(amax_ax, vjump_ax))
     jcap2[0] = cap[0] ** 2
     jcap2[n] = min(v_end, cap[n - 1]) ** 2
     for k in range(1, n):
         a_j = min(accels[live[k - 1]], accels[live[k]])
-        vj = min(cap[k - 1], cap[k], _junction_memo(els[k - 1], els[k], a_j, scv, amax_ax,
-                                                    vjump_ax, jkey))
+        vj = min(cap[k - 1], cap[k], _junction_cap(els[k - 1], els[k], a_j, scv, amax_ax,
+                                                   vjump_ax))
         jcap2[k] = vj * vj
     return feeds, accels, decels, live, acc, cap, length, dec, jcap2, v_start, mcr
 
