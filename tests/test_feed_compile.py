@@ -156,3 +156,20 @@ def test_soft_limit_edges_as_the_general_path(words, g):
                            for letter, v in words]
     text = "\n".join(lines)
     assert outcome(compile_text, text) == outcome(_compile_full, text)
+
+
+def test_convert_restores_the_collector():
+    import gc
+
+    bad = [canon.Feed((1.0, 0.0, 0.0, 0.0), 0.0, 3, "f.ngc", None)]  # F 0: refused
+    start = np.zeros(4)
+    assert gc.isenabled()
+    with pytest.raises(GCodeError, match="no usable speed"):
+        convert(bad, SCALES, start, ConvertOptions())
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        convert(bad[:0], SCALES, start, ConvertOptions())
+        assert not gc.isenabled()  # a caller's pause is left as it was
+    finally:
+        gc.enable()

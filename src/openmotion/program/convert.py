@@ -28,6 +28,7 @@ group's Arc accepts (a LinuxCNC-tolerated spiral) is sent as chords within `chor
 
 from __future__ import annotations
 
+import gc
 import math
 from dataclasses import dataclass, field, fields
 
@@ -159,8 +160,21 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
     the spindle speed commanded before it (a program continued after a probe).
 
     G38.x (`probing.Probe`) becomes a feed line whose `source` is the Probe record (the
-    runner arms the probe input for it), M66 (`probing.WaitInput`) an op "wait".
+    runner arms the probe input for it), M66 (`probing.WaitInput`) an op "wait". The
+    garbage collector is paused meanwhile, as for the compile (fastpath.py): the op list
+    only grows, and the collections it would trigger rescan every op made so far.
     """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _convert(cmds, scales, start, opts, rpm)
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
+             opts: ConvertOptions, rpm: float) -> list[Op]:
     lin = ~scales.rotary
     vmax = scales.vmax_units
     sys_max = float(np.max(vmax))
