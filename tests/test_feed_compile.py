@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -82,6 +83,9 @@ def test_line_op_is_the_dataclass_op():
     made = _line_op(7, "f.ngc", end * SCALES.ppu, 10.0, False, end, cmd)
     same_ops([made], [Op("line", 7, "f.ngc", end * SCALES.ppu, 10.0, end=end, source=cmd)])
     assert type(made) is Op and made.source is cmd
+    ref = Op("line", 7, "f.ngc", end, 10.0, end=end, source=cmd)
+    # a key-sharing dict as the dataclass's own (a copied table would be ~1.6x larger)
+    assert sys.getsizeof(vars(made)) == sys.getsizeof(vars(ref))
     with pytest.raises(AttributeError):
         made.feed = 1.0  # type: ignore[misc]  # still frozen
 
@@ -152,3 +156,20 @@ def test_soft_limit_edges_as_the_general_path(words, g):
                            for letter, v in words]
     text = "\n".join(lines)
     assert outcome(compile_text, text) == outcome(_compile_full, text)
+
+
+def test_convert_restores_the_collector():
+    import gc
+
+    bad = [canon.Feed((1.0, 0.0, 0.0, 0.0), 0.0, 3, "f.ngc", None)]  # F 0: refused
+    start = np.zeros(4)
+    assert gc.isenabled()
+    with pytest.raises(GCodeError, match="no usable speed"):
+        convert(bad, SCALES, start, ConvertOptions())
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        convert(bad[:0], SCALES, start, ConvertOptions())
+        assert not gc.isenabled()  # a caller's pause is left as it was
+    finally:
+        gc.enable()

@@ -28,6 +28,7 @@ group's Arc accepts (a LinuxCNC-tolerated spiral) is sent as chords within `chor
 
 from __future__ import annotations
 
+import gc
 import math
 from dataclasses import dataclass, field, fields
 
@@ -159,8 +160,21 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
     the spindle speed commanded before it (a program continued after a probe).
 
     G38.x (`probing.Probe`) becomes a feed line whose `source` is the Probe record (the
-    runner arms the probe input for it), M66 (`probing.WaitInput`) an op "wait".
+    runner arms the probe input for it), M66 (`probing.WaitInput`) an op "wait". The
+    garbage collector is paused meanwhile, as for the compile (fastpath.py): the op list
+    only grows, and the collections it would trigger rescan every op made so far.
     """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _convert(cmds, scales, start, opts, rpm)
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
+             opts: ConvertOptions, rpm: float) -> list[Op]:
     lin = ~scales.rotary
     vmax = scales.vmax_units
     sys_max = float(np.max(vmax))
@@ -310,17 +324,21 @@ def convert(cmds: list[canon.Command], scales: Scales, start: np.ndarray,
 
 
 _FEED, _RAPID = canon.Feed, canon.Rapid
-#: An Op's fields as `Op(...)` sets them, for `_line_op` (kind "line", the defaults).
-_LINE_FIELDS = {f.name: f.default for f in fields(Op)} | {"kind": "line"}
+#: An Op's fields after `kind` as `Op(...)` sets them (the defaults), for `_line_op`.
+_LINE_FIELDS = {f.name: f.default for f in fields(Op)[1:]}
 
 
 def _line_op(line: int, file: str, target: np.ndarray, feed: float, rapid: bool,
              end: np.ndarray, source: canon.Command) -> Op:
     """`Op("line", line, file, target, feed, rapid, end=end, source=source)`, the same
     object (the same attributes in the same order) made without the frozen dataclass's
-    field-by-field `__init__` (a program has one per line)."""
+    field-by-field `__init__` (a program has one per line). The keys go in one by one in
+    the class's order (`kind` first: an update of an empty dict would copy the template's
+    table), so the dict stays a key-sharing one: 328 bytes an op, not 528 (264 by
+    `__init__`, whose values are not in a dict object)."""
     op = _new(Op)
     d = op.__dict__
+    d["kind"] = "line"
     d.update(_LINE_FIELDS)
     d["line"], d["file"], d["target"], d["feed"] = line, file, target, feed
     d["rapid"], d["end"], d["source"] = rapid, end, source
